@@ -1,0 +1,180 @@
+// `ontime table INSTANCE...`: the layout of the paper's Table I — one row per instance, one
+// column per allocator (sampled mean ± 95%, exact value with --exact), the exact optimum, and
+// the mean decision time of each allocator.
+
+#include <filesystem>
+#include <fmt/format.h>
+
+#include "common.hpp"
+#include "ontime/instance_io.hpp"
+
+namespace ontime::cli {
+namespace {
+
+struct Cell {
+  MonteCarloResult sampled;
+  std::optional<ExactEvaluation> exact;
+};
+
+struct Row {
+  std::string path;
+  std::string label;
+  std::string name;
+  std::vector<Cell> cells;
+  std::optional<double> optimum;
+  std::size_t optimum_states = 0;
+};
+
+std::string render_markdown(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& body) {
+  std::vector<std::size_t> widths(header.size(), 0);
+  const auto widen = [&widths](const std::vector<std::string>& line) {
+    for (std::size_t i = 0; i < line.size(); ++i) {
+      // Display width: count UTF-8 code points, not bytes (for "±" and "µ").
+      std::size_t width = 0;
+      for (const char c : line[i]) width += (static_cast<unsigned char>(c) & 0xC0) != 0x80 ? 1 : 0;
+      widths[i] = std::max(widths[i], width);
+    }
+  };
+  widen(header);
+  for (const auto& line : body) widen(line);
+  const auto render = [&widths](const std::vector<std::string>& line) {
+    std::string out = "|";
+    for (std::size_t i = 0; i < line.size(); ++i) {
+      std::size_t width = 0;
+      for (const char c : line[i]) width += (static_cast<unsigned char>(c) & 0xC0) != 0x80 ? 1 : 0;
+      out += " " + line[i] + std::string(widths[i] - width, ' ') + " |";
+    }
+    return out + "\n";
+  };
+  std::string out = render(header);
+  std::string rule = "|";
+  for (const std::size_t width : widths) rule += std::string(width + 2, '-') + "|";
+  out += rule + "\n";
+  for (const auto& line : body) out += render(line);
+  return out;
+}
+
+}  // namespace
+
+void add_table_command(CLI::App& app) {
+  struct Options {
+    std::vector<std::string> instances;
+    std::vector<std::string> solvers;
+    bool exact = false;
+    bool json = false;
+    AllocatorFlags allocator;
+    MonteCarloFlags monte_carlo;
+  };
+  auto options = std::make_shared<Options>();
+  for (const std::string& name : allocator_names()) {
+    if (name != "optimal") options->solvers.push_back(name);
+  }
+  CLI::App* command = app.add_subcommand("table", "Table I: success of several allocators on several instances");
+  command->add_option("INSTANCE", options->instances, "Instance files (JSON, SPEC §5)")->required();
+  command->add_option("--solvers", options->solvers, "Comma-separated allocators, one column each")
+      ->delimiter(',')
+      ->capture_default_str();
+  command->add_flag("--exact", options->exact, "Add exact success probabilities and the exact optimum");
+  command->add_flag("--json", options->json, "Print JSON");
+  options->monte_carlo.add_to(*command);
+  options->allocator.add_to(*command);
+  command->callback([options] {
+    check_solver_names(options->solvers);
+    const MonteCarloOptions base = options->monte_carlo.options();
+    const AllocatorOptions allocator_options = options->allocator.options();
+    // Load every instance first: a bad file stops the command before any long computation.
+    std::vector<Problem> problems;
+    for (const std::string& path : options->instances) problems.push_back(load_problem(path));
+
+    std::vector<Row> rows;
+    ProgressBar bar("table");
+    const std::uint64_t total = base.episodes * problems.size() * options->solvers.size();
+    std::uint64_t finished = 0;
+    for (std::size_t i = 0; i < problems.size(); ++i) {
+      const Mdp mdp(problems[i]);
+      Row row;
+      row.path = options->instances[i];
+      row.label = std::filesystem::path(row.path).stem().string();
+      row.name = problems[i].name();
+      for (const std::string& solver : options->solvers) {
+        const AllocatorFactory factory = make_allocator_factory(solver, mdp, allocator_options);
+        MonteCarloOptions monte_carlo = base;
+        monte_carlo.progress = [&](std::uint64_t done, std::uint64_t) { bar.update(finished + done, total); };
+        Cell cell{run_monte_carlo(mdp, factory, monte_carlo), std::nullopt};
+        finished += base.episodes;
+        if (options->exact) {
+          const auto allocator = factory();
+          if (allocator->is_stationary()) cell.exact = evaluate_exactly(mdp, *allocator, allocator_options.max_states);
+        }
+        row.cells.push_back(std::move(cell));
+      }
+      if (options->exact) {
+        OptimalSolver solver(mdp, allocator_options.max_states);
+        row.optimum = solver.solve(mdp.start());
+        row.optimum_states = solver.states();
+      }
+      rows.push_back(std::move(row));
+    }
+
+    if (options->json) {
+      Json out;
+      out["episodes"] = base.episodes;
+      out["seed"] = base.seed;
+      out["solvers"] = options->solvers;
+      out["rows"] = Json::array();
+      for (const Row& row : rows) {
+        Json line;
+        line["instance"] = row.path;
+        line["name"] = row.name;
+        Json cells = Json::object();
+        for (std::size_t s = 0; s < options->solvers.size(); ++s) {
+          const Cell& cell = row.cells[s];
+          Json entry;
+          entry["success_rate"] = cell.sampled.success_rate;
+          entry["ci95"] = cell.sampled.ci95;
+          entry["decision_time_us"] = {{"median", cell.sampled.decision_time.median_us},
+                                       {"p99", cell.sampled.decision_time.p99_us},
+                                       {"mean", cell.sampled.decision_time.mean_us}};
+          if (cell.exact) entry["exact_success_probability"] = cell.exact->success_probability;
+          cells[options->solvers[s]] = entry;
+        }
+        line["solvers"] = cells;
+        if (row.optimum) {
+          line["optimal_success_probability"] = *row.optimum;
+          line["optimal_states"] = row.optimum_states;
+        }
+        out["rows"].push_back(line);
+      }
+      print_json(out);
+      return;
+    }
+
+    std::vector<std::string> header{"instance"};
+    for (const std::string& solver : options->solvers) header.push_back(solver);
+    if (options->exact) header.emplace_back("optimum");
+    std::vector<std::vector<std::string>> body;
+    std::vector<double> latency_sum(options->solvers.size(), 0.0);
+    for (const Row& row : rows) {
+      std::vector<std::string> line{row.label};
+      for (std::size_t s = 0; s < row.cells.size(); ++s) {
+        const Cell& cell = row.cells[s];
+        std::string text = fmt::format("{:.3f} ± {:.3f}", cell.sampled.success_rate, cell.sampled.ci95);
+        if (cell.exact) text += fmt::format(" ({:.4f})", cell.exact->success_probability);
+        line.push_back(text);
+        latency_sum[s] += cell.sampled.decision_time.mean_us;
+      }
+      if (options->exact) line.push_back(fmt::format("{:.4f}", *row.optimum));
+      body.push_back(std::move(line));
+    }
+    std::vector<std::string> latency{"mean decision time (µs)"};
+    for (const double sum : latency_sum) latency.push_back(fmt::format("{:.3f}", sum / static_cast<double>(rows.size())));
+    if (options->exact) latency.emplace_back("");
+    body.push_back(std::move(latency));
+
+    fmt::print("Success probability: mean ± 95% over {} episodes (seed {}){}.\n\n", base.episodes, base.seed,
+               options->exact ? "; exact value in parentheses; optimum = exact expectimax" : "");
+    fmt::print("{}", render_markdown(header, body));
+  });
+}
+
+}  // namespace ontime::cli

@@ -1,0 +1,74 @@
+#include "common.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include "ontime/error.hpp"
+
+namespace ontime::cli {
+
+void AllocatorFlags::add_to(CLI::App& command) {
+  command.add_option("--aggregation", aggregation, "How dp-rerun's Eq. (1) combines skeletons sharing an action")
+      ->check(CLI::IsMember({"sum", "max", "self"}))
+      ->capture_default_str();
+  command.add_option("--max-states", max_states, "Cap on the states the exact solver and evaluator may hold")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+}
+
+AllocatorOptions AllocatorFlags::options() const {
+  AllocatorOptions options;
+  options.aggregation = parse_aggregation(aggregation);
+  options.max_states = max_states;
+  return options;
+}
+
+void MonteCarloFlags::add_to(CLI::App& command) {
+  command.add_option("--episodes", episodes, "Simulated episodes per evaluation")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  command.add_option("--seed", seed, "Seed of the hidden worlds (episode i uses stream i of it)")->capture_default_str();
+  command.add_option("--threads", threads, "Worker threads (0: one per hardware thread); results do not depend on it")
+      ->capture_default_str();
+}
+
+MonteCarloOptions MonteCarloFlags::options() const {
+  MonteCarloOptions options;
+  options.episodes = episodes;
+  options.seed = seed;
+  options.threads = threads;
+  return options;
+}
+
+void check_solver_names(const std::vector<std::string>& names) {
+  const std::vector<std::string> known = allocator_names();
+  for (const std::string& name : names) {
+    if (std::find(known.begin(), known.end(), name) == known.end()) {
+      throw UsageError(fmt::format("unknown solver '{}' (known: {})", name, fmt::join(known, ", ")));
+    }
+  }
+}
+
+void print_json(const Json& value) { fmt::print("{}\n", value.dump(2)); }
+
+ProgressBar::ProgressBar(std::string label) : label_(std::move(label)), enabled_(::isatty(STDERR_FILENO) != 0) {}
+
+ProgressBar::~ProgressBar() {
+  if (enabled_ && last_percent_ >= 0) fmt::print(stderr, "\r\033[K");
+}
+
+void ProgressBar::update(std::uint64_t done, std::uint64_t total) {
+  if (!enabled_ || total == 0) return;
+  const int percent = static_cast<int>(100 * done / total);
+  if (percent == last_percent_) return;
+  last_percent_ = percent;
+  constexpr int kWidth = 30;
+  const int filled = percent * kWidth / 100;
+  fmt::print(stderr, "\r{} [{}{}] {:3d}%", label_, std::string(static_cast<std::size_t>(filled), '#'),
+             std::string(static_cast<std::size_t>(kWidth - filled), '.'), percent);
+  std::fflush(stderr);
+}
+
+}  // namespace ontime::cli

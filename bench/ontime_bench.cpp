@@ -1,0 +1,121 @@
+// Speed targets of the core (docs/performance.md): dp-rerun decision latency, exact solve
+// time, Monte Carlo throughput and the Table I workload. Run a Release build:
+//   build/ontime_bench --benchmark_repetitions=10 --benchmark_report_aggregates_only=true
+
+#include <benchmark/benchmark.h>
+
+#include <string>
+#include <vector>
+
+#include "ontime/ontime.hpp"
+
+namespace {
+
+ontime::Problem paper(int index) {
+  const std::string name = index == 0 ? "figure1" : "instance" + std::to_string(index);
+  return ontime::load_problem(std::string(ONTIME_SOURCE_DIR) + "/data/instances/paper/" + name + ".json");
+}
+
+// States dp-rerun actually decides in: those visited by its own episodes, in visiting order.
+std::vector<ontime::State> decision_states(const ontime::Mdp& mdp, ontime::Allocator& allocator, int episodes) {
+  class Recorder final : public ontime::Allocator {
+   public:
+    Recorder(ontime::Allocator& inner, std::vector<ontime::State>& states) : inner_(inner), states_(states) {}
+    std::string_view name() const noexcept override { return "recorder"; }
+    int choose(const ontime::State& state) override {
+      states_.push_back(state);
+      return inner_.choose(state);
+    }
+
+   private:
+    ontime::Allocator& inner_;
+    std::vector<ontime::State>& states_;
+  };
+  std::vector<ontime::State> states;
+  Recorder recorder(allocator, states);
+  for (int episode = 0; episode < episodes; ++episode) {
+    ontime::run_episode(mdp, recorder, ontime::stream_seed(9, static_cast<std::uint64_t>(episode)));
+  }
+  return states;
+}
+
+void BM_DpRerunDecision(benchmark::State& bench) {
+  const ontime::Problem problem = paper(static_cast<int>(bench.range(0)));
+  const ontime::Mdp mdp(problem);
+  ontime::DpRerunAllocator allocator(mdp);
+  const std::vector<ontime::State> states = decision_states(mdp, allocator, 2000);
+  std::size_t next = 0;
+  for (auto _ : bench) {
+    benchmark::DoNotOptimize(allocator.choose(states[next]));
+    next = next + 1 == states.size() ? 0 : next + 1;
+  }
+  bench.SetLabel(problem.name());
+}
+BENCHMARK(BM_DpRerunDecision)->DenseRange(1, 5);
+
+void BM_DpRerunTables(benchmark::State& bench) {
+  const ontime::Problem problem = paper(static_cast<int>(bench.range(0)));
+  const ontime::Mdp mdp(problem);
+  for (auto _ : bench) {
+    ontime::ContiguousSuccessTable table(mdp, ontime::Aggregation::sum);
+    benchmark::DoNotOptimize(&table);
+  }
+  bench.SetLabel(problem.name());
+}
+BENCHMARK(BM_DpRerunTables)->DenseRange(1, 5)->Unit(benchmark::kMicrosecond);
+
+void BM_OptimalSolve(benchmark::State& bench) {
+  const ontime::Problem problem = paper(static_cast<int>(bench.range(0)));
+  const ontime::Mdp mdp(problem);
+  std::size_t states = 0;
+  for (auto _ : bench) {
+    ontime::OptimalSolver solver(mdp);
+    benchmark::DoNotOptimize(solver.solve(mdp.start()));
+    states = solver.states();
+  }
+  bench.counters["states"] = static_cast<double>(states);
+  bench.SetLabel(problem.name());
+}
+BENCHMARK(BM_OptimalSolve)->DenseRange(0, 5)->Unit(benchmark::kMicrosecond);
+
+void BM_MonteCarloEpisodes(benchmark::State& bench) {
+  const ontime::Problem problem = paper(1);
+  const ontime::Mdp mdp(problem);
+  const ontime::AllocatorFactory factory = ontime::make_allocator_factory("dp-rerun", mdp);
+  ontime::MonteCarloOptions options;
+  options.episodes = 10'000;
+  options.threads = 1;
+  options.time_decisions = bench.range(0) != 0;
+  for (auto _ : bench) benchmark::DoNotOptimize(ontime::run_monte_carlo(mdp, factory, options).successes);
+  bench.SetItemsProcessed(bench.iterations() * static_cast<std::int64_t>(options.episodes));
+  bench.SetLabel(options.time_decisions ? "dp-rerun, instance 1, 1 thread, timed decisions"
+                                        : "dp-rerun, instance 1, 1 thread");
+}
+BENCHMARK(BM_MonteCarloEpisodes)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// What `ontime table instance1..5 --solvers optimal,dp,dp-rerun,round-robin,greedy --exact`
+// computes: 5 instances x 5 allocators x 10,000 episodes, plus exact values and optima.
+void BM_TableOneWorkload(benchmark::State& bench) {
+  std::vector<ontime::Problem> problems;
+  for (int i = 1; i <= 5; ++i) problems.push_back(paper(i));
+  for (auto _ : bench) {
+    for (const ontime::Problem& problem : problems) {
+      const ontime::Mdp mdp(problem);
+      for (const std::string& name : ontime::allocator_names()) {
+        const ontime::AllocatorFactory factory = ontime::make_allocator_factory(name, mdp);
+        ontime::MonteCarloOptions options;
+        options.episodes = 10'000;
+        benchmark::DoNotOptimize(ontime::run_monte_carlo(mdp, factory, options).successes);
+        const auto allocator = factory();
+        benchmark::DoNotOptimize(ontime::evaluate_exactly(mdp, *allocator).success_probability);
+      }
+      ontime::OptimalSolver solver(mdp);
+      benchmark::DoNotOptimize(solver.solve(mdp.start()));
+    }
+  }
+}
+BENCHMARK(BM_TableOneWorkload)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,30 @@
+#pragma once
+// Allocators by name, for command lines and experiment scripts.
+
+#include <cstddef>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "ontime/allocator.hpp"
+#include "ontime/allocators/optimal.hpp"
+#include "ontime/contiguous_success.hpp"
+#include "ontime/mdp.hpp"
+
+namespace ontime {
+
+struct AllocatorOptions {
+  Aggregation aggregation = Aggregation::sum;             // dp-rerun
+  std::size_t max_states = OptimalSolver::kDefaultMaxStates;  // optimal
+};
+
+// Names accepted by make_allocator_factory, in the order of the paper's tables.
+std::vector<std::string> allocator_names();
+
+// A factory of independent allocators of the named kind for `mdp` (which must outlive it).
+// Precomputation (Eq. (1) tables, the optimal solve) happens here, once, and is shared.
+// Throws UsageError for an unknown name, ResourceLimitError when `optimal` hits its cap.
+AllocatorFactory make_allocator_factory(std::string_view name, const Mdp& mdp,
+                                        const AllocatorOptions& options = {});
+
+}  // namespace ontime

@@ -1,0 +1,28 @@
+#pragma once
+// `dp` (the paper's DP, SPEC §3): the best linear contiguous policy over single skeletons.
+//
+// Computes PS(k, 0, 0, 0) of Eq. (1) with aggregation `self` for every skeleton, picks the
+// largest once (ties: lowest index) and refines only that skeleton for the whole episode.
+// No guarantee beyond optimality among "one skeleton, refined contiguously" policies.
+// Cost: one ContiguousSuccessTable build at construction; O(1) per decision.
+
+#include "ontime/allocator.hpp"
+#include "ontime/contiguous_success.hpp"
+
+namespace ontime {
+
+class DpAllocator final : public Allocator {
+ public:
+  explicit DpAllocator(const Mdp& mdp);
+  explicit DpAllocator(int chosen_skeleton) noexcept : chosen_(chosen_skeleton) {}
+
+  std::string_view name() const noexcept override { return "dp"; }
+  int choose(const State&) override { return chosen_; }
+
+  int chosen_skeleton() const noexcept { return chosen_; }
+
+ private:
+  int chosen_;
+};
+
+}  // namespace ontime

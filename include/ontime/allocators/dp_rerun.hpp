@@ -1,0 +1,35 @@
+#pragma once
+// `dp-rerun` (the paper's DP_Rerun, Algorithm 1, SPEC §3).
+//
+// Before every step, evaluates PS(k, l_k, CT, ET_k) of Eq. (1) for every skeleton with
+// actions left, conditioning the current action's planning time on the PT_k steps already
+// spent, and spends the step on the largest (ties: lowest index). Aggregation `sum` by
+// default (reproduces Table I); `max` and `self` are selectable.
+// No optimality guarantee; in the paper's instances it comes close to the optimum.
+// Cost: the Eq. (1) tables are built once per problem and shared; a decision is K dot
+// products of at most D - CT - ET_k terms, with no allocation (well under a microsecond on
+// the paper's instances, see docs/performance.md).
+
+#include <memory>
+
+#include "ontime/allocator.hpp"
+#include "ontime/contiguous_success.hpp"
+
+namespace ontime {
+
+class DpRerunAllocator final : public Allocator {
+ public:
+  DpRerunAllocator(const Mdp& mdp, Aggregation aggregation = Aggregation::sum);
+  DpRerunAllocator(const Mdp& mdp, std::shared_ptr<const ContiguousSuccessTable> table) noexcept;
+
+  std::string_view name() const noexcept override { return "dp-rerun"; }
+  int choose(const State& state) override;
+
+  const ContiguousSuccessTable& table() const noexcept { return *table_; }
+
+ private:
+  const Mdp* mdp_;
+  std::shared_ptr<const ContiguousSuccessTable> table_;
+};
+
+}  // namespace ontime

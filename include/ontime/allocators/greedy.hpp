@@ -1,0 +1,26 @@
+#pragma once
+// `greedy` (baseline, SPEC §3): the skeleton with the smallest sum over its actions of mean
+// planning time plus mean execution time (means over the finite support, E[T | T finite]),
+// chosen once (ties: lowest index) and refined for the whole episode.
+// Blind to spread and heavy tails, which is what the paper's instances 3-5 expose.
+// Cost: O(sum of support sizes) at construction; O(1) per decision.
+
+#include "ontime/allocator.hpp"
+#include "ontime/mdp.hpp"
+
+namespace ontime {
+
+class GreedyAllocator final : public Allocator {
+ public:
+  explicit GreedyAllocator(const Mdp& mdp);
+
+  std::string_view name() const noexcept override { return "greedy"; }
+  int choose(const State&) override { return chosen_; }
+
+  int chosen_skeleton() const noexcept { return chosen_; }
+
+ private:
+  int chosen_;
+};
+
+}  // namespace ontime

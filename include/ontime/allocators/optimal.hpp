@@ -1,0 +1,78 @@
+#pragma once
+// `optimal`: exact expectimax over the reachable MDP (SPEC §3).
+//
+// Computes the maximum success probability V*(s) = max_k sum_o P(o | s, k) V*(o) and the
+// choice that attains it, memoised over reachable states. The paper calls this impractical;
+// it is the reference every other allocator is measured against.
+//
+// Guarantees: the value is exact up to floating-point rounding. Among choices whose values
+// differ by at most kTieTolerance the lowest skeleton index wins. Only choices that make
+// progress on a skeleton that can still succeed are considered (spending a step idle, or on
+// a skeleton that cannot succeed, never raises the success probability), and skeletons that
+// share their next action are one choice, named by their lowest index.
+//
+// Cost: time and memory linear in the number of reachable states, which grows exponentially
+// with the number of skeletons (the problem is NP-hard, Theorem 1). States that differ only
+// in skeletons that can no longer succeed are merged. The solver stops with
+// ResourceLimitError when it would hold more than `max_states` states (about 130 bytes each),
+// never by running out of memory.
+
+#include <cstddef>
+#include <memory>
+#include <optional>
+
+#include "ontime/allocator.hpp"
+#include "ontime/mdp.hpp"
+
+namespace ontime {
+
+class OptimalSolver {
+ public:
+  static constexpr double kTieTolerance = 1e-12;
+  static constexpr std::size_t kDefaultMaxStates = 10'000'000;
+
+  explicit OptimalSolver(const Mdp& mdp, std::size_t max_states = kDefaultMaxStates);
+  ~OptimalSolver();
+  OptimalSolver(OptimalSolver&&) noexcept;
+  OptimalSolver& operator=(OptimalSolver&&) noexcept;
+
+  // V*(state) for a running state; solves every state reachable from it that is not yet
+  // known. Throws ResourceLimitError at the state cap (the states solved so far are kept).
+  double solve(const State& state);
+
+  // The optimal choice in a state already solved, or nullopt if it was not reached.
+  std::optional<int> best_choice(const State& state) const;
+
+  // States memoised so far.
+  std::size_t states() const noexcept;
+  std::size_t max_states() const noexcept { return max_states_; }
+  const Mdp& mdp() const noexcept { return *mdp_; }
+
+ private:
+  struct Impl;
+  const Mdp* mdp_;
+  std::size_t max_states_;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Follows the optimal policy. The solve from the start state is done once and shared by all
+// allocators a factory makes; a state outside it (a session resumed elsewhere) is solved on
+// demand by a private solver.
+class OptimalAllocator final : public Allocator {
+ public:
+  // Solves from the start state; throws ResourceLimitError at the cap.
+  OptimalAllocator(const Mdp& mdp, std::size_t max_states = OptimalSolver::kDefaultMaxStates);
+  OptimalAllocator(const Mdp& mdp, std::shared_ptr<const OptimalSolver> solved);
+
+  std::string_view name() const noexcept override { return "optimal"; }
+  int choose(const State& state) override;
+
+  const OptimalSolver& solver() const noexcept { return *solved_; }
+
+ private:
+  const Mdp* mdp_;
+  std::shared_ptr<const OptimalSolver> solved_;
+  std::unique_ptr<OptimalSolver> private_;
+};
+
+}  // namespace ontime

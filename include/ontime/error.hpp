@@ -1,0 +1,42 @@
+#pragma once
+// Error types of the library. Callers (the CLI among them) map them to exit codes:
+// InputError, UsageError and ResourceLimitError are the caller's to fix (exit 2),
+// anything else is a defect of the library (exit 1).
+
+#include <stdexcept>
+#include <string>
+
+namespace ontime {
+
+// Bad input data. Names where it came from (`source`, usually a file path), the place
+// inside it (a JSON path such as `actions.a3.planning.pmf."0"`, or `line 3, column 5`)
+// and the rule that was broken.
+class InputError : public std::runtime_error {
+ public:
+  InputError(std::string source, std::string place, std::string rule);
+
+  const std::string& source() const noexcept { return source_; }
+  const std::string& place() const noexcept { return place_; }
+  const std::string& rule() const noexcept { return rule_; }
+
+ private:
+  std::string source_;
+  std::string place_;
+  std::string rule_;
+};
+
+// A request that cannot be served as asked: an unknown allocator name, an option out of
+// range, an exact evaluation of an allocator whose choices are not a function of the state.
+class UsageError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+// A computation reached a cap the caller configured (states, memory) before finishing.
+// Raised instead of letting the process be killed for running out of memory.
+class ResourceLimitError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace ontime

@@ -1,0 +1,21 @@
+#pragma once
+// Everything of the OnTime library.
+
+#include "ontime/allocator.hpp"
+#include "ontime/allocators.hpp"
+#include "ontime/allocators/dp.hpp"
+#include "ontime/allocators/dp_rerun.hpp"
+#include "ontime/allocators/greedy.hpp"
+#include "ontime/allocators/optimal.hpp"
+#include "ontime/allocators/round_robin.hpp"
+#include "ontime/contiguous_success.hpp"
+#include "ontime/distribution.hpp"
+#include "ontime/error.hpp"
+#include "ontime/evaluation.hpp"
+#include "ontime/instance_io.hpp"
+#include "ontime/mdp.hpp"
+#include "ontime/problem.hpp"
+#include "ontime/random.hpp"
+#include "ontime/session.hpp"
+#include "ontime/simulator.hpp"
+#include "ontime/state.hpp"

@@ -1,0 +1,28 @@
+#include "ontime/allocators/greedy.hpp"
+
+#include <limits>
+
+namespace ontime {
+namespace {
+
+int fastest_on_average(const Problem& problem) {
+  int best = 0;
+  double best_mean = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < problem.skeleton_count(); ++k) {
+    double mean = 0;
+    for (const int action : problem.skeleton(k)) {
+      mean += problem.action(action).planning.mean_finite() + problem.action(action).execution.mean_finite();
+    }
+    if (mean < best_mean) {
+      best_mean = mean;
+      best = k;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+GreedyAllocator::GreedyAllocator(const Mdp& mdp) : chosen_(fastest_on_average(mdp.problem())) {}
+
+}  // namespace ontime

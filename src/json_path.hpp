@@ -1,0 +1,126 @@
+#pragma once
+// Internal: JSON paths for error messages, strict parsing (duplicate keys are errors, not
+// silently overwritten) and reading whole files. Shared by every reader of JSON input.
+
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "ontime/error.hpp"
+
+namespace ontime::detail {
+
+// `parent.key`, or `parent."key"` when the key is not an identifier (e.g. `pmf."0"`).
+inline std::string json_member(const std::string& parent, std::string_view key) {
+  bool identifier = !key.empty() && (std::isalpha(static_cast<unsigned char>(key[0])) || key[0] == '_');
+  for (const char c : key) identifier = identifier && (std::isalnum(static_cast<unsigned char>(c)) || c == '_');
+  std::string segment;
+  if (identifier) {
+    segment = std::string(key);
+  } else {
+    segment = "\"";
+    for (const char c : key) {
+      if (c == '"' || c == '\\') segment += '\\';
+      segment += c;
+    }
+    segment += "\"";
+  }
+  return parent.empty() ? segment : parent + "." + segment;
+}
+
+inline std::string json_index(const std::string& parent, std::size_t index) {
+  return parent + "[" + std::to_string(index) + "]";
+}
+
+inline std::string read_text_file(const std::filesystem::path& path) {
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error)) {
+    throw InputError(path.string(), "file", "is a directory, not a file");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path.string(), "file", "cannot be opened for reading (missing or unreadable)");
+  std::ostringstream content;
+  content << in.rdbuf();
+  if (in.bad()) throw InputError(path.string(), "file", "could not be read");
+  return content.str();
+}
+
+// Parses JSON text; malformed text raises InputError at `line L, column C`, and a key that
+// appears twice in one object raises InputError at its path.
+template <class Json>
+Json parse_json_strict(std::string_view text, const std::string& source) {
+  struct Frame {
+    bool object;
+    std::set<std::string> keys;
+    std::string key;
+    std::size_t index;
+    bool started;
+  };
+  std::vector<Frame> frames;
+  const auto path_of_parents = [&frames] {
+    std::string path;
+    for (std::size_t i = 0; i + 1 < frames.size(); ++i) {
+      path = frames[i].object ? json_member(path, frames[i].key) : json_index(path, frames[i].index);
+    }
+    return path;
+  };
+  const auto enter_element = [&frames] {
+    if (!frames.empty() && !frames.back().object) {
+      Frame& parent = frames.back();
+      parent.index = parent.started ? parent.index + 1 : 0;
+      parent.started = true;
+    }
+  };
+  const auto callback = [&](int, typename Json::parse_event_t event, Json& parsed) -> bool {
+    using Event = typename Json::parse_event_t;
+    switch (event) {
+      case Event::object_start:
+        enter_element();
+        frames.push_back(Frame{true, {}, {}, 0, false});
+        break;
+      case Event::array_start:
+        enter_element();
+        frames.push_back(Frame{false, {}, {}, 0, false});
+        break;
+      case Event::key: {
+        Frame& frame = frames.back();
+        std::string key = parsed.template get<std::string>();
+        if (!frame.keys.insert(key).second) {
+          std::string path = path_of_parents();
+          throw InputError(source, json_member(path, key), "duplicate key (each key may appear once in an object)");
+        }
+        frame.key = std::move(key);
+        break;
+      }
+      case Event::object_end:
+      case Event::array_end:
+        frames.pop_back();
+        break;
+      case Event::value:
+        enter_element();
+        break;
+    }
+    return true;
+  };
+  try {
+    return Json::parse(text.begin(), text.end(), callback, true, false);
+  } catch (const typename Json::parse_error& error) {
+    static const std::regex located(R"(parse error at (line \d+, column \d+): (.*))");
+    std::cmatch match;
+    const std::string message = error.what();
+    if (std::regex_search(message.c_str(), match, located)) {
+      throw InputError(source, match[1].str(), "invalid JSON: " + match[2].str());
+    }
+    throw InputError(source, "byte " + std::to_string(error.byte), "invalid JSON: " + message);
+  }
+}
+
+}  // namespace ontime::detail

@@ -1,0 +1,153 @@
+#include "ontime/mdp.hpp"
+
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace ontime {
+namespace {
+
+// A remaining-time bound that no deadline can meet; sums of a few of them do not overflow.
+constexpr std::int64_t kUnreachable = std::int64_t{1} << 40;
+
+std::int64_t least_steps(Steps steps) { return steps == kNever ? kUnreachable : steps; }
+
+}  // namespace
+
+Mdp::Mdp(const Problem& problem)
+    : problem_(&problem), skeleton_count_(problem.skeleton_count()), deadline_(problem.deadline()) {
+  const auto deadline = static_cast<std::size_t>(deadline_);
+  const auto action_count = static_cast<std::size_t>(problem.action_count());
+
+  hazards_.assign(action_count * deadline, 0.0);
+  next_finish_.assign(action_count * (deadline + 1), kNever);
+  execution_outcomes_.assign(action_count, {});
+  min_execution_.assign(action_count, kNever);
+  for (std::size_t a = 0; a < action_count; ++a) {
+    const Action& action = problem.actions()[a];
+    for (std::size_t spent = 0; spent < deadline; ++spent) {
+      hazards_[a * deadline + spent] = action.planning.hazard(static_cast<Steps>(spent));
+    }
+    // Least t >= 1 with p(spent + t) > 0, filled from the end of the support backwards.
+    const auto masses = action.planning.masses();
+    Steps next_support = kNever;
+    for (std::size_t u = masses.size(); u-- > 0;) {
+      if (u <= deadline) {
+        next_finish_[a * (deadline + 1) + u] = next_support == kNever ? kNever : next_support - static_cast<Steps>(u);
+      }
+      if (masses[u] > 0) next_support = static_cast<Steps>(u);
+    }
+    for (std::size_t spent = masses.size(); spent <= deadline; ++spent) {
+      next_finish_[a * (deadline + 1) + spent] = kNever;
+    }
+
+    double too_slow = action.execution.never();
+    const auto execution = action.execution.masses();
+    for (std::size_t x = 0; x < execution.size(); ++x) {
+      if (execution[x] <= 0) continue;
+      if (x <= deadline) {
+        execution_outcomes_[a].push_back({static_cast<Steps>(x), execution[x]});
+      } else {
+        too_slow += execution[x];
+      }
+    }
+    if (too_slow > 0) execution_outcomes_[a].push_back({deadline_ + 1, too_slow});
+    min_execution_[a] = action.execution.min_step();
+  }
+
+  lengths_.resize(static_cast<std::size_t>(skeleton_count_));
+  offsets_.resize(static_cast<std::size_t>(skeleton_count_));
+  for (int k = 0; k < skeleton_count_; ++k) {
+    const auto path = problem.skeleton(k);
+    lengths_[static_cast<std::size_t>(k)] = static_cast<int>(path.size());
+    offsets_[static_cast<std::size_t>(k)] = paths_.size();
+    paths_.insert(paths_.end(), path.begin(), path.end());
+  }
+  // rest_[offsets_[k] + k + l]: least planning + execution of positions l .. A_k - 1 of k.
+  rest_.assign(paths_.size() + static_cast<std::size_t>(skeleton_count_), 0);
+  for (int k = 0; k < skeleton_count_; ++k) {
+    const std::size_t base = offsets_[static_cast<std::size_t>(k)] + static_cast<std::size_t>(k);
+    const int length = lengths_[static_cast<std::size_t>(k)];
+    rest_[base + static_cast<std::size_t>(length)] = 0;
+    for (int l = length; l-- > 0;) {
+      const Action& action = problem.action(problem.action_at(k, l));
+      const std::int64_t least =
+          least_steps(action.planning.min_step()) + least_steps(action.execution.min_step());
+      rest_[base + static_cast<std::size_t>(l)] =
+          std::min(kUnreachable, rest_[base + static_cast<std::size_t>(l) + 1] + least);
+    }
+  }
+}
+
+bool Mdp::can_succeed(const State& state, int k) const noexcept {
+  const int action = next_action(state, k);
+  if (action < 0) return false;
+  const auto slot = static_cast<std::size_t>(k);
+  const Steps spent = state.spent[slot];
+  if (spent > deadline_) return false;
+  const Steps finish = next_finish_[static_cast<std::size_t>(action) * static_cast<std::size_t>(deadline_ + 1) + static_cast<std::size_t>(spent)];
+  const Steps execution = min_execution_[static_cast<std::size_t>(action)];
+  if (finish == kNever || execution == kNever) return false;
+  const std::int64_t need = std::int64_t{state.time} + state.execution[slot] + finish + execution +
+                            rest_[offsets_[slot] + slot + state.refined[slot] + 1];
+  return need <= deadline_;
+}
+
+bool Mdp::any_can_succeed(const State& state) const noexcept {
+  for (int k = 0; k < skeleton_count_; ++k) {
+    if (can_succeed(state, k)) return true;
+  }
+  return false;
+}
+
+Status Mdp::apply(State& state, int choice, const Observation& observation) const {
+  if (choice < 0 || choice >= skeleton_count_) {
+    throw std::invalid_argument("skeleton index " + std::to_string(choice) + " out of range [0, " +
+                                std::to_string(skeleton_count_) + ")");
+  }
+  const int action = next_action(state, choice);
+  ++state.time;
+  if (action < 0) {
+    if (observation.refined) {
+      throw std::invalid_argument("skeleton " + std::to_string(choice) +
+                                  " is fully refined: its step is idle and cannot refine anything");
+    }
+  } else if (!observation.refined) {
+    for (const int member : problem_->members(action)) {
+      std::uint16_t& spent = state.spent[static_cast<std::size_t>(member)];
+      if (spent <= deadline_) ++spent;
+    }
+  } else {
+    if (observation.execution < 0) {
+      throw std::invalid_argument("execution time must be >= 0 steps");
+    }
+    const std::int64_t total = observation.execution == kNever
+                                   ? std::int64_t{deadline_} + 1
+                                   : std::int64_t{state.execution[static_cast<std::size_t>(choice)]} + observation.execution;
+    const std::uint16_t execution = saturate_execution(total);
+    for (const int member : problem_->members(action)) {
+      const auto slot = static_cast<std::size_t>(member);
+      ++state.refined[slot];
+      state.spent[slot] = 0;
+      state.execution[slot] = execution;
+    }
+    if (problem_->completes_a_skeleton(action) && std::int64_t{state.time} + execution <= deadline_) {
+      return Status::success;
+    }
+  }
+  if (state.time >= deadline_ || !any_can_succeed(state)) return Status::failure;
+  return Status::running;
+}
+
+int Mdp::completed_skeleton(const State& state, int choice) const {
+  const auto slot = static_cast<std::size_t>(choice);
+  if (state.refined[slot] == 0) return -1;
+  const int action = paths_[offsets_[slot] + state.refined[slot] - 1U];
+  for (const int member : problem_->members(action)) {
+    const auto index = static_cast<std::size_t>(member);
+    if (state.refined[index] == lengths_[index]) return member;
+  }
+  return -1;
+}
+
+}  // namespace ontime

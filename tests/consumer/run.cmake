@@ -1,0 +1,24 @@
+# Installs the built library into a scratch prefix, then configures, builds and runs the
+# consumer project against it. Fails on any error or a wrong answer.
+file(REMOVE_RECURSE "${SCRATCH_DIR}")
+execute_process(COMMAND "${CMAKE_COMMAND}" --install "${ONTIME_BUILD_DIR}" --prefix "${SCRATCH_DIR}/prefix"
+  RESULT_VARIABLE status OUTPUT_QUIET)
+if(NOT status EQUAL 0)
+  message(FATAL_ERROR "cmake --install failed: ${status}")
+endif()
+execute_process(COMMAND "${CMAKE_COMMAND}" -S "${CONSUMER_SOURCE_DIR}" -B "${SCRATCH_DIR}/build" -G "${GENERATOR}"
+  "-DCMAKE_PREFIX_PATH=${SCRATCH_DIR}/prefix" -DCMAKE_BUILD_TYPE=Release
+  RESULT_VARIABLE status OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT status EQUAL 0)
+  message(FATAL_ERROR "configuring the consumer failed:\n${out}\n${err}")
+endif()
+execute_process(COMMAND "${CMAKE_COMMAND}" --build "${SCRATCH_DIR}/build"
+  RESULT_VARIABLE status OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT status EQUAL 0)
+  message(FATAL_ERROR "building the consumer failed:\n${out}\n${err}")
+endif()
+execute_process(COMMAND "${SCRATCH_DIR}/build/consumer" "${INSTANCE}" RESULT_VARIABLE status OUTPUT_VARIABLE out)
+if(NOT status EQUAL 0 OR NOT out STREQUAL "optimum 0.5625\n")
+  message(FATAL_ERROR "consumer answered '${out}' (exit ${status}), expected 'optimum 0.5625'")
+endif()
+message(STATUS "consumer built against the installed package: ${out}")

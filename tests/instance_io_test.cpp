@@ -1,0 +1,126 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+
+#include "ontime/error.hpp"
+#include "ontime/instance_io.hpp"
+#include "support/bad_inputs.hpp"
+#include "support/paper.hpp"
+
+namespace ontime {
+namespace {
+
+TEST(InstanceIo, LoadsFigureOne) {
+  const Problem problem = testing::paper_instance("figure1");
+  EXPECT_EQ(problem.name(), "paper-figure-1");
+  EXPECT_EQ(problem.deadline(), 5);
+  EXPECT_DOUBLE_EQ(problem.step_seconds(), 1.0);  // default when absent
+  EXPECT_EQ(problem.action_count(), 4);
+  const Action& d1 = problem.action(problem.find_action("d1"));
+  EXPECT_DOUBLE_EQ(d1.planning.pmf(1), 0.5);
+  EXPECT_DOUBLE_EQ(d1.planning.pmf(4), 0.5);
+  EXPECT_DOUBLE_EQ(d1.execution.pmf(10), 0.5);
+}
+
+TEST(InstanceIo, LoadsEveryPaperInstanceWithItsDeadline) {
+  const std::map<std::string, Steps> deadlines{{"instance1", 14}, {"instance2", 9}, {"instance3", 20},
+                                               {"instance4", 4},  {"instance5", 14}};
+  for (const auto& [name, deadline] : deadlines) {
+    EXPECT_EQ(testing::paper_instance(name).deadline(), deadline) << name;
+  }
+}
+
+TEST(InstanceIo, ReadsTheCdfFormOfTheSpecExample) {
+  const Problem problem = parse_problem(R"({
+    "name": "paper-instance-4", "deadline": 4, "step_seconds": 1.0,
+    "actions": {
+      "a1": {"planning": {"pmf": {"1": 0.3, "2": 0.15, "3": 0.1, "4": 0.15, "5": 0.3}}, "execution": {"pmf": {"1": 1.0}}},
+      "a2": {"planning": {"cdf": {"2": 0.1, "3": 0.9, "4": 1.0}}, "execution": {"pmf": {"1": 1.0}}}
+    },
+    "skeletons": [["a1"], ["a2"]]})",
+                                        "spec-example");
+  const Distribution& planning = problem.action(problem.find_action("a2")).planning;
+  EXPECT_DOUBLE_EQ(planning.pmf(2), 0.1);
+  EXPECT_DOUBLE_EQ(planning.pmf(3), 0.8);
+  EXPECT_NEAR(planning.pmf(4), 0.1, 1e-15);
+  EXPECT_NEAR(planning.never(), 0.0, 1e-15);
+}
+
+TEST(InstanceIo, MissingMassIsNever) {
+  const Problem problem = parse_problem(
+      R"({"deadline": 3, "actions": {"a": {"planning": {"pmf": {"2": 0.6}}, "execution": {"pmf": {}}}}, "skeletons": [["a"]]})",
+      "never.json");
+  EXPECT_DOUBLE_EQ(problem.action(0).planning.never(), 0.4);
+  EXPECT_DOUBLE_EQ(problem.action(0).execution.never(), 1.0);
+  EXPECT_EQ(problem.name(), "never");  // defaults to the file's stem
+}
+
+TEST(InstanceIo, WritesWhatItReads) {
+  for (const char* name : {"figure1", "instance1", "instance3"}) {
+    const Problem original = testing::paper_instance(name);
+    const Problem copy = parse_problem(problem_to_json(original), "copy");
+    ASSERT_EQ(copy.action_count(), original.action_count());
+    ASSERT_EQ(copy.skeleton_count(), original.skeleton_count());
+    EXPECT_EQ(copy.deadline(), original.deadline());
+    EXPECT_EQ(copy.name(), original.name());
+    for (int a = 0; a < original.action_count(); ++a) {
+      EXPECT_EQ(copy.action(a).id, original.action(a).id);
+      EXPECT_EQ(copy.action(a).planning, original.action(a).planning);
+      EXPECT_EQ(copy.action(a).execution, original.action(a).execution);
+    }
+    for (int k = 0; k < original.skeleton_count(); ++k) {
+      EXPECT_TRUE(std::ranges::equal(copy.skeleton(k), original.skeleton(k)));
+    }
+  }
+}
+
+TEST(InstanceIo, SaveReplacesTheFileWhole) {
+  const auto directory = std::filesystem::temp_directory_path() / "ontime_instance_io_test";
+  std::filesystem::create_directories(directory);
+  const auto path = directory / "saved.json";
+  std::ofstream(path) << "old content";
+  const Problem problem = testing::paper_instance("instance2");
+  save_problem(problem, path);
+  EXPECT_EQ(load_problem(path).deadline(), 9);
+  std::size_t leftovers = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(directory)) leftovers += entry.path() != path;
+  EXPECT_EQ(leftovers, 0U);
+  std::filesystem::remove_all(directory);
+}
+
+TEST(InstanceIo, MissingFileIsAnInputError) {
+  try {
+    load_problem("/nonexistent/instance.json");
+    FAIL() << "expected InputError";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.source(), "/nonexistent/instance.json");
+    EXPECT_NE(error.rule().find("cannot be opened"), std::string::npos);
+  }
+}
+
+// Every file of tests/data/bad is rejected with its expected place and rule.
+TEST(InstanceIo, EveryBadFileNamesItsPlaceAndRule) {
+  std::set<std::string> covered;
+  for (const testing::BadInput& bad : testing::kBadInputs) {
+    covered.insert(bad.file);
+    const auto path = testing::source_path("tests/data/bad/" + bad.file);
+    try {
+      load_problem(path);
+      ADD_FAILURE() << bad.file << " was accepted";
+    } catch (const InputError& error) {
+      EXPECT_EQ(error.source(), path.string()) << bad.file;
+      EXPECT_EQ(error.place(), bad.place) << bad.file;
+      EXPECT_NE(error.rule().find(bad.rule), std::string::npos) << bad.file << ": " << error.rule();
+    }
+  }
+  for (const auto& entry : std::filesystem::directory_iterator(testing::source_path("tests/data/bad"))) {
+    EXPECT_TRUE(covered.contains(entry.path().filename().string()))
+        << entry.path().filename() << " has no expectation in support/bad_inputs.hpp";
+  }
+}
+
+}  // namespace
+}  // namespace ontime

@@ -1,0 +1,66 @@
+#include "support/random_instances.hpp"
+
+#include <string>
+#include <vector>
+
+#include "ontime/random.hpp"
+
+namespace ontime::testing {
+namespace {
+
+int uniform_int(SplitMix64& generator, int low, int high) {
+  return low + static_cast<int>(generator() % static_cast<std::uint64_t>(high - low + 1));
+}
+
+Distribution random_distribution(SplitMix64& generator, Steps first, Steps last) {
+  std::vector<double> masses(static_cast<std::size_t>(last) + 1, 0.0);
+  const int support = uniform_int(generator, 1, 3);
+  double total = 0;
+  for (int i = 0; i < support; ++i) {
+    const auto step = static_cast<std::size_t>(uniform_int(generator, first, last));
+    const double weight = 0.1 + uniform01(generator);
+    masses[step] += weight;
+    total += weight;
+  }
+  // A quarter of the distributions keep some "never" mass.
+  const double scale = (generator() % 4 == 0) ? 0.6 + 0.3 * uniform01(generator) : 1.0;
+  for (double& mass : masses) mass = mass / total * scale;
+  return Distribution::from_pmf(std::move(masses));
+}
+
+}  // namespace
+
+Problem random_instance(std::uint64_t seed, int max_skeletons, int max_length, Steps max_deadline) {
+  SplitMix64 generator(seed);
+  const Steps deadline = uniform_int(generator, 2, max_deadline);
+  const int skeleton_count = uniform_int(generator, 1, max_skeletons);
+  std::vector<Action> actions;
+  std::vector<std::vector<int>> skeletons;
+  const auto new_action = [&] {
+    Action action;
+    action.id = std::to_string(actions.size());
+    action.id.insert(0, 1, 'a');
+    action.planning = random_distribution(generator, 1, deadline);
+    action.execution = random_distribution(generator, 0, deadline / 2 + 1);
+    actions.push_back(std::move(action));
+    return static_cast<int>(actions.size()) - 1;
+  };
+  while (static_cast<int>(skeletons.size()) < skeleton_count) {
+    std::vector<int> path;
+    // Share a prefix of an earlier skeleton half of the time.
+    if (!skeletons.empty() && generator() % 2 == 0) {
+      const auto& other = skeletons[generator() % skeletons.size()];
+      const int shared = uniform_int(generator, 1, static_cast<int>(other.size()));
+      path.assign(other.begin(), other.begin() + shared);
+    }
+    const int length = uniform_int(generator, static_cast<int>(path.size()) + (path.empty() ? 1 : 0),
+                                   std::max(static_cast<int>(path.size()) + 1, max_length));
+    while (static_cast<int>(path.size()) < length) path.push_back(new_action());
+    bool duplicate = false;
+    for (const auto& existing : skeletons) duplicate = duplicate || existing == path;
+    if (!duplicate) skeletons.push_back(std::move(path));
+  }
+  return Problem("random-" + std::to_string(seed), deadline, 1.0, std::move(actions), std::move(skeletons));
+}
+
+}  // namespace ontime::testing
