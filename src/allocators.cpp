@@ -3,13 +3,14 @@
 #include "ontime/allocators/dp.hpp"
 #include "ontime/allocators/dp_rerun.hpp"
 #include "ontime/allocators/greedy.hpp"
+#include "ontime/allocators/mcts.hpp"
 #include "ontime/allocators/round_robin.hpp"
 #include "ontime/error.hpp"
 
 namespace ontime {
 
 std::vector<std::string> allocator_names() {
-  return {"optimal", "dp", "dp-rerun", "round-robin", "greedy"};
+  return {"optimal", "mcts", "dp", "dp-rerun", "round-robin", "greedy"};
 }
 
 AllocatorFactory make_allocator_factory(std::string_view name, const Mdp& mdp, const AllocatorOptions& options) {
@@ -19,6 +20,20 @@ AllocatorFactory make_allocator_factory(std::string_view name, const Mdp& mdp, c
     solver->solve(mdp.start());
     std::shared_ptr<const OptimalSolver> solved = std::move(solver);
     return [model, solved] { return std::make_unique<OptimalAllocator>(*model, solved); };
+  }
+  if (name == "mcts") {
+    MctsOptions mcts;
+    mcts.exploration = options.exploration;
+    mcts.budget = options.seconds ? SearchBudget::either(options.iterations, *options.seconds)
+                                  : SearchBudget::iterations(options.iterations);
+    mcts.max_tree_bytes = options.max_tree_bytes;
+    if (options.rollout != "random") {
+      if (options.rollout == "mcts") throw UsageError("mcts cannot be its own rollout policy");
+      mcts.rollout = make_allocator_factory(options.rollout, mdp, options);
+    }
+    // Probe the options once here, so that a bad rollout policy fails before any episode.
+    MctsAllocator probe(mdp, mcts);
+    return [model, mcts] { return std::make_unique<MctsAllocator>(*model, mcts); };
   }
   if (name == "dp") {
     const int chosen = DpAllocator(mdp).chosen_skeleton();

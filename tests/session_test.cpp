@@ -15,7 +15,7 @@ class ScriptedAllocator final : public Allocator {
  public:
   explicit ScriptedAllocator(std::vector<int> script) : script_(std::move(script)) {}
   std::string_view name() const noexcept override { return "scripted"; }
-  void begin_episode() override { ++episodes; }
+  void begin_episode(std::uint64_t) override { ++episodes; }
   int choose(const State&) override { return script_.at(next_++); }
   void observe(const State&, int choice, const State& after, Status status) override {
     observed.push_back(choice);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <limits>
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -16,12 +17,37 @@ void AllocatorFlags::add_to(CLI::App& command) {
   command.add_option("--max-states", max_states, "Cap on the states the exact solver and evaluator may hold")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  command.add_option("--iterations", iterations,
+                     "mcts: search iterations per decision (default 10000; no limit when only --time-budget is given)")
+      ->check(CLI::PositiveNumber);
+  command.add_option("--time-budget", time_budget,
+                     "mcts: seconds per decision (with --iterations, whichever ends first; 0: no time limit)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  command.add_option("--exploration", exploration, "mcts: exploration constant C of UCT")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  command.add_option("--rollout", rollout, "mcts: rollout policy, 'random' or a stationary allocator (e.g. dp-rerun)")
+      ->capture_default_str();
+  command.add_option("--max-tree-mib", max_tree_mib, "mcts: memory cap of the search tree; a search stops there")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
 }
 
 AllocatorOptions AllocatorFlags::options() const {
   AllocatorOptions options;
   options.aggregation = parse_aggregation(aggregation);
   options.max_states = max_states;
+  options.exploration = exploration;
+  if (time_budget > 0) options.seconds = time_budget;
+  if (iterations > 0) {
+    options.iterations = iterations;
+  } else if (time_budget > 0) {
+    options.iterations = std::numeric_limits<std::uint64_t>::max();
+  }
+  if (rollout != "random") check_solver_names({rollout});
+  options.rollout = rollout;
+  options.max_tree_bytes = max_tree_mib << 20;
   return options;
 }
 

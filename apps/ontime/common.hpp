@@ -20,11 +20,17 @@ using Json = nlohmann::ordered_json;
 void add_solve_command(CLI::App& app);
 void add_evaluate_command(CLI::App& app);
 void add_table_command(CLI::App& app);
+void add_study_command(CLI::App& app);
 
 // Options shared by commands that build allocators.
 struct AllocatorFlags {
   std::string aggregation = "sum";
   std::size_t max_states = OptimalSolver::kDefaultMaxStates;
+  double exploration = 0.5;
+  std::uint64_t iterations = 0;  // 0: 10,000 without --time-budget, unlimited with it
+  double time_budget = 0;        // seconds per decision, 0: none
+  std::string rollout = "random";
+  std::size_t max_tree_mib = 1024;
   void add_to(CLI::App& command);
   AllocatorOptions options() const;
 };

@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   ontime::cli::add_solve_command(app);
   ontime::cli::add_evaluate_command(app);
   ontime::cli::add_table_command(app);
+  ontime::cli::add_study_command(app);
 
   try {
     app.parse(argc, argv);

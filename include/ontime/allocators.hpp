@@ -2,6 +2,8 @@
 // Allocators by name, for command lines and experiment scripts.
 
 #include <cstddef>
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -14,8 +16,14 @@
 namespace ontime {
 
 struct AllocatorOptions {
-  Aggregation aggregation = Aggregation::sum;             // dp-rerun
+  Aggregation aggregation = Aggregation::sum;                 // dp-rerun (and its use as mcts rollout)
   std::size_t max_states = OptimalSolver::kDefaultMaxStates;  // optimal
+  // mcts
+  double exploration = 0.5;
+  std::uint64_t iterations = 10'000;        // per decision
+  std::optional<double> seconds;            // per decision; with `iterations`, whichever ends first
+  std::size_t max_tree_bytes = std::size_t{1} << 30;
+  std::string rollout = "random";           // "random" or the name of a stationary allocator
 };
 
 // Names accepted by make_allocator_factory, in the order of the paper's tables.

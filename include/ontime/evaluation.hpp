@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 
 #include "ontime/allocator.hpp"
 #include "ontime/mdp.hpp"
@@ -30,7 +31,9 @@ struct MonteCarloResult {
   double success_rate = 0;
   double ci95 = 0;             // half-width: 1.96 * sqrt(r (1 - r) / N)  (SPEC §4)
   LatencySummary decision_time;
+  LatencySummary episode_decision_time;  // total decision time of each episode (meta-level cost)
   double seconds = 0;          // wall-clock time of the whole run
+  std::optional<SearchStatistics> search;  // merged over threads, for searching allocators
 };
 
 // Runs `options.episodes` episodes; episode i lives in the hidden world drawn from

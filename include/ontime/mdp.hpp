@@ -12,14 +12,31 @@
 // execution supports, lower bounds on remaining time) make a transition O(K) with no
 // allocation.
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
 
 #include "ontime/problem.hpp"
+#include "ontime/random.hpp"
 #include "ontime/state.hpp"
 
 namespace ontime {
+
+// A short list of skeleton indices, without allocation (at most Problem::kMaxSkeletons).
+class ChoiceList {
+ public:
+  void push_back(int choice) noexcept { items_[size_++] = static_cast<std::uint8_t>(choice); }
+  int operator[](std::size_t i) const noexcept { return items_[i]; }
+  std::size_t size() const noexcept { return size_; }
+  bool empty() const noexcept { return size_ == 0; }
+  const std::uint8_t* begin() const noexcept { return items_.data(); }
+  const std::uint8_t* end() const noexcept { return items_.data() + size_; }
+
+ private:
+  std::array<std::uint8_t, Problem::kMaxSkeletons> items_{};
+  std::size_t size_ = 0;
+};
 
 // What one step of refinement effort revealed.
 struct Observation {
@@ -63,6 +80,23 @@ class Mdp {
   template <class Visitor>
   void for_each_outcome(const State& state, int choice, Visitor&& visit) const;
 
+  // Calls visit(probability, observation) for every observation choosing `choice` in
+  // `state` can produce, in the order of for_each_outcome, without applying them.
+  template <class Visitor>
+  void for_each_observation(const State& state, int choice, Visitor&& visit) const;
+
+  // Draws the observation of one step on `choice` from the model (hazard, then execution).
+  template <class Generator>
+  Observation sample_observation(const State& state, int choice, Generator& generator) const;
+
+  // The choices worth considering: one per group of skeletons sharing their next action
+  // (named by the group's lowest index), and only groups in which some skeleton can still
+  // succeed. In increasing index order. Spending a step elsewhere cannot raise the success
+  // probability.
+  ChoiceList useful_choices(const State& state) const noexcept;
+  // Whether some skeleton sharing the next action of `action`'s group can still succeed.
+  bool group_can_succeed(const State& state, int action) const noexcept;
+
   // Whether skeleton k can still succeed from this state: it has actions left and the
   // least time it can still need (earliest completion of the current action given the
   // steps spent, plus the fastest planning and execution of the rest) fits the deadline.
@@ -98,27 +132,43 @@ class Mdp {
 };
 
 template <class Visitor>
-void Mdp::for_each_outcome(const State& state, int choice, Visitor&& visit) const {
+void Mdp::for_each_observation(const State& state, int choice, Visitor&& visit) const {
   const int action = next_action(state, choice);
   if (action < 0) {
-    State next = state;
-    const Status status = apply(next, choice, Observation::not_yet());
-    visit(1.0, status, next);
+    visit(1.0, Observation::not_yet());
     return;
   }
   const double found = hazard(action, state.spent[static_cast<std::size_t>(choice)]);
-  if (found < 1.0) {
-    State next = state;
-    const Status status = apply(next, choice, Observation::not_yet());
-    visit(1.0 - found, status, next);
-  }
+  if (found < 1.0) visit(1.0 - found, Observation::not_yet());
   if (found > 0.0) {
     for (const ExecutionOutcome& outcome : execution_outcomes_[static_cast<std::size_t>(action)]) {
-      State next = state;
-      const Status status = apply(next, choice, Observation::found(outcome.steps));
-      visit(found * outcome.probability, status, next);
+      visit(found * outcome.probability, Observation::found(outcome.steps));
     }
   }
+}
+
+template <class Visitor>
+void Mdp::for_each_outcome(const State& state, int choice, Visitor&& visit) const {
+  for_each_observation(state, choice, [&](double probability, const Observation& observation) {
+    State next = state;
+    const Status status = apply(next, choice, observation);
+    visit(probability, status, next);
+  });
+}
+
+template <class Generator>
+Observation Mdp::sample_observation(const State& state, int choice, Generator& generator) const {
+  const int action = next_action(state, choice);
+  if (action < 0) return Observation::not_yet();
+  const double found = hazard(action, state.spent[static_cast<std::size_t>(choice)]);
+  if (!(uniform01(generator) < found)) return Observation::not_yet();
+  const auto& outcomes = execution_outcomes_[static_cast<std::size_t>(action)];
+  double u = uniform01(generator);
+  for (const ExecutionOutcome& outcome : outcomes) {
+    if (u < outcome.probability) return Observation::found(outcome.steps);
+    u -= outcome.probability;
+  }
+  return Observation::found(outcomes.back().steps);  // rounding: u beyond the summed masses
 }
 
 }  // namespace ontime

@@ -29,8 +29,8 @@ struct Decision {
 
 class Session {
  public:
-  // Calls allocator.begin_episode(). The Mdp and the allocator must outlive the session.
-  Session(const Mdp& mdp, Allocator& allocator);
+  // Calls allocator.begin_episode(seed). The Mdp and the allocator must outlive the session.
+  Session(const Mdp& mdp, Allocator& allocator, std::uint64_t seed = 0);
 
   // Asks the allocator for the next step. Throws std::logic_error when the session is over
   // or a decision is still waiting for its report; UsageError when the allocator returns a

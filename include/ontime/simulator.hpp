@@ -43,7 +43,8 @@ struct EpisodeResult {
   int decisions = 0;
 };
 
-// Runs one episode of `allocator` in the hidden world drawn from `seed`.
+// Runs one episode of `allocator` in the hidden world drawn from `seed`; the allocator's own
+// randomness is seeded from another stream of the same seed.
 EpisodeResult run_episode(const Mdp& mdp, Allocator& allocator, std::uint64_t seed,
                           DecisionTimer* timer = nullptr);
 

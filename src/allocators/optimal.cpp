@@ -12,15 +12,8 @@ class OptimalPolicy {
  public:
   explicit OptimalPolicy(const Mdp& mdp) : mdp_(&mdp) {}
 
-  // One choice per group of skeletons sharing their next action (its lowest index), and
-  // only groups in which some skeleton can still succeed.
   void choices(const State& state, std::vector<int>& out) const {
-    const Problem& problem = mdp_->problem();
-    for (int k = 0; k < mdp_->skeleton_count(); ++k) {
-      const int action = mdp_->next_action(state, k);
-      if (action < 0 || problem.members(action).front() != k) continue;
-      if (group_can_succeed(state, action)) out.push_back(k);
-    }
+    for (const int choice : mdp_->useful_choices(state)) out.push_back(choice);
   }
 
   // Skeletons in a group that can no longer succeed influence nothing: their slots are
@@ -29,7 +22,7 @@ class OptimalPolicy {
     State key = state;
     for (int k = 0; k < mdp_->skeleton_count(); ++k) {
       const int action = mdp_->next_action(state, k);
-      if (action >= 0 && group_can_succeed(state, action)) continue;
+      if (action >= 0 && mdp_->group_can_succeed(state, action)) continue;
       const auto slot = static_cast<std::size_t>(k);
       key.refined[slot] = 0;
       key.spent[slot] = kBlank;
@@ -40,13 +33,6 @@ class OptimalPolicy {
 
  private:
   static constexpr std::uint16_t kBlank = 0xFFFF;  // above any reachable PT or ET
-
-  bool group_can_succeed(const State& state, int action) const {
-    for (const int member : mdp_->problem().members(action)) {
-      if (mdp_->can_succeed(state, member)) return true;
-    }
-    return false;
-  }
 
   const Mdp* mdp_;
 };

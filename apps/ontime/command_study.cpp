@@ -1,0 +1,174 @@
+// `ontime study compute-time|equal-time|anytime INSTANCE...`: the computation-time studies of
+// the paper's Figs. 4-6. Each writes a CSV (atomically) and a PNG drawn from it, and prints
+// where they are.
+
+#include <filesystem>
+#include <fmt/format.h>
+#include <limits>
+
+#include "common.hpp"
+#include "ontime/atomic_file.hpp"
+#include "ontime/error.hpp"
+#include "ontime/experiments.hpp"
+#include "ontime/instance_io.hpp"
+#include "python_runner.hpp"
+
+namespace ontime::cli {
+namespace {
+
+struct StudyOptions {
+  std::vector<std::string> instances;
+  std::string out = "out/studies";
+  std::string multipliers = "0,0.5,1,1.5,2,2.5,3,3.5,4,4.5,5";
+  bool no_plot = false;
+  std::uint64_t episodes = 1'000;
+  std::uint64_t seed = 1;
+  unsigned threads = 0;
+  AllocatorFlags allocator;
+};
+
+std::string label_of(const std::string& path) { return std::filesystem::path(path).stem().string(); }
+
+double iterations_per_search(const MonteCarloResult& result) {
+  if (!result.search || result.search->searches == 0) return 0.0;
+  return static_cast<double>(result.search->iterations) / static_cast<double>(result.search->searches);
+}
+
+std::vector<double> parse_multipliers(const std::string& text) {
+  std::vector<double> values;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', start), text.size());
+    const std::string item = text.substr(start, comma - start);
+    try {
+      std::size_t used = 0;
+      values.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw UsageError("--log10-multipliers: '" + item + "' is not a number");
+    }
+    start = comma + 1;
+  }
+  return values;
+}
+
+// Loads every instance first, so that a bad file stops the study before any computation.
+std::vector<Problem> load_all(const std::vector<std::string>& paths) {
+  std::vector<Problem> problems;
+  for (const std::string& path : paths) problems.push_back(load_problem(path));
+  return problems;
+}
+
+void finish(const StudyOptions& options, const std::string& kind, const std::string& csv) {
+  const std::filesystem::path directory(options.out);
+  std::filesystem::create_directories(directory);
+  const std::string stem = kind == "compute-time" ? "compute_time" : kind == "equal-time" ? "equal_time" : "anytime";
+  const std::string csv_path = (directory / (stem + ".csv")).string();
+  write_file_atomically(csv_path, csv);
+  fmt::print("wrote {}\n", csv_path);
+  if (options.no_plot) return;
+  const std::string png_path = (directory / (stem + ".png")).string();
+  run_python_script("plot_study.py", {kind, csv_path, png_path});
+  fmt::print("wrote {}\n", png_path);
+}
+
+StudySettings settings_of(const StudyOptions& options, ProgressBar& bar, std::size_t index, std::size_t count) {
+  StudySettings settings;
+  settings.episodes = options.episodes;
+  settings.seed = options.seed;
+  settings.threads = options.threads;
+  settings.allocator = options.allocator.options();
+  settings.progress = [&bar, index, count](std::uint64_t done, std::uint64_t total) {
+    bar.update(index * total + done, count * total);
+  };
+  return settings;
+}
+
+void run_compute_time(const StudyOptions& options) {
+  const std::vector<Problem> problems = load_all(options.instances);
+  std::string csv =
+      "instance,solver,episodes,success_rate,ci95,mean_episode_seconds,median_episode_seconds,"
+      "p99_episode_seconds,mean_decision_seconds,iterations_per_search\n";
+  ProgressBar bar("study compute-time");
+  for (std::size_t i = 0; i < problems.size(); ++i) {
+    const Mdp mdp(problems[i]);
+    const ComputeTimeStudy study = compute_time_study(mdp, settings_of(options, bar, i, problems.size()));
+    for (const auto& [solver, result] : {std::pair{"mcts", &study.mcts}, std::pair{"dp-rerun", &study.dp_rerun}}) {
+      csv += fmt::format("{},{},{},{},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.6g}\n", label_of(options.instances[i]), solver,
+                         result->episodes, result->success_rate, result->ci95,
+                         result->episode_decision_time.mean_us * 1e-6, result->episode_decision_time.median_us * 1e-6,
+                         result->episode_decision_time.p99_us * 1e-6, result->decision_time.mean_us * 1e-6,
+                         iterations_per_search(*result));
+    }
+  }
+  finish(options, "compute-time", csv);
+}
+
+void run_equal_time(const StudyOptions& options) {
+  const std::vector<Problem> problems = load_all(options.instances);
+  std::string csv =
+      "instance,episodes,dp_rerun_decision_seconds,dp_rerun_success_rate,dp_rerun_ci95,mcts_success_rate,"
+      "mcts_ci95,mcts_iterations_per_search\n";
+  ProgressBar bar("study equal-time");
+  for (std::size_t i = 0; i < problems.size(); ++i) {
+    const Mdp mdp(problems[i]);
+    const EqualTimeStudy study = equal_time_study(mdp, settings_of(options, bar, i, problems.size()));
+    csv += fmt::format("{},{},{:.9g},{},{},{},{},{:.6g}\n", label_of(options.instances[i]), options.episodes,
+                       study.dp_rerun_decision_seconds, study.dp_rerun.success_rate, study.dp_rerun.ci95,
+                       study.mcts.success_rate, study.mcts.ci95, iterations_per_search(study.mcts));
+  }
+  finish(options, "equal-time", csv);
+}
+
+void run_anytime(const StudyOptions& options) {
+  const std::vector<double> multipliers = parse_multipliers(options.multipliers);
+  const std::vector<Problem> problems = load_all(options.instances);
+  std::string csv =
+      "instance,episodes,log10_multiplier,seconds_per_decision,success_rate,ci95,iterations_per_search,"
+      "dp_rerun_decision_seconds,dp_rerun_success_rate,optimum\n";
+  ProgressBar bar("study anytime");
+  for (std::size_t i = 0; i < problems.size(); ++i) {
+    const Mdp mdp(problems[i]);
+    const AnytimeStudy study = anytime_study(mdp, multipliers, settings_of(options, bar, i, problems.size()));
+    for (const AnytimePoint& point : study.points) {
+      csv += fmt::format("{},{},{},{:.9g},{},{},{:.6g},{:.9g},{},{}\n", label_of(options.instances[i]), options.episodes,
+                         point.log10_multiplier, point.seconds_per_decision, point.mcts.success_rate, point.mcts.ci95,
+                         iterations_per_search(point.mcts), study.dp_rerun_decision_seconds,
+                         study.dp_rerun.success_rate, study.optimum);
+    }
+  }
+  finish(options, "anytime", csv);
+}
+
+}  // namespace
+
+void add_study_command(CLI::App& app) {
+  CLI::App* study = app.add_subcommand("study", "Computation-time studies of mcts against dp-rerun (Figs. 4-6)");
+  study->require_subcommand(1);
+  const auto add = [study](const std::string& name, const std::string& description,
+                           void (*run)(const StudyOptions&)) {
+    auto options = std::make_shared<StudyOptions>();
+    CLI::App* command = study->add_subcommand(name, description);
+    command->add_option("INSTANCE", options->instances, "Instance files (JSON, SPEC §5)")->required();
+    command->add_option("--out", options->out, "Directory for the CSV and PNG")->capture_default_str();
+    command->add_option("--episodes", options->episodes, "Episodes per evaluated configuration")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+    command->add_option("--seed", options->seed, "Seed of the hidden worlds")->capture_default_str();
+    command->add_option("--threads", options->threads, "Worker threads (0: one per hardware thread)")
+        ->capture_default_str();
+    command->add_flag("--no-plot", options->no_plot, "Write the CSV only");
+    if (name == "anytime") {
+      command->add_option("--log10-multipliers", options->multipliers,
+                          "Comma-separated exponents m: mcts gets 10^m times dp-rerun's time per decision")
+          ->capture_default_str();
+    }
+    options->allocator.add_to(*command);
+    command->callback([options, run] { run(*options); });
+  };
+  add("compute-time", "Fig. 4: total decision time per episode, mcts (--iterations) against dp-rerun", run_compute_time);
+  add("equal-time", "Fig. 5: mcts given exactly dp-rerun's measured time per decision", run_equal_time);
+  add("anytime", "Fig. 6: mcts success against log10 of a multiplier of dp-rerun's time", run_anytime);
+}
+
+}  // namespace ontime::cli

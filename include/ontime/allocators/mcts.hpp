@@ -1,0 +1,121 @@
+#pragma once
+// `mcts`: Monte Carlo tree search with UCT over decision and chance nodes (SPEC §3, paper §V-A).
+//
+// Computes, before every step, an estimate of Q(s, c) — the success probability of choosing c
+// in the current state s and continuing well — by repeated simulation from the model, and
+// returns the choice simulated most often (ties: lowest skeleton index).
+//
+// The tree alternates decision nodes (MDP states; one child per useful choice: skeletons that
+// share their next action are one choice, and choices on skeletons that can no longer succeed
+// are left out, as in `optimal`) and chance nodes (the outcomes of SPEC §2: "not yet", or
+// "refined, execution takes x steps", each with its model probability). An iteration selects
+// by UCT, Q + C sqrt(ln N(s) / N(s, c)) with C = 0.5 by default, samples outcomes from the
+// model, adds one decision node, finishes the episode with a rollout policy (uniformly random
+// useful choices by default, or any stationary allocator such as dp-rerun) and backs up the
+// success (1) or failure (0).
+//
+// It sees only the MDP state: the search samples from the model's distributions, never from
+// the hidden outcomes of the episode it decides for. After each observed transition the
+// matching subtree becomes the new root (tree reuse).
+//
+// Guarantees: UCT's choice converges to an optimal one as iterations grow (Kocsis and
+// Szepesvári 2006); for a finite budget it is an estimate. Same seed and an iteration budget:
+// same decisions.
+// Cost: per iteration O(depth * K) in the tree plus O(D * K) for the rollout; memory about
+// 24 bytes per decision node, 24 per chance node and 24 per outcome, bounded by
+// `max_tree_bytes`: a search that would exceed it stops with its best answer so far.
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "ontime/allocator.hpp"
+#include "ontime/mdp.hpp"
+#include "ontime/random.hpp"
+#include "ontime/search_budget.hpp"
+
+namespace ontime {
+
+struct MctsOptions {
+  double exploration = 0.5;                              // C of UCT
+  SearchBudget budget = SearchBudget::iterations(10'000);  // per decision
+  std::size_t max_tree_bytes = std::size_t{1} << 30;      // 1 GiB
+  bool reuse_tree = true;
+  // Rollout policy: nullptr for uniformly random useful choices, else a factory of a
+  // stationary allocator (its choices must depend on the state alone).
+  AllocatorFactory rollout;
+};
+
+class MctsAllocator final : public Allocator {
+ public:
+  // The Mdp must outlive the allocator. Throws UsageError for a non-stationary rollout
+  // policy or a negative exploration constant.
+  MctsAllocator(const Mdp& mdp, MctsOptions options);
+
+  std::string_view name() const noexcept override { return "mcts"; }
+  void begin_episode(std::uint64_t seed) override;
+  int choose(const State& state) override;
+  void observe(const State& before, int choice, const State& after, Status status) override;
+  bool is_stationary() const noexcept override { return false; }
+  const SearchStatistics* search_statistics() const noexcept override { return &statistics_; }
+
+  // Visits and estimated success of each root choice after the last search, for inspection.
+  struct RootChoice {
+    int skeleton;
+    std::uint32_t visits;
+    double value;
+  };
+  std::vector<RootChoice> root_choices() const;
+  std::size_t tree_nodes() const noexcept { return nodes_.size() + edges_.size(); }
+  std::size_t tree_bytes() const noexcept;
+
+ private:
+  static constexpr std::uint32_t kNone = 0xFFFFFFFFU;
+
+  struct DecisionNode {
+    std::uint32_t first_edge = kNone;  // kNone until expanded
+    std::uint32_t visits = 0;
+    std::uint16_t edge_count = 0;
+  };
+  struct Edge {  // a chance node: one choice in a decision node
+    std::uint32_t first_outcome = kNone;  // kNone until first taken
+    std::uint32_t visits = 0;
+    std::uint32_t successes = 0;
+    std::uint16_t outcome_count = 0;
+    std::uint8_t choice = 0;
+  };
+  struct Outcome {
+    double probability;
+    Observation observation;
+    std::uint32_t child = kNone;  // decision node, kNone until reached
+    Status status;
+  };
+
+  void reset(const State& root);
+  std::uint32_t add_node();
+  bool expand(std::uint32_t node, const State& state);  // false: memory cap
+  bool expand_outcomes(std::uint32_t edge, const State& state);
+  std::uint32_t select_edge(const DecisionNode& node) const;
+  static double estimate(const Edge& edge) noexcept {
+    return edge.visits == 0 ? 0.0 : static_cast<double>(edge.successes) / edge.visits;
+  }
+  bool iterate();  // false: memory cap reached
+  double rollout(State state);
+  void reroot(std::uint32_t new_root);
+  bool would_exceed_memory(std::size_t nodes, std::size_t edges, std::size_t outcomes) const;
+
+  const Mdp* mdp_;
+  MctsOptions options_;
+  std::unique_ptr<Allocator> rollout_policy_;
+  SplitMix64 generator_{0};
+  State root_state_;
+  bool has_tree_ = false;
+  std::vector<DecisionNode> nodes_;  // nodes_[0] is the root
+  std::vector<Edge> edges_;
+  std::vector<Outcome> outcomes_;
+  std::vector<std::uint32_t> path_;  // edges visited by the current iteration
+  SearchStatistics statistics_;
+};
+
+}  // namespace ontime

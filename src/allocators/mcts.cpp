@@ -1,0 +1,285 @@
+#include "ontime/allocators/mcts.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "ontime/error.hpp"
+
+namespace ontime {
+namespace {
+
+// Capacity a std::vector grows to when it must hold `needed` elements (libstdc++ doubles).
+std::size_t grown_capacity(std::size_t capacity, std::size_t needed) noexcept {
+  return needed <= capacity ? capacity : std::max(needed, 2 * capacity);
+}
+
+}  // namespace
+
+MctsAllocator::MctsAllocator(const Mdp& mdp, MctsOptions options) : mdp_(&mdp), options_(std::move(options)) {
+  if (!(options_.exploration >= 0.0) || !std::isfinite(options_.exploration)) {
+    throw UsageError("the exploration constant of mcts must be a finite number >= 0");
+  }
+  if (options_.rollout) {
+    rollout_policy_ = options_.rollout();
+    if (!rollout_policy_->is_stationary()) {
+      throw UsageError("the rollout policy of mcts must choose by the state alone; '" +
+                       std::string(rollout_policy_->name()) + "' does not");
+    }
+  }
+}
+
+void MctsAllocator::begin_episode(std::uint64_t seed) {
+  generator_ = SplitMix64(seed);
+  has_tree_ = false;
+  if (rollout_policy_) rollout_policy_->begin_episode(seed);
+}
+
+std::size_t MctsAllocator::tree_bytes() const noexcept {
+  return nodes_.capacity() * sizeof(DecisionNode) + edges_.capacity() * sizeof(Edge) +
+         outcomes_.capacity() * sizeof(Outcome);
+}
+
+bool MctsAllocator::would_exceed_memory(std::size_t nodes, std::size_t edges, std::size_t outcomes) const {
+  const std::size_t projected =
+      grown_capacity(nodes_.capacity(), nodes_.size() + nodes) * sizeof(DecisionNode) +
+      grown_capacity(edges_.capacity(), edges_.size() + edges) * sizeof(Edge) +
+      grown_capacity(outcomes_.capacity(), outcomes_.size() + outcomes) * sizeof(Outcome);
+  return projected > options_.max_tree_bytes;
+}
+
+void MctsAllocator::reset(const State& root) {
+  nodes_.clear();
+  edges_.clear();
+  outcomes_.clear();
+  nodes_.emplace_back();
+  root_state_ = root;
+  has_tree_ = true;
+}
+
+std::uint32_t MctsAllocator::add_node() {
+  nodes_.emplace_back();
+  return static_cast<std::uint32_t>(nodes_.size() - 1);
+}
+
+bool MctsAllocator::expand(std::uint32_t node, const State& state) {
+  const ChoiceList choices = mdp_->useful_choices(state);
+  if (would_exceed_memory(0, choices.size(), 0)) return false;
+  nodes_[node].first_edge = static_cast<std::uint32_t>(edges_.size());
+  nodes_[node].edge_count = static_cast<std::uint16_t>(choices.size());
+  for (const int choice : choices) {
+    Edge edge;
+    edge.choice = static_cast<std::uint8_t>(choice);
+    edges_.push_back(edge);
+  }
+  return true;
+}
+
+bool MctsAllocator::expand_outcomes(std::uint32_t edge, const State& state) {
+  const int choice = edges_[edge].choice;
+  std::size_t count = 0;
+  mdp_->for_each_observation(state, choice, [&](double, const Observation&) { ++count; });
+  if (would_exceed_memory(0, 0, count)) return false;
+  edges_[edge].first_outcome = static_cast<std::uint32_t>(outcomes_.size());
+  edges_[edge].outcome_count = static_cast<std::uint16_t>(count);
+  mdp_->for_each_observation(state, choice, [&](double probability, const Observation& observation) {
+    State next = state;
+    const Status status = mdp_->apply(next, choice, observation);
+    outcomes_.push_back(Outcome{probability, observation, kNone, status});
+  });
+  return true;
+}
+
+std::uint32_t MctsAllocator::select_edge(const DecisionNode& node) const {
+  const double log_visits = std::log(static_cast<double>(std::max<std::uint32_t>(node.visits, 1)));
+  std::uint32_t best = node.first_edge;
+  double best_score = -1.0;
+  for (std::uint32_t e = node.first_edge; e < node.first_edge + node.edge_count; ++e) {
+    const Edge& edge = edges_[e];
+    if (edge.visits == 0) return e;  // every choice once first, lowest index first
+    const double visits = edge.visits;
+    const double score = estimate(edge) + options_.exploration * std::sqrt(log_visits / visits);
+    if (score > best_score) {
+      best_score = score;
+      best = e;
+    }
+  }
+  return best;
+}
+
+double MctsAllocator::rollout(State state) {
+  for (;;) {
+    int choice;
+    if (rollout_policy_) {
+      choice = rollout_policy_->choose(state);
+    } else {
+      const ChoiceList choices = mdp_->useful_choices(state);
+      if (choices.empty()) return 0.0;
+      choice = choices[static_cast<std::size_t>(generator_() % choices.size())];
+    }
+    const Observation observation = mdp_->sample_observation(state, choice, generator_);
+    const Status status = mdp_->apply(state, choice, observation);
+    if (status == Status::success) return 1.0;
+    if (status == Status::failure) return 0.0;
+  }
+}
+
+bool MctsAllocator::iterate() {
+  path_.clear();
+  State state = root_state_;
+  std::uint32_t node = 0;
+  double reward = 0.0;
+  for (;;) {
+    if (nodes_[node].first_edge == kNone && !expand(node, state)) return false;
+    if (nodes_[node].edge_count == 0) break;  // no skeleton can succeed: reward 0
+    const std::uint32_t e = select_edge(nodes_[node]);
+    if (edges_[e].first_outcome == kNone && !expand_outcomes(e, state)) return false;
+    path_.push_back(node);
+    path_.push_back(e);
+
+    const Edge& edge = edges_[e];
+    std::uint32_t picked = edge.first_outcome + edge.outcome_count - 1U;
+    double u = uniform01(generator_);
+    for (std::uint32_t o = edge.first_outcome; o < edge.first_outcome + edge.outcome_count; ++o) {
+      if (u < outcomes_[o].probability) {
+        picked = o;
+        break;
+      }
+      u -= outcomes_[o].probability;
+    }
+    const Outcome& outcome = outcomes_[picked];
+    if (outcome.status != Status::running) {
+      reward = outcome.status == Status::success ? 1.0 : 0.0;
+      break;
+    }
+    mdp_->apply(state, edge.choice, outcome.observation);
+    if (outcome.child == kNone) {
+      if (would_exceed_memory(1, 0, 0)) return false;
+      const std::uint32_t child = add_node();
+      outcomes_[picked].child = child;
+      nodes_[child].visits = 1;
+      reward = rollout(state);
+      break;
+    }
+    node = outcome.child;
+  }
+  for (std::size_t i = 0; i < path_.size(); i += 2) {
+    ++nodes_[path_[i]].visits;
+    Edge& edge = edges_[path_[i + 1]];
+    ++edge.visits;
+    edge.successes += reward > 0.5 ? 1U : 0U;
+  }
+  return true;
+}
+
+int MctsAllocator::choose(const State& state) {
+  if (!has_tree_ || !(state == root_state_)) reset(state);
+  const ChoiceList choices = mdp_->useful_choices(state);
+  if (choices.empty()) {
+    // Nothing can succeed any more: any choice is as good; prefer one with work left.
+    for (int k = 0; k < mdp_->skeleton_count(); ++k) {
+      if (mdp_->next_action(state, k) >= 0) return k;
+    }
+    return 0;
+  }
+  if (choices.size() == 1) return choices[0];
+
+  ++statistics_.searches;
+  const BudgetMonitor monitor(options_.budget);
+  std::uint64_t iterations = 0;
+  while (!monitor.exhausted(iterations)) {
+    if (!iterate()) {
+      ++statistics_.memory_stops;
+      break;
+    }
+    ++iterations;
+  }
+  statistics_.iterations += iterations;
+  statistics_.peak_tree_nodes = std::max(statistics_.peak_tree_nodes, tree_nodes());
+  statistics_.peak_tree_bytes = std::max(statistics_.peak_tree_bytes, tree_bytes());
+
+  const DecisionNode& root = nodes_[0];
+  if (root.first_edge == kNone) return choices[0];
+  std::uint32_t best = root.first_edge;
+  for (std::uint32_t e = root.first_edge + 1; e < root.first_edge + root.edge_count; ++e) {
+    if (edges_[e].visits > edges_[best].visits) best = e;
+  }
+  return edges_[best].choice;
+}
+
+void MctsAllocator::observe(const State& before, int choice, const State& after, Status status) {
+  const bool reusable = options_.reuse_tree && has_tree_ && status == Status::running && before == root_state_ &&
+                        nodes_[0].first_edge != kNone;
+  has_tree_ = false;
+  if (!reusable) return;
+  const int action = mdp_->next_action(before, choice);
+  if (action < 0) return;
+  const int group = mdp_->problem().members(action).front();
+  const DecisionNode& root = nodes_[0];
+  for (std::uint32_t e = root.first_edge; e < root.first_edge + root.edge_count; ++e) {
+    const Edge& edge = edges_[e];
+    if (edge.choice != group || edge.first_outcome == kNone) continue;
+    for (std::uint32_t o = edge.first_outcome; o < edge.first_outcome + edge.outcome_count; ++o) {
+      State next = before;
+      mdp_->apply(next, choice, outcomes_[o].observation);
+      if (next == after && outcomes_[o].child != kNone) {
+        reroot(outcomes_[o].child);
+        root_state_ = after;
+        has_tree_ = true;
+        return;
+      }
+    }
+    return;
+  }
+}
+
+void MctsAllocator::reroot(std::uint32_t new_root) {
+  // Copies the subtree under new_root into fresh arrays (depth first), so that memory held
+  // stays proportional to the tree in use.
+  std::vector<DecisionNode> nodes;
+  std::vector<Edge> edges;
+  std::vector<Outcome> outcomes;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pending{{new_root, 0}};
+  nodes.push_back(nodes_[new_root]);
+  while (!pending.empty()) {
+    const auto [old_index, new_index] = pending.back();
+    pending.pop_back();
+    const DecisionNode old_node = nodes_[old_index];
+    if (old_node.first_edge == kNone) continue;
+    nodes[new_index].first_edge = static_cast<std::uint32_t>(edges.size());
+    for (std::uint32_t e = old_node.first_edge; e < old_node.first_edge + old_node.edge_count; ++e) {
+      Edge edge = edges_[e];
+      if (edge.first_outcome != kNone) {
+        const auto first = static_cast<std::uint32_t>(outcomes.size());
+        for (std::uint32_t o = edge.first_outcome; o < edge.first_outcome + edge.outcome_count; ++o) {
+          Outcome outcome = outcomes_[o];
+          if (outcome.child != kNone) {
+            const auto child = static_cast<std::uint32_t>(nodes.size());
+            nodes.push_back(nodes_[outcome.child]);
+            pending.emplace_back(outcome.child, child);
+            outcome.child = child;
+          }
+          outcomes.push_back(outcome);
+        }
+        edge.first_outcome = first;
+      }
+      edges.push_back(edge);
+    }
+  }
+  nodes_ = std::move(nodes);
+  edges_ = std::move(edges);
+  outcomes_ = std::move(outcomes);
+}
+
+std::vector<MctsAllocator::RootChoice> MctsAllocator::root_choices() const {
+  std::vector<RootChoice> result;
+  if (!has_tree_ || nodes_.empty() || nodes_[0].first_edge == kNone) return result;
+  const DecisionNode& root = nodes_[0];
+  for (std::uint32_t e = root.first_edge; e < root.first_edge + root.edge_count; ++e) {
+    const Edge& edge = edges_[e];
+    result.push_back({edge.choice, edge.visits, estimate(edge)});
+  }
+  return result;
+}
+
+}  // namespace ontime

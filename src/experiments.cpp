@@ -1,0 +1,131 @@
+#include "ontime/experiments.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "ontime/allocators/optimal.hpp"
+#include "ontime/error.hpp"
+#include "ontime/random.hpp"
+#include "ontime/simulator.hpp"
+
+namespace ontime {
+namespace {
+
+// Records the states an allocator decides in, passing its choices through.
+class StateRecorder final : public Allocator {
+ public:
+  StateRecorder(Allocator& inner, std::vector<State>& states) : inner_(&inner), states_(&states) {}
+  std::string_view name() const noexcept override { return inner_->name(); }
+  void begin_episode(std::uint64_t seed) override { inner_->begin_episode(seed); }
+  int choose(const State& state) override {
+    states_->push_back(state);
+    return inner_->choose(state);
+  }
+  void observe(const State& before, int choice, const State& after, Status status) override {
+    inner_->observe(before, choice, after, status);
+  }
+
+ private:
+  Allocator* inner_;
+  std::vector<State>* states_;
+};
+
+// Runs Monte Carlo episodes while reporting study-wide progress.
+class ProgressTracker {
+ public:
+  ProgressTracker(const StudySettings& settings, std::uint64_t total) : settings_(settings), total_(total) {}
+
+  MonteCarloResult run(const Mdp& mdp, const AllocatorFactory& factory) {
+    MonteCarloOptions options;
+    options.episodes = settings_.episodes;
+    options.seed = settings_.seed;
+    options.threads = settings_.threads;
+    const std::uint64_t before = done_;
+    if (settings_.progress) {
+      options.progress = [this, before](std::uint64_t done, std::uint64_t) { settings_.progress(before + done, total_); };
+    }
+    MonteCarloResult result = run_monte_carlo(mdp, factory, options);
+    done_ += settings_.episodes;
+    return result;
+  }
+
+ private:
+  const StudySettings& settings_;
+  std::uint64_t total_;
+  std::uint64_t done_ = 0;
+};
+
+AllocatorFactory mcts_with_time(const Mdp& mdp, AllocatorOptions options, double seconds) {
+  options.seconds = seconds;
+  options.iterations = std::numeric_limits<std::uint64_t>::max();
+  return make_allocator_factory("mcts", mdp, options);
+}
+
+}  // namespace
+
+double mean_decision_seconds(const Mdp& mdp, const AllocatorFactory& factory, std::uint64_t seed,
+                             std::uint64_t episodes) {
+  const std::unique_ptr<Allocator> allocator = factory();
+  std::vector<State> states;
+  StateRecorder recorder(*allocator, states);
+  for (std::uint64_t episode = 0; episode < episodes; ++episode) {
+    run_episode(mdp, recorder, stream_seed(seed, episode));
+  }
+  if (states.empty()) return 0.0;
+  // Enough passes over the recorded states for the clock's resolution not to matter.
+  constexpr std::size_t kMinimumDecisions = 2'000'000;
+  const std::size_t passes = std::max<std::size_t>(1, kMinimumDecisions / states.size());
+  allocator->begin_episode(seed);
+  int sink = 0;
+  const auto started = std::chrono::steady_clock::now();
+  for (std::size_t pass = 0; pass < passes; ++pass) {
+    for (const State& state : states) sink += allocator->choose(state);
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  volatile int keep = sink;  // the loop must not be optimised away
+  (void)keep;
+  return seconds / static_cast<double>(passes * states.size());
+}
+
+ComputeTimeStudy compute_time_study(const Mdp& mdp, const StudySettings& settings) {
+  ProgressTracker tracker(settings, 2 * settings.episodes);
+  ComputeTimeStudy study;
+  study.mcts = tracker.run(mdp, make_allocator_factory("mcts", mdp, settings.allocator));
+  study.dp_rerun = tracker.run(mdp, make_allocator_factory("dp-rerun", mdp, settings.allocator));
+  return study;
+}
+
+EqualTimeStudy equal_time_study(const Mdp& mdp, const StudySettings& settings) {
+  ProgressTracker tracker(settings, 2 * settings.episodes);
+  EqualTimeStudy study;
+  const AllocatorFactory dp_rerun = make_allocator_factory("dp-rerun", mdp, settings.allocator);
+  study.dp_rerun_decision_seconds = mean_decision_seconds(mdp, dp_rerun, settings.seed);
+  study.dp_rerun = tracker.run(mdp, dp_rerun);
+  study.mcts = tracker.run(mdp, mcts_with_time(mdp, settings.allocator, study.dp_rerun_decision_seconds));
+  return study;
+}
+
+AnytimeStudy anytime_study(const Mdp& mdp, const std::vector<double>& log10_multipliers, const StudySettings& settings) {
+  for (const double exponent : log10_multipliers) {
+    if (!std::isfinite(exponent) || exponent < -3 || exponent > 9) {
+      throw UsageError("log10 time multipliers must lie within [-3, 9]");
+    }
+  }
+  ProgressTracker tracker(settings, (log10_multipliers.size() + 1) * settings.episodes);
+  AnytimeStudy study;
+  const AllocatorFactory dp_rerun = make_allocator_factory("dp-rerun", mdp, settings.allocator);
+  study.dp_rerun_decision_seconds = mean_decision_seconds(mdp, dp_rerun, settings.seed);
+  study.optimum = OptimalSolver(mdp, settings.allocator.max_states).solve(mdp.start());
+  study.dp_rerun = tracker.run(mdp, dp_rerun);
+  for (const double exponent : log10_multipliers) {
+    AnytimePoint point;
+    point.log10_multiplier = exponent;
+    point.seconds_per_decision = study.dp_rerun_decision_seconds * std::pow(10.0, exponent);
+    point.mcts = tracker.run(mdp, mcts_with_time(mdp, settings.allocator, point.seconds_per_decision));
+    study.points.push_back(std::move(point));
+  }
+  return study;
+}
+
+}  // namespace ontime
