@@ -98,6 +98,15 @@ void BM_MctsIterations(benchmark::State& bench) {
 }
 BENCHMARK(BM_MctsIterations)->Arg(10'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
 
+// PPO training of 10,000 episodes (target <= 60 s on any paper instance).
+void BM_PpoTraining(benchmark::State& bench) {
+  const ontime::Problem problem = paper(static_cast<int>(bench.range(0)));
+  const ontime::Mdp mdp(problem);
+  for (auto _ : bench) benchmark::DoNotOptimize(ontime::train_ppo(mdp, 10'000, 1).curve.size());
+  bench.SetLabel(problem.name() + ", 10,000 episodes");
+}
+BENCHMARK(BM_PpoTraining)->DenseRange(1, 5)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+
 void BM_MonteCarloEpisodes(benchmark::State& bench) {
   const ontime::Problem problem = paper(1);
   const ontime::Mdp mdp(problem);

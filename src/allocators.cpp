@@ -10,7 +10,7 @@
 namespace ontime {
 
 std::vector<std::string> allocator_names() {
-  return {"optimal", "mcts", "dp", "dp-rerun", "round-robin", "greedy"};
+  return {"optimal", "mcts", "dp", "dp-rerun", "ppo", "round-robin", "greedy"};
 }
 
 AllocatorFactory make_allocator_factory(std::string_view name, const Mdp& mdp, const AllocatorOptions& options) {
@@ -42,6 +42,15 @@ AllocatorFactory make_allocator_factory(std::string_view name, const Mdp& mdp, c
   if (name == "dp-rerun") {
     auto table = std::make_shared<const ContiguousSuccessTable>(mdp, options.aggregation);
     return [model, table] { return std::make_unique<DpRerunAllocator>(*model, table); };
+  }
+  if (name == "ppo") {
+    if (!options.policy) {
+      throw UsageError("ppo needs a trained policy: train one with 'ontime train INSTANCE --solver ppo --out FILE' "
+                       "and pass it with --policy FILE");
+    }
+    PpoAllocator probe(mdp, options.policy);  // fails here when the policy is for another instance
+    const std::shared_ptr<const PpoPolicy> policy = options.policy;
+    return [model, policy] { return std::make_unique<PpoAllocator>(*model, policy); };
   }
   if (name == "greedy") {
     return [model] { return std::make_unique<GreedyAllocator>(*model); };

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "support/bad_inputs.hpp"
@@ -98,8 +100,70 @@ TEST(Cli, UsageErrorsExitWithTwo) {
   EXPECT_NE(capped.err.find("cap of 20 states"), std::string::npos) << capped.err;
 }
 
+std::filesystem::path scratch(const std::string& name) {
+  const auto directory = std::filesystem::temp_directory_path() / ("ontime_cli_test_" + name);
+  std::filesystem::remove_all(directory);
+  std::filesystem::create_directories(directory);
+  return directory;
+}
+
+std::size_t line_count(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::size_t lines = 0;
+  for (std::string line; std::getline(in, line);) ++lines;
+  return lines;
+}
+
+TEST(Cli, TrainWritesAPolicyThatEvaluateAndTableUse) {
+  const auto directory = scratch("train");
+  const std::string policy = (directory / "instance4.json").string();
+  const auto trained = ontime({"train", paper("instance4"), "--solver", "ppo", "--episodes", "300", "--seed", "2",
+                               "--out", policy, "--json"});
+  ASSERT_EQ(trained.exit_code, 0) << trained.err;
+  const json report = json::parse(trained.out);
+  EXPECT_TRUE(std::filesystem::exists(policy));
+  EXPECT_GT(line_count(directory / "instance4.curve.csv"), 1U);
+  EXPECT_TRUE(std::filesystem::exists(directory / "instance4.curve.png"));
+
+  const auto evaluated = ontime({"evaluate", paper("instance4"), "--solver", "ppo", "--policy", policy, "--episodes",
+                                 "500", "--exact", "--json"});
+  ASSERT_EQ(evaluated.exit_code, 0) << evaluated.err;
+  EXPECT_DOUBLE_EQ(json::parse(evaluated.out)["exact_success_probability"].get<double>(),
+                   report["exact_success_probability"].get<double>());
+  const auto table = ontime({"table", paper("instance4"), "--solvers", "ppo,dp", "--policy", policy, "--episodes", "200"});
+  ASSERT_EQ(table.exit_code, 0) << table.err;
+  EXPECT_NE(table.out.find("| ppo"), std::string::npos) << table.out;
+
+  const auto other = ontime({"evaluate", paper("instance1"), "--solver", "ppo", "--policy", policy});
+  EXPECT_EQ(other.exit_code, 2);
+  EXPECT_NE(other.err.find("trained for 2 skeletons"), std::string::npos) << other.err;
+  const auto missing = ontime({"evaluate", paper("instance4"), "--solver", "ppo"});
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.err.find("needs a trained policy"), std::string::npos) << missing.err;
+  const auto bad = ontime({"evaluate", paper("instance4"), "--solver", "ppo", "--policy", paper("instance4")});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find(paper("instance4") + ": format: "), std::string::npos) << bad.err;
+}
+
+TEST(Cli, StudiesWriteTheirCsvAndPlot) {
+  const auto directory = scratch("study");
+  const auto anytime = ontime({"study", "anytime", paper("instance4"), paper("instance5"), "--episodes", "30",
+                               "--log10-multipliers", "0,1", "--out", directory.string(), "--threads", "1"});
+  ASSERT_EQ(anytime.exit_code, 0) << anytime.err;
+  EXPECT_EQ(line_count(directory / "anytime.csv"), 1U + 2 * 2);
+  EXPECT_TRUE(std::filesystem::exists(directory / "anytime.png"));
+  EXPECT_NE(anytime.out.find((directory / "anytime.png").string()), std::string::npos);
+  const auto compute = ontime({"study", "compute-time", paper("instance4"), "--episodes", "20", "--iterations", "200",
+                               "--out", directory.string(), "--no-plot"});
+  ASSERT_EQ(compute.exit_code, 0) << compute.err;
+  EXPECT_EQ(line_count(directory / "compute_time.csv"), 1U + 2);
+  EXPECT_FALSE(std::filesystem::exists(directory / "compute_time.png"));
+  const auto bad = ontime({"study", "anytime", paper("instance4"), "--log10-multipliers", "0,x"});
+  EXPECT_EQ(bad.exit_code, 2);
+}
+
 TEST(Cli, HelpIsAvailableForEveryCommand) {
-  for (const char* command : {"solve", "evaluate", "table"}) {
+  for (const char* command : {"solve", "evaluate", "table", "train"}) {
     const auto result = ontime({command, "--help"});
     EXPECT_EQ(result.exit_code, 0) << command;
     EXPECT_NE(result.out.find("--json"), std::string::npos) << command;

@@ -29,13 +29,22 @@ void AllocatorFlags::add_to(CLI::App& command) {
       ->capture_default_str();
   command.add_option("--rollout", rollout, "mcts: rollout policy, 'random' or a stationary allocator (e.g. dp-rerun)")
       ->capture_default_str();
+  command.add_option("--policy", policies,
+                     "ppo: trained policy file (ontime train); for several instances, one per instance in order");
   command.add_option("--max-tree-mib", max_tree_mib, "mcts: memory cap of the search tree; a search stops there")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
 }
 
-AllocatorOptions AllocatorFlags::options() const {
+AllocatorOptions AllocatorFlags::options(std::size_t index, std::size_t instance_count) const {
   AllocatorOptions options;
+  if (!policies.empty()) {
+    if (policies.size() != 1 && policies.size() != instance_count) {
+      throw UsageError(fmt::format("--policy: give one policy file, or one per instance ({} given for {} instances)",
+                                   policies.size(), instance_count));
+    }
+    options.policy = std::make_shared<const PpoPolicy>(load_ppo_policy(policies[policies.size() == 1 ? 0 : index]));
+  }
   options.aggregation = parse_aggregation(aggregation);
   options.max_states = max_states;
   options.exploration = exploration;

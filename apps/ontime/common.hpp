@@ -21,6 +21,7 @@ void add_solve_command(CLI::App& app);
 void add_evaluate_command(CLI::App& app);
 void add_table_command(CLI::App& app);
 void add_study_command(CLI::App& app);
+void add_train_command(CLI::App& app);
 
 // Options shared by commands that build allocators.
 struct AllocatorFlags {
@@ -31,8 +32,10 @@ struct AllocatorFlags {
   double time_budget = 0;        // seconds per decision, 0: none
   std::string rollout = "random";
   std::size_t max_tree_mib = 1024;
+  std::vector<std::string> policies;  // ppo: one policy file, or one per instance
   void add_to(CLI::App& command);
-  AllocatorOptions options() const;
+  // Options for the instance at `index` of `instance_count` (selects its ppo policy, if any).
+  AllocatorOptions options(std::size_t index = 0, std::size_t instance_count = 1) const;
 };
 
 // Options shared by commands that run Monte Carlo episodes.

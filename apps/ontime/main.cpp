@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
   ontime::cli::add_evaluate_command(app);
   ontime::cli::add_table_command(app);
   ontime::cli::add_study_command(app);
+  ontime::cli::add_train_command(app);
 
   try {
     app.parse(argc, argv);

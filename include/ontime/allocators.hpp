@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -10,6 +11,7 @@
 
 #include "ontime/allocator.hpp"
 #include "ontime/allocators/optimal.hpp"
+#include "ontime/allocators/ppo.hpp"
 #include "ontime/contiguous_success.hpp"
 #include "ontime/mdp.hpp"
 
@@ -24,9 +26,11 @@ struct AllocatorOptions {
   std::optional<double> seconds;            // per decision; with `iterations`, whichever ends first
   std::size_t max_tree_bytes = std::size_t{1} << 30;
   std::string rollout = "random";           // "random" or the name of a stationary allocator
+  // ppo: the trained policy (load_ppo_policy); required for "ppo".
+  std::shared_ptr<const PpoPolicy> policy;
 };
 
-// Names accepted by make_allocator_factory, in the order of the paper's tables.
+// Names accepted by make_allocator_factory, in the order of the paper's tables (optimal first).
 std::vector<std::string> allocator_names();
 
 // A factory of independent allocators of the named kind for `mdp` (which must outlive it).

@@ -1,0 +1,84 @@
+// `ontime train INSTANCE --solver ppo --out POLICY`: learns a policy by PPO from simulated
+// episodes, writes it (atomically) with its learning curve (CSV and PNG), and reports the exact
+// success probability of the trained policy.
+
+#include <chrono>
+#include <filesystem>
+#include <fmt/format.h>
+
+#include "common.hpp"
+#include "ontime/atomic_file.hpp"
+#include "ontime/error.hpp"
+#include "ontime/instance_io.hpp"
+#include "ontime/ppo_training.hpp"
+#include "python_runner.hpp"
+
+namespace ontime::cli {
+
+void add_train_command(CLI::App& app) {
+  struct Options {
+    std::string instance;
+    std::string solver = "ppo";
+    std::uint64_t episodes = 10'000;
+    std::uint64_t seed = 1;
+    std::string out;
+    bool no_plot = false;
+    bool json = false;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* command = app.add_subcommand("train", "Learn a model-free policy (ppo) from simulated episodes");
+  command->add_option("INSTANCE", options->instance, "Instance file (JSON, SPEC §5)")->required();
+  command->add_option("--solver", options->solver, "Learner (only ppo)")->check(CLI::IsMember({"ppo"}))->capture_default_str();
+  command->add_option("--episodes", options->episodes, "Training episodes")->check(CLI::PositiveNumber)->capture_default_str();
+  command->add_option("--seed", options->seed, "Seed of initialisation, sampling and hidden worlds")->capture_default_str();
+  command->add_option("--out", options->out, "Policy file to write (JSON); the learning curve goes beside it")->required();
+  command->add_flag("--no-plot", options->no_plot, "Write the learning curve CSV only");
+  command->add_flag("--json", options->json, "Print JSON");
+  command->callback([options] {
+    const Problem problem = load_problem(options->instance);
+    const Mdp mdp(problem);
+    ProgressBar bar("train ppo");
+    const PpoTraining training =
+        train_ppo(mdp, options->episodes, options->seed, PpoHyperparameters{},
+                  [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); });
+    const std::filesystem::path policy_path(options->out);
+    if (policy_path.has_parent_path()) std::filesystem::create_directories(policy_path.parent_path());
+    save_ppo_policy(training.policy, policy_path);
+
+    std::string csv = "epoch,episodes,steps,success_rate,mean_episode_length,actor_steps,seconds\n";
+    for (const LearningCurvePoint& point : training.curve) {
+      csv += fmt::format("{},{},{},{},{},{},{:.6f}\n", point.epoch, point.episodes, point.steps, point.success_rate,
+                         point.mean_episode_length, point.actor_steps, point.seconds);
+    }
+    std::filesystem::path curve_csv = policy_path;
+    curve_csv.replace_extension(".curve.csv");
+    write_file_atomically(curve_csv, csv);
+    std::filesystem::path curve_png = policy_path;
+    curve_png.replace_extension(".curve.png");
+    if (!options->no_plot) run_python_script("plot_learning_curve.py", {curve_csv.string(), curve_png.string()});
+
+    PpoAllocator trained(mdp, std::make_shared<const PpoPolicy>(training.policy));
+    const ExactEvaluation exact = evaluate_exactly(mdp, trained);
+    const double seconds = training.curve.empty() ? 0.0 : training.curve.back().seconds;
+    if (options->json) {
+      Json out;
+      out["instance"] = options->instance;
+      out["policy"] = policy_path.string();
+      out["learning_curve"] = curve_csv.string();
+      out["episodes"] = options->episodes;
+      out["seed"] = options->seed;
+      out["epochs"] = training.curve.size();
+      out["seconds"] = seconds;
+      out["exact_success_probability"] = exact.success_probability;
+      print_json(out);
+      return;
+    }
+    fmt::print("trained ppo on {} ({}): {} episodes in {} epochs, {:.1f} s\n", options->instance, problem.name(),
+               options->episodes, training.curve.size(), seconds);
+    fmt::print("exact success probability of the trained policy (greedy): {:.4f}\n", exact.success_probability);
+    fmt::print("wrote {}\nwrote {}\n", policy_path.string(), curve_csv.string());
+    if (!options->no_plot) fmt::print("wrote {}\n", curve_png.string());
+  });
+}
+
+}  // namespace ontime::cli

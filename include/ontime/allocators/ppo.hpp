@@ -1,0 +1,79 @@
+#pragma once
+// `ppo`: a model-free policy learned by Proximal Policy Optimization (SPEC §3, paper §VI and
+// Appendix B), trained by `train_ppo` (ontime/ppo_training.hpp) from episodes alone, without
+// the distributions.
+//
+// Computes, before every step, the actor network's preferences over the useful choices of the
+// state (the others are masked out) and takes the most preferred (ties: lowest index). Acting
+// greedily makes the trained policy a function of the state, so its exact success probability
+// can be computed (SPEC §4).
+// Features of a state (the MDP state of SPEC §2 normalised): CT / D, and per skeleton
+// l_k / A_k, PT_k / D and ET_k / D.
+// No guarantee: as good as the training made it. Cost per decision: one forward pass of a
+// 3 x 64 tanh network (a few microseconds), no allocation.
+
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "ontime/allocator.hpp"
+#include "ontime/mdp.hpp"
+#include "ontime/neural_network.hpp"
+
+namespace ontime {
+
+using PolicyNetwork = Mlp<float>;
+
+// Fills the feature vector of a state (size 1 + 3K).
+void state_features(const Mdp& mdp, const State& state, PolicyNetwork::Vector& features);
+int feature_count(int skeleton_count) noexcept;
+
+struct PpoHyperparameters {
+  int hidden_layers = 3;
+  int hidden_units = 64;
+  double clip = 0.2;
+  double gamma = 0.99;
+  double lambda = 0.97;          // GAE
+  double actor_learning_rate = 3e-4;
+  double critic_learning_rate = 1e-3;
+  int train_iterations = 80;     // gradient steps per update, actor and critic each
+  int steps_per_epoch = 4'000;
+  int max_episode_steps = 1'000;
+  double target_kl = 0.01;       // actor steps stop early past 1.5 x this KL
+};
+
+// A trained actor and critic, and what they were trained for.
+struct PpoPolicy {
+  std::string instance;          // name of the instance it was trained on
+  int skeleton_count = 0;
+  Steps deadline = 0;
+  std::uint64_t seed = 0;
+  std::uint64_t episodes = 0;    // training episodes
+  PpoHyperparameters hyperparameters;
+  PolicyNetwork actor;
+  PolicyNetwork critic;
+};
+
+// Policy files (JSON). Saving is atomic; loading validates every field and raises InputError
+// naming the file, the JSON path and the rule.
+void save_ppo_policy(const PpoPolicy& policy, const std::filesystem::path& path);
+std::string ppo_policy_to_json(const PpoPolicy& policy);
+PpoPolicy load_ppo_policy(const std::filesystem::path& path);
+PpoPolicy parse_ppo_policy(std::string_view text, std::string_view source);
+
+class PpoAllocator final : public Allocator {
+ public:
+  // Throws UsageError when the policy was trained for another number of skeletons or deadline.
+  PpoAllocator(const Mdp& mdp, std::shared_ptr<const PpoPolicy> policy);
+
+  std::string_view name() const noexcept override { return "ppo"; }
+  int choose(const State& state) override;
+
+ private:
+  const Mdp* mdp_;
+  std::shared_ptr<const PpoPolicy> policy_;
+  PolicyNetwork actor_;  // own copy: evaluation uses per-network scratch buffers
+  PolicyNetwork::Vector features_;
+};
+
+}  // namespace ontime

@@ -1,0 +1,52 @@
+#include "ontime/allocators/ppo.hpp"
+
+#include <string>
+
+#include "ontime/error.hpp"
+
+namespace ontime {
+
+int feature_count(int skeleton_count) noexcept { return 1 + 3 * skeleton_count; }
+
+void state_features(const Mdp& mdp, const State& state, PolicyNetwork::Vector& features) {
+  const Problem& problem = mdp.problem();
+  const int count = mdp.skeleton_count();
+  const auto deadline = static_cast<float>(mdp.deadline());
+  features.resize(feature_count(count));
+  features(0) = static_cast<float>(state.time) / deadline;
+  for (int k = 0; k < count; ++k) {
+    const auto slot = static_cast<std::size_t>(k);
+    features(1 + 3 * k) = static_cast<float>(state.refined[slot]) / static_cast<float>(problem.skeleton_length(k));
+    features(2 + 3 * k) = static_cast<float>(state.spent[slot]) / deadline;
+    features(3 + 3 * k) = static_cast<float>(state.execution[slot]) / deadline;
+  }
+}
+
+PpoAllocator::PpoAllocator(const Mdp& mdp, std::shared_ptr<const PpoPolicy> policy)
+    : mdp_(&mdp), policy_(std::move(policy)), actor_(policy_->actor) {
+  if (policy_->skeleton_count != mdp.skeleton_count() || policy_->deadline != mdp.deadline()) {
+    throw UsageError("the ppo policy was trained for " + std::to_string(policy_->skeleton_count) +
+                     " skeletons and deadline " + std::to_string(policy_->deadline) + " ('" + policy_->instance +
+                     "'), not for this instance (" + std::to_string(mdp.skeleton_count()) + " skeletons, deadline " +
+                     std::to_string(mdp.deadline()) + ")");
+  }
+}
+
+int PpoAllocator::choose(const State& state) {
+  const ChoiceList choices = mdp_->useful_choices(state);
+  if (choices.empty()) {
+    for (int k = 0; k < mdp_->skeleton_count(); ++k) {
+      if (mdp_->next_action(state, k) >= 0) return k;
+    }
+    return 0;
+  }
+  state_features(*mdp_, state, features_);
+  const PolicyNetwork::Vector& logits = actor_.evaluate(features_);
+  int best = choices[0];
+  for (const int choice : choices) {
+    if (logits(choice) > logits(best)) best = choice;
+  }
+  return best;
+}
+
+}  // namespace ontime

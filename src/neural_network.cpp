@@ -1,0 +1,137 @@
+#include "ontime/neural_network.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace ontime {
+
+template <class Scalar>
+Mlp<Scalar>::Mlp(const std::vector<int>& sizes, SplitMix64& generator) : sizes_(sizes) {
+  if (sizes_.size() < 2) throw std::invalid_argument("a network needs at least an input and an output layer");
+  for (const int size : sizes_) {
+    if (size < 1) throw std::invalid_argument("layer sizes must be positive");
+  }
+  for (std::size_t layer = 0; layer + 1 < sizes_.size(); ++layer) {
+    const int fan_in = sizes_[layer];
+    const int fan_out = sizes_[layer + 1];
+    const double bound = 1.0 / std::sqrt(static_cast<double>(fan_in));
+    Matrix weight(fan_out, fan_in);
+    Vector bias(fan_out);
+    for (Eigen::Index j = 0; j < weight.cols(); ++j) {
+      for (Eigen::Index i = 0; i < weight.rows(); ++i) {
+        weight(i, j) = static_cast<Scalar>((2.0 * uniform01(generator) - 1.0) * bound);
+      }
+    }
+    for (Eigen::Index i = 0; i < bias.size(); ++i) bias(i) = static_cast<Scalar>((2.0 * uniform01(generator) - 1.0) * bound);
+    weights_.push_back(std::move(weight));
+    biases_.push_back(std::move(bias));
+  }
+  weight_gradients_.resize(weights_.size());
+  bias_gradients_.resize(biases_.size());
+}
+
+template <class Scalar>
+void Mlp<Scalar>::set_parameters(std::vector<Matrix> weights, std::vector<Vector> biases) {
+  if (weights.size() + 1 != sizes_.size() || biases.size() + 1 != sizes_.size()) {
+    throw std::invalid_argument("parameter count does not match the layers");
+  }
+  for (std::size_t layer = 0; layer < weights.size(); ++layer) {
+    if (weights[layer].rows() != sizes_[layer + 1] || weights[layer].cols() != sizes_[layer] ||
+        biases[layer].size() != sizes_[layer + 1]) {
+      throw std::invalid_argument("parameter shapes do not match the layers");
+    }
+  }
+  weights_ = std::move(weights);
+  biases_ = std::move(biases);
+  weight_gradients_.assign(weights_.size(), Matrix());
+  bias_gradients_.assign(biases_.size(), Vector());
+}
+
+template <class Scalar>
+std::size_t Mlp<Scalar>::parameter_count() const noexcept {
+  std::size_t count = 0;
+  for (std::size_t layer = 0; layer < weights_.size(); ++layer) {
+    count += static_cast<std::size_t>(weights_[layer].size() + biases_[layer].size());
+  }
+  return count;
+}
+
+template <class Scalar>
+const typename Mlp<Scalar>::Matrix& Mlp<Scalar>::forward(const Matrix& input) {
+  activations_.resize(weights_.size() + 1);
+  activations_[0] = input;
+  for (std::size_t layer = 0; layer < weights_.size(); ++layer) {
+    Matrix& out = activations_[layer + 1];
+    out.noalias() = weights_[layer] * activations_[layer];
+    out.colwise() += biases_[layer];
+    if (layer + 1 < weights_.size()) out = out.array().tanh().matrix();
+  }
+  return activations_.back();
+}
+
+template <class Scalar>
+void Mlp<Scalar>::backward(const Matrix& output_gradient) {
+  Matrix delta = output_gradient;  // dLoss / d(pre-activation) of the current layer
+  for (std::size_t layer = weights_.size(); layer-- > 0;) {
+    weight_gradients_[layer].noalias() = delta * activations_[layer].transpose();
+    bias_gradients_[layer] = delta.rowwise().sum();
+    if (layer == 0) break;
+    Matrix upstream = weights_[layer].transpose() * delta;
+    // tanh' = 1 - tanh^2, with tanh the stored activation of the layer below.
+    delta = upstream.array() * (Scalar(1) - activations_[layer].array().square());
+  }
+}
+
+template <class Scalar>
+const typename Mlp<Scalar>::Vector& Mlp<Scalar>::evaluate(const Vector& input) const {
+  scratch_.resize(weights_.size());
+  const Vector* current = &input;
+  for (std::size_t layer = 0; layer < weights_.size(); ++layer) {
+    Vector& out = scratch_[layer];
+    out.noalias() = weights_[layer] * (*current);
+    out += biases_[layer];
+    if (layer + 1 < weights_.size()) out = out.array().tanh().matrix();
+    current = &out;
+  }
+  return scratch_.back();
+}
+
+template <class Scalar>
+Adam<Scalar>::Adam(const Mlp<Scalar>& network, double learning_rate, double beta1, double beta2, double epsilon)
+    : learning_rate_(learning_rate), beta1_(beta1), beta2_(beta2), epsilon_(epsilon) {
+  for (const auto& weight : network.weights()) {
+    weight_m_.push_back(Mlp<Scalar>::Matrix::Zero(weight.rows(), weight.cols()));
+    weight_v_.push_back(Mlp<Scalar>::Matrix::Zero(weight.rows(), weight.cols()));
+  }
+  for (const auto& bias : network.biases()) {
+    bias_m_.push_back(Mlp<Scalar>::Vector::Zero(bias.size()));
+    bias_v_.push_back(Mlp<Scalar>::Vector::Zero(bias.size()));
+  }
+}
+
+template <class Scalar>
+void Adam<Scalar>::step(Mlp<Scalar>& network) {
+  ++steps_;
+  const auto b1 = static_cast<Scalar>(beta1_);
+  const auto b2 = static_cast<Scalar>(beta2_);
+  const double correction1 = 1.0 - std::pow(beta1_, static_cast<double>(steps_));
+  const double correction2 = 1.0 - std::pow(beta2_, static_cast<double>(steps_));
+  const auto rate = static_cast<Scalar>(learning_rate_ * std::sqrt(correction2) / correction1);
+  const auto epsilon = static_cast<Scalar>(epsilon_ * std::sqrt(correction2));
+  const auto update = [&](auto& parameter, const auto& gradient, auto& m, auto& v) {
+    m = b1 * m + (Scalar(1) - b1) * gradient;
+    v = b2 * v + (Scalar(1) - b2) * gradient.cwiseProduct(gradient);
+    parameter.array() -= rate * m.array() / (v.array().sqrt() + epsilon);
+  };
+  for (std::size_t layer = 0; layer < weight_m_.size(); ++layer) {
+    update(network.weights()[layer], network.weight_gradients()[layer], weight_m_[layer], weight_v_[layer]);
+    update(network.biases()[layer], network.bias_gradients()[layer], bias_m_[layer], bias_v_[layer]);
+  }
+}
+
+template class Mlp<float>;
+template class Mlp<double>;
+template class Adam<float>;
+template class Adam<double>;
+
+}  // namespace ontime

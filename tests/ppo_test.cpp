@@ -1,0 +1,169 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "ontime/allocators.hpp"
+#include "ontime/allocators/ppo.hpp"
+#include "ontime/error.hpp"
+#include "ontime/evaluation.hpp"
+#include "ontime/neural_network.hpp"
+#include "ontime/ppo_training.hpp"
+#include "support/paper.hpp"
+
+namespace ontime {
+namespace {
+
+using MatrixD = Mlp<double>::Matrix;
+
+double relative_error(double analytic, double numeric) {
+  return std::abs(analytic - numeric) / std::max({1e-8, std::abs(analytic), std::abs(numeric)});
+}
+
+// Backpropagation against central finite differences of L = sum(W .* output).
+TEST(NeuralNetwork, GradientsMatchFiniteDifferences) {
+  SplitMix64 generator(17);
+  Mlp<double> network({5, 7, 6, 3}, generator);
+  MatrixD input = MatrixD::Random(5, 4);
+  const MatrixD weights = MatrixD::Random(3, 4);
+  const auto loss = [&](Mlp<double>& net) { return net.forward(input).cwiseProduct(weights).sum(); };
+  loss(network);
+  network.backward(weights);
+  const auto analytic_weights = network.weight_gradients();
+  const auto analytic_biases = network.bias_gradients();
+  constexpr double kStep = 1e-6;
+  int checked = 0;
+  const auto check = [&](double& parameter, double analytic) {
+    const double saved = parameter;
+    parameter = saved + kStep;
+    const double up = loss(network);
+    parameter = saved - kStep;
+    const double down = loss(network);
+    parameter = saved;
+    EXPECT_LT(relative_error(analytic, (up - down) / (2 * kStep)), 1e-6);
+    ++checked;
+  };
+  for (std::size_t layer = 0; layer < network.weights().size(); ++layer) {
+    for (Eigen::Index i = 0; i < network.weights()[layer].size(); ++i) {
+      check(network.weights()[layer].data()[i], analytic_weights[layer].data()[i]);
+    }
+    for (Eigen::Index i = 0; i < network.biases()[layer].size(); ++i) {
+      check(network.biases()[layer](i), analytic_biases[layer](i));
+    }
+  }
+  EXPECT_EQ(checked, static_cast<int>(network.parameter_count()));
+  // The single-sample path agrees with the batch path.
+  const Mlp<double>::Vector one = network.evaluate(input.col(2));
+  EXPECT_LT((one - network.forward(input).col(2)).norm(), 1e-12);
+}
+
+// The clipped surrogate's gradient against finite differences, with masked choices, positive
+// and negative advantages, and ratios inside and outside the clip range.
+TEST(Ppo, SurrogateGradientMatchesFiniteDifferences) {
+  constexpr int kChoices = 4, kSamples = 6;
+  SplitMix64 generator(3);
+  MatrixD logits(kChoices, kSamples);
+  for (Eigen::Index i = 0; i < logits.size(); ++i) logits.data()[i] = 2 * uniform01(generator) - 1;
+  std::vector<std::uint8_t> valid{1, 1, 0, 1, 1, 1, 1, 1, 0, 1, 1, 0, 1, 1, 1, 1, 1, 0, 1, 1, 1, 0, 0, 1};
+  const std::vector<int> actions{3, 0, 1, 2, 3, 0};
+  const std::vector<double> advantages{1.2, -0.7, 0.4, -1.5, 0.9, 2.0};
+  // Old log-probabilities chosen so that ratios land inside (1, 4), below (2, 5) and above (0, 3) the range.
+  const std::vector<double> old_log{-1.0, -2.5, -0.4, -1.9, -0.2, -3.0};
+  MatrixD gradient;
+  double kl = 0;
+  clipped_surrogate_loss<double>(logits, valid, actions, old_log, advantages, 0.2, gradient, kl);
+  int below = 0, inside = 0, above = 0;
+  for (int n = 0; n < kSamples; ++n) {
+    double total = 0;
+    for (int k = 0; k < kChoices; ++k) {
+      if (valid[static_cast<std::size_t>(n * kChoices + k)] != 0) total += std::exp(logits(k, n));
+    }
+    const double ratio = std::exp(logits(actions[static_cast<std::size_t>(n)], n) - std::log(total) - old_log[static_cast<std::size_t>(n)]);
+    below += ratio < 0.8;
+    above += ratio > 1.2;
+    inside += ratio >= 0.8 && ratio <= 1.2;
+  }
+  ASSERT_GT(below, 0);
+  ASSERT_GT(above, 0);
+  ASSERT_GT(inside, 0);
+  constexpr double kStep = 1e-6;
+  for (Eigen::Index i = 0; i < logits.size(); ++i) {
+    MatrixD shifted = logits;
+    MatrixD ignored;
+    double ignored_kl = 0;
+    shifted.data()[i] += kStep;
+    const double up = clipped_surrogate_loss<double>(shifted, valid, actions, old_log, advantages, 0.2, ignored, ignored_kl);
+    shifted.data()[i] -= 2 * kStep;
+    const double down = clipped_surrogate_loss<double>(shifted, valid, actions, old_log, advantages, 0.2, ignored, ignored_kl);
+    EXPECT_NEAR(gradient.data()[i], (up - down) / (2 * kStep), 1e-7) << "entry " << i;
+  }
+  // Masked choices get no gradient.
+  EXPECT_EQ(gradient(2, 0), 0.0);
+  EXPECT_EQ(gradient(0, 2), 0.0);
+}
+
+TEST(Ppo, LearnsTheBetterSkeletonOfInstanceFour) {
+  const Problem problem = testing::paper_instance("instance4");
+  const Mdp mdp(problem);
+  const auto exact_of = [&mdp](const PpoPolicy& policy) {
+    PpoAllocator allocator(mdp, std::make_shared<const PpoPolicy>(policy));
+    return evaluate_exactly(mdp, allocator).success_probability;
+  };
+  // Barely trained, the network prefers a1_1 (0.55); trained, a2_1 (the optimum, 0.9).
+  EXPECT_LT(exact_of(train_ppo(mdp, 1, 1).policy), 0.85);
+  const PpoTraining training = train_ppo(mdp, 3'000, 1);
+  EXPECT_NEAR(exact_of(training.policy), 0.9, 1e-12);
+  ASSERT_FALSE(training.curve.empty());
+  EXPECT_EQ(training.curve.back().episodes, 3'000U);
+  EXPECT_GE(training.curve.front().steps, 4'000U);  // whole episodes until an epoch holds 4,000 steps
+}
+
+TEST(Ppo, SameSeedSamePolicyByteForByte) {
+  const Problem problem = testing::paper_instance("instance2");
+  const Mdp mdp(problem);
+  PpoHyperparameters small;
+  small.steps_per_epoch = 500;
+  const std::string first = ppo_policy_to_json(train_ppo(mdp, 300, 9, small).policy);
+  const std::string second = ppo_policy_to_json(train_ppo(mdp, 300, 9, small).policy);
+  EXPECT_EQ(first, second);
+  EXPECT_NE(first, ppo_policy_to_json(train_ppo(mdp, 300, 10, small).policy));
+}
+
+TEST(Ppo, PolicyFilesRoundTripAndAreValidated) {
+  const Problem problem = testing::paper_instance("instance4");
+  const Mdp mdp(problem);
+  PpoHyperparameters small;
+  small.steps_per_epoch = 200;
+  const PpoPolicy policy = train_ppo(mdp, 100, 4, small).policy;
+  const std::string text = ppo_policy_to_json(policy);
+  const PpoPolicy copy = parse_ppo_policy(text, "policy.json");
+  EXPECT_EQ(ppo_policy_to_json(copy), text);
+  EXPECT_EQ(copy.hyperparameters.steps_per_epoch, 200);
+
+  const auto place_of = [](const std::string& broken) {
+    try {
+      parse_ppo_policy(broken, "broken.json");
+    } catch (const InputError& error) {
+      return error.place();
+    }
+    return std::string("accepted");
+  };
+  std::string wrong_format = text;
+  wrong_format.replace(wrong_format.find("ontime-ppo-policy"), 17, "something-else-xx");
+  EXPECT_EQ(place_of(wrong_format), "format");
+  std::string wrong_size = text;
+  wrong_size.replace(wrong_size.find("\"skeletons\": 2"), 14, "\"skeletons\": 3");
+  EXPECT_EQ(place_of(wrong_size), "actor.sizes");
+  EXPECT_EQ(place_of(text.substr(0, text.size() / 2)).rfind("line ", 0), 0U);
+
+  // A policy trained for another instance is refused when used.
+  const Problem other = testing::paper_instance("instance1");
+  const Mdp other_mdp(other);
+  AllocatorOptions options;
+  options.policy = std::make_shared<const PpoPolicy>(copy);
+  EXPECT_THROW(make_allocator_factory("ppo", other_mdp, options), UsageError);
+  EXPECT_THROW(make_allocator_factory("ppo", mdp), UsageError);  // no policy at all
+  EXPECT_NO_THROW(make_allocator_factory("ppo", mdp, options));
+}
+
+}  // namespace
+}  // namespace ontime
