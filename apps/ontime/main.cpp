@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
   ontime::cli::add_table_command(app);
   ontime::cli::add_study_command(app);
   ontime::cli::add_train_command(app);
+  ontime::cli::add_reduce_knapsack_command(app);
 
   try {
     app.parse(argc, argv);

@@ -16,6 +16,7 @@
 #include "ontime/evaluation.hpp"
 #include "ontime/experiments.hpp"
 #include "ontime/instance_io.hpp"
+#include "ontime/knapsack.hpp"
 #include "ontime/mdp.hpp"
 #include "ontime/neural_network.hpp"
 #include "ontime/ppo_training.hpp"
