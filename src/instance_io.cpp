@@ -5,7 +5,6 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <regex>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -127,8 +126,10 @@ class InstanceReader {
   }
 
   Steps read_step(const std::string& key, const std::string& path, Steps first, const char* kind) const {
-    static const std::regex canonical("0|[1-9][0-9]{0,8}");
-    if (!std::regex_match(key, canonical)) {
+    // Canonical decimal: "0", or up to nine digits without a leading zero.
+    const bool digits = !key.empty() && key.size() <= 9 &&
+                        std::all_of(key.begin(), key.end(), [](char c) { return c >= '0' && c <= '9'; });
+    if (!digits || (key.size() > 1 && key[0] == '0')) {
       fail(path, std::string("keys must be whole numbers of steps, written without sign or leading zeros (got '") + key + "')");
     }
     const long step = std::stol(key);

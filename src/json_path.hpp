@@ -2,10 +2,10 @@
 // Internal: JSON paths for error messages, strict parsing (duplicate keys are errors, not
 // silently overwritten) and reading whole files. Shared by every reader of JSON input.
 
+#include <algorithm>
 #include <cctype>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -113,13 +113,34 @@ Json parse_json_strict(std::string_view text, const std::string& source) {
   try {
     return Json::parse(text.begin(), text.end(), callback, true, false);
   } catch (const typename Json::parse_error& error) {
-    static const std::regex located(R"(parse error at (line \d+, column \d+): (.*))");
-    std::cmatch match;
+    // nlohmann's message reads "[json.exception.parse_error.N] parse error at line L, column C: WHY".
     const std::string message = error.what();
-    if (std::regex_search(message.c_str(), match, located)) {
-      throw InputError(source, match[1].str(), "invalid JSON: " + match[2].str());
+    const std::size_t at = message.find("parse error at line ");
+    const std::size_t colon = at == std::string::npos ? std::string::npos : message.find(": ", at);
+    if (colon != std::string::npos) {
+      const std::size_t place = at + std::string_view("parse error at ").size();
+      throw InputError(source, message.substr(place, colon - place), "invalid JSON: " + message.substr(colon + 2));
     }
     throw InputError(source, "byte " + std::to_string(error.byte), "invalid JSON: " + message);
+  } catch (const typename Json::out_of_range& error) {
+    // A number too large for a double ("number overflow parsing '1e999'"): nlohmann gives no
+    // position, so the place is that of the first occurrence of the quoted token.
+    const std::string message = error.what();
+    const std::size_t open = message.find('\'');
+    const std::size_t close = open == std::string::npos ? std::string::npos : message.rfind('\'');
+    std::string place = "number";
+    if (open != std::string::npos && close > open + 1) {
+      const std::size_t at = text.find(std::string_view(message).substr(open + 1, close - open - 1));
+      if (at != std::string_view::npos) {
+        const std::string_view before = text.substr(0, at);
+        const std::size_t line = 1 + static_cast<std::size_t>(std::count(before.begin(), before.end(), '\n'));
+        const std::size_t line_start = before.rfind('\n');
+        const std::size_t column = at - (line_start == std::string_view::npos ? 0 : line_start + 1) + 1;
+        place = "line " + std::to_string(line) + ", column " + std::to_string(column);
+      }
+    }
+    const std::size_t reason = message.find("] ");
+    throw InputError(source, place, "invalid JSON: " + (reason == std::string::npos ? message : message.substr(reason + 2)));
   }
 }
 

@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <csignal>
 #include <nlohmann/json.hpp>
+
+#include "ontime/allocators/ppo.hpp"
 
 #include "support/bad_inputs.hpp"
 #include "support/paper.hpp"
@@ -175,6 +178,24 @@ TEST(Cli, KnapsackReductionWritesASolvableInstance) {
   const auto bad = ontime({"reduce-knapsack", paper("figure1")});
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find(paper("figure1") + ": name: unknown key"), std::string::npos) << bad.err;
+}
+
+// An interrupted run leaves the previous output file as it was; a complete run replaces it whole.
+TEST(Cli, InterruptedTrainingLeavesTheOldFile) {
+  const auto directory = scratch("interrupt");
+  const auto policy = directory / "policy.json";
+  { std::ofstream(policy) << "previous policy"; }
+  const auto interrupted = testing::run_process(
+      {ONTIME_CLI, "train", paper("instance1"), "--episodes", "10000", "--out", policy.string()}, 300);
+  EXPECT_EQ(interrupted.exit_code, 128 + SIGINT);
+  std::ifstream old(policy);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(old), {}), "previous policy");
+  std::size_t entries = 0;
+  for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(directory)) ++entries;
+  EXPECT_EQ(entries, 1U);  // no partial or temporary file
+  const auto complete = ontime({"train", paper("instance4"), "--episodes", "100", "--out", policy.string(), "--no-plot"});
+  ASSERT_EQ(complete.exit_code, 0) << complete.err;
+  EXPECT_NO_THROW(load_ppo_policy(policy));
 }
 
 TEST(Cli, HelpIsAvailableForEveryCommand) {

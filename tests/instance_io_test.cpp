@@ -101,6 +101,21 @@ TEST(InstanceIo, MissingFileIsAnInputError) {
   }
 }
 
+// Inputs that once crashed the instance fuzzer: each must now load or fail with InputError.
+TEST(InstanceIo, FuzzRegressionsAreHandled) {
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(testing::source_path("tests/data/fuzz_regressions"))) {
+    if (entry.path().filename().string().rfind("instance_", 0) != 0) continue;
+    ++files;
+    try {
+      load_problem(entry.path());
+    } catch (const InputError& error) {
+      EXPECT_FALSE(error.place().empty()) << entry.path();
+    }
+  }
+  EXPECT_GT(files, 0);
+}
+
 // Every file of tests/data/bad is rejected with its expected place and rule.
 TEST(InstanceIo, EveryBadFileNamesItsPlaceAndRule) {
   std::set<std::string> covered;

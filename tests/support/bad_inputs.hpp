@@ -17,6 +17,7 @@ inline const std::array kBadInputs{
     BadInput{"empty.json", "line 1, column 1", "invalid JSON"},
     BadInput{"nan_probability.json", "line 4, column 38", "invalid JSON"},
     BadInput{"trailing_garbage.json", "line 1, column 128", "expected end of input"},
+    BadInput{"number_overflow.json", "line 4, column 38", "number overflow"},
     BadInput{"duplicate_key.json", "actions.a1.planning.pmf.\"1\"", "duplicate key"},
     BadInput{"top_level_array.json", "top level", "must be a JSON object"},
     BadInput{"unknown_top_key.json", "deadlines", "unknown key"},

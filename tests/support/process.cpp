@@ -1,6 +1,8 @@
 #include "support/process.hpp"
 
 #include <array>
+#include <chrono>
+#include <csignal>
 #include <cerrno>
 #include <poll.h>
 #include <stdexcept>
@@ -9,7 +11,7 @@
 
 namespace ontime::testing {
 
-ProcessResult run_process(const std::vector<std::string>& arguments) {
+ProcessResult run_process(const std::vector<std::string>& arguments, int interrupt_after_ms) {
   int out_pipe[2], err_pipe[2];
   if (::pipe(out_pipe) != 0 || ::pipe(err_pipe) != 0) throw std::runtime_error("pipe failed");
   const pid_t child = ::fork();
@@ -28,11 +30,20 @@ ProcessResult run_process(const std::vector<std::string>& arguments) {
   ::close(out_pipe[1]);
   ::close(err_pipe[1]);
   ProcessResult result;
+  const auto started = std::chrono::steady_clock::now();
+  bool interrupted = interrupt_after_ms < 0;
   std::array<pollfd, 2> fds{pollfd{out_pipe[0], POLLIN, 0}, pollfd{err_pipe[0], POLLIN, 0}};
   int open = 2;
   std::array<char, 4096> buffer{};
   while (open > 0) {
-    if (::poll(fds.data(), fds.size(), -1) < 0) {
+    if (!interrupted) {
+      const auto elapsed = std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - started);
+      if (elapsed.count() >= interrupt_after_ms) {
+        ::kill(child, SIGINT);
+        interrupted = true;
+      }
+    }
+    if (::poll(fds.data(), fds.size(), interrupted ? -1 : 10) < 0) {
       if (errno == EINTR) continue;
       break;
     }

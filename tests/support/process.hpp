@@ -12,6 +12,7 @@ struct ProcessResult {
   std::string err;
 };
 
-ProcessResult run_process(const std::vector<std::string>& arguments);
+// With interrupt_after_ms >= 0, sends SIGINT to the command after that many milliseconds.
+ProcessResult run_process(const std::vector<std::string>& arguments, int interrupt_after_ms = -1);
 
 }  // namespace ontime::testing
