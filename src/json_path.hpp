@@ -36,6 +36,17 @@ inline std::string json_member(const std::string& parent, std::string_view key) 
   return parent.empty() ? segment : parent + "." + segment;
 }
 
+// "null", "a boolean", "a number", "a string", "an array" or "an object", for messages.
+template <class Json>
+std::string describe_json_type(const Json& value) {
+  if (value.is_null()) return "null";
+  if (value.is_boolean()) return "a boolean";
+  if (value.is_number()) return "a number";
+  if (value.is_string()) return "a string";
+  if (value.is_array()) return "an array";
+  return "an object";
+}
+
 inline std::string json_index(const std::string& parent, std::size_t index) {
   return parent + "[" + std::to_string(index) + "]";
 }

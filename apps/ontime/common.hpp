@@ -20,6 +20,9 @@ using Json = nlohmann::ordered_json;
 void add_solve_command(CLI::App& app);
 void add_evaluate_command(CLI::App& app);
 void add_table_command(CLI::App& app);
+void add_fit_command(CLI::App& app);
+void add_sample_log_command(CLI::App& app);
+void add_plot_command(CLI::App& app);
 
 // Options shared by commands that build allocators.
 struct AllocatorFlags {

@@ -32,6 +32,9 @@ int main(int argc, char** argv) {
   ontime::cli::add_solve_command(app);
   ontime::cli::add_evaluate_command(app);
   ontime::cli::add_table_command(app);
+  ontime::cli::add_fit_command(app);
+  ontime::cli::add_sample_log_command(app);
+  ontime::cli::add_plot_command(app);
 
   try {
     app.parse(argc, argv);
