@@ -81,12 +81,7 @@ class InstanceReader {
   }
 
   void check_keys(const Json& object, const std::string& path, std::initializer_list<std::string_view> allowed) const {
-    for (const auto& [key, value] : object.items()) {
-      if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
-      std::string expected;
-      for (const std::string_view name : allowed) expected += (expected.empty() ? "'" : ", '") + std::string(name) + "'";
-      fail(detail::json_member(path, key), "unknown key (expected " + expected + ")");
-    }
+    detail::check_known_keys(object, path, allowed, source_);
   }
 
   std::string string_at(const Json& value, const std::string& path) const {

@@ -2,7 +2,9 @@
 // Internal: JSON paths for error messages, strict parsing (duplicate keys are errors, not
 // silently overwritten) and reading whole files. Shared by every reader of JSON input.
 
+#include <algorithm>
 #include <cctype>
+#include <initializer_list>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -49,6 +51,18 @@ std::string describe_json_type(const Json& value) {
 
 inline std::string json_index(const std::string& parent, std::size_t index) {
   return parent + "[" + std::to_string(index) + "]";
+}
+
+// Raises InputError at the first key of `object` (at `path`) that is not in `allowed`.
+template <class Json>
+void check_known_keys(const Json& object, const std::string& path, std::initializer_list<std::string_view> allowed,
+                      const std::string& source) {
+  for (const auto& [key, value] : object.items()) {
+    if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
+    std::string expected;
+    for (const std::string_view name : allowed) expected += (expected.empty() ? "'" : ", '") + std::string(name) + "'";
+    throw InputError(source, json_member(path, key), "unknown key (expected " + expected + ")");
+  }
 }
 
 inline std::string read_text_file(const std::filesystem::path& path) {
