@@ -11,13 +11,9 @@ import argparse
 import collections
 import csv
 import math
-import os
-import tempfile
+from ontime_plotting import save_atomically  # sets the Agg backend: import it first
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
+import matplotlib.pyplot as plt  # noqa: E402
 
 PLANNING_COLOUR = "#3b6ea8"
 EXECUTION_COLOUR = "#d08a2c"
@@ -84,17 +80,7 @@ def main():
     figure.suptitle(arguments.title, fontsize=11)
     figure.tight_layout(rect=(0, 0, 1, 0.97))
 
-    directory = os.path.dirname(os.path.abspath(arguments.output))
-    handle, temporary = tempfile.mkstemp(prefix=".plot-", suffix=".png", dir=directory)
-    os.close(handle)
-    try:
-        figure.savefig(temporary, dpi=110)
-        os.chmod(temporary, 0o644)
-        os.replace(temporary, arguments.output)
-    finally:
-        if os.path.exists(temporary):
-            os.unlink(temporary)
-
+    save_atomically(figure, arguments.output)
 
 if __name__ == "__main__":
     main()

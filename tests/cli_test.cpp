@@ -187,7 +187,66 @@ TEST(Cli, PlotWritesTheHistogramsAndTheirData) {
   EXPECT_EQ(ontime({"plot", "/nonexistent.json"}).exit_code, 2);
 }
 
+TEST(Cli, CollectWritesTheLogAndTheFittedInstance) {
+  const std::filesystem::path dir = scratch("collect");
+  const std::string log = (dir / "logs" / "navigation.jsonl").string();
+  const std::string instance = (dir / "navigation.json").string();
+  const auto result = ontime({"collect", "--domain", "navigation", "--trials", "2", "--threads", "2", "--seed", "4",
+                              "--log", log, "-o", instance, "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const json out = json::parse(result.out);
+  EXPECT_EQ(out["attempts"].get<int>(), 30);
+  EXPECT_EQ(out["deadline"].get<int>(), 22);
+  EXPECT_EQ(out["effort"], "checks");
+  EXPECT_EQ(out["actions"].size(), 15u);
+  const std::string lines = read_file(log);
+  EXPECT_EQ(std::count(lines.begin(), lines.end(), '\n'), 30);
+  const auto solved = ontime({"solve", instance, "--json"});
+  EXPECT_EQ(solved.exit_code, 0) << solved.err;
+  // Fitting the written log again gives the same instance.
+  const std::string refit = (dir / "refit.json").string();
+  ASSERT_EQ(ontime({"fit", log, "--step", "3", "--deadline", "22", "--skeletons",
+                    testing::source_path("data/domains/navigation.json").string(), "-o", refit, "--name", "navigation"})
+                .exit_code,
+            0);
+  EXPECT_EQ(json::parse(read_file(refit))["actions"], json::parse(read_file(instance))["actions"]);
+}
+
+TEST(Cli, CollectRejectsBadDomainsAndWorlds) {
+  const std::filesystem::path dir = scratch("bad-world");
+  const auto unknown = ontime({"collect", "--domain", "kitchen", "--trials", "1"});
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.err.find("unknown domain 'kitchen'"), std::string::npos) << unknown.err;
+  json world = json::parse(read_file(testing::source_path("data/domains/navigation.json")));
+  world["doors"][3]["width"] = 0.5;
+  const std::string bad = (dir / "world.json").string();
+  std::ofstream(bad) << world.dump(1);
+  const auto result = ontime({"collect", "--domain", "navigation", "--world", bad, "--trials", "1", "--log",
+                              (dir / "l.jsonl").string(), "-o", (dir / "i.json").string()});
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+  EXPECT_NE(result.err.find(bad + ": doors[3].width: narrower than the robot"), std::string::npos) << result.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "l.jsonl"));
+  EXPECT_EQ(ontime({"collect", "--domain", "navigation", "--effort", "minutes"}).exit_code, 2);
+}
+
+TEST(Cli, MapDrawsTheWorldAndOneMotionPerSkeleton) {
+  const std::filesystem::path dir = scratch("map");
+  const std::string png = (dir / "map.png").string();
+  const auto result = ontime({"map", "--domain", "navigation", "-o", png});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(read_file(png).substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  const json drawing = json::parse(read_file(dir / "map.json"));
+  EXPECT_EQ(drawing["paths"].size(), 4u);
+  EXPECT_GT(drawing["polygons"].size(), 13u);
+}
+
 TEST(Cli, HelpIsAvailableForEveryCommand) {
+  for (const char* command : {"collect", "map"}) {
+    const auto result = ontime({command, "--help"});
+    EXPECT_EQ(result.exit_code, 0) << command;
+    EXPECT_NE(result.out.find("--domain"), std::string::npos) << command;
+  }
   for (const char* command : {"fit", "sample-log", "plot"}) {
     const auto result = ontime({command, "--help"});
     EXPECT_EQ(result.exit_code, 0) << command;

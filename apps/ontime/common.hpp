@@ -23,6 +23,8 @@ void add_table_command(CLI::App& app);
 void add_fit_command(CLI::App& app);
 void add_sample_log_command(CLI::App& app);
 void add_plot_command(CLI::App& app);
+void add_collect_command(CLI::App& app);
+void add_map_command(CLI::App& app);
 
 // Options shared by commands that build allocators.
 struct AllocatorFlags {

@@ -35,6 +35,8 @@ int main(int argc, char** argv) {
   ontime::cli::add_fit_command(app);
   ontime::cli::add_sample_log_command(app);
   ontime::cli::add_plot_command(app);
+  ontime::cli::add_collect_command(app);
+  ontime::cli::add_map_command(app);
 
   try {
     app.parse(argc, argv);
