@@ -1,8 +1,8 @@
 """A domain's world seen from above, with refined motions.
 
 Reads the JSON that `ontime map` writes: {"title", "polygons": [{"kind", "label", "points"}],
-"paths": [{"label", "points", "end"}]}, with kinds "room" (drawn light, labelled at the
-centre), "wall", "obstacle" and "robot" (the start footprint); each path is drawn in its own
+"paths": [{"label", "points", "end"}]}, with kinds "room" (drawn light, labelled in its
+top-left corner), "wall", "obstacle" and "robot" (the start footprint); each path is drawn in its own
 colour with the robot's footprint where it ends. Writes the PNG through a temporary file.
 """
 
@@ -37,9 +37,10 @@ def main():
     for polygon in drawing["polygons"]:
         axes.add_patch(Polygon(polygon["points"], closed=True, **STYLE.get(polygon["kind"], STYLE["obstacle"])))
         if polygon["label"]:
-            centre_x = sum(point[0] for point in polygon["points"]) / len(polygon["points"])
-            centre_y = sum(point[1] for point in polygon["points"]) / len(polygon["points"])
-            axes.text(centre_x, centre_y, polygon["label"], ha="center", va="center", fontsize=13, color="#7a7a7a",
+            # Rooms are labelled in their top-left corner, clear of furniture in the middle.
+            left = min(point[0] for point in polygon["points"])
+            top = max(point[1] for point in polygon["points"])
+            axes.text(left + 0.15, top - 0.15, polygon["label"], ha="left", va="top", fontsize=12, color="#7a7a7a",
                       fontweight="bold", zorder=5)
     for index, path in enumerate(drawing["paths"]):
         colour = PATH_COLOURS[index % len(PATH_COLOURS)]
