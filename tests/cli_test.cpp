@@ -228,6 +228,12 @@ TEST(Cli, CollectRejectsBadDomainsAndWorlds) {
   EXPECT_NE(result.err.find(bad + ": doors[3].width: narrower than the robot"), std::string::npos) << result.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "l.jsonl"));
   EXPECT_EQ(ontime({"collect", "--domain", "navigation", "--effort", "minutes"}).exit_code, 2);
+  // An output that cannot be written stops the command before any planning.
+  std::ofstream(dir / "file") << "x";
+  const auto unwritable = ontime({"collect", "--domain", "navigation", "--trials", "1", "--log",
+                                  (dir / "file" / "l.jsonl").string(), "-o", (dir / "i.json").string()});
+  EXPECT_EQ(unwritable.exit_code, 2);
+  EXPECT_NE(unwritable.err.find("cannot write into"), std::string::npos) << unwritable.err;
 }
 
 TEST(Cli, MapDrawsTheWorldAndOneMotionPerSkeleton) {

@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include "common.hpp"
 #include "data_paths.hpp"
@@ -14,6 +15,21 @@
 #include "ontime/instance_io.hpp"
 
 namespace ontime::cli {
+namespace {
+
+// Creates the directory an output goes to and checks that it can be written, so that a bad
+// path stops the command before the collection, not after it.
+void prepare_output(const std::filesystem::path& path) {
+  const std::filesystem::path directory = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+  std::error_code error;
+  std::filesystem::create_directories(directory, error);
+  if (error || ::access(directory.c_str(), W_OK) != 0) {
+    throw UsageError(path.string() + ": cannot write into " + directory.string() +
+                     (error ? " (" + error.message() + ")" : std::string(" (not writable)")));
+  }
+}
+
+}  // namespace
 
 void add_collect_command(CLI::App& app) {
   struct Options {
@@ -74,13 +90,12 @@ void add_collect_command(CLI::App& app) {
     collection.step_seconds = options->step_seconds > 0 ? options->step_seconds : defaults.step_seconds;
     const Steps deadline = options->deadline > 0 ? options->deadline : defaults.deadline;
     collection.budget_steps = options->budget > 0 ? options->budget : deadline;
+    prepare_output(log_path);
+    prepare_output(instance_path);
     ProgressBar bar("collect " + options->domain);
     collection.progress = [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); };
     const domains::CollectionResult result = domains::collect(*loaded.domain, collection);
 
-    for (const auto& path : {log_path, instance_path}) {
-      if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
-    }
     save_planner_log(result.log, log_path);
     FitOptions fit_options;
     fit_options.step_seconds = collection.step_seconds;

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "ontime/error.hpp"
 #include "ontime/random.hpp"
 
 namespace ontime::domains {
@@ -153,7 +154,8 @@ std::vector<std::vector<Configuration>> refine_skeleton(const Domain& domain, co
       }
     }
     if (!found) {
-      throw std::runtime_error("no motion found for " + skeleton[l] + " in " + std::to_string(attempts) + " attempts");
+      throw UsageError("no motion found for " + skeleton[l] + " in " + std::to_string(attempts) + " attempts of " +
+                       std::to_string(options.budget_steps) + " steps each");
     }
   }
   return motions;

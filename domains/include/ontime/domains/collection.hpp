@@ -54,7 +54,7 @@ CollectionResult collect(const Domain& domain, const CollectionOptions& options)
 
 // One refined motion per action of a skeleton, executed one after the other from the domain's
 // initial configuration (for pictures). Each action gets up to `attempts` attempts of
-// `budget_steps` steps; throws std::runtime_error when all of them are cut off.
+// `budget_steps` steps; throws ontime::UsageError when all of them are cut off.
 std::vector<std::vector<Configuration>> refine_skeleton(const Domain& domain, const std::vector<std::string>& skeleton,
                                                         std::uint64_t seed, const CollectionOptions& options,
                                                         int attempts = 20);
