@@ -25,6 +25,7 @@ void add_sample_log_command(CLI::App& app);
 void add_plot_command(CLI::App& app);
 void add_collect_command(CLI::App& app);
 void add_map_command(CLI::App& app);
+void add_run_command(CLI::App& app);
 
 // Options shared by commands that build allocators.
 struct AllocatorFlags {

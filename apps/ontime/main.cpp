@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   ontime::cli::add_plot_command(app);
   ontime::cli::add_collect_command(app);
   ontime::cli::add_map_command(app);
+  ontime::cli::add_run_command(app);
 
   try {
     app.parse(argc, argv);

@@ -1,17 +1,15 @@
 #include "ontime/domains/collection.hpp"
 
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <exception>
 #include <map>
 #include <mutex>
 #include <optional>
 #include <stdexcept>
-#include <thread>
 
 #include "ontime/error.hpp"
 #include "ontime/random.hpp"
+#include "parallel.hpp"
 
 namespace ontime::domains {
 namespace {
@@ -77,7 +75,6 @@ CollectionResult collect(const Domain& domain, const CollectionOptions& options)
   check_options(options);
   const auto started = std::chrono::steady_clock::now();
   const std::vector<TreeAction> tree = skeleton_tree(domain.skeletons());
-  const unsigned threads = std::max(1u, options.threads != 0 ? options.threads : std::thread::hardware_concurrency());
   const std::uint64_t total = options.trials * tree.size();
   std::uint64_t finished = 0;
   std::mutex progress_mutex;
@@ -90,40 +87,25 @@ CollectionResult collect(const Domain& domain, const CollectionOptions& options)
     const std::uint64_t action_seed = stream_seed(options.seed, a);
     const std::vector<Configuration>* starts = node.parent < 0 ? nullptr : &ends[static_cast<std::size_t>(node.parent)];
     std::vector<Outcome> outcomes(options.trials);
-    std::atomic<std::uint64_t> next{0};
-    std::exception_ptr failure;
-    std::mutex failure_mutex;
-    const auto work = [&] {
-      for (std::uint64_t t = next++; t < options.trials; t = next++) {
-        try {
-          const std::uint64_t trial_seed = stream_seed(action_seed, t);
-          Configuration start;
-          if (starts == nullptr) {
-            start = domain.initial_configuration();
-          } else if (!starts->empty()) {
-            start = (*starts)[t % starts->size()];
-          } else {
-            start = domain.fallback_start(node.action, stream_seed(trial_seed, 1));
-          }
-          outcomes[t] = attempt_once(domain, node.action, start, stream_seed(trial_seed, 0), options);
-          outcomes[t].attempt.trial = t;
-        } catch (...) {
-          const std::lock_guard lock(failure_mutex);
-          if (!failure) failure = std::current_exception();
-          next = options.trials;
-          return;
+    detail::for_each_index(options.trials, options.threads, [&] {
+      return [&](std::uint64_t t) {
+        const std::uint64_t trial_seed = stream_seed(action_seed, t);
+        Configuration start;
+        if (starts == nullptr) {
+          start = domain.initial_configuration();
+        } else if (!starts->empty()) {
+          start = (*starts)[t % starts->size()];
+        } else {
+          start = domain.fallback_start(node.action, stream_seed(trial_seed, 1));
         }
+        outcomes[t] = attempt_once(domain, node.action, start, stream_seed(trial_seed, 0), options);
+        outcomes[t].attempt.trial = t;
         if (options.progress) {
           const std::lock_guard lock(progress_mutex);
           options.progress(++finished, total);
         }
-      }
-    };
-    std::vector<std::thread> pool;
-    for (unsigned i = 1; i < threads; ++i) pool.emplace_back(work);
-    work();
-    for (std::thread& thread : pool) thread.join();
-    if (failure) std::rethrow_exception(failure);
+      };
+    });
     for (Outcome& outcome : outcomes) {
       if (outcome.end) ends[a].push_back(std::move(*outcome.end));
       result.collision_checks += outcome.attempt.collision_checks.value_or(0);
