@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "json_path.hpp"
+#include "skeleton_list.hpp"
 #include "ontime/atomic_file.hpp"
 #include "ontime/error.hpp"
 
@@ -19,15 +21,6 @@ namespace ontime {
 namespace {
 
 using Json = nlohmann::ordered_json;
-
-std::string describe_type(const Json& value) {
-  if (value.is_null()) return "null";
-  if (value.is_boolean()) return "a boolean";
-  if (value.is_number()) return "a number";
-  if (value.is_string()) return "a string";
-  if (value.is_array()) return "an array";
-  return "an object";
-}
 
 std::string format_number(double value) {
   std::ostringstream out;
@@ -42,7 +35,7 @@ class InstanceReader {
 
   Problem read(std::string_view text) {
     const Json root = detail::parse_json_strict<Json>(text, source_);
-    if (!root.is_object()) fail("top level", "an instance must be a JSON object (got " + describe_type(root) + ")");
+    if (!root.is_object()) fail("top level", "an instance must be a JSON object (got " + detail::describe_json_type(root) + ")");
     check_keys(root, "", {"name", "description", "deadline", "step_seconds", "actions", "skeletons"});
 
     std::string name = std::filesystem::path(source_).stem().string();
@@ -64,7 +57,7 @@ class InstanceReader {
     double step_seconds = 1.0;
     if (root.contains("step_seconds")) {
       const Json& value = root["step_seconds"];
-      if (!value.is_number()) fail("step_seconds", "must be a number (got " + describe_type(value) + ")");
+      if (!value.is_number()) fail("step_seconds", "must be a number (got " + detail::describe_json_type(value) + ")");
       step_seconds = value.get<double>();
       if (!(std::isfinite(step_seconds) && step_seconds > 0)) {
         fail("step_seconds", "must be a positive number of seconds (got " + value.dump() + ")");
@@ -87,16 +80,11 @@ class InstanceReader {
   }
 
   void check_keys(const Json& object, const std::string& path, std::initializer_list<std::string_view> allowed) const {
-    for (const auto& [key, value] : object.items()) {
-      if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
-      std::string expected;
-      for (const std::string_view name : allowed) expected += (expected.empty() ? "'" : ", '") + std::string(name) + "'";
-      fail(detail::json_member(path, key), "unknown key (expected " + expected + ")");
-    }
+    detail::check_known_keys(object, path, allowed, source_);
   }
 
   std::string string_at(const Json& value, const std::string& path) const {
-    if (!value.is_string()) fail(path, "must be a string (got " + describe_type(value) + ")");
+    if (!value.is_string()) fail(path, "must be a string (got " + detail::describe_json_type(value) + ")");
     return value.get<std::string>();
   }
 
@@ -104,14 +92,14 @@ class InstanceReader {
     if (!root.contains("actions")) fail("top level", "missing required key 'actions'");
     const Json& actions_json = root["actions"];
     if (!actions_json.is_object()) {
-      fail("actions", "must be an object mapping action ids to distributions (got " + describe_type(actions_json) + ")");
+      fail("actions", "must be an object mapping action ids to distributions (got " + detail::describe_json_type(actions_json) + ")");
     }
     if (actions_json.empty()) fail("actions", "at least one action is needed");
     std::vector<Action> actions;
     for (const auto& [id, value] : actions_json.items()) {
       const std::string path = detail::json_member("actions", id);
       if (id.empty()) fail(path, "action ids must be non-empty");
-      if (!value.is_object()) fail(path, "an action must be an object with 'planning' and 'execution' (got " + describe_type(value) + ")");
+      if (!value.is_object()) fail(path, "an action must be an object with 'planning' and 'execution' (got " + detail::describe_json_type(value) + ")");
       check_keys(value, path, {"planning", "execution"});
       for (const char* required : {"planning", "execution"}) {
         if (!value.contains(required)) fail(path, std::string("missing required key '") + required + "'");
@@ -143,7 +131,7 @@ class InstanceReader {
   }
 
   double read_probability(const Json& value, const std::string& path) const {
-    if (!value.is_number()) fail(path, "a probability must be a number (got " + describe_type(value) + ")");
+    if (!value.is_number()) fail(path, "a probability must be a number (got " + detail::describe_json_type(value) + ")");
     const double probability = value.get<double>();
     if (!(probability >= 0.0 && probability <= 1.0 + Distribution::kSumTolerance)) {
       fail(path, "a probability must be within [0, 1] (got " + value.dump() + ")");
@@ -153,7 +141,7 @@ class InstanceReader {
 
   Distribution read_distribution(const Json& value, const std::string& path, Steps first, const char* kind) const {
     if (!value.is_object()) {
-      fail(path, "a distribution must be an object {\"pmf\": {...}} or {\"cdf\": {...}} (got " + describe_type(value) + ")");
+      fail(path, "a distribution must be an object {\"pmf\": {...}} or {\"cdf\": {...}} (got " + detail::describe_json_type(value) + ")");
     }
     check_keys(value, path, {"pmf", "cdf"});
     const bool has_pmf = value.contains("pmf");
@@ -163,7 +151,7 @@ class InstanceReader {
     const std::string table_path = detail::json_member(path, form);
     const Json& table = value[form];
     if (!table.is_object()) {
-      fail(table_path, "must be an object mapping steps to probabilities (got " + describe_type(table) + ")");
+      fail(table_path, "must be an object mapping steps to probabilities (got " + detail::describe_json_type(table) + ")");
     }
     std::map<Steps, std::pair<double, std::string>> entries;  // numeric order
     for (const auto& [key, probability] : table.items()) {
@@ -204,71 +192,16 @@ class InstanceReader {
 
   std::vector<std::vector<int>> read_skeletons(const Json& root, const std::vector<Action>& actions) const {
     if (!root.contains("skeletons")) fail("top level", "missing required key 'skeletons'");
-    const Json& list = root["skeletons"];
-    if (!list.is_array()) fail("skeletons", "must be an array of skeletons (got " + describe_type(list) + ")");
-    if (list.empty()) fail("skeletons", "at least one skeleton is needed");
-    if (list.size() > static_cast<std::size_t>(Problem::kMaxSkeletons)) {
-      fail("skeletons", "at most " + std::to_string(Problem::kMaxSkeletons) + " skeletons are supported (got " +
-                            std::to_string(list.size()) + ")");
-    }
     std::map<std::string, int> index_of;
     for (std::size_t a = 0; a < actions.size(); ++a) index_of.emplace(actions[a].id, static_cast<int>(a));
-
-    struct Occurrence {
-      std::size_t skeleton, position;
-    };
-    std::map<int, Occurrence> first_use;
-    std::map<std::vector<int>, std::size_t> seen_skeletons;
-    std::vector<std::vector<int>> skeletons;
-    for (std::size_t k = 0; k < list.size(); ++k) {
-      const std::string path = detail::json_index("skeletons", k);
-      const Json& skeleton_json = list[k];
-      if (!skeleton_json.is_array()) fail(path, "a skeleton must be an array of action ids (got " + describe_type(skeleton_json) + ")");
-      if (skeleton_json.empty()) fail(path, "a skeleton must list at least one action");
-      if (skeleton_json.size() > static_cast<std::size_t>(Problem::kMaxSkeletonLength)) {
-        fail(path, "a skeleton may list at most " + std::to_string(Problem::kMaxSkeletonLength) + " actions (got " +
-                       std::to_string(skeleton_json.size()) + ")");
-      }
-      std::vector<int> skeleton;
-      for (std::size_t l = 0; l < skeleton_json.size(); ++l) {
-        const std::string place = detail::json_index(path, l);
-        const Json& id_json = skeleton_json[l];
-        if (!id_json.is_string()) fail(place, "an action id must be a string (got " + describe_type(id_json) + ")");
-        const std::string id = id_json.get<std::string>();
-        const auto known = index_of.find(id);
-        if (known == index_of.end()) fail(place, "unknown action id '" + id + "' (not a key of 'actions')");
-        const int action = known->second;
-        for (std::size_t earlier = 0; earlier < skeleton.size(); ++earlier) {
-          if (skeleton[earlier] == action) {
-            fail(place, "action '" + id + "' appears twice in one skeleton (also at " + detail::json_index(path, earlier) + ")");
-          }
-        }
-        const auto [use, first] = first_use.try_emplace(action, Occurrence{k, l});
-        if (!first) {
-          const Occurrence other = use->second;
-          const std::string there = detail::json_index(detail::json_index("skeletons", other.skeleton), other.position);
-          if (other.position != l) {
-            fail(place, "action '" + id + "' is shared with " + there +
-                            " at another position; shared actions must follow a common prefix (SPEC §1)");
-          }
-          const int parent_here = l == 0 ? -1 : skeleton[l - 1];
-          const int parent_there = l == 0 ? -1 : skeletons[other.skeleton][l - 1];
-          if (parent_here != parent_there) {
-            fail(place, "action '" + id + "' is shared with " + there + " but the actions before it differ ('" +
-                            actions[static_cast<std::size_t>(parent_here)].id + "' here, '" +
-                            actions[static_cast<std::size_t>(parent_there)].id +
-                            "' there); shared actions must follow a common prefix (SPEC §1)");
-          }
-        }
-        skeleton.push_back(action);
-      }
-      const auto [duplicate, fresh] = seen_skeletons.try_emplace(skeleton, k);
-      if (!fresh) {
-        fail(path, "the same skeleton as " + detail::json_index("skeletons", duplicate->second) + "; list each skeleton once");
-      }
-      skeletons.push_back(std::move(skeleton));
-    }
-    return skeletons;
+    return detail::read_skeleton_list(
+        root["skeletons"], source_,
+        [&index_of](const std::string& id) -> std::optional<int> {
+          const auto known = index_of.find(id);
+          if (known == index_of.end()) return std::nullopt;
+          return known->second;
+        },
+        [&actions](int index) { return actions[static_cast<std::size_t>(index)].id; });
   }
 
   std::string source_;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <initializer_list>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -36,8 +37,31 @@ inline std::string json_member(const std::string& parent, std::string_view key) 
   return parent.empty() ? segment : parent + "." + segment;
 }
 
+// "null", "a boolean", "a number", "a string", "an array" or "an object", for messages.
+template <class Json>
+std::string describe_json_type(const Json& value) {
+  if (value.is_null()) return "null";
+  if (value.is_boolean()) return "a boolean";
+  if (value.is_number()) return "a number";
+  if (value.is_string()) return "a string";
+  if (value.is_array()) return "an array";
+  return "an object";
+}
+
 inline std::string json_index(const std::string& parent, std::size_t index) {
   return parent + "[" + std::to_string(index) + "]";
+}
+
+// Raises InputError at the first key of `object` (at `path`) that is not in `allowed`.
+template <class Json>
+void check_known_keys(const Json& object, const std::string& path, std::initializer_list<std::string_view> allowed,
+                      const std::string& source) {
+  for (const auto& [key, value] : object.items()) {
+    if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
+    std::string expected;
+    for (const std::string_view name : allowed) expected += (expected.empty() ? "'" : ", '") + std::string(name) + "'";
+    throw InputError(source, json_member(path, key), "unknown key (expected " + expected + ")");
+  }
 }
 
 inline std::string read_text_file(const std::filesystem::path& path) {

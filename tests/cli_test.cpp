@@ -5,10 +5,12 @@
 #include <fstream>
 #include <csignal>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "ontime/allocators/ppo.hpp"
 
 #include "support/bad_inputs.hpp"
+#include "support/bad_logs.hpp"
 #include "support/paper.hpp"
 #include "support/process.hpp"
 
@@ -198,7 +200,154 @@ TEST(Cli, InterruptedTrainingLeavesTheOldFile) {
   EXPECT_NO_THROW(load_ppo_policy(policy));
 }
 
+std::string read_file(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+double optimum(const std::string& instance) {
+  const auto result = ontime({"solve", instance, "--json"});
+  EXPECT_EQ(result.exit_code, 0) << result.err;
+  return json::parse(result.out)["optimal_success_probability"].get<double>();
+}
+
+TEST(Cli, SampledLogFitsBackToTheOptimumWithinOneHundredth) {
+  const std::filesystem::path dir = scratch("round-trip");
+  const std::string log = (dir / "instance1.jsonl").string();
+  const std::string fitted = (dir / "fitted.json").string();
+  const auto sampled = ontime({"sample-log", paper("instance1"), "--attempts", "20000", "--seed", "3", "-o", log});
+  ASSERT_EQ(sampled.exit_code, 0) << sampled.err;
+  const auto fit = ontime({"fit", log, "--step", "1", "--deadline", "14", "--skeletons", paper("instance1"), "-o", fitted,
+                           "--json"});
+  ASSERT_EQ(fit.exit_code, 0) << fit.err;
+  const json report = json::parse(fit.out);
+  EXPECT_EQ(report["records"].get<int>(), 9 * 20000);  // instance 1 uses 9 actions
+  EXPECT_EQ(report["actions"].size(), 9u);
+  EXPECT_EQ(report["actions"][0]["attempts"].get<int>(), 20000);
+  EXPECT_NEAR(optimum(fitted), optimum(paper("instance1")), 0.01);
+  // Same seed, same log.
+  const std::string again = (dir / "again.jsonl").string();
+  ASSERT_EQ(ontime({"sample-log", paper("instance1"), "--attempts", "20000", "--seed", "3", "-o", again}).exit_code, 0);
+  EXPECT_EQ(read_file(log), read_file(again));
+}
+
+TEST(Cli, FitRejectsEveryBadLogWithOneLineNamingFileLineAndRule) {
+  const std::filesystem::path dir = scratch("bad-logs");
+  for (const testing::BadInput& bad : testing::kBadLogs) {
+    const std::string path = testing::source_path("tests/data/bad_logs/" + bad.file).string();
+    const std::string output = (dir / "never-written.json").string();
+    const auto result = ontime({"fit", path, "--step", "1", "--deadline", "5", "--skeletons", paper("figure1"), "-o", output});
+    EXPECT_EQ(result.exit_code, 2) << bad.file;
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << bad.file << ": " << result.err;
+    EXPECT_NE(result.err.find(path + ": " + bad.place + ": "), std::string::npos) << result.err;
+    EXPECT_NE(result.err.find(bad.rule), std::string::npos) << result.err;
+    EXPECT_FALSE(std::filesystem::exists(output)) << bad.file;
+  }
+}
+
+TEST(Cli, FitNamesTheSkeletonActionMissingFromTheLog) {
+  const std::filesystem::path dir = scratch("missing-action");
+  const std::string log = (dir / "figure1.jsonl").string();
+  ASSERT_EQ(ontime({"sample-log", paper("figure1"), "--attempts", "10", "-o", log}).exit_code, 0);
+  const auto result = ontime({"fit", log, "--step", "1", "--deadline", "5", "--skeletons", paper("instance1"), "-o",
+                              (dir / "out.json").string()});
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.err.find(paper("instance1") + ": skeletons[0][0]: action 'a1_1' has no record in the log " + log),
+            std::string::npos)
+      << result.err;
+  EXPECT_EQ(ontime({"fit", log, "--step", "0", "--deadline", "5", "--skeletons", paper("figure1"), "-o", "x.json"}).exit_code, 2);
+  EXPECT_EQ(ontime({"fit", log, "--step", "1", "--deadline", "0", "--skeletons", paper("figure1"), "-o", "x.json"}).exit_code, 2);
+  EXPECT_EQ(ontime({"fit", log, "--step", "1", "--deadline", "5", "--skeletons", paper("figure1"), "-o", "x.json",
+                    "--laplace", "-1"}).exit_code, 2);
+}
+
+TEST(Cli, PlotWritesTheHistogramsAndTheirData) {
+  const std::filesystem::path dir = scratch("plot");
+  const std::string png = (dir / "figure1.png").string();
+  const auto result = ontime({"plot", paper("figure1"), "-o", png});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(read_file(png).substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  const std::string csv = read_file(dir / "figure1.csv");
+  EXPECT_EQ(csv.substr(0, csv.find('\n')), "action,distribution,step,probability");
+  EXPECT_NE(csv.find("\"d1\",planning,4,0.5\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\"d1\",execution,10,0.5\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\"d1\",planning,never,0\n"), std::string::npos) << csv;
+  EXPECT_EQ(ontime({"plot", "/nonexistent.json"}).exit_code, 2);
+}
+
+TEST(Cli, CollectWritesTheLogAndTheFittedInstance) {
+  const std::filesystem::path dir = scratch("collect");
+  const std::string log = (dir / "logs" / "navigation.jsonl").string();
+  const std::string instance = (dir / "navigation.json").string();
+  const auto result = ontime({"collect", "--domain", "navigation", "--trials", "2", "--threads", "2", "--seed", "4",
+                              "--log", log, "-o", instance, "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const json out = json::parse(result.out);
+  EXPECT_EQ(out["attempts"].get<int>(), 30);
+  EXPECT_EQ(out["deadline"].get<int>(), 22);
+  EXPECT_EQ(out["effort"], "checks");
+  EXPECT_EQ(out["actions"].size(), 15u);
+  const std::string lines = read_file(log);
+  EXPECT_EQ(std::count(lines.begin(), lines.end(), '\n'), 30);
+  const auto solved = ontime({"solve", instance, "--json"});
+  EXPECT_EQ(solved.exit_code, 0) << solved.err;
+  // Fitting the written log again gives the same instance.
+  const std::string refit = (dir / "refit.json").string();
+  ASSERT_EQ(ontime({"fit", log, "--step", "3", "--deadline", "22", "--skeletons",
+                    testing::source_path("data/domains/navigation.json").string(), "-o", refit, "--name", "navigation"})
+                .exit_code,
+            0);
+  EXPECT_EQ(json::parse(read_file(refit))["actions"], json::parse(read_file(instance))["actions"]);
+}
+
+TEST(Cli, CollectRejectsBadDomainsAndWorlds) {
+  const std::filesystem::path dir = scratch("bad-world");
+  const auto unknown = ontime({"collect", "--domain", "kitchen", "--trials", "1"});
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.err.find("unknown domain 'kitchen'"), std::string::npos) << unknown.err;
+  json world = json::parse(read_file(testing::source_path("data/domains/navigation.json")));
+  world["doors"][3]["width"] = 0.5;
+  const std::string bad = (dir / "world.json").string();
+  std::ofstream(bad) << world.dump(1);
+  const auto result = ontime({"collect", "--domain", "navigation", "--world", bad, "--trials", "1", "--log",
+                              (dir / "l.jsonl").string(), "-o", (dir / "i.json").string()});
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+  EXPECT_NE(result.err.find(bad + ": doors[3].width: narrower than the robot"), std::string::npos) << result.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "l.jsonl"));
+  EXPECT_EQ(ontime({"collect", "--domain", "navigation", "--effort", "minutes"}).exit_code, 2);
+  // An output that cannot be written stops the command before any planning.
+  std::ofstream(dir / "file") << "x";
+  const auto unwritable = ontime({"collect", "--domain", "navigation", "--trials", "1", "--log",
+                                  (dir / "file" / "l.jsonl").string(), "-o", (dir / "i.json").string()});
+  EXPECT_EQ(unwritable.exit_code, 2);
+  EXPECT_NE(unwritable.err.find("cannot write into"), std::string::npos) << unwritable.err;
+}
+
+TEST(Cli, MapDrawsTheWorldAndOneMotionPerSkeleton) {
+  const std::filesystem::path dir = scratch("map");
+  const std::string png = (dir / "map.png").string();
+  const auto result = ontime({"map", "--domain", "navigation", "-o", png});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(read_file(png).substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  const json drawing = json::parse(read_file(dir / "map.json"));
+  EXPECT_EQ(drawing["paths"].size(), 4u);
+  EXPECT_GT(drawing["polygons"].size(), 13u);
+}
+
 TEST(Cli, HelpIsAvailableForEveryCommand) {
+  for (const char* command : {"collect", "map"}) {
+    const auto result = ontime({command, "--help"});
+    EXPECT_EQ(result.exit_code, 0) << command;
+    EXPECT_NE(result.out.find("--domain"), std::string::npos) << command;
+  }
+  for (const char* command : {"fit", "sample-log", "plot"}) {
+    const auto result = ontime({command, "--help"});
+    EXPECT_EQ(result.exit_code, 0) << command;
+    EXPECT_NE(result.out.find("--output"), std::string::npos) << command;
+  }
   for (const char* command : {"solve", "evaluate", "table", "train", "reduce-knapsack"}) {
     const auto result = ontime({command, "--help"});
     EXPECT_EQ(result.exit_code, 0) << command;

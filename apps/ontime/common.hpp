@@ -23,6 +23,12 @@ void add_table_command(CLI::App& app);
 void add_study_command(CLI::App& app);
 void add_train_command(CLI::App& app);
 void add_reduce_knapsack_command(CLI::App& app);
+void add_fit_command(CLI::App& app);
+void add_sample_log_command(CLI::App& app);
+void add_plot_command(CLI::App& app);
+void add_collect_command(CLI::App& app);
+void add_map_command(CLI::App& app);
+void add_run_command(CLI::App& app);
 
 // Options shared by commands that build allocators.
 struct AllocatorFlags {

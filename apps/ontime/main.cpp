@@ -35,6 +35,12 @@ int main(int argc, char** argv) {
   ontime::cli::add_study_command(app);
   ontime::cli::add_train_command(app);
   ontime::cli::add_reduce_knapsack_command(app);
+  ontime::cli::add_fit_command(app);
+  ontime::cli::add_sample_log_command(app);
+  ontime::cli::add_plot_command(app);
+  ontime::cli::add_collect_command(app);
+  ontime::cli::add_map_command(app);
+  ontime::cli::add_run_command(app);
 
   try {
     app.parse(argc, argv);

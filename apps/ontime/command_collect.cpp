@@ -1,0 +1,148 @@
+// `ontime collect --domain NAME --trials N`: refines every action of the domain's skeleton tree
+// N times with the real motion planner, writes the planner log and fits the instance.
+
+#include <filesystem>
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include "common.hpp"
+#include "data_paths.hpp"
+#include "fit_report.hpp"
+#include "ontime/domains/collection.hpp"
+#include "ontime/domains/registry.hpp"
+#include "ontime/error.hpp"
+#include "ontime/fitting.hpp"
+#include "ontime/instance_io.hpp"
+
+namespace ontime::cli {
+namespace {
+
+// Creates the directory an output goes to and checks that it can be written, so that a bad
+// path stops the command before the collection, not after it.
+void prepare_output(const std::filesystem::path& path) {
+  const std::filesystem::path directory = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+  std::error_code error;
+  std::filesystem::create_directories(directory, error);
+  if (error || ::access(directory.c_str(), W_OK) != 0) {
+    throw UsageError(path.string() + ": cannot write into " + directory.string() +
+                     (error ? " (" + error.message() + ")" : std::string(" (not writable)")));
+  }
+}
+
+}  // namespace
+
+void add_collect_command(CLI::App& app) {
+  struct Options {
+    std::string domain;
+    std::string world;
+    std::string log;
+    std::string instance;
+    std::string effort = "checks";
+    std::uint64_t trials = 1000;
+    std::uint64_t seed = 1;
+    unsigned threads = 0;
+    double step_seconds = 0;
+    Steps deadline = 0;
+    Steps budget = 0;
+    double checks_per_second = 0;
+    double laplace = 0;
+    bool json = false;
+  };
+  auto options = std::make_shared<Options>();
+  std::string names;
+  for (const std::string& name : domains::domain_names()) names += (names.empty() ? "" : ", ") + name;
+  CLI::App* command = app.add_subcommand("collect", "Refine every action of a domain many times, log it, fit the instance");
+  command->add_option("--domain", options->domain, "Domain: " + names)->required();
+  command->add_option("--world", options->world, "World file (default: data/domains/DOMAIN.json)");
+  command->add_option("--trials", options->trials, "Attempts per action")->check(CLI::PositiveNumber)->capture_default_str();
+  command->add_option("--seed", options->seed, "Seed (trial t of action a uses stream t of stream a)")->capture_default_str();
+  command->add_option("--threads", options->threads, "Worker threads (0: one per hardware thread); the log does not depend on it")
+      ->capture_default_str();
+  command->add_option("--effort", options->effort, "Effort unit: checks (deterministic) or wall (wall-clock seconds)")
+      ->check(CLI::IsMember({"checks", "wall"}))
+      ->capture_default_str();
+  command->add_option("--step", options->step_seconds, "Seconds of effort per step (default: the world file's)")
+      ->check(CLI::PositiveNumber);
+  command->add_option("--deadline", options->deadline, "Deadline D in steps (default: the world file's)")
+      ->check(CLI::Range(1, static_cast<int>(Problem::kMaxDeadline)));
+  command->add_option("--budget", options->budget, "Steps of effort after which an attempt is cut off (default: D)")
+      ->check(CLI::PositiveNumber);
+  command->add_option("--checks-per-second", options->checks_per_second,
+                      "Nominal collision checks per second of the checks unit (default: the world file's)")
+      ->check(CLI::PositiveNumber);
+  command->add_option("--laplace", options->laplace, "Laplace smoothing of the fit")->check(CLI::NonNegativeNumber)->capture_default_str();
+  command->add_option("--log", options->log, "Planner log to write (default: data/logs/DOMAIN.jsonl)");
+  command->add_option("-o,--instance", options->instance, "Instance to write (default: data/instances/DOMAIN.json)");
+  command->add_flag("--json", options->json, "Print JSON");
+  command->callback([options] {
+    const std::filesystem::path world = options->world.empty() ? default_world_file(options->domain) : std::filesystem::path(options->world);
+    const domains::LoadedDomain loaded = domains::load_domain(options->domain, world);
+    const domains::CollectionDefaults& defaults = loaded.defaults.collection;
+    const std::filesystem::path log_path = options->log.empty() ? std::filesystem::path("data/logs") / (options->domain + ".jsonl") : std::filesystem::path(options->log);
+    const std::filesystem::path instance_path = options->instance.empty() ? std::filesystem::path("data/instances") / (options->domain + ".json") : std::filesystem::path(options->instance);
+
+    domains::CollectionOptions collection;
+    collection.trials = options->trials;
+    collection.seed = options->seed;
+    collection.threads = options->threads;
+    collection.effort.unit = domains::parse_effort_unit(options->effort);
+    collection.effort.checks_per_second = options->checks_per_second > 0 ? options->checks_per_second : defaults.checks_per_second;
+    collection.step_seconds = options->step_seconds > 0 ? options->step_seconds : defaults.step_seconds;
+    const Steps deadline = options->deadline > 0 ? options->deadline : defaults.deadline;
+    collection.budget_steps = options->budget > 0 ? options->budget : deadline;
+    prepare_output(log_path);
+    prepare_output(instance_path);
+    ProgressBar bar("collect " + options->domain);
+    collection.progress = [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); };
+    const domains::CollectionResult result = domains::collect(*loaded.domain, collection);
+
+    save_planner_log(result.log, log_path);
+    FitOptions fit_options;
+    fit_options.step_seconds = collection.step_seconds;
+    fit_options.deadline = deadline;
+    fit_options.laplace = options->laplace;
+    fit_options.name = options->domain;
+    fit_options.description = fmt::format(
+        "Fitted from {} attempts per action of the {} domain ({}): seed {}, effort unit {}{}, step {} s, cut-off {} steps",
+        options->trials, options->domain, world.filename().string(), options->seed, options->effort,
+        collection.effort.unit == domains::EffortUnit::collision_checks
+            ? fmt::format(" at {} checks per second", collection.effort.checks_per_second)
+            : std::string(),
+        collection.step_seconds, collection.budget_steps);
+    const SkeletonList skeletons{world.string(), loaded.domain->skeletons()};
+    const FitResult fit = fit_problem(result.log, log_path.string(), skeletons, fit_options);
+    save_problem(fit.problem, instance_path);
+
+    std::uint64_t found = 0;
+    for (const RefinementAttempt& attempt : result.log) found += attempt.found ? 1 : 0;
+    if (options->json) {
+      Json out;
+      out["domain"] = options->domain;
+      out["world"] = world.string();
+      out["trials"] = options->trials;
+      out["seed"] = options->seed;
+      out["effort"] = options->effort;
+      out["step_seconds"] = collection.step_seconds;
+      out["deadline"] = deadline;
+      out["budget_steps"] = collection.budget_steps;
+      out["checks_per_second"] = collection.effort.checks_per_second;
+      out["attempts"] = result.log.size();
+      out["found"] = found;
+      out["collision_checks"] = result.collision_checks;
+      out["seconds"] = result.seconds;
+      out["log"] = log_path.string();
+      out["instance"] = instance_path.string();
+      out["actions"] = fit_report_json(fit);
+      print_json(out);
+      return;
+    }
+    fmt::print("Collected {} attempts ({} per action, {} found) in {:.1f} s: {} collision checks.\n", result.log.size(),
+               options->trials, found, result.seconds, result.collision_checks);
+    fmt::print("Log: {}. Instance: {} (deadline {} steps of {} s).\n\n", log_path.string(), instance_path.string(),
+               deadline, collection.step_seconds);
+    fmt::print("{}", fit_report_markdown(fit));
+    fmt::print("\nT: planning steps, X: execution steps (means over the steps within the deadline).\n");
+  });
+}
+
+}  // namespace ontime::cli

@@ -1,0 +1,76 @@
+// `ontime fit LOG --step S --deadline D --skeletons FILE --output INSTANCE`: learns each
+// action's planning and execution distributions from a planner log and writes the instance.
+
+#include <filesystem>
+#include <fmt/format.h>
+
+#include "common.hpp"
+#include "fit_report.hpp"
+#include "ontime/fitting.hpp"
+#include "ontime/instance_io.hpp"
+#include "ontime/planner_log.hpp"
+
+namespace ontime::cli {
+
+void add_fit_command(CLI::App& app) {
+  struct Options {
+    std::string log;
+    std::string skeletons;
+    std::string output;
+    std::string name;
+    std::string description;
+    double step_seconds = 1.0;
+    Steps deadline = 0;
+    double laplace = 0;
+    bool json = false;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* command = app.add_subcommand("fit", "Learn an instance's time distributions from a planner log");
+  command->add_option("LOG", options->log, "Planner log (JSON Lines, docs/formats.md)")->required();
+  command->add_option("--step", options->step_seconds, "Length of one step in seconds (times are rounded up to steps)")
+      ->required()
+      ->check(CLI::PositiveNumber);
+  command->add_option("--deadline", options->deadline, "Deadline D in steps; planning or execution beyond it is \"never\"")
+      ->required()
+      ->check(CLI::Range(1, static_cast<int>(Problem::kMaxDeadline)));
+  command->add_option("--skeletons", options->skeletons,
+                      "JSON file whose 'skeletons' member lists the plan skeletons (an instance or world file will do)")
+      ->required();
+  command->add_option("-o,--output", options->output, "Instance file to write (SPEC §5)")->required();
+  command->add_option("--laplace", options->laplace, "Laplace (add-alpha) smoothing of the estimates")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  command->add_option("--name", options->name, "Instance name (default: the output file's stem)");
+  command->add_option("--description", options->description, "Instance description");
+  command->add_flag("--json", options->json, "Print JSON");
+  command->callback([options] {
+    const SkeletonList skeletons = load_skeleton_file(options->skeletons);
+    const std::vector<RefinementAttempt> attempts = load_planner_log(options->log);
+    FitOptions fit_options;
+    fit_options.step_seconds = options->step_seconds;
+    fit_options.deadline = options->deadline;
+    fit_options.laplace = options->laplace;
+    fit_options.name = options->name.empty() ? std::filesystem::path(options->output).stem().string() : options->name;
+    fit_options.description = options->description;
+    const FitResult fit = fit_problem(attempts, options->log, skeletons, fit_options);
+    save_problem(fit.problem, options->output);
+    if (options->json) {
+      Json out;
+      out["log"] = options->log;
+      out["records"] = attempts.size();
+      out["instance"] = options->output;
+      out["deadline"] = options->deadline;
+      out["step_seconds"] = options->step_seconds;
+      out["laplace"] = options->laplace;
+      out["actions"] = fit_report_json(fit);
+      print_json(out);
+      return;
+    }
+    fmt::print("Fitted {} from {} records of {}: deadline {} steps of {} s, Laplace alpha {}.\n\n", options->output,
+               attempts.size(), options->log, options->deadline, options->step_seconds, options->laplace);
+    fmt::print("{}", fit_report_markdown(fit));
+    fmt::print("\nT: planning steps, X: execution steps (means over the steps within the deadline).\n");
+  });
+}
+
+}  // namespace ontime::cli

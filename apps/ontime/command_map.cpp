@@ -1,0 +1,80 @@
+// `ontime map --domain NAME`: a picture of the domain's world with one refined motion per
+// skeleton. The drawing primitives are written first as JSON beside the PNG.
+
+#include <filesystem>
+#include <fmt/format.h>
+
+#include "common.hpp"
+#include "data_paths.hpp"
+#include "ontime/atomic_file.hpp"
+#include "ontime/domains/collection.hpp"
+#include "ontime/domains/registry.hpp"
+#include "python_runner.hpp"
+
+namespace ontime::cli {
+namespace {
+
+Json points_json(const std::vector<std::array<double, 2>>& points) {
+  Json list = Json::array();
+  for (const auto& point : points) list.push_back({point[0], point[1]});
+  return list;
+}
+
+}  // namespace
+
+void add_map_command(CLI::App& app) {
+  struct Options {
+    std::string domain;
+    std::string world;
+    std::string output;
+    std::uint64_t seed = 1;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* command = app.add_subcommand("map", "Draw a domain's world with one refined motion per skeleton (PNG)");
+  command->add_option("--domain", options->domain, "Domain")->required();
+  command->add_option("--world", options->world, "World file (default: data/domains/DOMAIN.json)");
+  command->add_option("--seed", options->seed, "Seed of the refinements drawn")->capture_default_str();
+  command->add_option("-o,--output", options->output,
+                      "PNG to write (default: DOMAIN-map.png in the current directory); the drawing goes beside it as .json");
+  command->callback([options] {
+    const std::filesystem::path world =
+        options->world.empty() ? default_world_file(options->domain) : std::filesystem::path(options->world);
+    const domains::LoadedDomain loaded = domains::load_domain(options->domain, world);
+    const domains::Domain& domain = *loaded.domain;
+    domains::CollectionOptions settings;
+    settings.step_seconds = loaded.defaults.collection.step_seconds;
+    settings.budget_steps = loaded.defaults.collection.deadline;
+    settings.effort.checks_per_second = loaded.defaults.collection.checks_per_second;
+
+    const domains::Scene scene = domain.scene();
+    Json drawing;
+    drawing["title"] = fmt::format("{}: one refined motion per skeleton (seed {})", scene.title, options->seed);
+    drawing["polygons"] = Json::array();
+    for (const domains::ScenePolygon& polygon : scene.polygons) {
+      drawing["polygons"].push_back({{"kind", polygon.kind}, {"label", polygon.label}, {"points", points_json(polygon.points)}});
+    }
+    drawing["paths"] = Json::array();
+    const auto& skeletons = domain.skeletons();
+    for (std::size_t k = 0; k < skeletons.size(); ++k) {
+      const auto motions = domains::refine_skeleton(domain, skeletons[k], stream_seed(options->seed, k), settings);
+      std::vector<std::array<double, 2>> points;
+      for (const auto& motion : motions) {
+        const auto trace = domain.trace(motion);
+        points.insert(points.end(), trace.begin() + (points.empty() ? 0 : 1), trace.end());
+      }
+      const std::vector<domains::Configuration>& last = motions.back();
+      drawing["paths"].push_back({{"label", fmt::format("σ{}: {}", k + 1, fmt::join(skeletons[k], " "))},
+                                  {"points", points_json(points)},
+                                  {"end", points_json(domain.outline(last.back()))}});
+    }
+    const std::filesystem::path png = options->output.empty() ? std::filesystem::path(options->domain + "-map.png")
+                                                              : std::filesystem::path(options->output);
+    std::filesystem::path data = png;
+    data.replace_extension(".json");
+    write_file_atomically(data, drawing.dump(1) + "\n");
+    run_python_script("plot_map.py", {"--data", data.string(), "--output", png.string()});
+    fmt::print("Wrote {} (data: {}).\n", png.string(), data.string());
+  });
+}
+
+}  // namespace ontime::cli

@@ -1,0 +1,102 @@
+// `ontime run --domain NAME --solver NAME`: episodes in which an allocator drives the domain's
+// real motion planner step by step (several refinements interleaved), against the success the
+// allocator expects from the fitted instance.
+
+#include <filesystem>
+#include <fmt/format.h>
+
+#include "common.hpp"
+#include "data_paths.hpp"
+#include "ontime/domains/online.hpp"
+#include "ontime/domains/registry.hpp"
+#include "ontime/instance_io.hpp"
+
+namespace ontime::cli {
+
+void add_run_command(CLI::App& app) {
+  struct Options {
+    std::string domain;
+    std::string world;
+    std::string instance;
+    std::string solver;
+    std::string effort = "checks";
+    std::uint64_t episodes = 200;
+    std::uint64_t seed = 1;
+    unsigned threads = 0;
+    double checks_per_second = 0;
+    bool exact = false;
+    bool independent_starts = false;
+    bool json = false;
+    AllocatorFlags allocator;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* command = app.add_subcommand("run", "Episodes in which an allocator drives a domain's real motion planner");
+  command->add_option("--domain", options->domain, "Domain")->required();
+  command->add_option("--solver", options->solver, "Allocator: " + fmt::format("{}", fmt::join(allocator_names(), ", ")))
+      ->required();
+  command->add_option("--instance", options->instance, "The allocator's model (default: data/instances/DOMAIN.json)");
+  command->add_option("--world", options->world, "World file (default: data/domains/DOMAIN.json)");
+  command->add_option("--episodes", options->episodes, "Episodes")->check(CLI::PositiveNumber)->capture_default_str();
+  command->add_option("--seed", options->seed, "Seed (episode e uses stream e)")->capture_default_str();
+  command->add_option("--threads", options->threads, "Worker threads (0: one per hardware thread); results do not depend on it")
+      ->capture_default_str();
+  command->add_option("--effort", options->effort, "Effort unit: checks (deterministic) or wall")
+      ->check(CLI::IsMember({"checks", "wall"}))
+      ->capture_default_str();
+  command->add_option("--checks-per-second", options->checks_per_second,
+                      "Nominal collision checks per second of the checks unit (default: the world file's)")
+      ->check(CLI::PositiveNumber);
+  command->add_flag("--independent-starts", options->independent_starts,
+                    "Start every action after the first from a fresh pose in its room, not where the previous refinement ended");
+  command->add_flag("--exact", options->exact, "Also the exact success the allocator expects from the instance");
+  command->add_flag("--json", options->json, "Print JSON");
+  options->allocator.add_to(*command);
+  command->callback([options] {
+    check_solver_names({options->solver});
+    const std::filesystem::path world =
+        options->world.empty() ? default_world_file(options->domain) : std::filesystem::path(options->world);
+    const std::filesystem::path instance = options->instance.empty()
+                                               ? data_directory() / "instances" / (options->domain + ".json")
+                                               : std::filesystem::path(options->instance);
+    const domains::LoadedDomain loaded = domains::load_domain(options->domain, world);
+    const Problem problem = load_problem(instance);
+    const Mdp mdp(problem);
+    const AllocatorFactory factory = make_allocator_factory(options->solver, mdp, options->allocator.options());
+    domains::OnlineOptions online;
+    online.effort.unit = domains::parse_effort_unit(options->effort);
+    online.effort.checks_per_second =
+        options->checks_per_second > 0 ? options->checks_per_second : loaded.defaults.collection.checks_per_second;
+    online.independent_starts = options->independent_starts;
+    const domains::OnlineSummary summary =
+        domains::run_online(*loaded.domain, mdp, factory, options->episodes, options->seed, options->threads, online);
+    std::optional<ExactEvaluation> exact;
+    if (options->exact) {
+      const auto allocator = factory();
+      exact = evaluate_exactly(mdp, *allocator, options->allocator.max_states);
+    }
+    if (options->json) {
+      Json out;
+      out["domain"] = options->domain;
+      out["instance"] = instance.string();
+      out["solver"] = options->solver;
+      out["episodes"] = summary.episodes;
+      out["seed"] = options->seed;
+      out["successes"] = summary.successes;
+      out["success_rate"] = summary.success_rate;
+      out["ci95"] = summary.ci95;
+      out["independent_starts"] = options->independent_starts;
+      out["refinements_started"] = summary.mean_actions_started;
+      out["seconds"] = summary.seconds;
+      if (exact) out["model_exact_success_probability"] = exact->success_probability;
+      print_json(out);
+      return;
+    }
+    fmt::print("solver               {} on the {} domain (model {})\n", options->solver, options->domain, instance.string());
+    fmt::print("real planner         {:.4f} ± {:.4f}  ({} of {} episodes, seed {}, {:.1f} s)\n", summary.success_rate,
+               summary.ci95, summary.successes, summary.episodes, options->seed, summary.seconds);
+    fmt::print("refinements started  {:.2f} per episode\n", summary.mean_actions_started);
+    if (exact) fmt::print("model, exact         {:.4f}\n", exact->success_probability);
+  });
+}
+
+}  // namespace ontime::cli

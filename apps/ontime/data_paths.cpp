@@ -1,0 +1,18 @@
+#include "data_paths.hpp"
+
+#include <cstdlib>
+
+namespace ontime::cli {
+
+std::filesystem::path data_directory() {
+  if (const char* override_dir = std::getenv("ONTIME_DATA_DIR")) return override_dir;
+  std::error_code error;
+  if (std::filesystem::is_directory(ONTIME_DATA_SOURCE_DIR, error)) return ONTIME_DATA_SOURCE_DIR;
+  return ONTIME_DATA_INSTALL_DIR;
+}
+
+std::filesystem::path default_world_file(const std::string& domain) {
+  return data_directory() / "domains" / (domain + ".json");
+}
+
+}  // namespace ontime::cli

@@ -1,0 +1,72 @@
+// Speed of the navigation domain (docs/domains.md): one collision check, and one refinement of
+// each action in the deterministic checks unit, as the collection runs it (slices of one step,
+// cut off after the deadline). The collection target — 1,000 trials of every action of the
+// navigation tree within 10 minutes on 2 cores — needs 15,000 refinements in 1,200 core-seconds,
+// i.e. at most 80 ms per refinement on average. Run a Release build:
+//   build/ontime_domains_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+
+#include <benchmark/benchmark.h>
+
+#include <string>
+
+#include "ontime/domains/collection.hpp"
+#include "ontime/domains/navigation.hpp"
+#include "ontime/domains/navigation_collision.hpp"
+#include "ontime/random.hpp"
+
+namespace {
+
+const ontime::domains::NavigationDomain& office() {
+  static const ontime::domains::NavigationDomain domain(
+      ontime::domains::load_navigation_world(std::string(ONTIME_SOURCE_DIR) + "/data/domains/navigation.json"));
+  return domain;
+}
+
+void BM_NavigationCollisionCheck(benchmark::State& bench) {
+  const auto& world = office().world();
+  const ontime::domains::NavigationCollision collision(world, world.robot.clearance);
+  ontime::SplitMix64 random(1);
+  const auto bounds = world.bounds();
+  std::vector<ontime::domains::Pose> poses;
+  for (int i = 0; i < 4096; ++i) {
+    poses.push_back({bounds[0] + (bounds[2] - bounds[0]) * ontime::uniform01(random),
+                     bounds[1] + (bounds[3] - bounds[1]) * ontime::uniform01(random), 6.28 * ontime::uniform01(random)});
+  }
+  std::size_t next = 0;
+  for (auto _ : bench) {
+    benchmark::DoNotOptimize(collision.collides(poses[next]));
+    next = (next + 1) & 4095;
+  }
+}
+BENCHMARK(BM_NavigationCollisionCheck);
+
+// One refinement of the action with index range(0) in the skeleton tree, from the start or
+// from fallback starts, a fresh seed each time; reports checks per refinement and found share.
+void BM_NavigationRefinement(benchmark::State& bench) {
+  const auto& domain = office();
+  const auto tree = ontime::domains::skeleton_tree(domain.skeletons());
+  const auto& node = tree.at(static_cast<std::size_t>(bench.range(0)));
+  const auto& defaults = domain.world().collection;
+  const ontime::domains::EffortSettings effort{ontime::domains::EffortUnit::collision_checks, defaults.checks_per_second};
+  std::uint64_t seed = 0, checks = 0, found = 0;
+  for (auto _ : bench) {
+    ++seed;
+    const auto start = node.parent < 0 ? domain.initial_configuration() : domain.fallback_start(node.action, seed);
+    const auto refinement = domain.refine(node.action, start, seed, effort);
+    for (int step = 1; step <= defaults.deadline; ++step) {
+      if (refinement->advance(step * defaults.step_seconds) == ontime::domains::RefinementStatus::found) {
+        ++found;
+        break;
+      }
+    }
+    checks += refinement->effort().checks();
+  }
+  bench.counters["checks"] = benchmark::Counter(static_cast<double>(checks), benchmark::Counter::kAvgIterations);
+  bench.counters["found"] = benchmark::Counter(static_cast<double>(found), benchmark::Counter::kAvgIterations);
+  bench.SetLabel(node.action);
+}
+BENCHMARK(BM_NavigationRefinement)->DenseRange(0, 14)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,62 @@
+#pragma once
+// The collection pipeline: refine every action of a domain's skeleton tree many times and log
+// every attempt (planner log, ontime/planner_log.hpp), ready for ontime::fit_problem.
+//
+// Trial t of an action starts where a successful refinement of the action before it ended:
+// the (t mod m)-th of its m successful refinements, in trial order; a first action starts at
+// the domain's initial configuration. (If no refinement of the action before succeeded, the
+// domain draws a fallback start.) An attempt gets one step of effort at a time, exactly as an
+// allocator would give it (advance(1 step), advance(2 steps), ...), and is cut off after
+// `budget_steps` steps without a motion.
+//
+// Determinism: trial t of the a-th action of the tree draws everything from
+// stream_seed(stream_seed(seed, a), t), whichever thread runs it, and the log lists actions in
+// tree order and trials in order. In the collision-checks effort unit the same seed therefore
+// gives the same log byte for byte, for any number of threads.
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "ontime/distribution.hpp"
+#include "ontime/domains/domain.hpp"
+#include "ontime/planner_log.hpp"
+
+namespace ontime::domains {
+
+// The actions of the skeletons' prefix tree, parents before children (breadth first, in order
+// of first appearance), each with the index of the action before it (-1 for a first action).
+struct TreeAction {
+  std::string action;
+  int parent = -1;
+};
+std::vector<TreeAction> skeleton_tree(const std::vector<std::vector<std::string>>& skeletons);
+
+struct CollectionOptions {
+  std::uint64_t trials = 1000;  // attempts per action
+  std::uint64_t seed = 1;
+  unsigned threads = 0;         // 0: one per hardware thread
+  EffortSettings effort;
+  double step_seconds = 1.0;    // one step of effort
+  Steps budget_steps = 1;       // cut-off
+  // Called with the number of attempts done and the total (from one thread at a time).
+  std::function<void(std::uint64_t done, std::uint64_t total)> progress;
+};
+
+struct CollectionResult {
+  std::vector<RefinementAttempt> log;  // actions in tree order, trials in order
+  std::uint64_t collision_checks = 0;  // over all attempts
+  double seconds = 0;                  // wall-clock time of the collection
+};
+
+CollectionResult collect(const Domain& domain, const CollectionOptions& options);
+
+// One refined motion per action of a skeleton, executed one after the other from the domain's
+// initial configuration (for pictures). Each action gets up to `attempts` attempts of
+// `budget_steps` steps; throws ontime::UsageError when all of them are cut off.
+std::vector<std::vector<Configuration>> refine_skeleton(const Domain& domain, const std::vector<std::string>& skeleton,
+                                                        std::uint64_t seed, const CollectionOptions& options,
+                                                        int attempts = 20);
+
+}  // namespace ontime::domains

@@ -1,0 +1,86 @@
+#pragma once
+// The interface between a TAMP domain (a world, a robot, a motion planner) and the collection
+// pipeline (collection.hpp) that turns it into planner logs and instances.
+//
+// A domain names its plan skeletons (sequences of abstract actions) and refines one abstract
+// action at a time: from a start configuration, with all randomness drawn from a seed, in
+// slices of effort that resume the same planner, so that an allocator may interleave actions.
+// It also turns itself and its motions into 2D drawing primitives for the map pictures.
+//
+// A second domain implements the same two classes (Domain, Refinement); nothing else in the
+// pipeline knows about rooms, arms or OMPL.
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ontime/domains/effort.hpp"
+
+namespace ontime::domains {
+
+// A robot configuration in the domain's own coordinates (navigation: x, y, theta).
+using Configuration = std::vector<double>;
+
+enum class RefinementStatus { working, found };
+
+// One attempt to refine one abstract action.
+class Refinement {
+ public:
+  virtual ~Refinement() = default;
+
+  // Continues the attempt until a motion is found or the total effort reaches `limit_seconds`
+  // (checked between planner iterations, so it may overshoot by one iteration). Calling it
+  // again with a larger limit resumes the same planner where it stopped.
+  virtual RefinementStatus advance(double limit_seconds) = 0;
+
+  virtual RefinementStatus status() const = 0;
+  virtual const EffortMeter& effort() const = 0;
+
+  // Once found: the seconds the robot needs to execute the motion, the configuration it ends
+  // in, and the motion itself (waypoints, executed in straight segments).
+  virtual double execution_seconds() const = 0;
+  virtual Configuration final_configuration() const = 0;
+  virtual std::vector<Configuration> motion() const = 0;
+};
+
+// 2D drawing primitives (metres), drawn by python/plot_map.py.
+struct ScenePolygon {
+  std::string kind;   // "room", "wall", "obstacle", "robot"
+  std::string label;  // drawn at the centre when not empty
+  std::vector<std::array<double, 2>> points;
+};
+
+struct Scene {
+  std::string title;
+  std::vector<ScenePolygon> polygons;
+};
+
+class Domain {
+ public:
+  virtual ~Domain() = default;
+
+  virtual const std::string& name() const = 0;
+  // Plan skeletons, as action ids; actions shared by a common prefix are refined once.
+  virtual const std::vector<std::vector<std::string>>& skeletons() const = 0;
+  // Where the robot starts, before the first action of every skeleton.
+  virtual Configuration initial_configuration() const = 0;
+
+  // Starts refining `action` from `start`; every random choice comes from `seed`.
+  // Throws std::invalid_argument for an unknown action or an invalid start.
+  virtual std::unique_ptr<Refinement> refine(const std::string& action, const Configuration& start,
+                                             std::uint64_t seed, const EffortSettings& effort) const = 0;
+
+  // A start for `action` drawn from `seed` when no refinement of the action before it
+  // succeeded (so there is no end configuration to start from).
+  virtual Configuration fallback_start(const std::string& action, std::uint64_t seed) const = 0;
+
+  // The world, and a motion as a polyline of the robot's reference point.
+  virtual Scene scene() const = 0;
+  virtual std::vector<std::array<double, 2>> trace(const std::vector<Configuration>& motion) const = 0;
+  // The robot's outline at a configuration.
+  virtual std::vector<std::array<double, 2>> outline(const Configuration& configuration) const = 0;
+};
+
+}  // namespace ontime::domains

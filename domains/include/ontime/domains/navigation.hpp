@@ -1,0 +1,39 @@
+#pragma once
+// The navigation domain (paper §VII-A): a PR2-sized base on an office floor. `move(Ri,Rj)`
+// samples a collision-free goal pose uniformly in room Rj, plans to it from the current pose
+// (which must lie in Ri) with OMPL's RRT-Connect in SE(2), sampling within the two rooms'
+// bounding box (collision checks with FCL), shortens the path, and reports
+// its execution time: path length over the linear speed plus total rotation over the angular
+// speed. Planning is resumable: each call to advance() continues the same planner, trees kept.
+
+#include "ontime/domains/domain.hpp"
+#include "ontime/domains/navigation_world.hpp"
+
+namespace ontime::domains {
+
+class NavigationDomain final : public Domain {
+ public:
+  explicit NavigationDomain(NavigationWorld world);
+
+  const std::string& name() const override { return name_; }
+  const std::vector<std::vector<std::string>>& skeletons() const override { return world_.skeletons; }
+  Configuration initial_configuration() const override;
+  std::unique_ptr<Refinement> refine(const std::string& action, const Configuration& start, std::uint64_t seed,
+                                     const EffortSettings& effort) const override;
+  Configuration fallback_start(const std::string& action, std::uint64_t seed) const override;
+  Scene scene() const override;
+  std::vector<std::array<double, 2>> trace(const std::vector<Configuration>& motion) const override;
+  std::vector<std::array<double, 2>> outline(const Configuration& configuration) const override;
+
+  const NavigationWorld& world() const noexcept { return world_; }
+
+  // The execution time of a motion through these poses, in straight segments: length over
+  // the linear speed plus rotation (shortest angle at each segment) over the angular speed.
+  double execution_seconds(const std::vector<Pose>& poses) const;
+
+ private:
+  std::string name_ = "navigation";
+  NavigationWorld world_;
+};
+
+}  // namespace ontime::domains

@@ -1,0 +1,32 @@
+#pragma once
+// Domains by name, for the command line.
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "ontime/domains/domain.hpp"
+#include "ontime/domains/navigation_world.hpp"
+
+namespace ontime::domains {
+
+// Names of the domains that can be loaded: "navigation".
+std::vector<std::string> domain_names();
+
+// Settings a domain's world file carries besides the world itself.
+struct DomainDefaults {
+  CollectionDefaults collection;
+};
+
+struct LoadedDomain {
+  std::unique_ptr<Domain> domain;
+  DomainDefaults defaults;
+};
+
+// Loads the named domain from its world file. Throws ontime::UsageError for an unknown name
+// and ontime::InputError for a bad world file.
+LoadedDomain load_domain(std::string_view name, const std::filesystem::path& world_file);
+
+}  // namespace ontime::domains

@@ -1,0 +1,146 @@
+#include "ontime/domains/collection.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <stdexcept>
+
+#include "ontime/error.hpp"
+#include "ontime/random.hpp"
+#include "parallel.hpp"
+
+namespace ontime::domains {
+namespace {
+
+struct Outcome {
+  RefinementAttempt attempt;
+  std::optional<Configuration> end;
+};
+
+// Times in the log are rounded to microseconds: plenty for durations of seconds, and short.
+// (With the checks unit a planning time of exactly k steps, k * step * rate checks, stays exact.)
+double round_to_microseconds(double seconds) { return std::round(seconds * 1e6) / 1e6; }
+
+Outcome attempt_once(const Domain& domain, const std::string& action, const Configuration& start, std::uint64_t seed,
+                     const CollectionOptions& options) {
+  const std::unique_ptr<Refinement> refinement = domain.refine(action, start, seed, options.effort);
+  for (Steps step = 1; step <= options.budget_steps; ++step) {
+    if (refinement->advance(static_cast<double>(step) * options.step_seconds) == RefinementStatus::found) break;
+  }
+  Outcome outcome;
+  outcome.attempt.action = action;
+  outcome.attempt.planning_seconds = round_to_microseconds(refinement->effort().seconds());
+  outcome.attempt.collision_checks = refinement->effort().checks();
+  outcome.attempt.found = refinement->status() == RefinementStatus::found;
+  if (outcome.attempt.found) {
+    outcome.attempt.execution_seconds = round_to_microseconds(refinement->execution_seconds());
+    outcome.end = refinement->final_configuration();
+  }
+  return outcome;
+}
+
+void check_options(const CollectionOptions& options) {
+  if (!(std::isfinite(options.step_seconds) && options.step_seconds > 0)) {
+    throw std::invalid_argument("the step must be a positive number of seconds");
+  }
+  if (options.budget_steps < 1) throw std::invalid_argument("the cut-off must be at least 1 step");
+  if (options.effort.unit == EffortUnit::collision_checks && !(options.effort.checks_per_second > 0)) {
+    throw std::invalid_argument("the checks per second must be positive");
+  }
+}
+
+}  // namespace
+
+std::vector<TreeAction> skeleton_tree(const std::vector<std::vector<std::string>>& skeletons) {
+  std::vector<TreeAction> tree;
+  std::map<std::string, int> index_of;
+  std::size_t longest = 0;
+  for (const auto& skeleton : skeletons) longest = std::max(longest, skeleton.size());
+  for (std::size_t position = 0; position < longest; ++position) {
+    for (const auto& skeleton : skeletons) {
+      if (position >= skeleton.size()) continue;
+      const std::string& action = skeleton[position];
+      if (index_of.count(action) != 0) continue;
+      const int parent = position == 0 ? -1 : index_of.at(skeleton[position - 1]);
+      index_of.emplace(action, static_cast<int>(tree.size()));
+      tree.push_back(TreeAction{action, parent});
+    }
+  }
+  return tree;
+}
+
+CollectionResult collect(const Domain& domain, const CollectionOptions& options) {
+  check_options(options);
+  const auto started = std::chrono::steady_clock::now();
+  const std::vector<TreeAction> tree = skeleton_tree(domain.skeletons());
+  const std::uint64_t total = options.trials * tree.size();
+  std::uint64_t finished = 0;
+  std::mutex progress_mutex;
+
+  // ends[a]: end configurations of the successful refinements of action a, in trial order.
+  std::vector<std::vector<Configuration>> ends(tree.size());
+  CollectionResult result;
+  for (std::size_t a = 0; a < tree.size(); ++a) {
+    const TreeAction& node = tree[a];
+    const std::uint64_t action_seed = stream_seed(options.seed, a);
+    const std::vector<Configuration>* starts = node.parent < 0 ? nullptr : &ends[static_cast<std::size_t>(node.parent)];
+    std::vector<Outcome> outcomes(options.trials);
+    detail::for_each_index(options.trials, options.threads, [&] {
+      return [&](std::uint64_t t) {
+        const std::uint64_t trial_seed = stream_seed(action_seed, t);
+        Configuration start;
+        if (starts == nullptr) {
+          start = domain.initial_configuration();
+        } else if (!starts->empty()) {
+          start = (*starts)[t % starts->size()];
+        } else {
+          start = domain.fallback_start(node.action, stream_seed(trial_seed, 1));
+        }
+        outcomes[t] = attempt_once(domain, node.action, start, stream_seed(trial_seed, 0), options);
+        outcomes[t].attempt.trial = t;
+        if (options.progress) {
+          const std::lock_guard lock(progress_mutex);
+          options.progress(++finished, total);
+        }
+      };
+    });
+    for (Outcome& outcome : outcomes) {
+      if (outcome.end) ends[a].push_back(std::move(*outcome.end));
+      result.collision_checks += outcome.attempt.collision_checks.value_or(0);
+      result.log.push_back(std::move(outcome.attempt));
+    }
+  }
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return result;
+}
+
+std::vector<std::vector<Configuration>> refine_skeleton(const Domain& domain, const std::vector<std::string>& skeleton,
+                                                        std::uint64_t seed, const CollectionOptions& options,
+                                                        int attempts) {
+  check_options(options);
+  std::vector<std::vector<Configuration>> motions;
+  Configuration at = domain.initial_configuration();
+  for (std::size_t l = 0; l < skeleton.size(); ++l) {
+    bool found = false;
+    for (int attempt = 0; attempt < attempts && !found; ++attempt) {
+      const std::uint64_t attempt_seed = stream_seed(stream_seed(seed, l), static_cast<std::uint64_t>(attempt));
+      const std::unique_ptr<Refinement> refinement = domain.refine(skeleton[l], at, attempt_seed, options.effort);
+      for (Steps step = 1; step <= options.budget_steps && !found; ++step) {
+        found = refinement->advance(static_cast<double>(step) * options.step_seconds) == RefinementStatus::found;
+      }
+      if (found) {
+        motions.push_back(refinement->motion());
+        at = refinement->final_configuration();
+      }
+    }
+    if (!found) {
+      throw UsageError("no motion found for " + skeleton[l] + " in " + std::to_string(attempts) + " attempts of " +
+                       std::to_string(options.budget_steps) + " steps each");
+    }
+  }
+  return motions;
+}
+
+}  // namespace ontime::domains

@@ -1,0 +1,103 @@
+#include "ontime/domains/navigation.hpp"
+
+#include <ompl/util/Console.h>
+
+#include <cmath>
+#include <mutex>
+#include <numbers>
+#include <stdexcept>
+
+#include "navigation_refinement.hpp"
+#include "ontime/domains/navigation_collision.hpp"
+#include "ontime/random.hpp"
+
+namespace ontime::domains {
+namespace {
+
+Pose pose_of(const Configuration& configuration) {
+  if (configuration.size() != 3) throw std::invalid_argument("a navigation configuration is (x, y, theta)");
+  return Pose{configuration[0], configuration[1], configuration[2]};
+}
+
+}  // namespace
+
+NavigationDomain::NavigationDomain(NavigationWorld world) : world_(std::move(world)) {
+  // OMPL reports every planner start and stop on the console; the collection runs thousands.
+  static std::once_flag quiet;
+  std::call_once(quiet, [] { ompl::msg::setLogLevel(ompl::msg::LOG_NONE); });
+}
+
+Configuration NavigationDomain::initial_configuration() const { return {world_.start.x, world_.start.y, world_.start.theta}; }
+
+std::unique_ptr<Refinement> NavigationDomain::refine(const std::string& action, const Configuration& start,
+                                                     std::uint64_t seed, const EffortSettings& effort) const {
+  const std::vector<std::string> rooms = move_rooms(action);
+  if (rooms.size() != 2 || world_.room_index(rooms[0]) < 0 || world_.room_index(rooms[1]) < 0) {
+    throw std::invalid_argument("'" + action + "' is not move(FROM,TO) between rooms of " + world_.name);
+  }
+  return make_navigation_refinement(*this, world_.room(rooms[0]), world_.room(rooms[1]), pose_of(start), seed, effort);
+}
+
+Configuration NavigationDomain::fallback_start(const std::string& action, std::uint64_t seed) const {
+  const std::vector<std::string> rooms = move_rooms(action);
+  if (rooms.size() != 2 || world_.room_index(rooms[0]) < 0) {
+    throw std::invalid_argument("'" + action + "' is not move(FROM,TO) between rooms of " + world_.name);
+  }
+  const Room& room = world_.room(rooms[0]);
+  const NavigationCollision collision(world_, world_.robot.clearance);
+  SplitMix64 random(seed);
+  const double half = world_.wall_thickness / 2;
+  for (int attempt = 0; attempt < 1'000'000; ++attempt) {
+    const Pose pose{room.min_x + half + (room.max_x - room.min_x - 2 * half) * uniform01(random),
+                    room.min_y + half + (room.max_y - room.min_y - 2 * half) * uniform01(random),
+                    std::numbers::pi * (2 * uniform01(random) - 1)};
+    if (!collision.collides(pose)) return {pose.x, pose.y, pose.theta};
+  }
+  throw std::runtime_error("no collision-free pose found in room " + room.id);
+}
+
+double NavigationDomain::execution_seconds(const std::vector<Pose>& poses) const {
+  double length = 0, rotation = 0;
+  for (std::size_t i = 1; i < poses.size(); ++i) {
+    length += std::hypot(poses[i].x - poses[i - 1].x, poses[i].y - poses[i - 1].y);
+    rotation += std::abs(std::remainder(poses[i].theta - poses[i - 1].theta, 2 * std::numbers::pi));
+  }
+  return length / world_.robot.linear_speed + rotation / world_.robot.angular_speed;
+}
+
+Scene NavigationDomain::scene() const {
+  Scene scene;
+  scene.title = world_.name;
+  for (const Room& room : world_.rooms) {
+    scene.polygons.push_back(ScenePolygon{"room", room.id,
+                                          {{room.min_x, room.min_y}, {room.max_x, room.min_y}, {room.max_x, room.max_y},
+                                           {room.min_x, room.max_y}}});
+  }
+  for (const Rectangle& wall : world_.walls) {
+    const auto corners = wall.corners();
+    scene.polygons.push_back(ScenePolygon{"wall", "", {corners.begin(), corners.end()}});
+  }
+  for (const Obstacle& obstacle : world_.obstacles) {
+    const auto corners = obstacle.shape.corners();
+    scene.polygons.push_back(ScenePolygon{"obstacle", "", {corners.begin(), corners.end()}});
+  }
+  scene.polygons.push_back(ScenePolygon{"robot", "", outline(initial_configuration())});
+  return scene;
+}
+
+std::vector<std::array<double, 2>> NavigationDomain::trace(const std::vector<Configuration>& motion) const {
+  std::vector<std::array<double, 2>> points;
+  for (const Configuration& configuration : motion) {
+    const Pose pose = pose_of(configuration);
+    points.push_back({pose.x, pose.y});
+  }
+  return points;
+}
+
+std::vector<std::array<double, 2>> NavigationDomain::outline(const Configuration& configuration) const {
+  const Pose pose = pose_of(configuration);
+  const auto corners = Rectangle{pose.x, pose.y, world_.robot.length, world_.robot.width, pose.theta}.corners();
+  return {corners.begin(), corners.end()};
+}
+
+}  // namespace ontime::domains

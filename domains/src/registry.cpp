@@ -1,0 +1,21 @@
+#include "ontime/domains/registry.hpp"
+
+#include "ontime/domains/navigation.hpp"
+#include "ontime/error.hpp"
+
+namespace ontime::domains {
+
+std::vector<std::string> domain_names() { return {"navigation"}; }
+
+LoadedDomain load_domain(std::string_view name, const std::filesystem::path& world_file) {
+  if (name == "navigation") {
+    NavigationWorld world = load_navigation_world(world_file);
+    const DomainDefaults defaults{world.collection};
+    return LoadedDomain{std::make_unique<NavigationDomain>(std::move(world)), defaults};
+  }
+  std::string known;
+  for (const std::string& candidate : domain_names()) known += (known.empty() ? "" : ", ") + candidate;
+  throw UsageError("unknown domain '" + std::string(name) + "' (known: " + known + ")");
+}
+
+}  // namespace ontime::domains

@@ -1,0 +1,86 @@
+"""Histograms of every action's planning and execution PMF, "never" as a bar of its own.
+
+A dotted line marks the deadline; steps an instance lists beyond it are drawn too.
+
+Reads the CSV that `ontime plot` writes (action,distribution,step,probability; step "never"
+for the mass beyond every deadline) and draws one panel per action and distribution, planning
+and execution side by side, into one PNG (written to a temporary file, then renamed).
+"""
+
+import argparse
+import collections
+import csv
+import math
+from ontime_plotting import save_atomically  # sets the Agg backend: import it first
+
+import matplotlib.pyplot as plt  # noqa: E402
+
+PLANNING_COLOUR = "#3b6ea8"
+EXECUTION_COLOUR = "#d08a2c"
+NEVER_COLOUR = "#9b2f2f"
+
+
+def read_histograms(path):
+    """action -> distribution -> ({step: probability}, never)."""
+    data = collections.OrderedDict()
+    with open(path, newline="", encoding="utf-8") as handle:
+        for row in csv.DictReader(handle):
+            entry = data.setdefault(row["action"], {}).setdefault(row["distribution"], [{}, 0.0])
+            probability = float(row["probability"])
+            if row["step"] == "never":
+                entry[1] = probability
+            else:
+                entry[0][int(row["step"])] = probability
+    return data
+
+
+def draw_panel(axes, masses, never, deadline, colour, title, first_step):
+    last = max([deadline] + list(masses))
+    steps = list(range(first_step, last + 1))
+    axes.bar(steps, [masses.get(step, 0.0) for step in steps], width=0.85, color=colour)
+    never_position = last + 2
+    axes.bar([never_position], [never], width=0.85, color=NEVER_COLOUR)
+    if never > 0:
+        axes.annotate(f"{never:.2f}", (never_position, never), ha="center", va="bottom", fontsize=6)
+    axes.axvline(deadline + 0.5, color="grey", linestyle=":", linewidth=0.8)
+    ticks = [step for step in steps if step % 5 == 0 or step == first_step] + [never_position]
+    axes.set_xticks(ticks)
+    axes.set_xticklabels([str(step) for step in ticks[:-1]] + ["never"], fontsize=7)
+    axes.set_xlim(first_step - 1, never_position + 1)
+    axes.set_ylim(0, 1.15 * max([never] + list(masses.values()) + [1e-9]))
+    axes.tick_params(axis="y", labelsize=7)
+    axes.set_title(title, fontsize=8)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--data", required=True)
+    parser.add_argument("--output", required=True)
+    parser.add_argument("--title", default="")
+    parser.add_argument("--deadline", type=int, required=True)
+    arguments = parser.parse_args()
+
+    histograms = read_histograms(arguments.data)
+    pairs_per_row = 2
+    rows = max(1, math.ceil(len(histograms) / pairs_per_row))
+    figure, grid = plt.subplots(rows, 2 * pairs_per_row, figsize=(4 * pairs_per_row * 2, 1.9 * rows + 0.8),
+                                squeeze=False)
+    for axes in grid.flat:
+        axes.set_visible(False)
+    for index, (action, distributions) in enumerate(histograms.items()):
+        row, pair = divmod(index, pairs_per_row)
+        for column, (kind, colour, first_step) in enumerate(
+                [("planning", PLANNING_COLOUR, 1), ("execution", EXECUTION_COLOUR, 0)]):
+            axes = grid[row][2 * pair + column]
+            axes.set_visible(True)
+            masses, never = distributions.get(kind, [{}, 1.0])
+            draw_panel(axes, masses, never, arguments.deadline, colour, f"{action}: {kind}", first_step)
+            if row == rows - 1 or index + pairs_per_row >= len(histograms):
+                axes.set_xlabel("steps", fontsize=7)
+    figure.suptitle(arguments.title, fontsize=11)
+    figure.tight_layout(rect=(0, 0, 1, 0.97))
+
+    save_atomically(figure, arguments.output)
+
+if __name__ == "__main__":
+    main()
