@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets with clang (build-fuzz/) and runs each for a bounded time.
 #   scripts/fuzz.sh [SECONDS_PER_TARGET]   (default 60)
-# Seeds come from data/ and tests/data/bad/; new corpus entries go to build-fuzz/corpus/.
+# Seeds come from data/, tests/data/ (bad inputs, fuzz regressions) and fuzz/seeds/; new corpus entries go to build-fuzz/corpus/.
 # A crash leaves its input in build-fuzz/ (crash-*) and fails the script.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -10,12 +10,13 @@ generator=()
 if command -v ninja >/dev/null 2>&1 && [ ! -f build-fuzz/CMakeCache.txt ]; then generator=(-G Ninja); fi
 cmake -S . -B build-fuzz "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
   -DONTIME_BUILD_FUZZERS=ON -DONTIME_BUILD_APPS=OFF -DONTIME_BUILD_BENCHMARKS=OFF -DBUILD_TESTING=OFF
-cmake --build build-fuzz --parallel "$(nproc)" --target instance_fuzzer
+cmake --build build-fuzz --parallel "$(nproc)" --target instance_fuzzer planner_log_fuzzer
 
 run() {
   local target="$1"; shift
   mkdir -p "build-fuzz/corpus/$target"
-  (cd build-fuzz && "./fuzz/$target" -max_total_time="$seconds" -print_final_stats=1 -timeout=10 \
+  (cd build-fuzz && "./fuzz/$target" -max_total_time="$seconds" -print_final_stats=1 -timeout=10 -max_len=8192 \
      -rss_limit_mb=4096 "corpus/$target" "$@" 2>&1 | tail -n 25)
 }
 run instance_fuzzer ../data/instances/paper ../tests/data/bad ../tests/data/fuzz_regressions ../data/knapsack
+run planner_log_fuzzer ../tests/data/bad_logs ../tests/data/fuzz_regressions ../fuzz/seeds/planner_log
