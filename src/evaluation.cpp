@@ -51,7 +51,9 @@ LatencySummary summarise(std::vector<std::int64_t>& samples) {
   return summary;
 }
 
-// The allocator's own choice is the only choice; states are their own keys.
+// The allocator's own choice is the only choice; states are their own keys (packed into
+// Words 64-bit words when Words > 0).
+template <std::size_t Words>
 class StationaryPolicy {
  public:
   StationaryPolicy(Allocator& allocator, int skeleton_count) : allocator_(&allocator), skeleton_count_(skeleton_count) {}
@@ -63,7 +65,13 @@ class StationaryPolicy {
     }
     out.push_back(choice);
   }
-  const State& key(const State& state) const { return state; }
+  auto key(const State& state) const {
+    if constexpr (Words > 0) {
+      return detail::pack<Words>(state, skeleton_count_);
+    } else {
+      return state;
+    }
+  }
 
  private:
   Allocator* allocator_;
@@ -156,12 +164,19 @@ ExactEvaluation evaluate_exactly(const Mdp& mdp, Allocator& allocator, std::size
                      std::string(allocator.name()) + "' does not (use Monte Carlo)");
   }
   allocator.begin_episode(0);
-  detail::Expectimax<StationaryPolicy> search(mdp, StationaryPolicy(allocator, mdp.skeleton_count()), max_states, 0.0,
-                                              "exact evaluation of " + std::string(allocator.name()));
-  ExactEvaluation result;
-  result.success_probability = search.solve(mdp.start()).value;
-  result.states = search.memo().size();
-  return result;
+  const auto run = [&](auto policy) {
+    detail::Expectimax<decltype(policy)> search(mdp, policy, max_states, 0.0,
+                                                "exact evaluation of " + std::string(allocator.name()));
+    ExactEvaluation result;
+    result.success_probability = search.solve(mdp.start()).value;
+    result.states = search.memo().size();
+    return result;
+  };
+  switch (detail::packed_words(mdp)) {
+    case 2: return run(StationaryPolicy<2>(allocator, mdp.skeleton_count()));
+    case 4: return run(StationaryPolicy<4>(allocator, mdp.skeleton_count()));
+    default: return run(StationaryPolicy<0>(allocator, mdp.skeleton_count()));
+  }
 }
 
 }  // namespace ontime

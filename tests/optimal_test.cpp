@@ -48,6 +48,36 @@ TEST(Optimal, MatchesAnIndependentReferenceOnRandomInstances) {
   }
 }
 
+// States are memoised under 16-byte, 32-byte or full keys depending on the skeleton count and
+// the deadline; each encoding must give the reference value.
+TEST(Optimal, EveryStateEncodingGivesTheReferenceValue) {
+  for (std::uint64_t seed = 1; seed <= 60; ++seed) {  // up to 6 skeletons: 16- and 32-byte keys
+    const Problem problem = testing::random_instance(seed * 7919, 6, 2, 7);
+    const Mdp mdp(problem);
+    OptimalSolver solver(mdp);
+    EXPECT_NEAR(solver.solve(mdp.start()), testing::ReferenceSolver(problem).optimum(), 1e-12) << "seed " << seed;
+  }
+  // A deadline above 253 needs full keys. Three single-action skeletons, each found with
+  // probability 1/2 at a fixed step (100, 100, 50) and executed at once: all three fit in
+  // D = 254 one after the other, so the optimum is 1 - 1/8; with D = 249 only two fit: 3/4.
+  const auto at = [](std::size_t step) {
+    std::vector<double> pmf(step + 1, 0.0);
+    pmf[step] = 0.5;
+    return Distribution::from_pmf(pmf);
+  };
+  for (const auto& [deadline, expected] : {std::pair{254, 0.875}, std::pair{249, 0.75}}) {
+    const Problem problem("long", deadline, 1.0,
+                          {Action{"a", at(100), Distribution::from_pmf({1.0})}, Action{"b", at(100), Distribution::from_pmf({1.0})},
+                           Action{"c", at(50), Distribution::from_pmf({1.0})}},
+                          {{0}, {1}, {2}});
+    const Mdp mdp(problem);
+    OptimalSolver solver(mdp);
+    EXPECT_NEAR(solver.solve(mdp.start()), expected, 1e-12) << deadline;
+    OptimalAllocator allocator(mdp);
+    EXPECT_NEAR(evaluate_exactly(mdp, allocator).success_probability, expected, 1e-12) << deadline;
+  }
+}
+
 TEST(Optimal, FollowingItsChoicesAchievesItsValue) {
   for (const char* name : {"figure1", "instance1", "instance2", "instance3", "instance4", "instance5"}) {
     const Problem problem = testing::paper_instance(name);

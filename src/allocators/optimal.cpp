@@ -1,5 +1,6 @@
 #include "ontime/allocators/optimal.hpp"
 
+#include <variant>
 #include <vector>
 
 #include "../expectimax.hpp"
@@ -7,7 +8,9 @@
 namespace ontime {
 namespace {
 
-// Choices and state keys of the optimal solver.
+// Choices and state keys of the optimal solver; Words > 0 packs keys into that many 64-bit
+// words (detail::pack), 0 keeps full states.
+template <std::size_t Words>
 class OptimalPolicy {
  public:
   explicit OptimalPolicy(const Mdp& mdp) : mdp_(&mdp) {}
@@ -18,7 +21,7 @@ class OptimalPolicy {
 
   // Skeletons in a group that can no longer succeed influence nothing: their slots are
   // blanked so that states differing only there share one memo entry.
-  State key(const State& state) const {
+  auto key(const State& state) const {
     State key = state;
     for (int k = 0; k < mdp_->skeleton_count(); ++k) {
       const int action = mdp_->next_action(state, k);
@@ -28,21 +31,41 @@ class OptimalPolicy {
       key.spent[slot] = kBlank;
       key.execution[slot] = kBlank;
     }
-    return key;
+    if constexpr (Words > 0) {
+      return detail::pack<Words>(key, mdp_->skeleton_count());
+    } else {
+      return key;
+    }
   }
 
  private:
-  static constexpr std::uint16_t kBlank = 0xFFFF;  // above any reachable PT or ET
+  // Above any reachable PT or ET; its low byte (255) is above them too when packed.
+  static constexpr std::uint16_t kBlank = 0xFFFF;
 
   const Mdp* mdp_;
 };
 
+using Search = std::variant<detail::Expectimax<OptimalPolicy<2>>, detail::Expectimax<OptimalPolicy<4>>,
+                            detail::Expectimax<OptimalPolicy<0>>>;
+
 }  // namespace
 
 struct OptimalSolver::Impl {
-  Impl(const Mdp& mdp, std::size_t max_states)
-      : search(mdp, OptimalPolicy(mdp), max_states, OptimalSolver::kTieTolerance, "optimal") {}
-  detail::Expectimax<OptimalPolicy> search;
+  Impl(const Mdp& mdp, std::size_t max_states) : search(make(mdp, max_states)) {}
+
+  static Search make(const Mdp& mdp, std::size_t max_states) {
+    const auto build = [&]<std::size_t Words>() -> Search {
+      return detail::Expectimax<OptimalPolicy<Words>>(mdp, OptimalPolicy<Words>(mdp), max_states,
+                                                       OptimalSolver::kTieTolerance, "optimal");
+    };
+    switch (detail::packed_words(mdp)) {
+      case 2: return build.template operator()<2>();
+      case 4: return build.template operator()<4>();
+      default: return build.template operator()<0>();
+    }
+  }
+
+  Search search;
 };
 
 OptimalSolver::OptimalSolver(const Mdp& mdp, std::size_t max_states)
@@ -51,16 +74,23 @@ OptimalSolver::~OptimalSolver() = default;
 OptimalSolver::OptimalSolver(OptimalSolver&&) noexcept = default;
 OptimalSolver& OptimalSolver::operator=(OptimalSolver&&) noexcept = default;
 
-double OptimalSolver::solve(const State& state) { return impl_->search.solve(state).value; }
-
-std::optional<int> OptimalSolver::best_choice(const State& state) const {
-  const auto& memo = impl_->search.memo();
-  const auto found = memo.find(impl_->search.policy().key(state));
-  if (found == memo.end() || found->second.choice < 0) return std::nullopt;
-  return found->second.choice;
+double OptimalSolver::solve(const State& state) {
+  return std::visit([&state](auto& search) { return search.solve(state).value; }, impl_->search);
 }
 
-std::size_t OptimalSolver::states() const noexcept { return impl_->search.memo().size(); }
+std::optional<int> OptimalSolver::best_choice(const State& state) const {
+  return std::visit(
+      [&state](const auto& search) -> std::optional<int> {
+        const auto found = search.memo().find(search.policy().key(state));
+        if (found == search.memo().end() || found->second.choice < 0) return std::nullopt;
+        return found->second.choice;
+      },
+      impl_->search);
+}
+
+std::size_t OptimalSolver::states() const noexcept {
+  return std::visit([](const auto& search) { return search.memo().size(); }, impl_->search);
+}
 
 OptimalAllocator::OptimalAllocator(const Mdp& mdp, std::size_t max_states) : mdp_(&mdp) {
   auto solver = std::make_shared<OptimalSolver>(mdp, max_states);
