@@ -13,11 +13,10 @@
 //
 // Cost: time and memory linear in the number of reachable states, which grows exponentially
 // with the number of skeletons (the problem is NP-hard, Theorem 1). States that differ only
-// in skeletons that can no longer succeed are merged. The solver stops with
-// ResourceLimitError when it would hold more than `max_states` states (a hash-table slot of 33
-// bytes each for up to 4 skeletons and D <= 253, 49 up to 10 skeletons, 99 beyond; the table
-// doubles as it grows),
-// never by running out of memory.
+// in skeletons that can no longer succeed are merged. Each state takes a hash-table slot of
+// 33 bytes (up to 4 skeletons and D <= 253), 49 (up to 10 skeletons) or 99 (beyond); the
+// table doubles as it grows. The solver stops with ResourceLimitError when it would hold more
+// than `max_states` states, never by running out of memory.
 
 #include <cstddef>
 #include <memory>
