@@ -131,7 +131,7 @@ class NavigationRefinement final : public Refinement {
   }
 
   void plan(double limit_seconds) {
-    if (!planner_->run(meter_, limit_seconds)) return;
+    if (!planner_->run(meter_, [this, limit_seconds] { return meter_.reached(limit_seconds); })) return;
     for (const ob::State* state : planner_->path()) path_.push_back(pose_of(state));
     shortcut_ = detail::GreedyShortcut(path_.size());
     planner_.reset();  // the trees are no longer needed

@@ -2,6 +2,9 @@
 
 #include <ompl/base/PlannerTerminationCondition.h>
 #include <ompl/base/ScopedState.h>
+#include <ompl/util/Console.h>
+
+#include <mutex>
 
 #include <stdexcept>
 
@@ -9,6 +12,11 @@ namespace ontime::domains::detail {
 
 namespace ob = ompl::base;
 namespace og = ompl::geometric;
+
+void quiet_ompl() {
+  static std::once_flag quiet;
+  std::call_once(quiet, [] { ompl::msg::setLogLevel(ompl::msg::LOG_NONE); });
+}
 
 ResumableRrtConnect::ResumableRrtConnect(const ob::SpaceInformationPtr& information, const ob::State* from,
                                          const ob::State* to, double range)
@@ -22,11 +30,10 @@ ResumableRrtConnect::ResumableRrtConnect(const ob::SpaceInformationPtr& informat
   planner_->setup();
 }
 
-bool ResumableRrtConnect::run(const EffortMeter& meter, double limit_seconds) {
+bool ResumableRrtConnect::run(const EffortMeter& meter, const std::function<bool()>& stop) {
   problem_->clearSolutionPaths();
   const std::uint64_t checks_before = meter.checks();
-  const ob::PlannerTerminationCondition stop([&meter, limit_seconds] { return meter.reached(limit_seconds); });
-  const ob::PlannerStatus result = planner_->solve(stop);
+  const ob::PlannerStatus result = planner_->solve(ob::PlannerTerminationCondition(stop));
   if (result == ob::PlannerStatus::EXACT_SOLUTION) return true;
   if ((result != ob::PlannerStatus::TIMEOUT && result != ob::PlannerStatus::APPROXIMATE_SOLUTION) ||
       meter.checks() == checks_before) {

@@ -25,6 +25,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <numbers>
 #include <utility>
 #include <vector>
@@ -33,6 +34,10 @@
 #include "ontime/random.hpp"
 
 namespace ontime::domains::detail {
+
+// Silences OMPL's console messages (it reports every planner start and stop; a collection
+// runs thousands), once per process.
+void quiet_ompl();
 
 // Uniform poses (x, y within `bounds` = {min x, min y, max x, max y}, heading uniform) in an
 // SE(2) state space.
@@ -145,10 +150,10 @@ class ResumableRrtConnect {
   ResumableRrtConnect(const ompl::base::SpaceInformationPtr& information, const ompl::base::State* from,
                       const ompl::base::State* to, double range);
 
-  // Plans until a path is found (true) or `meter` reaches `limit_seconds` (false); a later
-  // call continues with the same trees. Throws std::logic_error when the planner stops without
-  // spending any effort (start and goal are checked before planning, so that is a defect).
-  bool run(const EffortMeter& meter, double limit_seconds);
+  // Plans until a path is found (true) or `stop()` holds (false); a later call continues with
+  // the same trees. `meter` counts the planner's checks: the planner stopping without spending
+  // any is a defect (start and goal are checked before planning), std::logic_error.
+  bool run(const EffortMeter& meter, const std::function<bool()>& stop);
 
   // Once run() returned true: the waypoints of the path found, start and goal included.
   std::vector<const ompl::base::State*> path() const;
