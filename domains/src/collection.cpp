@@ -7,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "ontime/domains/collection_journal.hpp"
 #include "ontime/error.hpp"
 #include "ontime/random.hpp"
 #include "parallel.hpp"
@@ -79,6 +80,15 @@ CollectionResult collect(const Domain& domain, const CollectionOptions& options)
   std::uint64_t finished = 0;
   std::mutex progress_mutex;
 
+  // Trials an earlier, interrupted run finished: resumed[a][t].
+  std::vector<std::vector<const JournalTrial*>> resumed(tree.size(), std::vector<const JournalTrial*>(options.trials, nullptr));
+  if (options.journal != nullptr) {
+    for (const JournalTrial& trial : options.journal->finished()) {
+      resumed.at(trial.action).at(trial.attempt.trial.value()) = &trial;
+      ++finished;
+    }
+  }
+
   // ends[a]: end configurations of the successful refinements of action a, in trial order.
   std::vector<std::vector<Configuration>> ends(tree.size());
   CollectionResult result;
@@ -89,6 +99,10 @@ CollectionResult collect(const Domain& domain, const CollectionOptions& options)
     std::vector<Outcome> outcomes(options.trials);
     detail::for_each_index(options.trials, options.threads, [&] {
       return [&](std::uint64_t t) {
+        if (const JournalTrial* earlier = resumed[a][t]) {
+          outcomes[t] = Outcome{earlier->attempt, earlier->end};
+          return;
+        }
         const std::uint64_t trial_seed = stream_seed(action_seed, t);
         Configuration start;
         if (starts == nullptr) {
@@ -100,6 +114,7 @@ CollectionResult collect(const Domain& domain, const CollectionOptions& options)
         }
         outcomes[t] = attempt_once(domain, node.action, start, stream_seed(trial_seed, 0), options);
         outcomes[t].attempt.trial = t;
+        if (options.journal != nullptr) options.journal->record(JournalTrial{a, outcomes[t].attempt, outcomes[t].end});
         if (options.progress) {
           const std::lock_guard lock(progress_mutex);
           options.progress(++finished, total);
