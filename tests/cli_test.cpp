@@ -278,6 +278,26 @@ TEST(Cli, PlotWritesTheHistogramsAndTheirData) {
   EXPECT_EQ(ontime({"plot", "/nonexistent.json"}).exit_code, 2);
 }
 
+// An exact part beyond --max-states is reported in its cell; the rest of the table stands.
+TEST(Cli, TableReportsAnExactPartOverTheCapInItsCell) {
+  const auto text = ontime({"table", paper("instance1"), "--solvers", "dp,round-robin", "--episodes", "200", "--exact",
+                            "--max-states", "100"});
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("(0.9340)"), std::string::npos) << text.out;                 // dp: 48 states
+  EXPECT_NE(text.out.find("(cap reached)"), std::string::npos) << text.out;            // round-robin: 143
+  EXPECT_NE(text.out.find("optimum over 100 states"), std::string::npos) << text.out;  // 872 states
+  const auto as_json = ontime({"table", paper("instance1"), "--solvers", "dp,round-robin", "--episodes", "200",
+                               "--exact", "--max-states", "100", "--json"});
+  ASSERT_EQ(as_json.exit_code, 0) << as_json.err;
+  const json row = json::parse(as_json.out)["rows"][0];
+  EXPECT_EQ(row["solvers"]["dp"]["exact"]["states"].get<int>(), 48);
+  EXPECT_FALSE(row["solvers"]["dp"]["exact"]["cap_reached"].get<bool>());
+  EXPECT_TRUE(row["solvers"]["round-robin"]["exact"]["cap_reached"].get<bool>());
+  EXPECT_FALSE(row["solvers"]["round-robin"].contains("exact_success_probability"));
+  EXPECT_TRUE(row["optimum"]["cap_reached"].get<bool>());
+  EXPECT_FALSE(row.contains("optimal_success_probability"));
+}
+
 TEST(Cli, CollectWritesTheLogAndTheFittedInstance) {
   const std::filesystem::path dir = scratch("collect");
   const std::string log = (dir / "logs" / "navigation.jsonl").string();
