@@ -44,13 +44,14 @@ void BM_NavigationCollisionCheck(benchmark::State& bench) {
 }
 BENCHMARK(BM_NavigationCollisionCheck);
 
-// One refinement of the action with index range(0) in the skeleton tree, from the start or
-// from fallback starts, a fresh seed each time; reports checks per refinement and found share.
-void BM_NavigationRefinement(benchmark::State& bench) {
-  const auto& domain = office();
+// One refinement of the action with index range(0) in the domain's skeleton tree, from the start
+// or from fallback starts, a fresh seed each time, in slices of one step of the world file's
+// collection settings, cut off at its deadline; reports checks per refinement and found share.
+template <class World>
+void refinement_benchmark(benchmark::State& bench, const ontime::domains::Domain& domain, const World& world) {
   const auto tree = ontime::domains::skeleton_tree(domain.skeletons());
   const auto& node = tree.at(static_cast<std::size_t>(bench.range(0)));
-  const auto& defaults = domain.world().collection;
+  const auto& defaults = world.collection;
   const ontime::domains::EffortSettings effort{ontime::domains::EffortUnit::collision_checks, defaults.checks_per_second};
   std::uint64_t seed = 0, checks = 0, found = 0;
   for (auto _ : bench) {
@@ -69,6 +70,8 @@ void BM_NavigationRefinement(benchmark::State& bench) {
   bench.counters["found"] = benchmark::Counter(static_cast<double>(found), benchmark::Counter::kAvgIterations);
   bench.SetLabel(node.action);
 }
+
+void BM_NavigationRefinement(benchmark::State& bench) { refinement_benchmark(bench, office(), office().world()); }
 BENCHMARK(BM_NavigationRefinement)->DenseRange(0, 14)->Unit(benchmark::kMillisecond);
 
 const ontime::domains::ManipulationDomain& kitchen() {
@@ -122,29 +125,7 @@ void BM_ManipulationInverseKinematics(benchmark::State& bench) {
 }
 BENCHMARK(BM_ManipulationInverseKinematics);
 
-void BM_ManipulationRefinement(benchmark::State& bench) {
-  const auto& domain = kitchen();
-  const auto tree = ontime::domains::skeleton_tree(domain.skeletons());
-  const auto& node = tree.at(static_cast<std::size_t>(bench.range(0)));
-  const auto& defaults = domain.world().collection;
-  const ontime::domains::EffortSettings effort{ontime::domains::EffortUnit::collision_checks, defaults.checks_per_second};
-  std::uint64_t seed = 0, checks = 0, found = 0;
-  for (auto _ : bench) {
-    ++seed;
-    const auto start = node.parent < 0 ? domain.initial_configuration() : domain.fallback_start(node.action, seed);
-    const auto refinement = domain.refine(node.action, start, seed, effort);
-    for (int step = 1; step <= defaults.deadline; ++step) {
-      if (refinement->advance(step * defaults.step_seconds) == ontime::domains::RefinementStatus::found) {
-        ++found;
-        break;
-      }
-    }
-    checks += refinement->effort().checks();
-  }
-  bench.counters["checks"] = benchmark::Counter(static_cast<double>(checks), benchmark::Counter::kAvgIterations);
-  bench.counters["found"] = benchmark::Counter(static_cast<double>(found), benchmark::Counter::kAvgIterations);
-  bench.SetLabel(node.action);
-}
+void BM_ManipulationRefinement(benchmark::State& bench) { refinement_benchmark(bench, kitchen(), kitchen().world()); }
 BENCHMARK(BM_ManipulationRefinement)->DenseRange(0, 35)->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -112,6 +112,20 @@ TEST(Collection, RefinesAWholeSkeletonForPictures) {
   EXPECT_EQ(motions[0].front(), office().initial_configuration());
 }
 
+const ManipulationDomain& kitchen() {
+  static const ManipulationDomain domain(load_manipulation_world(testing::source_path("data/domains/manipulation.json")));
+  return domain;
+}
+
+// The kitchen's collection settings, cut off after `budget` steps.
+CollectionOptions kitchen_options(std::uint64_t trials, std::uint64_t seed, unsigned threads, Steps budget) {
+  CollectionOptions result = options(trials, seed, threads);
+  result.effort.checks_per_second = kitchen().world().collection.checks_per_second;
+  result.step_seconds = kitchen().world().collection.step_seconds;
+  result.budget_steps = budget;
+  return result;
+}
+
 std::filesystem::path fresh(const std::string& name) {
   const auto path = std::filesystem::temp_directory_path() / ("ontime_collection_test_" + name);
   std::filesystem::remove(path);
@@ -155,26 +169,22 @@ TEST(CollectionJournal, AnInterruptedCollectionResumesToTheSameLog) {
 }
 
 TEST(CollectionJournal, KeepsTheEndConfigurationsTheNextActionStartsFrom) {
-  const ManipulationDomain kitchen(load_manipulation_world(testing::source_path("data/domains/manipulation.json")));
-  CollectionOptions settings = options(1, 3, 1);
-  settings.effort.checks_per_second = 300;
-  settings.step_seconds = 8;
-  settings.budget_steps = 3;
+  CollectionOptions settings = kitchen_options(1, 3, 1, 3);
   const auto path = fresh("kitchen.checkpoint");
   {
-    CollectionJournal journal(path, kitchen, settings, "kitchen", false);
+    CollectionJournal journal(path, kitchen(), settings, "kitchen", false);
     settings.journal = &journal;
     settings.progress = [](std::uint64_t done, std::uint64_t) {
       if (done == 3) throw std::runtime_error("interrupted");
     };
-    EXPECT_THROW(collect(kitchen, settings), std::runtime_error);
+    EXPECT_THROW(collect(kitchen(), settings), std::runtime_error);
   }
-  const CollectionJournal journal(path, kitchen, settings, "kitchen", true);
+  const CollectionJournal journal(path, kitchen(), settings, "kitchen", true);
   ASSERT_EQ(journal.finished().size(), 3u);
   for (const JournalTrial& trial : journal.finished()) {
     ASSERT_EQ(trial.end.has_value(), trial.attempt.found);
     if (trial.end) {
-      EXPECT_EQ(trial.end->size(), kitchen.initial_configuration().size());  // robot and objects
+      EXPECT_EQ(trial.end->size(), kitchen().initial_configuration().size());  // robot and objects
     }
   }
   std::filesystem::remove(path);
@@ -225,14 +235,10 @@ TEST(CollectionJournal, RefusesAnotherCollectionAndNeverDropsWorkSilently) {
 }
 
 TEST(Collection, TheKitchenGivesIdenticalLogsForIdenticalSeedsWhateverTheThreads) {
-  const ManipulationDomain kitchen(load_manipulation_world(testing::source_path("data/domains/manipulation.json")));
-  CollectionOptions settings = options(2, 5, 1);
-  settings.effort.checks_per_second = 300;
-  settings.step_seconds = 8;
-  settings.budget_steps = 2;
-  const CollectionResult one = collect(kitchen, settings);
+  CollectionOptions settings = kitchen_options(2, 5, 1, 2);
+  const CollectionResult one = collect(kitchen(), settings);
   settings.threads = 2;
-  const CollectionResult two = collect(kitchen, settings);
+  const CollectionResult two = collect(kitchen(), settings);
   ASSERT_EQ(one.log.size(), 72u);
   EXPECT_EQ(text(one.log), text(two.log));
   std::size_t found = 0;

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "ompl_support.hpp"
+#include "phased_refinement.hpp"
 #include "ontime/domains/manipulation_collision.hpp"
 #include "ontime/random.hpp"
 
@@ -31,16 +32,8 @@ void set_joints(ob::State* state, const ArmJoints& joints) {
   for (std::size_t j = 0; j < kArmJointCount; ++j) values->values[j] = joints[j];
 }
 
-Pose pose_of(const ob::State* state) {
-  const auto* pose = state->as<ob::SE2StateSpace::StateType>();
-  return Pose{pose->getX(), pose->getY(), pose->getYaw()};
-}
-
-void set_pose(ob::State* state, const Pose& pose) {
-  auto* se2 = state->as<ob::SE2StateSpace::StateType>();
-  se2->setXY(pose.x, pose.y);
-  se2->setYaw(pose.theta);
-}
+using detail::se2_pose;
+using detail::set_se2_pose;
 
 // The arm's joint space: a box of joint limits in which the continuous joints wrap around
 // (distance and interpolation take the short way, pr2_arm.hpp), so that a path never turns a
@@ -80,17 +73,17 @@ struct Leg {
   std::vector<Waypoint> shortened;
 };
 
-class ManipulationRefinement final : public Refinement {
+class ManipulationRefinement final : public detail::PhasedRefinement {
  public:
   ManipulationRefinement(const ManipulationDomain& domain, const ManipulationAction& action, const KitchenState& start,
                          std::uint64_t seed, const EffortSettings& effort)
-      : domain_(domain),
+      : PhasedRefinement(effort),
+        domain_(domain),
         world_(domain.world()),
         action_(action),
         object_(static_cast<std::size_t>(world_.object_index(action.object))),
         start_(start),
         seed_(seed),
-        meter_(effort),
         random_(stream_seed(seed, 0)),
         arm_(world_.robot.torso_lift) {
     if (world_.object_index(action.object) < 0) throw std::invalid_argument("unknown object " + action.object);
@@ -118,42 +111,31 @@ class ManipulationRefinement final : public Refinement {
     if (start.arm != world_.robot.carry) phase_ = Phase::retreat;
   }
 
-  RefinementStatus advance(double limit_seconds) override {
-    meter_.start_working();
-    const auto stop = [this, limit_seconds] { return meter_.reached(limit_seconds); };
-    while (phase_ != Phase::done && !stop()) {
-      switch (phase_) {
-        case Phase::retreat:
-          retreat();
-          break;
-        case Phase::retract:
-          if (planner_->run(meter_, stop)) {
-            if (retreated_) retract_.waypoints.push_back(start_.arm);
-            const std::vector<ArmJoints> path = arm_path();
-            retract_.waypoints.insert(retract_.waypoints.end(), path.begin(), path.end());
-            phase_ = Phase::target;
-          }
-          break;
-        case Phase::target:
-          draw_target();
-          break;
-        case Phase::approach:
-        case Phase::drive:
-          plan_to_target(limit_seconds);
-          break;
-        case Phase::shorten:
-          shorten_one();
-          break;
-        case Phase::done:
-          break;
-      }
+  void work(double limit_seconds) override {
+    switch (phase_) {
+      case Phase::retreat:
+        retreat();
+        break;
+      case Phase::retract:
+        if (planner_->run(meter_, [this, limit_seconds] { return meter_.reached(limit_seconds); })) {
+          if (retreated_) retract_.waypoints.push_back(start_.arm);
+          const std::vector<ArmJoints> path = arm_path();
+          retract_.waypoints.insert(retract_.waypoints.end(), path.begin(), path.end());
+          phase_ = Phase::target;
+        }
+        break;
+      case Phase::target:
+        draw_target();
+        break;
+      case Phase::approach:
+      case Phase::drive:
+        plan_to_target(limit_seconds);
+        break;
+      case Phase::shorten:
+        shorten_one();
+        break;
     }
-    meter_.stop_working();
-    return status();
   }
-
-  RefinementStatus status() const override { return phase_ == Phase::done ? RefinementStatus::found : RefinementStatus::working; }
-  const EffortMeter& effort() const override { return meter_; }
 
   double execution_seconds() const override {
     require_found();
@@ -188,11 +170,7 @@ class ManipulationRefinement final : public Refinement {
   }
 
  private:
-  enum class Phase { retreat, retract, target, approach, drive, shorten, done };
-
-  void require_found() const {
-    if (phase_ != Phase::done) throw std::logic_error("the refinement has not found a motion yet");
-  }
+  enum class Phase { retreat, retract, target, approach, drive, shorten };
 
   double uniform(double low, double high) { return low + (high - low) * uniform01(random_); }
 
@@ -271,7 +249,7 @@ class ManipulationRefinement final : public Refinement {
     auto information = std::make_shared<ob::SpaceInformation>(space);
     information->setStateValidityChecker([this](const ob::State* state) {
       meter_.count_check();
-      return !collision_->collides(pose_of(state), world_.robot.carry);
+      return !collision_->collides(se2_pose(state), world_.robot.carry);
     });
     // One check every `base_resolution` of state-space distance (metres, plus half a metre per radian).
     information->setStateValidityCheckingResolution(world_.planner.base_resolution / space->getMaximumExtent());
@@ -289,7 +267,7 @@ class ManipulationRefinement final : public Refinement {
   }
 
   static void set(ob::State* state, const ArmJoints& joints) { set_joints(state, joints); }
-  static void set(ob::State* state, const Pose& pose) { set_pose(state, pose); }
+  static void set(ob::State* state, const Pose& pose) { set_se2_pose(state, pose); }
 
   std::vector<ArmJoints> arm_path() const {
     std::vector<ArmJoints> path;
@@ -375,7 +353,7 @@ class ManipulationRefinement final : public Refinement {
       phase_ = Phase::drive;
       return;
     }
-    for (const ob::State* state : planner_->path()) drive_.waypoints.push_back(pose_of(state));
+    for (const ob::State* state : planner_->path()) drive_.waypoints.push_back(se2_pose(state));
     planner_.reset();
     start_shortening();
   }
@@ -420,7 +398,7 @@ class ManipulationRefinement final : public Refinement {
     }
     for (const std::size_t i : drive_.shortcut.kept()) drive_.shortened.push_back(drive_.waypoints[i]);
     for (const std::size_t i : approach_.shortcut.kept()) approach_.shortened.push_back(approach_.waypoints[i]);
-    phase_ = Phase::done;
+    found();
   }
 
   const ManipulationDomain& domain_;
@@ -430,7 +408,6 @@ class ManipulationRefinement final : public Refinement {
   const PlacementRegion* region_ = nullptr;
   KitchenState start_;
   std::uint64_t seed_;
-  EffortMeter meter_;
   SplitMix64 random_;
   Pr2Arm arm_;
   Transform grasp_ = Transform::Identity();  // object in the tool frame, while held

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "ompl_support.hpp"
+#include "phased_refinement.hpp"
 #include "ontime/domains/navigation_collision.hpp"
 #include "ontime/random.hpp"
 
@@ -17,25 +18,17 @@ namespace {
 
 namespace ob = ompl::base;
 
-Pose pose_of(const ob::State* state) {
-  const auto* pose = state->as<ob::SE2StateSpace::StateType>();
-  return Pose{pose->getX(), pose->getY(), pose->getYaw()};
-}
+using detail::se2_pose;
+using detail::set_se2_pose;
 
-void set_pose(ob::State* state, const Pose& pose) {
-  auto* se2 = state->as<ob::SE2StateSpace::StateType>();
-  se2->setXY(pose.x, pose.y);
-  se2->setYaw(pose.theta);
-}
-
-class NavigationRefinement final : public Refinement {
+class NavigationRefinement final : public detail::PhasedRefinement {
  public:
   NavigationRefinement(const NavigationDomain& domain, const Room& source, const Room& target, const Pose& start,
                        std::uint64_t seed, const EffortSettings& effort)
-      : domain_(domain),
+      : PhasedRefinement(effort),
+        domain_(domain),
         target_(target),
         start_(start),
-        meter_(effort),
         goal_random_(stream_seed(seed, 0)),
         collision_(domain.world(), domain.world().robot.clearance) {
     const NavigationWorld& world = domain.world();
@@ -58,36 +51,26 @@ class NavigationRefinement final : public Refinement {
     information_ = std::make_shared<ob::SpaceInformation>(space);
     information_->setStateValidityChecker([this](const ob::State* state) {
       meter_.count_check();
-      return !collision_.collides(pose_of(state));
+      return !collision_.collides(se2_pose(state));
     });
     // One check every `resolution` of state-space distance (metres, plus half a metre per radian).
     information_->setStateValidityCheckingResolution(world.planner.resolution / space->getMaximumExtent());
     information_->setup();
   }
 
-  RefinementStatus advance(double limit_seconds) override {
-    meter_.start_working();
-    while (phase_ != Phase::done && !meter_.reached(limit_seconds)) {
-      switch (phase_) {
-        case Phase::goal:
-          sample_goal();
-          break;
-        case Phase::plan:
-          plan(limit_seconds);
-          break;
-        case Phase::shorten:
-          shorten_one();
-          break;
-        case Phase::done:
-          break;
-      }
+  void work(double limit_seconds) override {
+    switch (phase_) {
+      case Phase::goal:
+        sample_goal();
+        break;
+      case Phase::plan:
+        plan(limit_seconds);
+        break;
+      case Phase::shorten:
+        shorten_one();
+        break;
     }
-    meter_.stop_working();
-    return status();
   }
-
-  RefinementStatus status() const override { return phase_ == Phase::done ? RefinementStatus::found : RefinementStatus::working; }
-  const EffortMeter& effort() const override { return meter_; }
 
   double execution_seconds() const override {
     require_found();
@@ -107,11 +90,7 @@ class NavigationRefinement final : public Refinement {
   }
 
  private:
-  enum class Phase { goal, plan, shorten, done };
-
-  void require_found() const {
-    if (phase_ != Phase::done) throw std::logic_error("the refinement has not found a motion yet");
-  }
+  enum class Phase { goal, plan, shorten };
 
   double uniform(double low, double high) { return low + (high - low) * uniform01(goal_random_); }
 
@@ -123,8 +102,8 @@ class NavigationRefinement final : public Refinement {
     if (collision_.collides(candidate)) return;
     goal_ = candidate;
     ob::ScopedState<ob::SE2StateSpace> from(information_), to(information_);
-    set_pose(from.get(), start_);
-    set_pose(to.get(), goal_);
+    set_se2_pose(from.get(), start_);
+    set_se2_pose(to.get(), goal_);
     planner_ = std::make_unique<detail::ResumableRrtConnect>(information_, from.get(), to.get(),
                                                              domain_.world().planner.range);
     phase_ = Phase::plan;
@@ -132,7 +111,7 @@ class NavigationRefinement final : public Refinement {
 
   void plan(double limit_seconds) {
     if (!planner_->run(meter_, [this, limit_seconds] { return meter_.reached(limit_seconds); })) return;
-    for (const ob::State* state : planner_->path()) path_.push_back(pose_of(state));
+    for (const ob::State* state : planner_->path()) path_.push_back(se2_pose(state));
     shortcut_ = detail::GreedyShortcut(path_.size());
     planner_.reset();  // the trees are no longer needed
     phase_ = Phase::shorten;
@@ -143,8 +122,8 @@ class NavigationRefinement final : public Refinement {
   void shorten_one() {
     const auto [from, to] = shortcut_.candidate();
     ob::ScopedState<ob::SE2StateSpace> a(information_), b(information_);
-    set_pose(a.get(), path_[from]);
-    set_pose(b.get(), path_[to]);
+    set_se2_pose(a.get(), path_[from]);
+    set_se2_pose(b.get(), path_[to]);
     shortcut_.report(shortcut_.adjacent() || information_->checkMotion(a.get(), b.get()));
     finish_if_shortened();
   }
@@ -152,13 +131,12 @@ class NavigationRefinement final : public Refinement {
   void finish_if_shortened() {
     if (!shortcut_.done()) return;
     for (const std::size_t index : shortcut_.kept()) shortened_.push_back(path_[index]);
-    phase_ = Phase::done;
+    found();
   }
 
   const NavigationDomain& domain_;
   Room target_;
   Pose start_, goal_;
-  EffortMeter meter_;
   SplitMix64 goal_random_;
   NavigationCollision collision_;
   ob::SpaceInformationPtr information_;

@@ -31,9 +31,22 @@
 #include <vector>
 
 #include "ontime/domains/effort.hpp"
+#include "ontime/domains/navigation_world.hpp"
 #include "ontime/random.hpp"
 
 namespace ontime::domains::detail {
+
+// A base pose to and from a state of an SE(2) state space.
+inline Pose se2_pose(const ompl::base::State* state) {
+  const auto* pose = state->as<ompl::base::SE2StateSpace::StateType>();
+  return Pose{pose->getX(), pose->getY(), pose->getYaw()};
+}
+
+inline void set_se2_pose(ompl::base::State* state, const Pose& pose) {
+  auto* se2 = state->as<ompl::base::SE2StateSpace::StateType>();
+  se2->setXY(pose.x, pose.y);
+  se2->setYaw(pose.theta);
+}
 
 // Silences OMPL's console messages (it reports every planner start and stop; a collection
 // runs thousands), once per process.
