@@ -135,25 +135,31 @@ std::vector<std::vector<Configuration>> refine_skeleton(const Domain& domain, co
                                                         std::uint64_t seed, const CollectionOptions& options,
                                                         int attempts) {
   check_options(options);
-  std::vector<std::vector<Configuration>> motions;
-  Configuration at = domain.initial_configuration();
-  for (std::size_t l = 0; l < skeleton.size(); ++l) {
+  std::vector<std::vector<Configuration>> motions;  // motions[l]: the motion refined for position l
+  std::vector<Configuration> ends;                   // ends[l]: where it ended
+  std::vector<std::uint64_t> tried(skeleton.size(), 0), restarts(skeleton.size(), 0);
+  while (motions.size() < skeleton.size()) {
+    const std::size_t l = motions.size();
+    const Configuration& at = l == 0 ? domain.initial_configuration() : ends.back();
     bool found = false;
     for (int attempt = 0; attempt < attempts && !found; ++attempt) {
-      const std::uint64_t attempt_seed = stream_seed(stream_seed(seed, l), static_cast<std::uint64_t>(attempt));
+      const std::uint64_t attempt_seed = stream_seed(stream_seed(seed, l), tried[l]++);
       const std::unique_ptr<Refinement> refinement = domain.refine(skeleton[l], at, attempt_seed, options.effort);
       for (Steps step = 1; step <= options.budget_steps && !found; ++step) {
         found = refinement->advance(static_cast<double>(step) * options.step_seconds) == RefinementStatus::found;
       }
       if (found) {
         motions.push_back(refinement->motion());
-        at = refinement->final_configuration();
+        ends.push_back(refinement->final_configuration());
       }
     }
-    if (!found) {
-      throw UsageError("no motion found for " + skeleton[l] + " in " + std::to_string(attempts) + " attempts of " +
+    if (found) continue;
+    if (l == 0 || restarts[l]++ == static_cast<std::uint64_t>(attempts)) {
+      throw UsageError("no motion found for " + skeleton[l] + " in " + std::to_string(tried[l]) + " attempts of " +
                        std::to_string(options.budget_steps) + " steps each");
     }
+    motions.pop_back();  // refine the action before anew, then this one from its new end
+    ends.pop_back();
   }
   return motions;
 }

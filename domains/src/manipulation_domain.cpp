@@ -190,9 +190,9 @@ Scene ManipulationDomain::scene() const {
       scene.polygons.push_back(ScenePolygon{"obstacle", "", rectangle(box.min[0], box.min[1], box.max[0], box.max[1]), "top"});
       scene.polygons.push_back(ScenePolygon{"obstacle", "", rectangle(box.min[0], box.min[2], box.max[0], box.max[2]), "front"});
     }
-    // The name, once per piece of furniture, beneath it in the front view.
-    scene.polygons.push_back(
-        ScenePolygon{"caption", fixed.name, rectangle(extent.min[0], -0.12, extent.max[0], -0.02), "front"});
+    // The name, once per piece of furniture, just beneath it in the front view.
+    scene.polygons.push_back(ScenePolygon{
+        "caption", fixed.name, rectangle(extent.min[0], extent.min[2] - 0.12, extent.max[0], extent.min[2] - 0.02), "front"});
   }
   for (const PlacementRegion& region : world_.regions) {
     scene.polygons.push_back(
@@ -239,6 +239,16 @@ std::vector<std::array<double, 2>> ManipulationDomain::trace(const std::vector<C
 std::vector<std::array<double, 2>> ManipulationDomain::outline(const Configuration& configuration) const {
   const KitchenState at = state(configuration);
   return turned_rectangle(at.base.x, at.base.y, world_.robot.base_size[0], world_.robot.base_size[1], at.base.theta);
+}
+
+std::string ManipulationDomain::describe(const std::vector<std::string>& skeleton) const {
+  std::string text;
+  for (const std::string& id : skeleton) {
+    const std::optional<ManipulationAction> action = parse_manipulation_action(id);
+    if (!action || action->kind != ManipulationKind::place) continue;
+    text += (text.empty() ? "" : ", ") + action->object + "→" + action->region;
+  }
+  return text;
 }
 
 }  // namespace ontime::domains

@@ -6,6 +6,12 @@
 
 namespace ontime::domains {
 
+std::string Domain::describe(const std::vector<std::string>& skeleton) const {
+  std::string text;
+  for (const std::string& action : skeleton) text += (text.empty() ? "" : " ") + action;
+  return text;
+}
+
 std::vector<std::string> domain_names() { return {"navigation", "manipulation"}; }
 
 LoadedDomain load_domain(std::string_view name, const std::filesystem::path& world_file) {

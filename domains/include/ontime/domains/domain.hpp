@@ -82,6 +82,8 @@ class Domain {
   virtual std::vector<std::array<double, 2>> trace(const std::vector<Configuration>& motion) const = 0;
   // The robot's outline at a configuration.
   virtual std::vector<std::array<double, 2>> outline(const Configuration& configuration) const = 0;
+  // A short caption of a skeleton for pictures; by default its action ids.
+  virtual std::string describe(const std::vector<std::string>& skeleton) const;
 };
 
 }  // namespace ontime::domains

@@ -58,6 +58,8 @@ class ManipulationDomain final : public Domain {
   Scene scene() const override;
   std::vector<std::array<double, 2>> trace(const std::vector<Configuration>& motion) const override;
   std::vector<std::array<double, 2>> outline(const Configuration& configuration) const override;
+  // The moves of a skeleton, e.g. "B3→C1, B4→C1, B1→R1, B2→R2".
+  std::string describe(const std::vector<std::string>& skeleton) const override;
 
   const ManipulationWorld& world() const noexcept { return world_; }
 
