@@ -1,8 +1,10 @@
-// Speed of the navigation domain (docs/domains.md): one collision check, and one refinement of
-// each action in the deterministic checks unit, as the collection runs it (slices of one step,
-// cut off after the deadline). The collection target — 1,000 trials of every action of the
-// navigation tree within 10 minutes on 2 cores — needs 15,000 refinements in 1,200 core-seconds,
-// i.e. at most 80 ms per refinement on average. Run a Release build:
+// Speed of the domains (docs/domains.md): one collision check, and one refinement of each action
+// in the deterministic checks unit, as the collection runs it (slices of one step, cut off after
+// the deadline). Navigation's target — 1,000 trials of every action of its tree within 10 minutes
+// on 2 cores — needs 15,000 refinements in 1,200 core-seconds, at most 80 ms per refinement on
+// average; manipulation's — within 30 minutes — 36,000 refinements in 3,600 core-seconds, at most
+// 100 ms. For manipulation also one IK solve, whose cost sets `planner.ik_checks` (the checks an
+// IK solve counts as). Run a Release build:
 //   build/ontime_domains_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 
 #include <benchmark/benchmark.h>
@@ -10,6 +12,8 @@
 #include <string>
 
 #include "ontime/domains/collection.hpp"
+#include "ontime/domains/manipulation.hpp"
+#include "ontime/domains/manipulation_collision.hpp"
 #include "ontime/domains/navigation.hpp"
 #include "ontime/domains/navigation_collision.hpp"
 #include "ontime/random.hpp"
@@ -40,13 +44,14 @@ void BM_NavigationCollisionCheck(benchmark::State& bench) {
 }
 BENCHMARK(BM_NavigationCollisionCheck);
 
-// One refinement of the action with index range(0) in the skeleton tree, from the start or
-// from fallback starts, a fresh seed each time; reports checks per refinement and found share.
-void BM_NavigationRefinement(benchmark::State& bench) {
-  const auto& domain = office();
+// One refinement of the action with index range(0) in the domain's skeleton tree, from the start
+// or from fallback starts, a fresh seed each time, in slices of one step of the world file's
+// collection settings, cut off at its deadline; reports checks per refinement and found share.
+template <class World>
+void refinement_benchmark(benchmark::State& bench, const ontime::domains::Domain& domain, const World& world) {
   const auto tree = ontime::domains::skeleton_tree(domain.skeletons());
   const auto& node = tree.at(static_cast<std::size_t>(bench.range(0)));
-  const auto& defaults = domain.world().collection;
+  const auto& defaults = world.collection;
   const ontime::domains::EffortSettings effort{ontime::domains::EffortUnit::collision_checks, defaults.checks_per_second};
   std::uint64_t seed = 0, checks = 0, found = 0;
   for (auto _ : bench) {
@@ -65,7 +70,63 @@ void BM_NavigationRefinement(benchmark::State& bench) {
   bench.counters["found"] = benchmark::Counter(static_cast<double>(found), benchmark::Counter::kAvgIterations);
   bench.SetLabel(node.action);
 }
+
+void BM_NavigationRefinement(benchmark::State& bench) { refinement_benchmark(bench, office(), office().world()); }
 BENCHMARK(BM_NavigationRefinement)->DenseRange(0, 14)->Unit(benchmark::kMillisecond);
+
+const ontime::domains::ManipulationDomain& kitchen() {
+  static const ontime::domains::ManipulationDomain domain(
+      ontime::domains::load_manipulation_world(std::string(ONTIME_SOURCE_DIR) + "/data/domains/manipulation.json"));
+  return domain;
+}
+
+// Random arm configurations with the base in front of the shelf, among the objects.
+std::vector<ontime::domains::ArmJoints> random_arms(std::size_t count) {
+  ontime::SplitMix64 random(1);
+  std::vector<ontime::domains::ArmJoints> arms(count);
+  for (auto& arm : arms) {
+    for (std::size_t j = 0; j < arm.size(); ++j) {
+      const auto& joint = ontime::domains::pr2_left_arm_joints()[j];
+      arm[j] = joint.lower + (joint.upper - joint.lower) * ontime::uniform01(random);
+    }
+  }
+  return arms;
+}
+
+void BM_ManipulationCollisionCheck(benchmark::State& bench) {
+  const auto& world = kitchen().world();
+  const ontime::domains::Pr2Arm arm(world.robot.torso_lift);
+  std::vector<ontime::domains::ObjectPose> poses;
+  for (const auto& object : world.objects) poses.push_back(object.pose);
+  const ontime::domains::ManipulationCollision collision(world, arm, poses, -1, ontime::domains::Transform::Identity(),
+                                                         world.robot.clearance);
+  const auto arms = random_arms(4096);
+  const ontime::domains::Pose base{0.85, 2.75, 1.5708};
+  std::size_t next = 0;
+  for (auto _ : bench) {
+    benchmark::DoNotOptimize(collision.collides(base, arms[next]));
+    next = (next + 1) & 4095;
+  }
+}
+BENCHMARK(BM_ManipulationCollisionCheck);
+
+// One IK solve from a random initial guess to the tool frame of another random configuration
+// (about a third of them converge within the limits).
+void BM_ManipulationInverseKinematics(benchmark::State& bench) {
+  const ontime::domains::Pr2Arm arm(kitchen().world().robot.torso_lift);
+  const auto targets = random_arms(4096);
+  const auto guesses = random_arms(4097);
+  std::size_t next = 0, found = 0;
+  for (auto _ : bench) {
+    found += arm.inverse(arm.tool(targets[next]), guesses[next + 1]).has_value() ? 1 : 0;
+    next = (next + 1) & 4095;
+  }
+  bench.counters["found"] = benchmark::Counter(static_cast<double>(found), benchmark::Counter::kAvgIterations);
+}
+BENCHMARK(BM_ManipulationInverseKinematics);
+
+void BM_ManipulationRefinement(benchmark::State& bench) { refinement_benchmark(bench, kitchen(), kitchen().world()); }
+BENCHMARK(BM_ManipulationRefinement)->DenseRange(0, 35)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -11,6 +11,7 @@
 
 #include "support/bad_inputs.hpp"
 #include "support/bad_logs.hpp"
+#include "support/mini_world.hpp"
 #include "support/paper.hpp"
 #include "support/process.hpp"
 
@@ -277,6 +278,26 @@ TEST(Cli, PlotWritesTheHistogramsAndTheirData) {
   EXPECT_EQ(ontime({"plot", "/nonexistent.json"}).exit_code, 2);
 }
 
+// An exact part beyond --max-states is reported in its cell; the rest of the table stands.
+TEST(Cli, TableReportsAnExactPartOverTheCapInItsCell) {
+  const auto text = ontime({"table", paper("instance1"), "--solvers", "dp,round-robin", "--episodes", "200", "--exact",
+                            "--max-states", "100"});
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("(0.9340)"), std::string::npos) << text.out;                 // dp: 48 states
+  EXPECT_NE(text.out.find("(cap reached)"), std::string::npos) << text.out;            // round-robin: 143
+  EXPECT_NE(text.out.find("optimum over 100 states"), std::string::npos) << text.out;  // 872 states
+  const auto as_json = ontime({"table", paper("instance1"), "--solvers", "dp,round-robin", "--episodes", "200",
+                               "--exact", "--max-states", "100", "--json"});
+  ASSERT_EQ(as_json.exit_code, 0) << as_json.err;
+  const json row = json::parse(as_json.out)["rows"][0];
+  EXPECT_EQ(row["solvers"]["dp"]["exact"]["states"].get<int>(), 48);
+  EXPECT_FALSE(row["solvers"]["dp"]["exact"]["cap_reached"].get<bool>());
+  EXPECT_TRUE(row["solvers"]["round-robin"]["exact"]["cap_reached"].get<bool>());
+  EXPECT_FALSE(row["solvers"]["round-robin"].contains("exact_success_probability"));
+  EXPECT_TRUE(row["optimum"]["cap_reached"].get<bool>());
+  EXPECT_FALSE(row.contains("optimal_success_probability"));
+}
+
 TEST(Cli, CollectWritesTheLogAndTheFittedInstance) {
   const std::filesystem::path dir = scratch("collect");
   const std::string log = (dir / "logs" / "navigation.jsonl").string();
@@ -324,6 +345,62 @@ TEST(Cli, CollectRejectsBadDomainsAndWorlds) {
                                   (dir / "file" / "l.jsonl").string(), "-o", (dir / "i.json").string()});
   EXPECT_EQ(unwritable.exit_code, 2);
   EXPECT_NE(unwritable.err.find("cannot write into"), std::string::npos) << unwritable.err;
+}
+
+// SIGINT in the middle of a collection leaves no output and a checkpoint; --resume finishes it
+// with the very files an uninterrupted run writes.
+TEST(Cli, AnInterruptedCollectionResumesToTheSameFiles) {
+  const std::filesystem::path dir = scratch("resume");
+  const std::string world = (dir / "mini.json").string();
+  std::ofstream(world) << testing::kMiniWorld;
+  const auto collect = [&](const std::string& name, const std::vector<std::string>& extra) {
+    std::vector<std::string> arguments{ONTIME_CLI, "collect", "--domain", "navigation", "--world", world, "--trials", "300",
+                                       "--seed", "8", "--log", (dir / (name + ".jsonl")).string(), "-o",
+                                       (dir / (name + ".json")).string()};
+    arguments.insert(arguments.end(), extra.begin(), extra.end());
+    return arguments;
+  };
+  ASSERT_EQ(testing::run_process(collect("whole", {})).exit_code, 0);
+  const std::filesystem::path checkpoint = dir / "cut.jsonl.checkpoint";
+  const auto interrupted = testing::run_process(collect("cut", {"--threads", "2"}), [&] {
+    const std::string text = read_file(checkpoint);
+    return std::count(text.begin(), text.end(), '\n') >= 20;
+  });
+  ASSERT_EQ(interrupted.exit_code, 128 + SIGINT) << interrupted.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "cut.jsonl"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "cut.json"));
+  const std::size_t saved = line_count(checkpoint);
+  EXPECT_GE(saved, 20u);
+  EXPECT_LT(saved, 601u);  // the settings line and at most 600 trials: the run was cut short
+  // Without --resume the checkpoint is not thrown away.
+  const auto refused = testing::run_process(collect("cut", {}));
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_NE(refused.err.find("--resume"), std::string::npos) << refused.err;
+  EXPECT_EQ(line_count(checkpoint), saved);
+  // Another cut-off is another collection: refused, naming the setting.
+  const auto other = testing::run_process(collect("cut", {"--resume", "--budget", "5"}));
+  EXPECT_EQ(other.exit_code, 2);
+  EXPECT_NE(other.err.find("line 1: the checkpoint of another collection ('budget_steps'"), std::string::npos) << other.err;
+  const auto resumed = testing::run_process(collect("cut", {"--resume", "--threads", "1", "--json"}));
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
+  EXPECT_EQ(json::parse(resumed.out)["resumed_attempts"].get<std::size_t>(), saved - 1);
+  EXPECT_EQ(read_file(dir / "cut.jsonl"), read_file(dir / "whole.jsonl"));
+  EXPECT_EQ(read_file(dir / "cut.json"), read_file(dir / "whole.json"));
+  EXPECT_FALSE(std::filesystem::exists(checkpoint));
+}
+
+TEST(Cli, CollectRunsTheManipulationDomain) {
+  const std::filesystem::path dir = scratch("collect-kitchen");
+  const auto result = ontime({"collect", "--domain", "manipulation", "--trials", "1", "--budget", "1", "--log",
+                              (dir / "m.jsonl").string(), "-o", (dir / "m.json").string(), "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const json out = json::parse(result.out);
+  EXPECT_EQ(out["attempts"].get<int>(), 36);
+  EXPECT_EQ(out["deadline"].get<int>(), 40);
+  const json instance = json::parse(read_file(dir / "m.json"));
+  EXPECT_EQ(instance["skeletons"].size(), 8u);
+  EXPECT_EQ(instance["actions"].size(), 36u);
+  EXPECT_EQ(instance["skeletons"][7].size(), 12u);
 }
 
 TEST(Cli, MapDrawsTheWorldAndOneMotionPerSkeleton) {

@@ -1,8 +1,14 @@
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <map>
+#include <stdexcept>
 
 #include "ontime/domains/collection.hpp"
+#include "ontime/domains/collection_journal.hpp"
+#include "ontime/domains/manipulation.hpp"
+#include "ontime/error.hpp"
 #include "ontime/domains/navigation.hpp"
 #include "ontime/fitting.hpp"
 #include "ontime/planner_log.hpp"
@@ -104,6 +110,140 @@ TEST(Collection, RefinesAWholeSkeletonForPictures) {
   ASSERT_EQ(motions.size(), 4u);
   for (std::size_t l = 1; l < motions.size(); ++l) EXPECT_EQ(motions[l].front(), motions[l - 1].back());
   EXPECT_EQ(motions[0].front(), office().initial_configuration());
+}
+
+const ManipulationDomain& kitchen() {
+  static const ManipulationDomain domain(load_manipulation_world(testing::source_path("data/domains/manipulation.json")));
+  return domain;
+}
+
+// The kitchen's collection settings, cut off after `budget` steps.
+CollectionOptions kitchen_options(std::uint64_t trials, std::uint64_t seed, unsigned threads, Steps budget) {
+  CollectionOptions result = options(trials, seed, threads);
+  result.effort.checks_per_second = kitchen().world().collection.checks_per_second;
+  result.step_seconds = kitchen().world().collection.step_seconds;
+  result.budget_steps = budget;
+  return result;
+}
+
+std::filesystem::path fresh(const std::string& name) {
+  const auto path = std::filesystem::temp_directory_path() / ("ontime_collection_test_" + name);
+  std::filesystem::remove(path);
+  return path;
+}
+
+std::string contents(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// An interruption after 20 attempts (an exception out of the progress callback, as a crash
+// would stop the run), then a resumed run: the same log as an uninterrupted one.
+TEST(CollectionJournal, AnInterruptedCollectionResumesToTheSameLog) {
+  const CollectionOptions settings = options(3, 9, 2);
+  const std::string whole = text(collect(office(), settings).log);
+  const auto path = fresh("resume.checkpoint");
+  {
+    CollectionJournal journal(path, office(), settings, "world text", false);
+    CollectionOptions interrupted = settings;
+    interrupted.journal = &journal;
+    interrupted.progress = [](std::uint64_t done, std::uint64_t) {
+      if (done == 20) throw std::runtime_error("interrupted");
+    };
+    EXPECT_THROW(collect(office(), interrupted), std::runtime_error);
+  }
+  CollectionJournal journal(path, office(), settings, "world text", true);
+  EXPECT_GE(journal.finished().size(), 20u);
+  EXPECT_LT(journal.finished().size(), 45u);
+  CollectionOptions resumed = settings;
+  resumed.journal = &journal;
+  resumed.threads = 1;
+  std::uint64_t first_progress = 0;
+  resumed.progress = [&](std::uint64_t done, std::uint64_t) {
+    if (first_progress == 0) first_progress = done;
+  };
+  EXPECT_EQ(text(collect(office(), resumed).log), whole);
+  EXPECT_EQ(first_progress, journal.finished().size() + 1);  // the resumed trials count as done
+  journal.remove();
+  EXPECT_FALSE(std::filesystem::exists(path));
+}
+
+TEST(CollectionJournal, KeepsTheEndConfigurationsTheNextActionStartsFrom) {
+  CollectionOptions settings = kitchen_options(1, 3, 1, 3);
+  const auto path = fresh("kitchen.checkpoint");
+  {
+    CollectionJournal journal(path, kitchen(), settings, "kitchen", false);
+    settings.journal = &journal;
+    settings.progress = [](std::uint64_t done, std::uint64_t) {
+      if (done == 3) throw std::runtime_error("interrupted");
+    };
+    EXPECT_THROW(collect(kitchen(), settings), std::runtime_error);
+  }
+  const CollectionJournal journal(path, kitchen(), settings, "kitchen", true);
+  ASSERT_EQ(journal.finished().size(), 3u);
+  for (const JournalTrial& trial : journal.finished()) {
+    ASSERT_EQ(trial.end.has_value(), trial.attempt.found);
+    if (trial.end) {
+      EXPECT_EQ(trial.end->size(), kitchen().initial_configuration().size());  // robot and objects
+    }
+  }
+  std::filesystem::remove(path);
+}
+
+TEST(CollectionJournal, RefusesAnotherCollectionAndNeverDropsWorkSilently) {
+  const CollectionOptions settings = options(2, 4, 1);
+  const auto path = fresh("refuse.checkpoint");
+  {
+    CollectionJournal journal(path, office(), settings, "world text", false);
+    CollectionOptions with_journal = settings;
+    with_journal.journal = &journal;
+    collect(office(), with_journal);
+  }
+  const std::string full = contents(path);
+  ASSERT_EQ(std::count(full.begin(), full.end(), '\n'), 31);  // the settings and 30 trials
+  // Not resuming: refused, the file kept.
+  EXPECT_THROW(CollectionJournal(path, office(), settings, "world text", false), UsageError);
+  // Another seed or another world file: refused, naming the setting.
+  CollectionOptions other = settings;
+  other.seed = 5;
+  try {
+    CollectionJournal(path, office(), other, "world text", true);
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.place(), "line 1");
+    EXPECT_NE(error.rule().find("'seed' is 4 there, 5 here"), std::string::npos) << error.what();
+  }
+  EXPECT_THROW(CollectionJournal(path, office(), settings, "another world", true), InputError);
+  // A last line cut short by a crash is dropped (and its trial run again).
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << full.substr(0, full.size() - 7);
+  {
+    const CollectionJournal journal(path, office(), settings, "world text", true);
+    EXPECT_EQ(journal.finished().size(), 29u);
+  }
+  EXPECT_EQ(contents(path), full.substr(0, full.rfind('\n', full.size() - 2) + 1));
+  // A damaged line in the middle is an error with its line number.
+  std::string damaged = full;
+  damaged.replace(damaged.find("\"record\""), 8, "\"recurd\"");
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << damaged;
+  try {
+    CollectionJournal(path, office(), settings, "world text", true);
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.place(), "line 2");
+  }
+  std::filesystem::remove(path);
+}
+
+TEST(Collection, TheKitchenGivesIdenticalLogsForIdenticalSeedsWhateverTheThreads) {
+  CollectionOptions settings = kitchen_options(2, 5, 1, 2);
+  const CollectionResult one = collect(kitchen(), settings);
+  settings.threads = 2;
+  const CollectionResult two = collect(kitchen(), settings);
+  ASSERT_EQ(one.log.size(), 72u);
+  EXPECT_EQ(text(one.log), text(two.log));
+  std::size_t found = 0;
+  for (const RefinementAttempt& attempt : one.log) found += attempt.found ? 1 : 0;
+  EXPECT_GT(found, 20u);
 }
 
 }  // namespace

@@ -1,14 +1,19 @@
 // `ontime collect --domain NAME --trials N`: refines every action of the domain's skeleton tree
-// N times with the real motion planner, writes the planner log and fits the instance.
+// N times with the real motion planner, writes the planner log and fits the instance. Every
+// finished trial goes to a checkpoint first, so that an interrupted collection can be resumed
+// (--resume) with the same result; the checkpoint is deleted once the outputs are written.
 
 #include <filesystem>
 #include <fmt/format.h>
+#include <fstream>
+#include <sstream>
 #include <unistd.h>
 
 #include "common.hpp"
 #include "data_paths.hpp"
 #include "fit_report.hpp"
 #include "ontime/domains/collection.hpp"
+#include "ontime/domains/collection_journal.hpp"
 #include "ontime/domains/registry.hpp"
 #include "ontime/error.hpp"
 #include "ontime/fitting.hpp"
@@ -29,6 +34,13 @@ void prepare_output(const std::filesystem::path& path) {
   }
 }
 
+std::string file_text(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
 }  // namespace
 
 void add_collect_command(CLI::App& app) {
@@ -37,6 +49,7 @@ void add_collect_command(CLI::App& app) {
     std::string world;
     std::string log;
     std::string instance;
+    std::string checkpoint;
     std::string effort = "checks";
     std::uint64_t trials = 1000;
     std::uint64_t seed = 1;
@@ -46,6 +59,7 @@ void add_collect_command(CLI::App& app) {
     Steps budget = 0;
     double checks_per_second = 0;
     double laplace = 0;
+    bool resume = false;
     bool json = false;
   };
   auto options = std::make_shared<Options>();
@@ -73,6 +87,10 @@ void add_collect_command(CLI::App& app) {
   command->add_option("--laplace", options->laplace, "Laplace smoothing of the fit")->check(CLI::NonNegativeNumber)->capture_default_str();
   command->add_option("--log", options->log, "Planner log to write (default: data/logs/DOMAIN.jsonl)");
   command->add_option("-o,--instance", options->instance, "Instance to write (default: data/instances/DOMAIN.json)");
+  command->add_option("--checkpoint", options->checkpoint,
+                      "Journal of finished trials, kept until the outputs are written (default: LOG.checkpoint)");
+  command->add_flag("--resume", options->resume,
+                    "Continue the collection recorded in the checkpoint, if there is one (same settings, same result)");
   command->add_flag("--json", options->json, "Print JSON");
   command->callback([options] {
     const std::filesystem::path world = options->world.empty() ? default_world_file(options->domain) : std::filesystem::path(options->world);
@@ -92,6 +110,12 @@ void add_collect_command(CLI::App& app) {
     collection.budget_steps = options->budget > 0 ? options->budget : deadline;
     prepare_output(log_path);
     prepare_output(instance_path);
+    const std::filesystem::path checkpoint_path =
+        options->checkpoint.empty() ? std::filesystem::path(log_path.string() + ".checkpoint") : std::filesystem::path(options->checkpoint);
+    prepare_output(checkpoint_path);
+    domains::CollectionJournal journal(checkpoint_path, *loaded.domain, collection, file_text(world), options->resume);
+    collection.journal = &journal;
+    const std::size_t resumed = journal.finished().size();
     ProgressBar bar("collect " + options->domain);
     collection.progress = [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); };
     const domains::CollectionResult result = domains::collect(*loaded.domain, collection);
@@ -112,6 +136,7 @@ void add_collect_command(CLI::App& app) {
     const SkeletonList skeletons{world.string(), loaded.domain->skeletons()};
     const FitResult fit = fit_problem(result.log, log_path.string(), skeletons, fit_options);
     save_problem(fit.problem, instance_path);
+    journal.remove();
 
     std::uint64_t found = 0;
     for (const RefinementAttempt& attempt : result.log) found += attempt.found ? 1 : 0;
@@ -130,6 +155,7 @@ void add_collect_command(CLI::App& app) {
       out["found"] = found;
       out["collision_checks"] = result.collision_checks;
       out["seconds"] = result.seconds;
+      out["resumed_attempts"] = resumed;
       out["log"] = log_path.string();
       out["instance"] = instance_path.string();
       out["actions"] = fit_report_json(fit);
@@ -138,6 +164,7 @@ void add_collect_command(CLI::App& app) {
     }
     fmt::print("Collected {} attempts ({} per action, {} found) in {:.1f} s: {} collision checks.\n", result.log.size(),
                options->trials, found, result.seconds, result.collision_checks);
+    if (resumed > 0) fmt::print("Resumed from {}: {} attempts were done before.\n", checkpoint_path.string(), resumed);
     fmt::print("Log: {}. Instance: {} (deadline {} steps of {} s).\n\n", log_path.string(), instance_path.string(),
                deadline, collection.step_seconds);
     fmt::print("{}", fit_report_markdown(fit));

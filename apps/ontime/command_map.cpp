@@ -51,7 +51,8 @@ void add_map_command(CLI::App& app) {
     drawing["title"] = fmt::format("{}: one refined motion per skeleton (seed {})", scene.title, options->seed);
     drawing["polygons"] = Json::array();
     for (const domains::ScenePolygon& polygon : scene.polygons) {
-      drawing["polygons"].push_back({{"kind", polygon.kind}, {"label", polygon.label}, {"points", points_json(polygon.points)}});
+      drawing["polygons"].push_back(
+          {{"kind", polygon.kind}, {"label", polygon.label}, {"view", polygon.view}, {"points", points_json(polygon.points)}});
     }
     drawing["paths"] = Json::array();
     const auto& skeletons = domain.skeletons();
@@ -63,7 +64,7 @@ void add_map_command(CLI::App& app) {
         points.insert(points.end(), trace.begin() + (points.empty() ? 0 : 1), trace.end());
       }
       const std::vector<domains::Configuration>& last = motions.back();
-      drawing["paths"].push_back({{"label", fmt::format("σ{}: {}", k + 1, fmt::join(skeletons[k], " "))},
+      drawing["paths"].push_back({{"label", fmt::format("σ{}: {}", k + 1, domain.describe(skeletons[k]))},
                                   {"points", points_json(points)},
                                   {"end", points_json(domain.outline(last.back()))}});
     }

@@ -1,20 +1,33 @@
 // `ontime table INSTANCE...`: the layout of the paper's Table I — one row per instance, one
 // column per allocator (sampled mean ± 95%, exact value with --exact), the exact optimum, and
-// the mean decision time of each allocator.
+// the mean decision time of each allocator. An exact part that would need more than
+// --max-states states is reported as such in its cell (the sampled value stands), so that one
+// large instance does not cost the whole table; the states and seconds of every exact part are
+// listed below the table.
 
+#include <chrono>
 #include <filesystem>
 #include <fmt/format.h>
 
 #include "common.hpp"
 #include "markdown_table.hpp"
+#include "ontime/error.hpp"
 #include "ontime/instance_io.hpp"
 
 namespace ontime::cli {
 namespace {
 
+// An exact computation: its value, or the cap it reached; its states and seconds.
+struct ExactPart {
+  std::optional<double> value;
+  bool cap_reached = false;
+  std::size_t states = 0;  // memoised states; at the cap: the cap
+  double seconds = 0;
+};
+
 struct Cell {
   MonteCarloResult sampled;
-  std::optional<ExactEvaluation> exact;
+  std::optional<ExactPart> exact;  // with --exact, for stationary allocators
 };
 
 struct Row {
@@ -22,9 +35,37 @@ struct Row {
   std::string label;
   std::string name;
   std::vector<Cell> cells;
-  std::optional<double> optimum;
-  std::size_t optimum_states = 0;
+  std::optional<ExactPart> optimum;
 };
+
+// Runs an exact computation that returns (value, states); a ResourceLimitError becomes a
+// reached cap of `max_states`.
+template <class Compute>
+ExactPart exact_part(std::size_t max_states, const Compute& compute) {
+  ExactPart part;
+  const auto started = std::chrono::steady_clock::now();
+  try {
+    const auto [value, states] = compute();
+    part.value = value;
+    part.states = states;
+  } catch (const ResourceLimitError&) {
+    part.cap_reached = true;
+    part.states = max_states;
+  }
+  part.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return part;
+}
+
+std::string exact_text(const ExactPart& part) { return part.value ? fmt::format("{:.4f}", *part.value) : "cap reached"; }
+
+Json exact_json(const ExactPart& part) {
+  Json out;
+  if (part.value) out["value"] = *part.value;
+  out["cap_reached"] = part.cap_reached;
+  out["states"] = part.states;
+  out["seconds"] = part.seconds;
+  return out;
+}
 
 }  // namespace
 
@@ -80,14 +121,21 @@ void add_table_command(CLI::App& app) {
         finished += base.episodes;
         if (options->exact) {
           const auto allocator = factory();
-          if (allocator->is_stationary()) cell.exact = evaluate_exactly(mdp, *allocator, allocator_options.max_states);
+          if (allocator->is_stationary()) {
+            cell.exact = exact_part(allocator_options.max_states, [&] {
+              const ExactEvaluation evaluation = evaluate_exactly(mdp, *allocator, allocator_options.max_states);
+              return std::pair{evaluation.success_probability, evaluation.states};
+            });
+          }
         }
         row.cells.push_back(std::move(cell));
       }
       if (options->exact) {
-        OptimalSolver solver(mdp, allocator_options.max_states);
-        row.optimum = solver.solve(mdp.start());
-        row.optimum_states = solver.states();
+        row.optimum = exact_part(allocator_options.max_states, [&] {
+          OptimalSolver solver(mdp, allocator_options.max_states);
+          const double value = solver.solve(mdp.start());
+          return std::pair{value, solver.states()};
+        });
       }
       rows.push_back(std::move(row));
     }
@@ -111,13 +159,17 @@ void add_table_command(CLI::App& app) {
           entry["decision_time_us"] = {{"median", cell.sampled.decision_time.median_us},
                                        {"p99", cell.sampled.decision_time.p99_us},
                                        {"mean", cell.sampled.decision_time.mean_us}};
-          if (cell.exact) entry["exact_success_probability"] = cell.exact->success_probability;
+          if (cell.exact) {
+            if (cell.exact->value) entry["exact_success_probability"] = *cell.exact->value;
+            entry["exact"] = exact_json(*cell.exact);
+          }
           cells[options->solvers[s]] = entry;
         }
         line["solvers"] = cells;
         if (row.optimum) {
-          line["optimal_success_probability"] = *row.optimum;
-          line["optimal_states"] = row.optimum_states;
+          if (row.optimum->value) line["optimal_success_probability"] = *row.optimum->value;
+          line["optimal_states"] = row.optimum->states;
+          line["optimum"] = exact_json(*row.optimum);
         }
         out["rows"].push_back(line);
       }
@@ -135,11 +187,11 @@ void add_table_command(CLI::App& app) {
       for (std::size_t s = 0; s < row.cells.size(); ++s) {
         const Cell& cell = row.cells[s];
         std::string text = fmt::format("{:.3f} ± {:.3f}", cell.sampled.success_rate, cell.sampled.ci95);
-        if (cell.exact) text += fmt::format(" ({:.4f})", cell.exact->success_probability);
+        if (cell.exact) text += " (" + exact_text(*cell.exact) + ")";
         line.push_back(text);
         latency_sum[s] += cell.sampled.decision_time.mean_us;
       }
-      if (options->exact) line.push_back(fmt::format("{:.4f}", *row.optimum));
+      if (options->exact) line.push_back(exact_text(*row.optimum));
       body.push_back(std::move(line));
     }
     std::vector<std::string> latency{"mean decision time (µs)"};
@@ -150,6 +202,21 @@ void add_table_command(CLI::App& app) {
     fmt::print("Success probability: mean ± 95% over {} episodes (seed {}){}.\n\n", base.episodes, base.seed,
                options->exact ? "; exact value in parentheses; optimum = exact expectimax" : "");
     fmt::print("{}", render_markdown(header, body));
+    if (!options->exact) return;
+    fmt::print("\nExact parts (states, seconds; 'cap reached': more than --max-states {} states):\n",
+               options->allocator.max_states);
+    for (const Row& row : rows) {
+      std::vector<std::string> parts;
+      for (std::size_t s = 0; s < row.cells.size(); ++s) {
+        const auto& exact = row.cells[s].exact;
+        if (!exact) continue;
+        parts.push_back(fmt::format("{} {}{} states, {:.1f} s", options->solvers[s], exact->cap_reached ? "over " : "",
+                                    exact->states, exact->seconds));
+      }
+      parts.push_back(fmt::format("optimum {}{} states, {:.1f} s", row.optimum->cap_reached ? "over " : "",
+                                  row.optimum->states, row.optimum->seconds));
+      fmt::print("- {}: {}.\n", row.label, fmt::join(parts, "; "));
+    }
   });
 }
 

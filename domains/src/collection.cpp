@@ -7,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "ontime/domains/collection_journal.hpp"
 #include "ontime/error.hpp"
 #include "ontime/random.hpp"
 #include "parallel.hpp"
@@ -79,6 +80,15 @@ CollectionResult collect(const Domain& domain, const CollectionOptions& options)
   std::uint64_t finished = 0;
   std::mutex progress_mutex;
 
+  // Trials an earlier, interrupted run finished: resumed[a][t].
+  std::vector<std::vector<const JournalTrial*>> resumed(tree.size(), std::vector<const JournalTrial*>(options.trials, nullptr));
+  if (options.journal != nullptr) {
+    for (const JournalTrial& trial : options.journal->finished()) {
+      resumed.at(trial.action).at(trial.attempt.trial.value()) = &trial;
+      ++finished;
+    }
+  }
+
   // ends[a]: end configurations of the successful refinements of action a, in trial order.
   std::vector<std::vector<Configuration>> ends(tree.size());
   CollectionResult result;
@@ -89,6 +99,10 @@ CollectionResult collect(const Domain& domain, const CollectionOptions& options)
     std::vector<Outcome> outcomes(options.trials);
     detail::for_each_index(options.trials, options.threads, [&] {
       return [&](std::uint64_t t) {
+        if (const JournalTrial* earlier = resumed[a][t]) {
+          outcomes[t] = Outcome{earlier->attempt, earlier->end};
+          return;
+        }
         const std::uint64_t trial_seed = stream_seed(action_seed, t);
         Configuration start;
         if (starts == nullptr) {
@@ -100,6 +114,7 @@ CollectionResult collect(const Domain& domain, const CollectionOptions& options)
         }
         outcomes[t] = attempt_once(domain, node.action, start, stream_seed(trial_seed, 0), options);
         outcomes[t].attempt.trial = t;
+        if (options.journal != nullptr) options.journal->record(JournalTrial{a, outcomes[t].attempt, outcomes[t].end});
         if (options.progress) {
           const std::lock_guard lock(progress_mutex);
           options.progress(++finished, total);
@@ -120,25 +135,31 @@ std::vector<std::vector<Configuration>> refine_skeleton(const Domain& domain, co
                                                         std::uint64_t seed, const CollectionOptions& options,
                                                         int attempts) {
   check_options(options);
-  std::vector<std::vector<Configuration>> motions;
-  Configuration at = domain.initial_configuration();
-  for (std::size_t l = 0; l < skeleton.size(); ++l) {
+  std::vector<std::vector<Configuration>> motions;  // motions[l]: the motion refined for position l
+  std::vector<Configuration> ends;                   // ends[l]: where it ended
+  std::vector<std::uint64_t> tried(skeleton.size(), 0), restarts(skeleton.size(), 0);
+  while (motions.size() < skeleton.size()) {
+    const std::size_t l = motions.size();
+    const Configuration& at = l == 0 ? domain.initial_configuration() : ends.back();
     bool found = false;
     for (int attempt = 0; attempt < attempts && !found; ++attempt) {
-      const std::uint64_t attempt_seed = stream_seed(stream_seed(seed, l), static_cast<std::uint64_t>(attempt));
+      const std::uint64_t attempt_seed = stream_seed(stream_seed(seed, l), tried[l]++);
       const std::unique_ptr<Refinement> refinement = domain.refine(skeleton[l], at, attempt_seed, options.effort);
       for (Steps step = 1; step <= options.budget_steps && !found; ++step) {
         found = refinement->advance(static_cast<double>(step) * options.step_seconds) == RefinementStatus::found;
       }
       if (found) {
         motions.push_back(refinement->motion());
-        at = refinement->final_configuration();
+        ends.push_back(refinement->final_configuration());
       }
     }
-    if (!found) {
-      throw UsageError("no motion found for " + skeleton[l] + " in " + std::to_string(attempts) + " attempts of " +
+    if (found) continue;
+    if (l == 0 || restarts[l]++ == static_cast<std::uint64_t>(attempts)) {
+      throw UsageError("no motion found for " + skeleton[l] + " in " + std::to_string(tried[l]) + " attempts of " +
                        std::to_string(options.budget_steps) + " steps each");
     }
+    motions.pop_back();  // refine the action before anew, then this one from its new end
+    ends.pop_back();
   }
   return motions;
 }

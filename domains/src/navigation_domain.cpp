@@ -1,13 +1,11 @@
 #include "ontime/domains/navigation.hpp"
 
-#include <ompl/util/Console.h>
-
 #include <cmath>
-#include <mutex>
 #include <numbers>
 #include <stdexcept>
 
 #include "navigation_refinement.hpp"
+#include "ompl_support.hpp"
 #include "ontime/domains/navigation_collision.hpp"
 #include "ontime/random.hpp"
 
@@ -21,11 +19,7 @@ Pose pose_of(const Configuration& configuration) {
 
 }  // namespace
 
-NavigationDomain::NavigationDomain(NavigationWorld world) : world_(std::move(world)) {
-  // OMPL reports every planner start and stop on the console; the collection runs thousands.
-  static std::once_flag quiet;
-  std::call_once(quiet, [] { ompl::msg::setLogLevel(ompl::msg::LOG_NONE); });
-}
+NavigationDomain::NavigationDomain(NavigationWorld world) : world_(std::move(world)) { detail::quiet_ompl(); }
 
 Configuration NavigationDomain::initial_configuration() const { return {world_.start.x, world_.start.y, world_.start.theta}; }
 
@@ -56,13 +50,17 @@ Configuration NavigationDomain::fallback_start(const std::string& action, std::u
   throw std::runtime_error("no collision-free pose found in room " + room.id);
 }
 
-double NavigationDomain::execution_seconds(const std::vector<Pose>& poses) const {
+double drive_seconds(const std::vector<Pose>& poses, double linear_speed, double angular_speed) {
   double length = 0, rotation = 0;
   for (std::size_t i = 1; i < poses.size(); ++i) {
     length += std::hypot(poses[i].x - poses[i - 1].x, poses[i].y - poses[i - 1].y);
     rotation += std::abs(std::remainder(poses[i].theta - poses[i - 1].theta, 2 * std::numbers::pi));
   }
-  return length / world_.robot.linear_speed + rotation / world_.robot.angular_speed;
+  return length / linear_speed + rotation / angular_speed;
+}
+
+double NavigationDomain::execution_seconds(const std::vector<Pose>& poses) const {
+  return drive_seconds(poses, world_.robot.linear_speed, world_.robot.angular_speed);
 }
 
 Scene NavigationDomain::scene() const {

@@ -1,17 +1,15 @@
 #include "navigation_refinement.hpp"
 
-#include <ompl/base/PlannerTerminationCondition.h>
-#include <ompl/base/ProblemDefinition.h>
+#include <ompl/base/ScopedState.h>
 #include <ompl/base/SpaceInformation.h>
-#include <ompl/base/StateSampler.h>
 #include <ompl/base/spaces/SE2StateSpace.h>
-#include <ompl/geometric/PathGeometric.h>
-#include <ompl/geometric/planners/rrt/RRTConnect.h>
 
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
 
+#include "ompl_support.hpp"
+#include "phased_refinement.hpp"
 #include "ontime/domains/navigation_collision.hpp"
 #include "ontime/random.hpp"
 
@@ -19,68 +17,18 @@ namespace ontime::domains {
 namespace {
 
 namespace ob = ompl::base;
-namespace og = ompl::geometric;
 
-// Uniform poses in the planning bounds, drawn from a seeded SplitMix64. Written here instead of
-// OMPL's default sampler because that one draws from OMPL's RNG, whose seeds come from one
-// process-wide sequence in the order samplers are created: with several threads the same
-// refinement would get other samples from run to run.
-class SeededPoseSampler final : public ob::StateSampler {
- public:
-  SeededPoseSampler(const ob::StateSpace* space, std::array<double, 4> bounds, std::uint64_t seed)
-      : ob::StateSampler(space), bounds_(bounds), random_(seed) {}
+using detail::se2_pose;
+using detail::set_se2_pose;
 
-  void sampleUniform(ob::State* state) override {
-    set(state, uniform(bounds_[0], bounds_[2]), uniform(bounds_[1], bounds_[3]),
-        uniform(-std::numbers::pi, std::numbers::pi));
-  }
-
-  // Not used by RRT-Connect; uniform within `distance` of `near` in x, y and heading.
-  void sampleUniformNear(ob::State* state, const ob::State* near, double distance) override {
-    const auto* centre = near->as<ob::SE2StateSpace::StateType>();
-    set(state, std::clamp(centre->getX() + uniform(-distance, distance), bounds_[0], bounds_[2]),
-        std::clamp(centre->getY() + uniform(-distance, distance), bounds_[1], bounds_[3]),
-        centre->getYaw() + uniform(-distance, distance));
-  }
-
-  // Not used by RRT-Connect; approximated by the uniform draw of the same spread.
-  void sampleGaussian(ob::State* state, const ob::State* mean, double standard_deviation) override {
-    sampleUniformNear(state, mean, standard_deviation);
-  }
-
- private:
-  double uniform(double low, double high) { return low + (high - low) * uniform01(random_); }
-
-  void set(ob::State* state, double x, double y, double yaw) const {
-    auto* pose = state->as<ob::SE2StateSpace::StateType>();
-    pose->setXY(x, y);
-    pose->setYaw(std::remainder(yaw, 2 * std::numbers::pi));
-    space_->enforceBounds(state);
-  }
-
-  std::array<double, 4> bounds_;
-  SplitMix64 random_;
-};
-
-Pose pose_of(const ob::State* state) {
-  const auto* pose = state->as<ob::SE2StateSpace::StateType>();
-  return Pose{pose->getX(), pose->getY(), pose->getYaw()};
-}
-
-void set_pose(ob::State* state, const Pose& pose) {
-  auto* se2 = state->as<ob::SE2StateSpace::StateType>();
-  se2->setXY(pose.x, pose.y);
-  se2->setYaw(pose.theta);
-}
-
-class NavigationRefinement final : public Refinement {
+class NavigationRefinement final : public detail::PhasedRefinement {
  public:
   NavigationRefinement(const NavigationDomain& domain, const Room& source, const Room& target, const Pose& start,
                        std::uint64_t seed, const EffortSettings& effort)
-      : domain_(domain),
+      : PhasedRefinement(effort),
+        domain_(domain),
         target_(target),
         start_(start),
-        meter_(effort),
         goal_random_(stream_seed(seed, 0)),
         collision_(domain.world(), domain.world().robot.clearance) {
     const NavigationWorld& world = domain.world();
@@ -98,41 +46,31 @@ class NavigationRefinement final : public Refinement {
     space->setBounds(limits);
     const std::uint64_t sampler_seed = stream_seed(seed, 1);
     space->setStateSamplerAllocator([bounds, sampler_seed](const ob::StateSpace* owner) {
-      return std::make_shared<SeededPoseSampler>(owner, bounds, sampler_seed);
+      return std::make_shared<detail::SeededPoseSampler>(owner, bounds, sampler_seed);
     });
     information_ = std::make_shared<ob::SpaceInformation>(space);
     information_->setStateValidityChecker([this](const ob::State* state) {
       meter_.count_check();
-      return !collision_.collides(pose_of(state));
+      return !collision_.collides(se2_pose(state));
     });
     // One check every `resolution` of state-space distance (metres, plus half a metre per radian).
     information_->setStateValidityCheckingResolution(world.planner.resolution / space->getMaximumExtent());
     information_->setup();
   }
 
-  RefinementStatus advance(double limit_seconds) override {
-    meter_.start_working();
-    while (phase_ != Phase::done && !meter_.reached(limit_seconds)) {
-      switch (phase_) {
-        case Phase::goal:
-          sample_goal();
-          break;
-        case Phase::plan:
-          plan(limit_seconds);
-          break;
-        case Phase::shorten:
-          shorten_one();
-          break;
-        case Phase::done:
-          break;
-      }
+  void work(double limit_seconds) override {
+    switch (phase_) {
+      case Phase::goal:
+        sample_goal();
+        break;
+      case Phase::plan:
+        plan(limit_seconds);
+        break;
+      case Phase::shorten:
+        shorten_one();
+        break;
     }
-    meter_.stop_working();
-    return status();
   }
-
-  RefinementStatus status() const override { return phase_ == Phase::done ? RefinementStatus::found : RefinementStatus::working; }
-  const EffortMeter& effort() const override { return meter_; }
 
   double execution_seconds() const override {
     require_found();
@@ -152,11 +90,7 @@ class NavigationRefinement final : public Refinement {
   }
 
  private:
-  enum class Phase { goal, plan, shorten, done };
-
-  void require_found() const {
-    if (phase_ != Phase::done) throw std::logic_error("the refinement has not found a motion yet");
-  }
+  enum class Phase { goal, plan, shorten };
 
   double uniform(double low, double high) { return low + (high - low) * uniform01(goal_random_); }
 
@@ -167,66 +101,49 @@ class NavigationRefinement final : public Refinement {
     meter_.count_check();
     if (collision_.collides(candidate)) return;
     goal_ = candidate;
-    problem_ = std::make_shared<ob::ProblemDefinition>(information_);
     ob::ScopedState<ob::SE2StateSpace> from(information_), to(information_);
-    set_pose(from.get(), start_);
-    set_pose(to.get(), goal_);
-    problem_->setStartAndGoalStates(from, to);
-    planner_ = std::make_shared<og::RRTConnect>(information_);
-    planner_->setRange(domain_.world().planner.range);
-    planner_->setProblemDefinition(problem_);
-    planner_->setup();
+    set_se2_pose(from.get(), start_);
+    set_se2_pose(to.get(), goal_);
+    planner_ = std::make_unique<detail::ResumableRrtConnect>(information_, from.get(), to.get(),
+                                                             domain_.world().planner.range);
     phase_ = Phase::plan;
   }
 
   void plan(double limit_seconds) {
-    problem_->clearSolutionPaths();
-    const std::uint64_t checks_before = meter_.checks();
-    const ob::PlannerTerminationCondition stop([this, limit_seconds] { return meter_.reached(limit_seconds); });
-    const ob::PlannerStatus result = planner_->solve(stop);
-    if (result == ob::PlannerStatus::EXACT_SOLUTION) {
-      const auto* path = problem_->getSolutionPath()->as<og::PathGeometric>();
-      for (unsigned i = 0; i < path->getStateCount(); ++i) path_.push_back(pose_of(path->getState(i)));
-      shortened_ = {path_.front()};
-      from_ = 0;
-      to_ = path_.size() - 1;
-      planner_.reset();  // the trees are no longer needed
-      phase_ = path_.size() < 2 ? Phase::done : Phase::shorten;
-    } else if ((result != ob::PlannerStatus::TIMEOUT && result != ob::PlannerStatus::APPROXIMATE_SOLUTION) ||
-               meter_.checks() == checks_before) {
-      // Start and goal are checked before planning, so this is a defect, not bad input.
-      throw std::logic_error("RRT-Connect stopped without progress, with status " + result.asString());
-    }
+    if (!planner_->run(meter_, [this, limit_seconds] { return meter_.reached(limit_seconds); })) return;
+    for (const ob::State* state : planner_->path()) path_.push_back(se2_pose(state));
+    shortcut_ = detail::GreedyShortcut(path_.size());
+    planner_.reset();  // the trees are no longer needed
+    phase_ = Phase::shorten;
+    finish_if_shortened();
   }
 
-  // One step of the greedy shortcut: is the straight motion path_[from_] -> path_[to_] free?
+  // One step of the greedy shortcut: is the straight motion between its candidate waypoints free?
   void shorten_one() {
-    const bool adjacent = to_ == from_ + 1;  // the planner's own segment, known to be free
+    const auto [from, to] = shortcut_.candidate();
     ob::ScopedState<ob::SE2StateSpace> a(information_), b(information_);
-    set_pose(a.get(), path_[from_]);
-    set_pose(b.get(), path_[to_]);
-    if (adjacent || information_->checkMotion(a.get(), b.get())) {
-      shortened_.push_back(path_[to_]);
-      from_ = to_;
-      to_ = path_.size() - 1;
-      if (from_ == to_) phase_ = Phase::done;
-    } else {
-      --to_;
-    }
+    set_se2_pose(a.get(), path_[from]);
+    set_se2_pose(b.get(), path_[to]);
+    shortcut_.report(shortcut_.adjacent() || information_->checkMotion(a.get(), b.get()));
+    finish_if_shortened();
+  }
+
+  void finish_if_shortened() {
+    if (!shortcut_.done()) return;
+    for (const std::size_t index : shortcut_.kept()) shortened_.push_back(path_[index]);
+    found();
   }
 
   const NavigationDomain& domain_;
   Room target_;
   Pose start_, goal_;
-  EffortMeter meter_;
   SplitMix64 goal_random_;
   NavigationCollision collision_;
   ob::SpaceInformationPtr information_;
-  ob::ProblemDefinitionPtr problem_;
-  std::shared_ptr<og::RRTConnect> planner_;
+  std::unique_ptr<detail::ResumableRrtConnect> planner_;
   Phase phase_ = Phase::goal;
   std::vector<Pose> path_, shortened_;
-  std::size_t from_ = 0, to_ = 0;
+  detail::GreedyShortcut shortcut_;
 };
 
 }  // namespace

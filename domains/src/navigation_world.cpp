@@ -9,7 +9,7 @@
 #include <set>
 #include <stdexcept>
 
-#include "json_path.hpp"
+#include "world_fields.hpp"
 #include "ontime/domains/navigation_collision.hpp"
 #include "ontime/error.hpp"
 #include "ontime/problem.hpp"
@@ -18,14 +18,9 @@
 namespace ontime::domains {
 namespace {
 
-using Json = nlohmann::ordered_json;
+using detail::Json;
+using detail::number_text;
 constexpr double kTolerance = 1e-9;
-
-std::string number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", value);
-  return text;
-}
 
 // The edge two rooms share: a vertical one (x = across) when they sit side by side in x, a
 // horizontal one (y = across) when one is above the other; it runs from `low` to `high`.
@@ -53,23 +48,23 @@ std::optional<SharedEdge> shared_edge(const Room& a, const Room& b) {
   return std::nullopt;
 }
 
-class WorldReader {
+class WorldReader : detail::WorldFields {
  public:
-  explicit WorldReader(std::string source) : source_(std::move(source)) {}
+  explicit WorldReader(std::string source) : WorldFields(std::move(source)) {}
 
   NavigationWorld read(std::string_view text) {
-    const Json root = detail::parse_json_strict<Json>(text, source_);
+    const Json root = detail::parse_json_strict<Json>(text, source());
     if (!root.is_object()) fail("top level", "a world must be a JSON object (got " + detail::describe_json_type(root) + ")");
     check_keys(root, "", {"name", "description", "wall_thickness", "rooms", "doors", "obstacles", "robot", "start",
                           "goal_room", "planner", "collection", "skeletons"});
     NavigationWorld world;
-    world.source = source_;
-    world.name = root.contains("name") ? string_at(root["name"], "name") : std::filesystem::path(source_).stem().string();
+    world.source = source();
+    world.name = root.contains("name") ? string_at(root["name"], "name") : std::filesystem::path(source()).stem().string();
     if (root.contains("description")) world.description = string_at(root["description"], "description");
     world.wall_thickness = positive(member(root, "", "wall_thickness"), "wall_thickness");
     world.robot = read_robot(member(root, "", "robot"));
     world.planner = read_planner(member(root, "", "planner"), world.wall_thickness);
-    world.collection = read_collection(member(root, "", "collection"));
+    world.collection = collection(member(root, "", "collection"));
     read_rooms(member(root, "", "rooms"), world);
     read_doors(member(root, "", "doors"), world);
     if (root.contains("obstacles")) read_obstacles(root["obstacles"], world);
@@ -82,51 +77,6 @@ class WorldReader {
   }
 
  private:
-  [[noreturn]] void fail(const std::string& place, const std::string& rule) const {
-    throw InputError(source_, place, rule);
-  }
-
-  void check_keys(const Json& object, const std::string& path, std::initializer_list<std::string_view> allowed) const {
-    detail::check_known_keys(object, path, allowed, source_);
-  }
-
-  const Json& member(const Json& object, const std::string& path, const char* key) const {
-    if (!object.contains(key)) fail(path.empty() ? "top level" : path, std::string("missing required key '") + key + "'");
-    return object[key];
-  }
-
-  const Json& object_at(const Json& value, const std::string& path) const {
-    if (!value.is_object()) fail(path, "must be an object (got " + detail::describe_json_type(value) + ")");
-    return value;
-  }
-
-  std::string string_at(const Json& value, const std::string& path) const {
-    if (!value.is_string()) fail(path, "must be a string (got " + detail::describe_json_type(value) + ")");
-    return value.get<std::string>();
-  }
-
-  double finite(const Json& value, const std::string& path) const {
-    if (!value.is_number()) fail(path, "must be a number (got " + detail::describe_json_type(value) + ")");
-    const double result = value.get<double>();
-    if (!std::isfinite(result)) fail(path, "must be a finite number");
-    return result;
-  }
-
-  double positive(const Json& value, const std::string& path) const {
-    const double result = finite(value, path);
-    if (!(result > 0)) fail(path, "must be a positive number (got " + value.dump() + ")");
-    return result;
-  }
-
-  std::vector<double> numbers(const Json& value, const std::string& path, std::size_t count, const char* what) const {
-    if (!value.is_array() || value.size() != count) {
-      fail(path, std::string("must be an array of ") + std::to_string(count) + " numbers (" + what + ")");
-    }
-    std::vector<double> result;
-    for (std::size_t i = 0; i < count; ++i) result.push_back(finite(value[i], detail::json_index(path, i)));
-    return result;
-  }
-
   RobotModel read_robot(const Json& value) const {
     object_at(value, "robot");
     check_keys(value, "robot", {"footprint", "clearance", "linear_speed", "angular_speed"});
@@ -149,25 +99,10 @@ class WorldReader {
     planner.range = positive(member(value, "planner", "range"), "planner.range");
     planner.resolution = positive(member(value, "planner", "resolution"), "planner.resolution");
     if (planner.resolution >= wall_thickness) {
-      fail("planner.resolution", "must be below the wall thickness (" + number(wall_thickness) +
+      fail("planner.resolution", "must be below the wall thickness (" + number_text(wall_thickness) +
                                      " m), or a motion could jump through a wall between two checks");
     }
     return planner;
-  }
-
-  CollectionDefaults read_collection(const Json& value) const {
-    object_at(value, "collection");
-    check_keys(value, "collection", {"deadline", "step_seconds", "checks_per_second"});
-    CollectionDefaults collection;
-    const Json& deadline = member(value, "collection", "deadline");
-    if (!deadline.is_number_integer() || deadline.get<std::int64_t>() < 1 ||
-        deadline.get<std::int64_t>() > Problem::kMaxDeadline) {
-      fail("collection.deadline", "must be a whole number of steps between 1 and " + std::to_string(Problem::kMaxDeadline));
-    }
-    collection.deadline = static_cast<Steps>(deadline.get<std::int64_t>());
-    collection.step_seconds = positive(member(value, "collection", "step_seconds"), "collection.step_seconds");
-    collection.checks_per_second = positive(member(value, "collection", "checks_per_second"), "collection.checks_per_second");
-    return collection;
   }
 
   void read_rooms(const Json& value, NavigationWorld& world) const {
@@ -186,7 +121,7 @@ class WorldReader {
       Room room{id, low[0], low[1], high[0], high[1]};
       if (!(room.max_x > room.min_x && room.max_y > room.min_y)) fail(path, "'max' must exceed 'min' in x and in y");
       if (std::min(room.max_x - room.min_x, room.max_y - room.min_y) - world.wall_thickness <= smallest) {
-        fail(path, "too small for the robot (its footprint with clearance needs more than " + number(smallest) +
+        fail(path, "too small for the robot (its footprint with clearance needs more than " + number_text(smallest) +
                        " m between the walls)");
       }
       for (const Room& other : world.rooms) {
@@ -224,7 +159,7 @@ class WorldReader {
       door.y = center[1];
       door.width = positive(member(door_json, path, "width"), detail::json_member(path, "width"));
       if (door.width <= passable) {
-        fail(detail::json_member(path, "width"), "narrower than the robot (" + number(passable) +
+        fail(detail::json_member(path, "width"), "narrower than the robot (" + number_text(passable) +
                                                      " m with clearance); it could never pass");
       }
       const Room& a = world.room(door.rooms[0]);
@@ -236,7 +171,7 @@ class WorldReader {
       const double along = edge->vertical ? door.y : door.x;
       if (std::abs(across - edge->across) > kTolerance) {
         fail(detail::json_member(path, "center"), std::string("not on the edge ") + (edge->vertical ? "x" : "y") + " = " +
-                                                      number(edge->across) + " that rooms " + a.id + " and " + b.id +
+                                                      number_text(edge->across) + " that rooms " + a.id + " and " + b.id +
                                                       " share");
       }
       const double along_low = edge->low, along_high = edge->high;
@@ -284,7 +219,7 @@ class WorldReader {
   }
 
   void read_skeletons(std::string_view text, NavigationWorld& world) const {
-    world.skeletons = parse_skeleton_file(text, source_).skeletons;
+    world.skeletons = parse_skeleton_file(text, source()).skeletons;
     std::set<std::pair<std::string, std::string>> joined;
     for (const Door& door : world.doors) {
       joined.emplace(door.rooms[0], door.rooms[1]);
@@ -365,8 +300,6 @@ class WorldReader {
     }
     return walls;
   }
-
-  std::string source_;
 };
 
 }  // namespace

@@ -1,17 +1,29 @@
 #include "ontime/domains/registry.hpp"
 
+#include "ontime/domains/manipulation.hpp"
 #include "ontime/domains/navigation.hpp"
 #include "ontime/error.hpp"
 
 namespace ontime::domains {
 
-std::vector<std::string> domain_names() { return {"navigation"}; }
+std::string Domain::describe(const std::vector<std::string>& skeleton) const {
+  std::string text;
+  for (const std::string& action : skeleton) text += (text.empty() ? "" : " ") + action;
+  return text;
+}
+
+std::vector<std::string> domain_names() { return {"navigation", "manipulation"}; }
 
 LoadedDomain load_domain(std::string_view name, const std::filesystem::path& world_file) {
   if (name == "navigation") {
     NavigationWorld world = load_navigation_world(world_file);
     const DomainDefaults defaults{world.collection};
     return LoadedDomain{std::make_unique<NavigationDomain>(std::move(world)), defaults};
+  }
+  if (name == "manipulation") {
+    ManipulationWorld world = load_manipulation_world(world_file);
+    const DomainDefaults defaults{world.collection};
+    return LoadedDomain{std::make_unique<ManipulationDomain>(std::move(world)), defaults};
   }
   std::string known;
   for (const std::string& candidate : domain_names()) known += (known.empty() ? "" : ", ") + candidate;

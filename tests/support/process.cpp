@@ -12,6 +12,14 @@
 namespace ontime::testing {
 
 ProcessResult run_process(const std::vector<std::string>& arguments, int interrupt_after_ms) {
+  if (interrupt_after_ms < 0) return run_process(arguments, std::function<bool()>());
+  const auto started = std::chrono::steady_clock::now();
+  return run_process(arguments, [started, interrupt_after_ms] {
+    return std::chrono::steady_clock::now() - started >= std::chrono::milliseconds(interrupt_after_ms);
+  });
+}
+
+ProcessResult run_process(const std::vector<std::string>& arguments, const std::function<bool()>& interrupt_when) {
   int out_pipe[2], err_pipe[2];
   if (::pipe(out_pipe) != 0 || ::pipe(err_pipe) != 0) throw std::runtime_error("pipe failed");
   const pid_t child = ::fork();
@@ -30,20 +38,16 @@ ProcessResult run_process(const std::vector<std::string>& arguments, int interru
   ::close(out_pipe[1]);
   ::close(err_pipe[1]);
   ProcessResult result;
-  const auto started = std::chrono::steady_clock::now();
-  bool interrupted = interrupt_after_ms < 0;
+  bool interrupted = !interrupt_when;
   std::array<pollfd, 2> fds{pollfd{out_pipe[0], POLLIN, 0}, pollfd{err_pipe[0], POLLIN, 0}};
   int open = 2;
   std::array<char, 4096> buffer{};
   while (open > 0) {
-    if (!interrupted) {
-      const auto elapsed = std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - started);
-      if (elapsed.count() >= interrupt_after_ms) {
-        ::kill(child, SIGINT);
-        interrupted = true;
-      }
+    if (!interrupted && interrupt_when()) {
+      ::kill(child, SIGINT);
+      interrupted = true;
     }
-    if (::poll(fds.data(), fds.size(), interrupted ? -1 : 10) < 0) {
+    if (::poll(fds.data(), fds.size(), interrupted ? -1 : 5) < 0) {
       if (errno == EINTR) continue;
       break;
     }

@@ -12,7 +12,8 @@
 // Determinism: trial t of the a-th action of the tree draws everything from
 // stream_seed(stream_seed(seed, a), t), whichever thread runs it, and the log lists actions in
 // tree order and trials in order. In the collision-checks effort unit the same seed therefore
-// gives the same log byte for byte, for any number of threads.
+// gives the same log byte for byte, for any number of threads, and a collection resumed from its
+// journal (collection_journal.hpp) the same log as one never interrupted.
 
 #include <cstdint>
 #include <functional>
@@ -24,6 +25,8 @@
 #include "ontime/planner_log.hpp"
 
 namespace ontime::domains {
+
+class CollectionJournal;
 
 // The actions of the skeletons' prefix tree, parents before children (breadth first, in order
 // of first appearance), each with the index of the action before it (-1 for a first action).
@@ -42,6 +45,9 @@ struct CollectionOptions {
   Steps budget_steps = 1;       // cut-off
   // Called with the number of attempts done and the total (from one thread at a time).
   std::function<void(std::uint64_t done, std::uint64_t total)> progress;
+  // When set: trials it holds are taken from it instead of being run again, and every trial
+  // run is recorded in it as soon as it is finished.
+  CollectionJournal* journal = nullptr;
 };
 
 struct CollectionResult {
@@ -54,7 +60,9 @@ CollectionResult collect(const Domain& domain, const CollectionOptions& options)
 
 // One refined motion per action of a skeleton, executed one after the other from the domain's
 // initial configuration (for pictures). Each action gets up to `attempts` attempts of
-// `budget_steps` steps; throws ontime::UsageError when all of them are cut off.
+// `budget_steps` steps from where the action before it ended; when all are cut off, the action
+// before it is refined anew (some ends are hard to go on from) and the action tried again from
+// there, up to `attempts` times per position. Throws ontime::UsageError when that fails too.
 std::vector<std::vector<Configuration>> refine_skeleton(const Domain& domain, const std::vector<std::string>& skeleton,
                                                         std::uint64_t seed, const CollectionOptions& options,
                                                         int attempts = 20);

@@ -47,9 +47,10 @@ class Refinement {
 
 // 2D drawing primitives (metres), drawn by python/plot_map.py.
 struct ScenePolygon {
-  std::string kind;   // "room", "wall", "obstacle", "robot"
-  std::string label;  // drawn at the centre when not empty
+  std::string kind;   // "room", "wall", "obstacle", "region", "object", "robot"
+  std::string label;  // drawn when not empty
   std::vector<std::array<double, 2>> points;
+  std::string view = "top";  // "top" (x, y seen from above) or "front" (x, z seen from the front)
 };
 
 struct Scene {
@@ -76,11 +77,13 @@ class Domain {
   // succeeded (so there is no end configuration to start from).
   virtual Configuration fallback_start(const std::string& action, std::uint64_t seed) const = 0;
 
-  // The world, and a motion as a polyline of the robot's reference point.
+  // The world, and a motion as a polyline of the robot's reference point (seen from above).
   virtual Scene scene() const = 0;
   virtual std::vector<std::array<double, 2>> trace(const std::vector<Configuration>& motion) const = 0;
   // The robot's outline at a configuration.
   virtual std::vector<std::array<double, 2>> outline(const Configuration& configuration) const = 0;
+  // A short caption of a skeleton for pictures; by default its action ids.
+  virtual std::string describe(const std::vector<std::string>& skeleton) const;
 };
 
 }  // namespace ontime::domains

@@ -33,6 +33,8 @@ class EffortMeter {
   explicit EffortMeter(EffortSettings settings) : settings_(settings) {}
 
   void count_check() noexcept { ++checks_; }
+  // Work that is not a collision check but costs as much as `checks` of them (an IK solve).
+  void count_checks(std::uint64_t checks) noexcept { checks_ += checks; }
   std::uint64_t checks() const noexcept { return checks_; }
 
   // Effort spent so far, in seconds of the selected unit.

@@ -11,6 +11,10 @@
 
 namespace ontime::domains {
 
+// The time a base needs to drive through these poses in straight segments: length over
+// `linear_speed` plus rotation (shortest angle at each segment) over `angular_speed`.
+double drive_seconds(const std::vector<Pose>& poses, double linear_speed, double angular_speed);
+
 class NavigationDomain final : public Domain {
  public:
   explicit NavigationDomain(NavigationWorld world);
@@ -27,8 +31,7 @@ class NavigationDomain final : public Domain {
 
   const NavigationWorld& world() const noexcept { return world_; }
 
-  // The execution time of a motion through these poses, in straight segments: length over
-  // the linear speed plus rotation (shortest angle at each segment) over the angular speed.
+  // The execution time of a motion through these poses (drive_seconds at the robot's speeds).
   double execution_seconds(const std::vector<Pose>& poses) const;
 
  private:

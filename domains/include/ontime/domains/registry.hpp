@@ -12,7 +12,7 @@
 
 namespace ontime::domains {
 
-// Names of the domains that can be loaded: "navigation".
+// Names of the domains that can be loaded: "navigation", "manipulation".
 std::vector<std::string> domain_names();
 
 // Settings a domain's world file carries besides the world itself.

@@ -1,0 +1,156 @@
+#include "ontime/domains/collection_journal.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <set>
+#include <stdexcept>
+
+#include "json_path.hpp"
+#include "ontime/domains/collection.hpp"
+#include "ontime/error.hpp"
+
+namespace ontime::domains {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+// FNV-1a (64 bits) of the world file, to notice that it changed between two runs. Written here
+// (a few lines) because std::hash gives no guarantee to stay the same across builds.
+std::string fingerprint(std::string_view text) {
+  std::uint64_t hash = 0xcbf29ce484222325ULL;
+  for (const char c : text) {
+    hash ^= static_cast<unsigned char>(c);
+    hash *= 0x100000001b3ULL;
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
+  return hex;
+}
+
+Json settings(const Domain& domain, const CollectionOptions& options, std::string_view world_text) {
+  Json actions = Json::array();
+  for (const TreeAction& node : skeleton_tree(domain.skeletons())) actions.push_back(node.action);
+  Json line;
+  line["ontime_collection_journal"] = 1;
+  line["domain"] = domain.name();
+  line["world_fnv1a"] = fingerprint(world_text);
+  line["trials"] = options.trials;
+  line["seed"] = options.seed;
+  line["effort"] = std::string(effort_unit_name(options.effort.unit));
+  line["checks_per_second"] = options.effort.checks_per_second;
+  line["step_seconds"] = options.step_seconds;
+  line["budget_steps"] = options.budget_steps;
+  line["actions"] = actions;
+  return line;
+}
+
+void write_all(int descriptor, const std::string& text, const std::filesystem::path& path) {
+  std::size_t written = 0;
+  while (written < text.size()) {
+    const ssize_t n = ::write(descriptor, text.data() + written, text.size() - written);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) throw std::runtime_error(path.string() + ": cannot write the checkpoint (" + std::strerror(errno) + ")");
+    written += static_cast<std::size_t>(n);
+  }
+}
+
+}  // namespace
+
+CollectionJournal::CollectionJournal(std::filesystem::path path, const Domain& domain, const CollectionOptions& options,
+                                     std::string_view world_text, bool resume)
+    : path_(std::move(path)) {
+  const Json expected = settings(domain, options, world_text);
+  const std::string source = path_.string();
+  std::error_code error;
+  const bool exists = std::filesystem::exists(path_, error);
+  std::size_t keep = 0;  // bytes of the existing file to keep (whole lines)
+  if (exists && !resume) {
+    throw UsageError(source + ": the checkpoint of an unfinished collection is there; resume it (--resume) or delete it");
+  }
+  if (exists) {
+    const std::string text = ontime::detail::read_text_file(path_);
+    std::set<std::pair<std::size_t, std::uint64_t>> seen;
+    std::size_t start = 0, number = 0;
+    while (start < text.size()) {
+      const std::size_t end = text.find('\n', start);
+      if (end == std::string::npos) break;  // a last line cut short: dropped
+      ++number;
+      const std::string place = "line " + std::to_string(number);
+      const std::string_view line(text.data() + start, end - start);
+      Json value;
+      try {
+        value = ontime::detail::parse_json_strict<Json>(line, source);
+      } catch (const InputError& bad) {
+        throw InputError(source, place, bad.rule());
+      }
+      if (number == 1) {
+        for (const auto& [key, wanted] : expected.items()) {
+          if (!value.is_object() || !value.contains(key) || value[key] != wanted) {
+            throw InputError(source, place,
+                             "the checkpoint of another collection ('" + key + "' is " +
+                                 (value.is_object() && value.contains(key) ? value[key].dump() : std::string("missing")) +
+                                 " there, " + wanted.dump() + " here); delete it to start over");
+          }
+        }
+      } else {
+        if (!value.is_object() || !value.contains("action") || !value["action"].is_number_unsigned() ||
+            value["action"].get<std::size_t>() >= expected["actions"].size() || !value.contains("record") ||
+            !value["record"].is_object()) {
+          throw InputError(source, place, "a trial needs 'action' (an index into the actions of line 1) and 'record'");
+        }
+        JournalTrial trial;
+        trial.action = value["action"].get<std::size_t>();
+        const std::vector<RefinementAttempt> records = parse_planner_log(value["record"].dump() + "\n", source + " " + place);
+        trial.attempt = records.front();
+        if (trial.attempt.action != expected["actions"][trial.action].get<std::string>() || !trial.attempt.trial ||
+            *trial.attempt.trial >= options.trials || !seen.emplace(trial.action, *trial.attempt.trial).second) {
+          throw InputError(source, place, "a trial that does not belong to this collection or is there twice");
+        }
+        if (value.contains("end")) {
+          if (!value["end"].is_array()) throw InputError(source, place, "'end' must be an array of numbers");
+          Configuration configuration;
+          for (const Json& number_value : value["end"]) {
+            if (!number_value.is_number()) throw InputError(source, place, "'end' must be an array of numbers");
+            configuration.push_back(number_value.get<double>());
+          }
+          trial.end = std::move(configuration);
+        }
+        finished_.push_back(std::move(trial));
+      }
+      start = end + 1;
+      keep = start;
+    }
+  }
+  descriptor_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
+  if (descriptor_ < 0) throw std::runtime_error(source + ": cannot open the checkpoint (" + std::strerror(errno) + ")");
+  if (::ftruncate(descriptor_, static_cast<off_t>(keep)) != 0 || ::lseek(descriptor_, 0, SEEK_END) < 0) {
+    throw std::runtime_error(source + ": cannot prepare the checkpoint (" + std::strerror(errno) + ")");
+  }
+  if (keep == 0) write_all(descriptor_, expected.dump() + "\n", path_);
+}
+
+CollectionJournal::~CollectionJournal() {
+  if (descriptor_ >= 0) ::close(descriptor_);
+}
+
+void CollectionJournal::record(const JournalTrial& trial) {
+  Json line;
+  line["action"] = trial.action;
+  line["record"] = Json::parse(planner_log_line(trial.attempt));
+  if (trial.end) line["end"] = *trial.end;
+  const std::string text = line.dump() + "\n";
+  const std::lock_guard lock(mutex_);
+  write_all(descriptor_, text, path_);
+}
+
+void CollectionJournal::remove() {
+  const std::lock_guard lock(mutex_);
+  if (descriptor_ >= 0) ::close(descriptor_);
+  descriptor_ = -1;
+  std::filesystem::remove(path_);
+}
+
+}  // namespace ontime::domains
