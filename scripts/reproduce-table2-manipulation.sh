@@ -6,7 +6,7 @@
 # data/logs/manipulation.jsonl, fits data/instances/manipulation.json (D = 40), draws the kitchen
 # and the histograms into docs/images/, trains the ppo policy and prints the table with every
 # allocator, exact values where they fit within --max-states, and how far the exact optimum got.
-# About 35 minutes on 2 cores (collection ~20 min, ppo 1.5 min, table 9 min); peak 4.9 GB: the
+# About 20 minutes on 2 cores (collection 8 min, ppo 1.5 min, table 9 min); peak 4.9 GB: the
 # exact optimum stops at the cap of 58 million states, the most a hash table under 8 GiB holds.
 set -euo pipefail
 cd "$(dirname "$0")/.."
