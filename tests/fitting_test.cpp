@@ -249,7 +249,7 @@ double total_variation(const Distribution& p, const Distribution& q, Steps deadl
 TEST(Fitting, SampledLogsFitBackToTheInstanceOptimum) {
   // Coupling argument: run both instances' hidden worlds from maximal couplings of every
   // action's distributions; under any policy the episodes differ only when some coupled draw
-  // differs, so |V* - V*_fitted| <= sum of the total variations. The target is 0.01.
+  // differs, so |V* - V*_fitted| <= sum of the total variations. The project's target is 0.01.
   for (const char* name : {"figure1", "instance1", "instance2", "instance3", "instance4", "instance5"}) {
     const Problem original = testing::paper_instance(name);
     LogSamplingOptions sampling;
