@@ -20,8 +20,7 @@ void add_evaluate_command(CLI::App& app) {
   auto options = std::make_shared<Options>();
   CLI::App* command = app.add_subcommand("evaluate", "Success rate of one allocator over simulated episodes");
   command->add_option("INSTANCE", options->instance, "Instance file (JSON, SPEC §5)")->required();
-  command->add_option("--solver", options->solver, "Allocator: " + fmt::format("{}", fmt::join(allocator_names(), ", ")))
-      ->required();
+  add_solver_option(*command, options->solver);
   command->add_flag("--exact", options->exact, "Also compute the exact success probability (no sampling)");
   command->add_flag("--json", options->json, "Print JSON");
   options->monte_carlo.add_to(*command);

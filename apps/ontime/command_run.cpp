@@ -32,8 +32,7 @@ void add_run_command(CLI::App& app) {
   auto options = std::make_shared<Options>();
   CLI::App* command = app.add_subcommand("run", "Episodes in which an allocator drives a domain's real motion planner");
   command->add_option("--domain", options->domain, "Domain")->required();
-  command->add_option("--solver", options->solver, "Allocator: " + fmt::format("{}", fmt::join(allocator_names(), ", ")))
-      ->required();
+  add_solver_option(*command, options->solver);
   command->add_option("--instance", options->instance, "The allocator's model (default: data/instances/DOMAIN.json)");
   command->add_option("--world", options->world, "World file (default: data/domains/DOMAIN.json)");
   command->add_option("--episodes", options->episodes, "Episodes")->check(CLI::PositiveNumber)->capture_default_str();

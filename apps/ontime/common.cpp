@@ -77,6 +77,11 @@ MonteCarloOptions MonteCarloFlags::options() const {
   return options;
 }
 
+CLI::Option* add_solver_option(CLI::App& command, std::string& solver) {
+  return command.add_option("--solver", solver, "Allocator: " + fmt::format("{}", fmt::join(allocator_names(), ", ")))
+      ->required();
+}
+
 void check_solver_names(const std::vector<std::string>& names) {
   const std::vector<std::string> known = allocator_names();
   for (const std::string& name : names) {

@@ -54,6 +54,9 @@ struct MonteCarloFlags {
   MonteCarloOptions options() const;
 };
 
+// Adds the required `--solver NAME` option, its help listing the allocators.
+CLI::Option* add_solver_option(CLI::App& command, std::string& solver);
+
 // Checks that every name is a known allocator; throws UsageError otherwise.
 void check_solver_names(const std::vector<std::string>& names);
 
