@@ -83,17 +83,18 @@ void BM_MctsIterations(benchmark::State& bench) {
   const ontime::Problem problem = paper(1);
   const ontime::Mdp mdp(problem);
   ontime::MctsOptions options;
-  options.budget = ontime::SearchBudget::iterations(static_cast<std::uint64_t>(bench.range(0)));
+  options.budget = ontime::DecisionBudget::iterations(static_cast<std::uint64_t>(bench.range(0)));
   ontime::MctsAllocator mcts(mdp, options);
   std::uint64_t episode = 0;
   for (auto _ : bench) {
     mcts.begin_episode(++episode);  // a fresh tree every time
     benchmark::DoNotOptimize(mcts.choose(mdp.start()));
   }
-  const ontime::SearchStatistics& statistics = *mcts.search_statistics();
-  bench.SetItemsProcessed(static_cast<std::int64_t>(statistics.iterations));
-  bench.counters["tree_MiB"] = static_cast<double>(statistics.peak_tree_bytes) / (1 << 20);
-  bench.counters["tree_nodes"] = static_cast<double>(statistics.peak_tree_nodes);
+  ontime::Statistics statistics;
+  mcts.collect_statistics(statistics);
+  bench.SetItemsProcessed(static_cast<std::int64_t>(statistics.find("iterations").value_or(0)));
+  bench.counters["tree_MiB"] = statistics.find("peak_tree_bytes").value_or(0) / (1 << 20);
+  bench.counters["tree_nodes"] = statistics.find("peak_tree_nodes").value_or(0);
   bench.SetLabel("instance 1, root search, iterations/s");
 }
 BENCHMARK(BM_MctsIterations)->Arg(10'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond);

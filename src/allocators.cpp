@@ -24,8 +24,8 @@ AllocatorFactory make_allocator_factory(std::string_view name, const Mdp& mdp, c
   if (name == "mcts") {
     MctsOptions mcts;
     mcts.exploration = options.exploration;
-    mcts.budget = options.seconds ? SearchBudget::either(options.iterations, *options.seconds)
-                                  : SearchBudget::iterations(options.iterations);
+    mcts.budget = options.seconds ? DecisionBudget::either(options.iterations, *options.seconds)
+                                  : DecisionBudget::iterations(options.iterations);
     mcts.max_tree_bytes = options.max_tree_bytes;
     if (options.rollout != "random") {
       if (options.rollout == "mcts") throw UsageError("mcts cannot be its own rollout policy");

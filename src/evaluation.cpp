@@ -98,7 +98,7 @@ MonteCarloResult run_monte_carlo(const Mdp& mdp, const AllocatorFactory& factory
   std::mutex progress;
   std::vector<std::int64_t> samples;
   std::vector<std::int64_t> episode_totals;
-  std::optional<SearchStatistics> search;
+  Statistics statistics;
   std::exception_ptr failure;
 
   const auto work = [&] {
@@ -126,10 +126,9 @@ MonteCarloResult run_monte_carlo(const Mdp& mdp, const AllocatorFactory& factory
       const std::lock_guard lock(merge);
       samples.insert(samples.end(), timer.samples.begin(), timer.samples.end());
       episode_totals.insert(episode_totals.end(), timer.episode_totals.begin(), timer.episode_totals.end());
-      if (const SearchStatistics* statistics = allocator->search_statistics()) {
-        if (!search) search.emplace();
-        search->merge(*statistics);
-      }
+      Statistics own;
+      allocator->collect_statistics(own);
+      statistics.merge(own);
     } catch (...) {
       const std::lock_guard lock(merge);
       if (!failure) failure = std::current_exception();
@@ -153,7 +152,7 @@ MonteCarloResult run_monte_carlo(const Mdp& mdp, const AllocatorFactory& factory
   result.ci95 = ci95_half_width(result.success_rate, options.episodes);
   result.decision_time = summarise(samples);
   result.episode_decision_time = summarise(episode_totals);
-  result.search = search;
+  result.statistics = std::move(statistics);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }

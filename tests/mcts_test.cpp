@@ -16,8 +16,14 @@ namespace {
 
 MctsOptions with_iterations(std::uint64_t iterations) {
   MctsOptions options;
-  options.budget = SearchBudget::iterations(iterations);
+  options.budget = DecisionBudget::iterations(iterations);
   return options;
+}
+
+double counter(const Allocator& allocator, std::string_view name) {
+  Statistics statistics;
+  allocator.collect_statistics(statistics);
+  return statistics.find(name).value_or(-1.0);
 }
 
 // An allocator that reads the hidden world: what a leak of hidden outcomes would amount to.
@@ -130,10 +136,10 @@ TEST(Mcts, SameSeedSameDecisionsWhateverTheThreads) {
   monte_carlo.threads = 2;
   const MonteCarloResult two = run_monte_carlo(mdp, factory, monte_carlo);
   EXPECT_EQ(one.successes, two.successes);
-  ASSERT_TRUE(one.search.has_value());
-  ASSERT_TRUE(two.search.has_value());
-  EXPECT_EQ(one.search->iterations, two.search->iterations);
-  EXPECT_EQ(one.search->iterations, one.search->searches * 300);
+  ASSERT_TRUE(one.statistics.find("iterations").has_value());
+  ASSERT_TRUE(two.statistics.find("iterations").has_value());
+  EXPECT_EQ(*one.statistics.find("iterations"), *two.statistics.find("iterations"));
+  EXPECT_EQ(*one.statistics.find("iterations"), *one.statistics.find("searches") * 300);
 }
 
 TEST(Mcts, KeepsTheObservedSubtree) {
@@ -173,22 +179,22 @@ TEST(Mcts, StopsAtItsMemoryCapWithAnAnswer) {
   const int choice = mcts.choose(mdp.start());
   EXPECT_TRUE(choice == 0 || choice == 1 || choice == 3);  // a useful choice
   EXPECT_LE(mcts.tree_bytes(), options.max_tree_bytes);
-  EXPECT_EQ(mcts.search_statistics()->memory_stops, 1U);
-  EXPECT_LT(mcts.search_statistics()->iterations, 1'000'000U);
-  EXPECT_GT(mcts.search_statistics()->iterations, 0U);
+  EXPECT_EQ(counter(mcts, "memory_stops"), 1.0);
+  EXPECT_LT(counter(mcts, "iterations"), 1'000'000.0);
+  EXPECT_GT(counter(mcts, "iterations"), 0.0);
 }
 
 TEST(Mcts, TimeBudgetEndsTheSearch) {
   const Problem problem = testing::paper_instance("instance3");
   const Mdp mdp(problem);
   MctsOptions options;
-  options.budget = SearchBudget::seconds(0.002);
+  options.budget = DecisionBudget::seconds(0.002);
   MctsAllocator mcts(mdp, options);
   mcts.begin_episode(4);
   mcts.choose(mdp.start());
-  EXPECT_GE(mcts.search_statistics()->iterations, 1U);
-  EXPECT_THROW(SearchBudget::seconds(0.0), UsageError);
-  EXPECT_THROW(SearchBudget::iterations(0), UsageError);
+  EXPECT_GE(counter(mcts, "iterations"), 1.0);
+  EXPECT_THROW(DecisionBudget::seconds(0.0), UsageError);
+  EXPECT_THROW(DecisionBudget::iterations(0), UsageError);
 }
 
 TEST(Mcts, AcceptsOnlyStationaryRolloutPolicies) {
@@ -210,6 +216,48 @@ TEST(Mcts, AcceptsOnlyStationaryRolloutPolicies) {
   MctsOptions negative;
   negative.exploration = -1;
   EXPECT_THROW(MctsAllocator(mdp, negative), UsageError);
+}
+
+}  // namespace
+}  // namespace ontime
+
+namespace ontime {
+namespace {
+
+TEST(DecisionBudget, APerDecisionBudgetReplacesTheDefault) {
+  const Problem problem = testing::paper_instance("instance3");
+  const Mdp mdp(problem);
+  MctsAllocator mcts(mdp, with_iterations(10'000));
+  mcts.begin_episode(4);
+  mcts.choose(mdp.start(), DecisionBudget::iterations(123));
+  EXPECT_EQ(counter(mcts, "iterations"), 123.0);
+  mcts.begin_episode(4);
+  mcts.choose(mdp.start());  // the default budget again
+  EXPECT_EQ(counter(mcts, "iterations"), 123.0 + 10'000.0);
+}
+
+TEST(DecisionBudget, AStopConditionEndsTheSearch) {
+  const Problem problem = testing::paper_instance("instance3");
+  const Mdp mdp(problem);
+  MctsAllocator mcts(mdp, with_iterations(10'000));
+  mcts.begin_episode(4);
+  int calls = 0;
+  // Tripped on its 50th check: checks come after iterations 1, 2, ..., so 50 iterations run.
+  mcts.choose(mdp.start(), DecisionBudget::until([&calls] { return ++calls >= 50; }));
+  EXPECT_EQ(counter(mcts, "iterations"), 50.0);
+}
+
+TEST(DecisionBudget, AHugeTimeLimitLeavesTheIterationLimitInForce) {
+  const Problem problem = testing::paper_instance("instance3");
+  const Mdp mdp(problem);
+  for (const double seconds : {1e10, 1e308}) {
+    MctsAllocator mcts(mdp, with_iterations(1));
+    mcts.begin_episode(4);
+    mcts.choose(mdp.start(), DecisionBudget::either(1'000, seconds));
+    EXPECT_EQ(counter(mcts, "iterations"), 1'000.0) << seconds;
+  }
+  EXPECT_THROW(DecisionBudget::seconds(std::nan("")), UsageError);
+  EXPECT_THROW(DecisionBudget::seconds(-1.0), UsageError);
 }
 
 }  // namespace

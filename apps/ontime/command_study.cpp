@@ -30,8 +30,8 @@ struct StudyOptions {
 std::string label_of(const std::string& path) { return std::filesystem::path(path).stem().string(); }
 
 double iterations_per_search(const MonteCarloResult& result) {
-  if (!result.search || result.search->searches == 0) return 0.0;
-  return static_cast<double>(result.search->iterations) / static_cast<double>(result.search->searches);
+  const double searches = result.statistics.find("searches").value_or(0.0);
+  return searches > 0 ? result.statistics.find("iterations").value_or(0.0) / searches : 0.0;
 }
 
 std::vector<double> parse_multipliers(const std::string& text) {

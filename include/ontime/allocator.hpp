@@ -20,26 +20,11 @@
 #include <string_view>
 #include <vector>
 
+#include "ontime/decision_budget.hpp"
 #include "ontime/state.hpp"
+#include "ontime/statistics.hpp"
 
 namespace ontime {
-
-// What a searching allocator (mcts) did, accumulated over its decisions.
-struct SearchStatistics {
-  std::uint64_t searches = 0;        // decisions that ran a search
-  std::uint64_t iterations = 0;      // search iterations over all searches
-  std::size_t peak_tree_nodes = 0;   // largest tree held (decision + chance nodes)
-  std::size_t peak_tree_bytes = 0;   // its memory, capacity included
-  std::uint64_t memory_stops = 0;    // searches ended early by the memory cap
-
-  void merge(const SearchStatistics& other) noexcept {
-    searches += other.searches;
-    iterations += other.iterations;
-    peak_tree_nodes = peak_tree_nodes > other.peak_tree_nodes ? peak_tree_nodes : other.peak_tree_nodes;
-    peak_tree_bytes = peak_tree_bytes > other.peak_tree_bytes ? peak_tree_bytes : other.peak_tree_bytes;
-    memory_stops += other.memory_stops;
-  }
-};
 
 class Allocator {
  public:
@@ -50,8 +35,16 @@ class Allocator {
   // Starts a new episode from the start state; `seed` seeds any randomness of the episode.
   virtual void begin_episode(std::uint64_t seed) { (void)seed; }
 
-  // The skeleton (0-based) to spend the next step on. Ties go to the lowest index.
+  // The skeleton (0-based) to spend the next step on. Ties go to the lowest index. An anytime
+  // allocator decides within its own default budget (its parameters).
   virtual int choose(const State& state) = 0;
+
+  // The same decision within `budget` (an unset budget: the default one). Only anytime
+  // allocators use the budget; the others decide as choose(state), which is already cheap.
+  virtual int choose(const State& state, const DecisionBudget& budget) {
+    (void)budget;
+    return choose(state);
+  }
 
   // The transition that followed the last `choose`.
   virtual void observe(const State& before, int choice, const State& after, Status status) {
@@ -62,8 +55,9 @@ class Allocator {
   // that the exact success probability can be computed over the reachable states (SPEC §4).
   virtual bool is_stationary() const noexcept { return true; }
 
-  // Statistics of a searching allocator, or nullptr.
-  virtual const SearchStatistics* search_statistics() const noexcept { return nullptr; }
+  // Adds this allocator's counters (work done since it was made) to `statistics`; most
+  // allocators have none.
+  virtual void collect_statistics(Statistics& statistics) const { (void)statistics; }
 };
 
 using AllocatorFactory = std::function<std::unique_ptr<Allocator>()>;

@@ -33,7 +33,7 @@ struct MonteCarloResult {
   LatencySummary decision_time;
   LatencySummary episode_decision_time;  // total decision time of each episode (meta-level cost)
   double seconds = 0;          // wall-clock time of the whole run
-  std::optional<SearchStatistics> search;  // merged over threads, for searching allocators
+  Statistics statistics;       // the allocators' counters, merged over threads
 };
 
 // Runs `options.episodes` episodes; episode i lives in the hidden world drawn from

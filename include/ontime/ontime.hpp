@@ -25,7 +25,6 @@
 #include "ontime/ppo_training.hpp"
 #include "ontime/problem.hpp"
 #include "ontime/random.hpp"
-#include "ontime/search_budget.hpp"
 #include "ontime/session.hpp"
 #include "ontime/simulator.hpp"
 #include "ontime/skeleton_file.hpp"

@@ -172,7 +172,9 @@ bool MctsAllocator::iterate() {
   return true;
 }
 
-int MctsAllocator::choose(const State& state) {
+int MctsAllocator::choose(const State& state) { return choose(state, options_.budget); }
+
+int MctsAllocator::choose(const State& state, const DecisionBudget& budget) {
   if (!has_tree_ || !(state == root_state_)) reset(state);
   const ChoiceList choices = mdp_->useful_choices(state);
   if (choices.empty()) {
@@ -184,19 +186,19 @@ int MctsAllocator::choose(const State& state) {
   }
   if (choices.size() == 1) return choices[0];
 
-  ++statistics_.searches;
-  const BudgetMonitor monitor(options_.budget);
+  ++counters_.searches;
+  const BudgetMonitor monitor(budget.is_set() ? budget : options_.budget);
   std::uint64_t iterations = 0;
   while (!monitor.exhausted(iterations)) {
     if (!iterate()) {
-      ++statistics_.memory_stops;
+      ++counters_.memory_stops;
       break;
     }
     ++iterations;
   }
-  statistics_.iterations += iterations;
-  statistics_.peak_tree_nodes = std::max(statistics_.peak_tree_nodes, tree_nodes());
-  statistics_.peak_tree_bytes = std::max(statistics_.peak_tree_bytes, tree_bytes());
+  counters_.iterations += iterations;
+  counters_.peak_tree_nodes = std::max(counters_.peak_tree_nodes, tree_nodes());
+  counters_.peak_tree_bytes = std::max(counters_.peak_tree_bytes, tree_bytes());
 
   const DecisionNode& root = nodes_[0];
   if (root.first_edge == kNone) return choices[0];
@@ -269,6 +271,14 @@ void MctsAllocator::reroot(std::uint32_t new_root) {
   nodes_ = std::move(nodes);
   edges_ = std::move(edges);
   outcomes_ = std::move(outcomes);
+}
+
+void MctsAllocator::collect_statistics(Statistics& statistics) const {
+  statistics.add("searches", static_cast<double>(counters_.searches));
+  statistics.add("iterations", static_cast<double>(counters_.iterations));
+  statistics.add("memory_stops", static_cast<double>(counters_.memory_stops));
+  statistics.add("peak_tree_nodes", static_cast<double>(counters_.peak_tree_nodes), Statistics::Merge::max);
+  statistics.add("peak_tree_bytes", static_cast<double>(counters_.peak_tree_bytes), Statistics::Merge::max);
 }
 
 std::vector<MctsAllocator::RootChoice> MctsAllocator::root_choices() const {

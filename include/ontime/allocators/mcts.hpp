@@ -33,13 +33,13 @@
 #include "ontime/allocator.hpp"
 #include "ontime/mdp.hpp"
 #include "ontime/random.hpp"
-#include "ontime/search_budget.hpp"
+#include "ontime/decision_budget.hpp"
 
 namespace ontime {
 
 struct MctsOptions {
   double exploration = 0.5;                              // C of UCT
-  SearchBudget budget = SearchBudget::iterations(10'000);  // per decision
+  DecisionBudget budget = DecisionBudget::iterations(10'000);  // default per decision
   std::size_t max_tree_bytes = std::size_t{1} << 30;      // 1 GiB
   bool reuse_tree = true;
   // Rollout policy: nullptr for uniformly random useful choices, else a factory of a
@@ -56,9 +56,11 @@ class MctsAllocator final : public Allocator {
   std::string_view name() const noexcept override { return "mcts"; }
   void begin_episode(std::uint64_t seed) override;
   int choose(const State& state) override;
+  int choose(const State& state, const DecisionBudget& budget) override;
   void observe(const State& before, int choice, const State& after, Status status) override;
   bool is_stationary() const noexcept override { return false; }
-  const SearchStatistics* search_statistics() const noexcept override { return &statistics_; }
+  // searches, iterations, memory_stops (summed); peak_tree_nodes, peak_tree_bytes (largest).
+  void collect_statistics(Statistics& statistics) const override;
 
   // Visits and estimated success of each root choice after the last search, for inspection.
   struct RootChoice {
@@ -115,7 +117,13 @@ class MctsAllocator final : public Allocator {
   std::vector<Edge> edges_;
   std::vector<Outcome> outcomes_;
   std::vector<std::uint32_t> path_;  // edges visited by the current iteration
-  SearchStatistics statistics_;
+  struct Counters {
+    std::uint64_t searches = 0;       // decisions that ran a search
+    std::uint64_t iterations = 0;     // search iterations over all searches
+    std::size_t peak_tree_nodes = 0;  // largest tree held (decision + chance nodes)
+    std::size_t peak_tree_bytes = 0;  // its memory, capacity included
+    std::uint64_t memory_stops = 0;   // searches ended early by the memory cap
+  } counters_;
 };
 
 }  // namespace ontime
