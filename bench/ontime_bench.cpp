@@ -131,7 +131,8 @@ void BM_TableOneWorkload(benchmark::State& bench) {
   for (auto _ : bench) {
     for (const ontime::Problem& problem : problems) {
       const ontime::Mdp mdp(problem);
-      for (const std::string& name : ontime::allocator_names()) {
+      for (const std::string& name :
+           ontime::allocator_registry().names({ontime::Capability::stationary}, {ontime::Capability::needs_policy})) {
         const ontime::AllocatorFactory factory = ontime::make_allocator_factory(name, mdp);
         ontime::MonteCarloOptions options;
         options.episodes = 10'000;

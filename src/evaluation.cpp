@@ -112,7 +112,7 @@ MonteCarloResult run_monte_carlo(const Mdp& mdp, const AllocatorFactory& factory
         const std::uint64_t end = std::min(options.episodes, begin + kChunk);
         for (std::uint64_t episode = begin; episode < end; ++episode) {
           const EpisodeResult result = run_episode(mdp, *allocator, stream_seed(options.seed, episode),
-                                                   options.time_decisions ? &timer : nullptr);
+                                                   options.time_decisions ? &timer : nullptr, options.decision_budget);
           if (result.status == Status::success) ++local_successes;
           if (options.time_decisions) timer.end_episode();
         }

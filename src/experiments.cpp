@@ -2,7 +2,7 @@
 
 #include <chrono>
 #include <cmath>
-#include <limits>
+#include <fmt/format.h>
 
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/error.hpp"
@@ -36,8 +36,9 @@ class ProgressTracker {
  public:
   ProgressTracker(const StudySettings& settings, std::uint64_t total) : settings_(settings), total_(total) {}
 
-  MonteCarloResult run(const Mdp& mdp, const AllocatorFactory& factory) {
+  MonteCarloResult run(const Mdp& mdp, const AllocatorFactory& factory, const DecisionBudget& budget = {}) {
     MonteCarloOptions options;
+    options.decision_budget = budget;
     options.episodes = settings_.episodes;
     options.seed = settings_.seed;
     options.threads = settings_.threads;
@@ -56,10 +57,28 @@ class ProgressTracker {
   std::uint64_t done_ = 0;
 };
 
-AllocatorFactory mcts_with_time(const Mdp& mdp, AllocatorOptions options, double seconds) {
-  options.seconds = seconds;
-  options.iterations = std::numeric_limits<std::uint64_t>::max();
-  return make_allocator_factory("mcts", mdp, options);
+// The two kinds of a study, checked by capability.
+struct StudyPair {
+  AllocatorFactory searcher;
+  AllocatorFactory reference;
+};
+
+double optimum_of(const Mdp& mdp, const ParameterValues& values) {
+  return OptimalSolver(mdp, max_states_of(values)).solve(mdp.start());
+}
+
+StudyPair make_pair(const Mdp& mdp, const StudySettings& settings) {
+  const AllocatorRegistry& registry = allocator_registry();
+  if (!registry.find(settings.searcher).capabilities.has(Capability::anytime)) {
+    throw UsageError("the searcher of a study must be an anytime allocator (known: " +
+                     fmt::format("{}", fmt::join(registry.names({Capability::anytime}), ", ")) + "), not '" +
+                     settings.searcher + "'");
+  }
+  if (!registry.find(settings.reference).capabilities.has(Capability::stationary)) {
+    throw UsageError("the reference of a study must be a stationary allocator, not '" + settings.reference + "'");
+  }
+  return {registry.make_factory(settings.searcher, mdp, settings.parameters),
+          registry.make_factory(settings.reference, mdp, settings.parameters)};
 }
 
 }  // namespace
@@ -89,20 +108,21 @@ double mean_decision_seconds(const Mdp& mdp, const AllocatorFactory& factory, st
 }
 
 ComputeTimeStudy compute_time_study(const Mdp& mdp, const StudySettings& settings) {
+  const StudyPair pair = make_pair(mdp, settings);
   ProgressTracker tracker(settings, 2 * settings.episodes);
   ComputeTimeStudy study;
-  study.mcts = tracker.run(mdp, make_allocator_factory("mcts", mdp, settings.allocator));
-  study.dp_rerun = tracker.run(mdp, make_allocator_factory("dp-rerun", mdp, settings.allocator));
+  study.searcher = tracker.run(mdp, pair.searcher);
+  study.reference = tracker.run(mdp, pair.reference);
   return study;
 }
 
 EqualTimeStudy equal_time_study(const Mdp& mdp, const StudySettings& settings) {
+  const StudyPair pair = make_pair(mdp, settings);
   ProgressTracker tracker(settings, 2 * settings.episodes);
   EqualTimeStudy study;
-  const AllocatorFactory dp_rerun = make_allocator_factory("dp-rerun", mdp, settings.allocator);
-  study.dp_rerun_decision_seconds = mean_decision_seconds(mdp, dp_rerun, settings.seed);
-  study.dp_rerun = tracker.run(mdp, dp_rerun);
-  study.mcts = tracker.run(mdp, mcts_with_time(mdp, settings.allocator, study.dp_rerun_decision_seconds));
+  study.reference_decision_seconds = mean_decision_seconds(mdp, pair.reference, settings.seed);
+  study.reference = tracker.run(mdp, pair.reference);
+  study.searcher = tracker.run(mdp, pair.searcher, DecisionBudget::seconds(study.reference_decision_seconds));
   return study;
 }
 
@@ -112,17 +132,17 @@ AnytimeStudy anytime_study(const Mdp& mdp, const std::vector<double>& log10_mult
       throw UsageError("log10 time multipliers must lie within [-3, 9]");
     }
   }
+  const StudyPair pair = make_pair(mdp, settings);
   ProgressTracker tracker(settings, (log10_multipliers.size() + 1) * settings.episodes);
   AnytimeStudy study;
-  const AllocatorFactory dp_rerun = make_allocator_factory("dp-rerun", mdp, settings.allocator);
-  study.dp_rerun_decision_seconds = mean_decision_seconds(mdp, dp_rerun, settings.seed);
-  study.optimum = OptimalSolver(mdp, settings.allocator.max_states).solve(mdp.start());
-  study.dp_rerun = tracker.run(mdp, dp_rerun);
+  study.reference_decision_seconds = mean_decision_seconds(mdp, pair.reference, settings.seed);
+  study.optimum = optimum_of(mdp, settings.parameters);
+  study.reference = tracker.run(mdp, pair.reference);
   for (const double exponent : log10_multipliers) {
     AnytimePoint point;
     point.log10_multiplier = exponent;
-    point.seconds_per_decision = study.dp_rerun_decision_seconds * std::pow(10.0, exponent);
-    point.mcts = tracker.run(mdp, mcts_with_time(mdp, settings.allocator, point.seconds_per_decision));
+    point.seconds_per_decision = study.reference_decision_seconds * std::pow(10.0, exponent);
+    point.searcher = tracker.run(mdp, pair.searcher, DecisionBudget::seconds(point.seconds_per_decision));
     study.points.push_back(std::move(point));
   }
   return study;

@@ -100,6 +100,13 @@ bool Mdp::any_can_succeed(const State& state) const noexcept {
   return false;
 }
 
+int Mdp::first_with_work_left(const State& state) const noexcept {
+  for (int k = 0; k < skeleton_count_; ++k) {
+    if (next_action(state, k) >= 0) return k;
+  }
+  return 0;
+}
+
 bool Mdp::group_can_succeed(const State& state, int action) const noexcept {
   for (const int member : problem_->members(action)) {
     if (can_succeed(state, member)) return true;

@@ -165,17 +165,10 @@ PpoTraining train_ppo(const Mdp& mdp, std::uint64_t episodes, std::uint64_t seed
         const Vector& logits = policy.actor.evaluate(features);
         masked_log_softmax(logits, valid, count, log_probabilities.data());
         const double value = policy.critic.evaluate(features)(0);
-        // Sample a choice by inverting the cumulative probabilities.
-        int action = choices[choices.size() - 1];
-        double u = uniform01(sampling);
-        for (const int choice : choices) {
-          const double probability = std::exp(log_probabilities[static_cast<std::size_t>(choice)]);
-          if (u < probability) {
-            action = choice;
-            break;
-          }
-          u -= probability;
-        }
+        const auto probability = [&](std::size_t i) {
+          return std::exp(log_probabilities[static_cast<std::size_t>(choices[i])]);
+        };
+        const int action = choices[sample_index(choices.size(), probability, sampling)];
         const int refining = mdp.next_action(state, action);
         const Observation observation =
             world.observe(refining, state.spent[static_cast<std::size_t>(action)]);

@@ -13,9 +13,14 @@ Session::Session(const Mdp& mdp, Allocator& allocator, std::uint64_t seed)
 }
 
 Decision Session::choose() {
+  static const DecisionBudget kOwnBudget;
+  return choose(kOwnBudget);
+}
+
+Decision Session::choose(const DecisionBudget& budget) {
   if (status_ != Status::running) throw std::logic_error("the session is over; nothing more to choose");
   if (pending_ >= 0) throw std::logic_error("the last decision has not been reported yet");
-  const int choice = allocator_->choose(state_);
+  const int choice = budget.is_set() ? allocator_->choose(state_, budget) : allocator_->choose(state_);
   if (choice < 0 || choice >= mdp_->skeleton_count()) {
     throw UsageError("allocator '" + std::string(allocator_->name()) + "' chose skeleton " +
                      std::to_string(choice) + ", outside [0, " + std::to_string(mdp_->skeleton_count()) + ")");

@@ -25,7 +25,8 @@ Observation HiddenWorld::observe(int action, Steps spent) const {
   return Observation::not_yet();
 }
 
-EpisodeResult run_episode(const Mdp& mdp, Allocator& allocator, std::uint64_t seed, DecisionTimer* timer) {
+EpisodeResult run_episode(const Mdp& mdp, Allocator& allocator, std::uint64_t seed, DecisionTimer* timer,
+                          const DecisionBudget& budget) {
   const HiddenWorld world(mdp.problem(), seed);
   Session session(mdp, allocator, stream_seed(seed, 1));
   EpisodeResult result;
@@ -33,11 +34,11 @@ EpisodeResult run_episode(const Mdp& mdp, Allocator& allocator, std::uint64_t se
     Decision decision;
     if (timer != nullptr) {
       const auto start = std::chrono::steady_clock::now();
-      decision = session.choose();
+      decision = session.choose(budget);
       const auto stop = std::chrono::steady_clock::now();
       timer->record(std::chrono::duration_cast<std::chrono::nanoseconds>(stop - start).count());
     } else {
-      decision = session.choose();
+      decision = session.choose(budget);
     }
     ++result.decisions;
     if (decision.action < 0) {

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "ontime/allocators.hpp"
+#include "ontime/allocator_registry.hpp"
 #include "ontime/allocators/dp.hpp"
 #include "ontime/allocators/dp_rerun.hpp"
 #include "ontime/allocators/greedy.hpp"
@@ -100,11 +100,12 @@ TEST(Allocators, DpRerunAggregationsAreSelectable) {
 TEST(Allocators, FactoryKnowsEveryNameAndRejectsOthers) {
   const Problem problem = testing::paper_instance("figure1");
   const Mdp mdp(problem);
-  for (const std::string& name : allocator_names()) {
-    if (name == "ppo") continue;  // needs a trained policy: see ppo_test
+  const AllocatorRegistry& registry = allocator_registry();
+  // Every kind that needs nothing beyond the instance (a policy file is tested in ppo_test).
+  for (const std::string& name : registry.names({}, {Capability::needs_policy})) {
     const auto allocator = make_allocator_factory(name, mdp)();
     EXPECT_EQ(allocator->name(), name);
-    EXPECT_EQ(allocator->is_stationary(), name != "mcts");
+    EXPECT_EQ(allocator->is_stationary(), registry.find(name).capabilities.has(Capability::stationary)) << name;
   }
   EXPECT_THROW(make_allocator_factory("mcts-typo", mdp), UsageError);
 }

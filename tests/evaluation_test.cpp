@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "ontime/allocators.hpp"
+#include "ontime/allocator_registry.hpp"
 #include "ontime/error.hpp"
 #include "ontime/evaluation.hpp"
 #include "ontime/random.hpp"

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "ontime/allocators.hpp"
+#include "ontime/allocator_registry.hpp"
 #include "ontime/allocators/mcts.hpp"
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/error.hpp"
@@ -125,9 +125,7 @@ TEST(Mcts, SharingSkeletonsAreOneChoice) {
 TEST(Mcts, SameSeedSameDecisionsWhateverTheThreads) {
   const Problem problem = testing::paper_instance("instance3");
   const Mdp mdp(problem);
-  AllocatorOptions options;
-  options.iterations = 300;
-  const AllocatorFactory factory = make_allocator_factory("mcts", mdp, options);
+  const AllocatorFactory factory = make_allocator_factory("mcts", mdp, {{"iterations", "300"}});
   MonteCarloOptions monte_carlo;
   monte_carlo.episodes = 400;
   monte_carlo.seed = 5;
@@ -200,15 +198,13 @@ TEST(Mcts, TimeBudgetEndsTheSearch) {
 TEST(Mcts, AcceptsOnlyStationaryRolloutPolicies) {
   const Problem problem = testing::paper_instance("instance4");
   const Mdp mdp(problem);
-  AllocatorOptions options;
-  options.rollout = "dp-rerun";
-  options.iterations = 2'000;
+  ParameterValues options{{"rollout", "dp-rerun"}, {"iterations", "2000"}};
   const AllocatorFactory factory = make_allocator_factory("mcts", mdp, options);
   MonteCarloOptions monte_carlo;
   monte_carlo.episodes = 2'000;
   const MonteCarloResult result = run_monte_carlo(mdp, factory, monte_carlo);
   EXPECT_NEAR(result.success_rate, 0.9, 4 * std::sqrt(0.09 / 2'000));  // the optimum of instance 4
-  options.rollout = "mcts";
+  options.set("rollout", "mcts");
   EXPECT_THROW(make_allocator_factory("mcts", mdp, options), UsageError);
   MctsOptions direct;
   direct.rollout = [&mdp] { return std::make_unique<MctsAllocator>(mdp, MctsOptions{}); };

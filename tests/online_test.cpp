@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "ontime/allocators.hpp"
+#include "ontime/allocator_registry.hpp"
 #include "ontime/domains/navigation.hpp"
 #include "ontime/domains/online.hpp"
 #include "ontime/instance_io.hpp"

@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "ontime/allocators.hpp"
+#include "ontime/allocator_registry.hpp"
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/error.hpp"
 #include "ontime/evaluation.hpp"
@@ -93,8 +93,8 @@ TEST(Optimal, IsAtLeastEveryOtherAllocator) {
     const Problem problem = testing::random_instance(seed, 4, 3, 10);
     const Mdp mdp(problem);
     const double optimum = OptimalSolver(mdp).solve(mdp.start());
-    for (const std::string& name : allocator_names()) {
-      if (name == "mcts" || name == "ppo") continue;  // covered by their own tests
+    // Every stationary kind that needs nothing beyond the instance (mcts and ppo have their own tests).
+    for (const std::string& name : allocator_registry().names({Capability::stationary}, {Capability::needs_policy})) {
       const auto allocator = make_allocator_factory(name, mdp)();
       const double value = evaluate_exactly(mdp, *allocator).success_probability;
       EXPECT_LE(value, optimum + 1e-12) << name << " seed " << seed;
@@ -113,9 +113,7 @@ TEST(Optimal, StopsAtTheStateCapWithAClearError) {
     EXPECT_NE(std::string(error.what()).find("cap of 50 states"), std::string::npos) << error.what();
   }
   EXPECT_LE(solver.states(), 50U);
-  AllocatorOptions capped;
-  capped.max_states = 50;
-  EXPECT_THROW(make_allocator_factory("optimal", mdp, capped), ResourceLimitError);
+  EXPECT_THROW(make_allocator_factory("optimal", mdp, {{"max-states", "50"}}), ResourceLimitError);
 }
 
 TEST(Optimal, TiesGoToTheLowestIndex) {

@@ -1,8 +1,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 
-#include "ontime/allocators.hpp"
+#include "ontime/allocator_registry.hpp"
 #include "ontime/allocators/ppo.hpp"
 #include "ontime/error.hpp"
 #include "ontime/evaluation.hpp"
@@ -158,11 +159,13 @@ TEST(Ppo, PolicyFilesRoundTripAndAreValidated) {
   // A policy trained for another instance is refused when used.
   const Problem other = testing::paper_instance("instance1");
   const Mdp other_mdp(other);
-  AllocatorOptions options;
-  options.policy = std::make_shared<const PpoPolicy>(copy);
+  const std::filesystem::path file = std::filesystem::temp_directory_path() / "ontime-ppo-test-policy.json";
+  save_ppo_policy(copy, file);
+  const ParameterValues options{{"policy", file.string()}};
   EXPECT_THROW(make_allocator_factory("ppo", other_mdp, options), UsageError);
   EXPECT_THROW(make_allocator_factory("ppo", mdp), UsageError);  // no policy at all
   EXPECT_NO_THROW(make_allocator_factory("ppo", mdp, options));
+  std::filesystem::remove(file);
 }
 
 }  // namespace

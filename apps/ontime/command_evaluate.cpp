@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include "common.hpp"
+#include "ontime/allocators/optimal.hpp"
 #include "ontime/instance_io.hpp"
 
 namespace ontime::cli {
@@ -29,7 +30,8 @@ void add_evaluate_command(CLI::App& app) {
     check_solver_names({options->solver});
     const Problem problem = load_problem(options->instance);
     const Mdp mdp(problem);
-    const AllocatorFactory factory = make_allocator_factory(options->solver, mdp, options->allocator.options());
+    const ParameterValues parameters = options->allocator.values();
+    const AllocatorFactory factory = make_allocator_factory(options->solver, mdp, parameters);
 
     MonteCarloOptions monte_carlo = options->monte_carlo.options();
     ProgressBar bar("evaluate " + options->solver);
@@ -39,11 +41,12 @@ void add_evaluate_command(CLI::App& app) {
     std::optional<ExactEvaluation> exact;
     if (options->exact) {
       const auto allocator = factory();
-      exact = evaluate_exactly(mdp, *allocator, options->allocator.max_states);
+      exact = evaluate_exactly(mdp, *allocator, max_states_of(parameters));
     }
     if (options->json) {
       Json out;
       out["solver"] = options->solver;
+      out["parameters"] = parameters_json(allocator_registry().find(options->solver), parameters);
       out["instance"] = options->instance;
       out["episodes"] = result.episodes;
       out["seed"] = options->monte_carlo.seed;

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "common.hpp"
+#include "ontime/allocators/optimal.hpp"
 #include "data_paths.hpp"
 #include "ontime/domains/online.hpp"
 #include "ontime/domains/registry.hpp"
@@ -60,7 +61,8 @@ void add_run_command(CLI::App& app) {
     const domains::LoadedDomain loaded = domains::load_domain(options->domain, world);
     const Problem problem = load_problem(instance);
     const Mdp mdp(problem);
-    const AllocatorFactory factory = make_allocator_factory(options->solver, mdp, options->allocator.options());
+    const ParameterValues parameters = options->allocator.values();
+    const AllocatorFactory factory = make_allocator_factory(options->solver, mdp, parameters);
     domains::OnlineOptions online;
     online.effort.unit = domains::parse_effort_unit(options->effort);
     online.effort.checks_per_second =
@@ -71,13 +73,14 @@ void add_run_command(CLI::App& app) {
     std::optional<ExactEvaluation> exact;
     if (options->exact) {
       const auto allocator = factory();
-      exact = evaluate_exactly(mdp, *allocator, options->allocator.max_states);
+      exact = evaluate_exactly(mdp, *allocator, max_states_of(parameters));
     }
     if (options->json) {
       Json out;
       out["domain"] = options->domain;
       out["instance"] = instance.string();
       out["solver"] = options->solver;
+      out["parameters"] = parameters_json(allocator_registry().find(options->solver), parameters);
       out["episodes"] = summary.episodes;
       out["seed"] = options->seed;
       out["successes"] = summary.successes;

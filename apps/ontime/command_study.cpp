@@ -24,6 +24,8 @@ struct StudyOptions {
   std::uint64_t episodes = 1'000;
   std::uint64_t seed = 1;
   unsigned threads = 0;
+  std::string searcher = "mcts";
+  std::string reference = "dp-rerun";
   AllocatorFlags allocator;
 };
 
@@ -77,7 +79,9 @@ StudySettings settings_of(const StudyOptions& options, ProgressBar& bar, std::si
   settings.episodes = options.episodes;
   settings.seed = options.seed;
   settings.threads = options.threads;
-  settings.allocator = options.allocator.options();
+  settings.searcher = options.searcher;
+  settings.reference = options.reference;
+  settings.parameters = options.allocator.values();
   settings.progress = [&bar, index, count](std::uint64_t done, std::uint64_t total) {
     bar.update(index * total + done, count * total);
   };
@@ -93,7 +97,8 @@ void run_compute_time(const StudyOptions& options) {
   for (std::size_t i = 0; i < problems.size(); ++i) {
     const Mdp mdp(problems[i]);
     const ComputeTimeStudy study = compute_time_study(mdp, settings_of(options, bar, i, problems.size()));
-    for (const auto& [solver, result] : {std::pair{"mcts", &study.mcts}, std::pair{"dp-rerun", &study.dp_rerun}}) {
+    for (const auto& [solver, result] : {std::pair{options.searcher, &study.searcher},
+                                         std::pair{options.reference, &study.reference}}) {
       csv += fmt::format("{},{},{},{},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.6g}\n", label_of(options.instances[i]), solver,
                          result->episodes, result->success_rate, result->ci95,
                          result->episode_decision_time.mean_us * 1e-6, result->episode_decision_time.median_us * 1e-6,
@@ -114,8 +119,8 @@ void run_equal_time(const StudyOptions& options) {
     const Mdp mdp(problems[i]);
     const EqualTimeStudy study = equal_time_study(mdp, settings_of(options, bar, i, problems.size()));
     csv += fmt::format("{},{},{:.9g},{},{},{},{},{:.6g}\n", label_of(options.instances[i]), options.episodes,
-                       study.dp_rerun_decision_seconds, study.dp_rerun.success_rate, study.dp_rerun.ci95,
-                       study.mcts.success_rate, study.mcts.ci95, iterations_per_search(study.mcts));
+                       study.reference_decision_seconds, study.reference.success_rate, study.reference.ci95,
+                       study.searcher.success_rate, study.searcher.ci95, iterations_per_search(study.searcher));
   }
   finish(options, "equal-time", csv);
 }
@@ -132,9 +137,9 @@ void run_anytime(const StudyOptions& options) {
     const AnytimeStudy study = anytime_study(mdp, multipliers, settings_of(options, bar, i, problems.size()));
     for (const AnytimePoint& point : study.points) {
       csv += fmt::format("{},{},{},{:.9g},{},{},{:.6g},{:.9g},{},{}\n", label_of(options.instances[i]), options.episodes,
-                         point.log10_multiplier, point.seconds_per_decision, point.mcts.success_rate, point.mcts.ci95,
-                         iterations_per_search(point.mcts), study.dp_rerun_decision_seconds,
-                         study.dp_rerun.success_rate, study.optimum);
+                         point.log10_multiplier, point.seconds_per_decision, point.searcher.success_rate,
+                         point.searcher.ci95, iterations_per_search(point.searcher), study.reference_decision_seconds,
+                         study.reference.success_rate, study.optimum);
     }
   }
   finish(options, "anytime", csv);
@@ -158,6 +163,15 @@ void add_study_command(CLI::App& app) {
     command->add_option("--threads", options->threads, "Worker threads (0: one per hardware thread)")
         ->capture_default_str();
     command->add_flag("--no-plot", options->no_plot, "Write the CSV only");
+    command
+        ->add_option("--searcher", options->searcher,
+                     "The anytime allocator studied (" +
+                         fmt::format("{}", fmt::join(allocator_registry().names({Capability::anytime}), ", ")) + ")")
+        ->capture_default_str();
+    command
+        ->add_option("--reference", options->reference,
+                     "The stationary allocator it is measured against (its time per decision sets the searcher's)")
+        ->capture_default_str();
     if (name == "anytime") {
       command->add_option("--log10-multipliers", options->multipliers,
                           "Comma-separated exponents m: mcts gets 10^m times dp-rerun's time per decision")

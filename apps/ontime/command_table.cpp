@@ -7,10 +7,12 @@
 
 #include <chrono>
 #include <filesystem>
+#include <functional>
 #include <fmt/format.h>
 
 #include "common.hpp"
 #include "markdown_table.hpp"
+#include "ontime/allocators/optimal.hpp"
 #include "ontime/error.hpp"
 #include "ontime/instance_io.hpp"
 
@@ -67,22 +69,137 @@ Json exact_json(const ExactPart& part) {
   return out;
 }
 
+struct TableOptions {
+  std::vector<std::string> instances;
+  std::vector<std::string> solvers;
+  bool exact = false;
+  bool json = false;
+  AllocatorFlags allocator;
+  MonteCarloFlags monte_carlo;
+};
+
+// One row: every column's Monte Carlo run and, with --exact, exact parts. `factories` are the
+// columns' allocators for this row's instance.
+Row measure_row(const TableOptions& options, std::size_t index, const Mdp& mdp,
+                const std::vector<AllocatorFactory>& factories, std::size_t max_states,
+                const std::function<void(std::uint64_t)>& progress) {
+  Row row;
+  row.path = options.instances[index];
+  row.label = std::filesystem::path(row.path).stem().string();
+  row.name = mdp.problem().name();
+  std::uint64_t finished = 0;
+  for (std::size_t column = 0; column < options.solvers.size(); ++column) {
+    const std::string& solver = options.solvers[column];
+    const AllocatorFactory& factory = factories[column];
+    MonteCarloOptions monte_carlo = options.monte_carlo.options();
+    monte_carlo.progress = [&](std::uint64_t done, std::uint64_t) { progress(finished + done); };
+    Cell cell{run_monte_carlo(mdp, factory, monte_carlo), std::nullopt};
+    finished += monte_carlo.episodes;
+    if (options.exact && allocator_registry().find(solver).capabilities.has(Capability::stationary)) {
+      const auto allocator = factory();
+      cell.exact = exact_part(max_states, [&] {
+        const ExactEvaluation evaluation = evaluate_exactly(mdp, *allocator, max_states);
+        return std::pair{evaluation.success_probability, evaluation.states};
+      });
+    }
+    row.cells.push_back(std::move(cell));
+  }
+  if (options.exact) {
+    row.optimum = exact_part(max_states, [&] {
+      OptimalSolver solver(mdp, max_states);
+      const double value = solver.solve(mdp.start());
+      return std::pair{value, solver.states()};
+    });
+  }
+  return row;
+}
+
+Json table_json(const TableOptions& options, const std::vector<Row>& rows) {
+  Json out;
+  out["episodes"] = options.monte_carlo.episodes;
+  out["seed"] = options.monte_carlo.seed;
+  out["solvers"] = options.solvers;
+  out["rows"] = Json::array();
+  for (const Row& row : rows) {
+    Json line;
+    line["instance"] = row.path;
+    line["name"] = row.name;
+    Json cells = Json::object();
+    for (std::size_t s = 0; s < options.solvers.size(); ++s) {
+      const Cell& cell = row.cells[s];
+      Json entry;
+      entry["success_rate"] = cell.sampled.success_rate;
+      entry["ci95"] = cell.sampled.ci95;
+      entry["decision_time_us"] = {{"median", cell.sampled.decision_time.median_us},
+                                   {"p99", cell.sampled.decision_time.p99_us},
+                                   {"mean", cell.sampled.decision_time.mean_us}};
+      if (cell.exact) {
+        if (cell.exact->value) entry["exact_success_probability"] = *cell.exact->value;
+        entry["exact"] = exact_json(*cell.exact);
+      }
+      cells[options.solvers[s]] = entry;
+    }
+    line["solvers"] = cells;
+    if (row.optimum) {
+      if (row.optimum->value) line["optimal_success_probability"] = *row.optimum->value;
+      line["optimal_states"] = row.optimum->states;
+      line["optimum"] = exact_json(*row.optimum);
+    }
+    out["rows"].push_back(line);
+  }
+  return out;
+}
+
+void print_table(const TableOptions& options, const std::vector<Row>& rows) {
+  std::vector<std::string> header{"instance"};
+  for (const std::string& solver : options.solvers) header.push_back(solver);
+  if (options.exact) header.emplace_back("optimum");
+  std::vector<std::vector<std::string>> body;
+  std::vector<double> latency_sum(options.solvers.size(), 0.0);
+  for (const Row& row : rows) {
+    std::vector<std::string> line{row.label};
+    for (std::size_t s = 0; s < row.cells.size(); ++s) {
+      const Cell& cell = row.cells[s];
+      std::string text = fmt::format("{:.3f} ± {:.3f}", cell.sampled.success_rate, cell.sampled.ci95);
+      if (cell.exact) text += " (" + exact_text(*cell.exact) + ")";
+      line.push_back(text);
+      latency_sum[s] += cell.sampled.decision_time.mean_us;
+    }
+    if (options.exact) line.push_back(exact_text(*row.optimum));
+    body.push_back(std::move(line));
+  }
+  std::vector<std::string> latency{"mean decision time (µs)"};
+  for (const double sum : latency_sum) latency.push_back(fmt::format("{:.3f}", sum / static_cast<double>(rows.size())));
+  if (options.exact) latency.emplace_back("");
+  body.push_back(std::move(latency));
+
+  fmt::print("Success probability: mean ± 95% over {} episodes (seed {}){}.\n\n", options.monte_carlo.episodes,
+             options.monte_carlo.seed, options.exact ? "; exact value in parentheses; optimum = exact expectimax" : "");
+  fmt::print("{}", render_markdown(header, body));
+  if (!options.exact) return;
+  fmt::print("\nExact parts (states, seconds; 'cap reached': more than --max-states {} states):\n",
+             options.allocator.max_states());
+  for (const Row& row : rows) {
+    std::vector<std::string> parts;
+    for (std::size_t s = 0; s < row.cells.size(); ++s) {
+      const auto& exact = row.cells[s].exact;
+      if (!exact) continue;
+      parts.push_back(fmt::format("{} {}{} states, {:.1f} s", options.solvers[s], exact->cap_reached ? "over " : "",
+                                  exact->states, exact->seconds));
+    }
+    parts.push_back(fmt::format("optimum {}{} states, {:.1f} s", row.optimum->cap_reached ? "over " : "",
+                                row.optimum->states, row.optimum->seconds));
+    fmt::print("- {}: {}.\n", row.label, fmt::join(parts, "; "));
+  }
+}
+
 }  // namespace
 
 void add_table_command(CLI::App& app) {
-  struct Options {
-    std::vector<std::string> instances;
-    std::vector<std::string> solvers;
-    bool exact = false;
-    bool json = false;
-    AllocatorFlags allocator;
-    MonteCarloFlags monte_carlo;
-  };
-  auto options = std::make_shared<Options>();
-  for (const std::string& name : allocator_names()) {
-    // The default columns: every allocator that needs nothing beyond the instance.
-    if (name != "optimal" && name != "ppo") options->solvers.push_back(name);
-  }
+  auto options = std::make_shared<TableOptions>();
+  // The default columns: every allocator that needs nothing beyond the instance, the optimum
+  // (its own column with --exact) aside.
+  options->solvers = allocator_registry().names({}, {Capability::needs_policy, Capability::optimal});
   CLI::App* command = app.add_subcommand("table", "Table I: success of several allocators on several instances");
   command->add_option("INSTANCE", options->instances, "Instance files (JSON, SPEC §5)")->required();
   command->add_option("--solvers", options->solvers, "Comma-separated allocators, one column each")
@@ -94,128 +211,34 @@ void add_table_command(CLI::App& app) {
   options->allocator.add_to(*command);
   command->callback([options] {
     check_solver_names(options->solvers);
-    const MonteCarloOptions base = options->monte_carlo.options();
-
-    // Load every instance first: a bad file stops the command before any long computation.
+    // Load every instance and make every column's allocators first (policies loaded, parameters
+    // checked): a bad file or value stops the command before any long computation.
     std::vector<Problem> problems;
-    std::vector<AllocatorOptions> per_instance;
     for (const std::string& path : options->instances) problems.push_back(load_problem(path));
-    for (std::size_t i = 0; i < problems.size(); ++i) per_instance.push_back(options->allocator.options(i, problems.size()));
-
-    std::vector<Row> rows;
-    ProgressBar bar("table");
-    const std::uint64_t total = base.episodes * problems.size() * options->solvers.size();
-    std::uint64_t finished = 0;
+    std::vector<std::unique_ptr<Mdp>> mdps;
+    std::vector<std::vector<AllocatorFactory>> factories(problems.size());
+    std::vector<std::size_t> max_states;
     for (std::size_t i = 0; i < problems.size(); ++i) {
-      const Mdp mdp(problems[i]);
-      const AllocatorOptions& allocator_options = per_instance[i];
-      Row row;
-      row.path = options->instances[i];
-      row.label = std::filesystem::path(row.path).stem().string();
-      row.name = problems[i].name();
+      const ParameterValues parameters = options->allocator.values(i, problems.size());
+      mdps.push_back(std::make_unique<Mdp>(problems[i]));
+      max_states.push_back(max_states_of(parameters));
       for (const std::string& solver : options->solvers) {
-        const AllocatorFactory factory = make_allocator_factory(solver, mdp, allocator_options);
-        MonteCarloOptions monte_carlo = base;
-        monte_carlo.progress = [&](std::uint64_t done, std::uint64_t) { bar.update(finished + done, total); };
-        Cell cell{run_monte_carlo(mdp, factory, monte_carlo), std::nullopt};
-        finished += base.episodes;
-        if (options->exact) {
-          const auto allocator = factory();
-          if (allocator->is_stationary()) {
-            cell.exact = exact_part(allocator_options.max_states, [&] {
-              const ExactEvaluation evaluation = evaluate_exactly(mdp, *allocator, allocator_options.max_states);
-              return std::pair{evaluation.success_probability, evaluation.states};
-            });
-          }
-        }
-        row.cells.push_back(std::move(cell));
+        factories[i].push_back(make_allocator_factory(solver, *mdps[i], parameters));
       }
-      if (options->exact) {
-        row.optimum = exact_part(allocator_options.max_states, [&] {
-          OptimalSolver solver(mdp, allocator_options.max_states);
-          const double value = solver.solve(mdp.start());
-          return std::pair{value, solver.states()};
-        });
-      }
-      rows.push_back(std::move(row));
     }
 
+    ProgressBar bar("table");
+    const std::uint64_t per_row = options->monte_carlo.episodes * options->solvers.size();
+    const std::uint64_t total = per_row * problems.size();
+    std::vector<Row> rows;
+    for (std::size_t i = 0; i < problems.size(); ++i) {
+      rows.push_back(measure_row(*options, i, *mdps[i], factories[i], max_states[i],
+                                 [&bar, i, per_row, total](std::uint64_t done) { bar.update(i * per_row + done, total); }));
+    }
     if (options->json) {
-      Json out;
-      out["episodes"] = base.episodes;
-      out["seed"] = base.seed;
-      out["solvers"] = options->solvers;
-      out["rows"] = Json::array();
-      for (const Row& row : rows) {
-        Json line;
-        line["instance"] = row.path;
-        line["name"] = row.name;
-        Json cells = Json::object();
-        for (std::size_t s = 0; s < options->solvers.size(); ++s) {
-          const Cell& cell = row.cells[s];
-          Json entry;
-          entry["success_rate"] = cell.sampled.success_rate;
-          entry["ci95"] = cell.sampled.ci95;
-          entry["decision_time_us"] = {{"median", cell.sampled.decision_time.median_us},
-                                       {"p99", cell.sampled.decision_time.p99_us},
-                                       {"mean", cell.sampled.decision_time.mean_us}};
-          if (cell.exact) {
-            if (cell.exact->value) entry["exact_success_probability"] = *cell.exact->value;
-            entry["exact"] = exact_json(*cell.exact);
-          }
-          cells[options->solvers[s]] = entry;
-        }
-        line["solvers"] = cells;
-        if (row.optimum) {
-          if (row.optimum->value) line["optimal_success_probability"] = *row.optimum->value;
-          line["optimal_states"] = row.optimum->states;
-          line["optimum"] = exact_json(*row.optimum);
-        }
-        out["rows"].push_back(line);
-      }
-      print_json(out);
-      return;
-    }
-
-    std::vector<std::string> header{"instance"};
-    for (const std::string& solver : options->solvers) header.push_back(solver);
-    if (options->exact) header.emplace_back("optimum");
-    std::vector<std::vector<std::string>> body;
-    std::vector<double> latency_sum(options->solvers.size(), 0.0);
-    for (const Row& row : rows) {
-      std::vector<std::string> line{row.label};
-      for (std::size_t s = 0; s < row.cells.size(); ++s) {
-        const Cell& cell = row.cells[s];
-        std::string text = fmt::format("{:.3f} ± {:.3f}", cell.sampled.success_rate, cell.sampled.ci95);
-        if (cell.exact) text += " (" + exact_text(*cell.exact) + ")";
-        line.push_back(text);
-        latency_sum[s] += cell.sampled.decision_time.mean_us;
-      }
-      if (options->exact) line.push_back(exact_text(*row.optimum));
-      body.push_back(std::move(line));
-    }
-    std::vector<std::string> latency{"mean decision time (µs)"};
-    for (const double sum : latency_sum) latency.push_back(fmt::format("{:.3f}", sum / static_cast<double>(rows.size())));
-    if (options->exact) latency.emplace_back("");
-    body.push_back(std::move(latency));
-
-    fmt::print("Success probability: mean ± 95% over {} episodes (seed {}){}.\n\n", base.episodes, base.seed,
-               options->exact ? "; exact value in parentheses; optimum = exact expectimax" : "");
-    fmt::print("{}", render_markdown(header, body));
-    if (!options->exact) return;
-    fmt::print("\nExact parts (states, seconds; 'cap reached': more than --max-states {} states):\n",
-               options->allocator.max_states);
-    for (const Row& row : rows) {
-      std::vector<std::string> parts;
-      for (std::size_t s = 0; s < row.cells.size(); ++s) {
-        const auto& exact = row.cells[s].exact;
-        if (!exact) continue;
-        parts.push_back(fmt::format("{} {}{} states, {:.1f} s", options->solvers[s], exact->cap_reached ? "over " : "",
-                                    exact->states, exact->seconds));
-      }
-      parts.push_back(fmt::format("optimum {}{} states, {:.1f} s", row.optimum->cap_reached ? "over " : "",
-                                  row.optimum->states, row.optimum->seconds));
-      fmt::print("- {}: {}.\n", row.label, fmt::join(parts, "; "));
+      print_json(table_json(*options, rows));
+    } else {
+      print_table(*options, rows);
     }
   });
 }

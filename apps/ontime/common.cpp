@@ -2,62 +2,69 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <limits>
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include "ontime/allocators/optimal.hpp"
 #include "ontime/error.hpp"
 
 namespace ontime::cli {
 
-void AllocatorFlags::add_to(CLI::App& command) {
-  command.add_option("--aggregation", aggregation, "How dp-rerun's Eq. (1) combines skeletons sharing an action")
-      ->check(CLI::IsMember({"sum", "max", "self"}))
-      ->capture_default_str();
-  command.add_option("--max-states", max_states, "Cap on the states the exact solver and evaluator may hold")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  command.add_option("--iterations", iterations,
-                     "mcts: search iterations per decision (default 10000; no limit when only --time-budget is given)")
-      ->check(CLI::PositiveNumber);
-  command.add_option("--time-budget", time_budget,
-                     "mcts: seconds per decision (with --iterations, whichever ends first; 0: no time limit)")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  command.add_option("--exploration", exploration, "mcts: exploration constant C of UCT")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  command.add_option("--rollout", rollout, "mcts: rollout policy, 'random' or a stationary allocator (e.g. dp-rerun)")
-      ->capture_default_str();
-  command.add_option("--policy", policies,
-                     "ppo: trained policy file (ontime train); for several instances, one per instance in order");
-  command.add_option("--max-tree-mib", max_tree_mib, "mcts: memory cap of the search tree; a search stops there")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
+namespace {
+
+std::string type_name(const Parameter& parameter) {
+  switch (parameter.type) {
+    case ParameterType::integer: return "INT";
+    case ParameterType::real: return "REAL";
+    case ParameterType::text: return "TEXT";
+    case ParameterType::choice: return fmt::format("{{{}}}", fmt::join(parameter.choices, ","));
+    case ParameterType::path: return "FILE";
+  }
+  return "VALUE";
 }
 
-AllocatorOptions AllocatorFlags::options(std::size_t index, std::size_t instance_count) const {
-  AllocatorOptions options;
-  if (!policies.empty()) {
-    if (policies.size() != 1 && policies.size() != instance_count) {
-      throw UsageError(fmt::format("--policy: give one policy file, or one per instance ({} given for {} instances)",
-                                   policies.size(), instance_count));
+}  // namespace
+
+void AllocatorFlags::add_to(CLI::App& command) {
+  const AllocatorRegistry& registry = allocator_registry();
+  for (const Parameter& parameter : registry.parameters()) {
+    std::string help = fmt::format("{}: {}", fmt::join(registry.kinds_with_parameter(parameter.name), ", "),
+                                   parameter.help);
+    if (!parameter.default_value.empty()) help += fmt::format(" (default {})", parameter.default_value);
+    CLI::Option* option = command.add_option("--" + parameter.name, given[parameter.name], help);
+    option->type_name(type_name(parameter));
+    // Files may follow one flag (--policy a.json b.json); other values one per flag, repeatable.
+    if (parameter.type != ParameterType::path) option->expected(1)->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  }
+}
+
+ParameterValues AllocatorFlags::values(std::size_t index, std::size_t instance_count) const {
+  ParameterValues values;
+  for (const auto& [name, list] : given) {
+    if (list.empty()) continue;
+    if (list.size() != 1 && list.size() != instance_count) {
+      throw UsageError(fmt::format("--{}: give one value, or one per instance ({} given for {} instance{})", name,
+                                   list.size(), instance_count, instance_count == 1 ? "" : "s"));
     }
-    options.policy = std::make_shared<const PpoPolicy>(load_ppo_policy(policies[policies.size() == 1 ? 0 : index]));
+    values.set(name, list[list.size() == 1 ? 0 : index]);
   }
-  options.aggregation = parse_aggregation(aggregation);
-  options.max_states = max_states;
-  options.exploration = exploration;
-  if (time_budget > 0) options.seconds = time_budget;
-  if (iterations > 0) {
-    options.iterations = iterations;
-  } else if (time_budget > 0) {
-    options.iterations = std::numeric_limits<std::uint64_t>::max();
+  for (const Parameter& parameter : allocator_registry().parameters()) {
+    const std::string* value = values.find(parameter.name);
+    if (value == nullptr) continue;
+    if (const std::optional<std::string> rule = parameter.violation(*value)) {
+      throw UsageError("--" + parameter.name + ": " + *rule);
+    }
   }
-  if (rollout != "random") check_solver_names({rollout});
-  options.rollout = rollout;
-  options.max_tree_bytes = max_tree_mib << 20;
-  return options;
+  return values;
+}
+
+std::size_t AllocatorFlags::max_states() const { return max_states_of(values()); }
+
+nlohmann::ordered_json parameters_json(const AllocatorKind& kind, const ParameterValues& values) {
+  nlohmann::ordered_json out = nlohmann::ordered_json::object();
+  const ParameterReader reader(kind, values);
+  for (const Parameter& parameter : kind.parameters) out[parameter.name] = reader.text(parameter.name);
+  return out;
 }
 
 void MonteCarloFlags::add_to(CLI::App& command) {
@@ -78,16 +85,17 @@ MonteCarloOptions MonteCarloFlags::options() const {
 }
 
 CLI::Option* add_solver_option(CLI::App& command, std::string& solver) {
-  return command.add_option("--solver", solver, "Allocator: " + fmt::format("{}", fmt::join(allocator_names(), ", ")))
+  return command
+      .add_option("--solver", solver,
+                  "Allocator: " + fmt::format("{}", fmt::join(allocator_registry().names(), ", ")) +
+                      " ('ontime allocators' describes them)")
       ->required();
 }
 
 void check_solver_names(const std::vector<std::string>& names) {
-  const std::vector<std::string> known = allocator_names();
+  const std::vector<std::string> known = allocator_registry().names();
   for (const std::string& name : names) {
-    if (std::find(known.begin(), known.end(), name) == known.end()) {
-      throw UsageError(fmt::format("unknown solver '{}' (known: {})", name, fmt::join(known, ", ")));
-    }
+    if (std::find(known.begin(), known.end(), name) == known.end()) throw unknown_name_error("solver", name, known);
   }
 }
 

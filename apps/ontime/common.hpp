@@ -4,12 +4,13 @@
 #include <CLI/CLI.hpp>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
-#include "ontime/allocators.hpp"
+#include "ontime/allocator_registry.hpp"
 #include "ontime/evaluation.hpp"
 
 namespace ontime::cli {
@@ -29,21 +30,29 @@ void add_plot_command(CLI::App& app);
 void add_collect_command(CLI::App& app);
 void add_map_command(CLI::App& app);
 void add_run_command(CLI::App& app);
+void add_allocators_command(CLI::App& app);
 
-// Options shared by commands that build allocators.
+// The allocator kinds and their parameters as Markdown tables (`ontime allocators`).
+std::string allocators_markdown();
+
+// The whole command line, every command registered (main and the tests use it).
+std::unique_ptr<CLI::App> make_app();
+
+// One option `--NAME` per parameter declared in the allocator registry (its help, type and
+// default from the declaration), for the commands that build allocators. A parameter given
+// once applies to every instance of the command; given once per instance, to each in order.
 struct AllocatorFlags {
-  std::string aggregation = "sum";
-  std::size_t max_states = OptimalSolver::kDefaultMaxStates;
-  double exploration = 0.5;
-  std::uint64_t iterations = 0;  // 0: 10,000 without --time-budget, unlimited with it
-  double time_budget = 0;        // seconds per decision, 0: none
-  std::string rollout = "random";
-  std::size_t max_tree_mib = 1024;
-  std::vector<std::string> policies;  // ppo: one policy file, or one per instance
+  std::map<std::string, std::vector<std::string>> given;  // by parameter name
   void add_to(CLI::App& command);
-  // Options for the instance at `index` of `instance_count` (selects its ppo policy, if any).
-  AllocatorOptions options(std::size_t index = 0, std::size_t instance_count = 1) const;
+  // The values for the instance at `index` of `instance_count`, each checked against its
+  // declaration; UsageError naming the option otherwise.
+  ParameterValues values(std::size_t index = 0, std::size_t instance_count = 1) const;
+  // The state cap of exact computations (the `max-states` parameter).
+  std::size_t max_states() const;
 };
+
+// The values of the parameters `kind` declares, given or defaulted, as JSON (text values).
+nlohmann::ordered_json parameters_json(const AllocatorKind& kind, const ParameterValues& values);
 
 // Options shared by commands that run Monte Carlo episodes.
 struct MonteCarloFlags {
@@ -57,7 +66,8 @@ struct MonteCarloFlags {
 // Adds the required `--solver NAME` option, its help listing the allocators.
 CLI::Option* add_solver_option(CLI::App& command, std::string& solver);
 
-// Checks that every name is a known allocator; throws UsageError otherwise.
+// Checks that every name is a known allocator (the CLI calls them solvers); throws UsageError
+// otherwise.
 void check_solver_names(const std::vector<std::string>& names);
 
 // Prints JSON to stdout, two-space indented.

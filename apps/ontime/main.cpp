@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <exception>
 #include <fmt/core.h>
+#include <memory>
 #include <new>
 
 #include "common.hpp"
@@ -24,23 +25,8 @@ int report(const char* kind, const char* message, int code) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app("OnTime: deadline-aware effort allocation for task and motion planning.\n"
-               "Decides, step by step, which plan skeleton gets the motion planner's next slice of effort.",
-               "ontime");
-  app.set_version_flag("--version", std::string("ontime ") + ONTIME_VERSION);
-  app.require_subcommand(1);
-  ontime::cli::add_solve_command(app);
-  ontime::cli::add_evaluate_command(app);
-  ontime::cli::add_table_command(app);
-  ontime::cli::add_study_command(app);
-  ontime::cli::add_train_command(app);
-  ontime::cli::add_reduce_knapsack_command(app);
-  ontime::cli::add_fit_command(app);
-  ontime::cli::add_sample_log_command(app);
-  ontime::cli::add_plot_command(app);
-  ontime::cli::add_collect_command(app);
-  ontime::cli::add_map_command(app);
-  ontime::cli::add_run_command(app);
+  const std::unique_ptr<CLI::App> application = ontime::cli::make_app();
+  CLI::App& app = *application;
 
   try {
     app.parse(argc, argv);

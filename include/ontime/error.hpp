@@ -3,8 +3,10 @@
 // InputError, UsageError and ResourceLimitError are the caller's to fix (exit 2),
 // anything else is a defect of the library (exit 1).
 
+#include <span>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace ontime {
 
@@ -31,6 +33,9 @@ class UsageError : public std::invalid_argument {
  public:
   using std::invalid_argument::invalid_argument;
 };
+
+// The error for a name that is not one of `known`: "unknown WHAT 'NAME' (known: a, b, c)".
+UsageError unknown_name_error(std::string_view what, std::string_view name, std::span<const std::string> known);
 
 // A computation reached a cap the caller configured (states, memory) before finishing.
 // Raised instead of letting the process be killed for running out of memory.

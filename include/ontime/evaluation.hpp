@@ -16,6 +16,7 @@ struct MonteCarloOptions {
   std::uint64_t seed = 1;
   unsigned threads = 0;          // 0: one per hardware thread
   bool time_decisions = true;    // measure each decision (adds ~40 ns of clock reads)
+  DecisionBudget decision_budget;  // passed with every decision (unset: the allocators' own)
   // Called now and then with the number of episodes done (from one thread at a time).
   std::function<void(std::uint64_t done, std::uint64_t total)> progress;
 };

@@ -1,8 +1,11 @@
 #pragma once
 // The computation-time studies of the paper's §VIII-C (Figs. 4-6): how much meta-level
-// computation mcts needs against dp-rerun, how mcts fares when held to dp-rerun's time, and
-// how its success grows with time. Each returns the measured numbers; writing and plotting
-// them is the caller's business.
+// computation an anytime allocator (the searcher; the paper's mcts) needs against a stationary
+// one (the reference; the paper's dp-rerun), how the searcher fares when held to the
+// reference's time per decision, and how its success grows with time. The searcher's time is
+// given through the budget passed with each decision, so one factory serves every time
+// setting. Each returns the measured numbers; writing and plotting them is the caller's
+// business.
 //
 // Times are wall-clock on the running machine: the success counts of iteration budgets are
 // reproducible for a seed, those of time budgets are not (the number of iterations that fit
@@ -13,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "ontime/allocators.hpp"
+#include "ontime/allocator_registry.hpp"
 #include "ontime/evaluation.hpp"
 
 namespace ontime {
@@ -22,7 +25,9 @@ struct StudySettings {
   std::uint64_t episodes = 1'000;  // per evaluated configuration
   std::uint64_t seed = 1;
   unsigned threads = 0;
-  AllocatorOptions allocator;      // mcts and dp-rerun settings (budget overridden where a study sets it)
+  std::string searcher = "mcts";       // an anytime allocator kind
+  std::string reference = "dp-rerun";  // a stationary allocator kind
+  ParameterValues parameters;          // of both kinds (the searcher's time is set per study)
   // Called with the episodes done so far in this study and its total.
   std::function<void(std::uint64_t done, std::uint64_t total)> progress;
 };
@@ -32,31 +37,33 @@ struct StudySettings {
 double mean_decision_seconds(const Mdp& mdp, const AllocatorFactory& factory, std::uint64_t seed,
                              std::uint64_t episodes = 500);
 
-// Fig. 4: total decision time per episode, mcts (its iteration budget) against dp-rerun.
+// Fig. 4: total decision time per episode, the searcher (its own default budget) against the
+// reference.
 struct ComputeTimeStudy {
-  MonteCarloResult mcts;
-  MonteCarloResult dp_rerun;
+  MonteCarloResult searcher;
+  MonteCarloResult reference;
 };
 ComputeTimeStudy compute_time_study(const Mdp& mdp, const StudySettings& settings);
 
-// Fig. 5: mcts given exactly dp-rerun's measured time per decision.
+// Fig. 5: the searcher given exactly the reference's measured time per decision.
 struct EqualTimeStudy {
-  double dp_rerun_decision_seconds = 0;
-  MonteCarloResult dp_rerun;
-  MonteCarloResult mcts;
+  double reference_decision_seconds = 0;
+  MonteCarloResult reference;
+  MonteCarloResult searcher;
 };
 EqualTimeStudy equal_time_study(const Mdp& mdp, const StudySettings& settings);
 
-// Fig. 6: mcts success against log10 of a multiplier of dp-rerun's time per decision.
+// Fig. 6: the searcher's success against log10 of a multiplier of the reference's time per
+// decision.
 struct AnytimePoint {
   double log10_multiplier = 0;
   double seconds_per_decision = 0;
-  MonteCarloResult mcts;
+  MonteCarloResult searcher;
 };
 struct AnytimeStudy {
-  double dp_rerun_decision_seconds = 0;
-  double optimum = 0;               // exact, from `optimal`
-  MonteCarloResult dp_rerun;
+  double reference_decision_seconds = 0;
+  double optimum = 0;               // exact (the optimal solver, within the max-states parameter)
+  MonteCarloResult reference;
   std::vector<AnytimePoint> points;
 };
 AnytimeStudy anytime_study(const Mdp& mdp, const std::vector<double>& log10_multipliers,

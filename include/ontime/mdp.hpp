@@ -103,6 +103,10 @@ class Mdp {
   bool can_succeed(const State& state, int k) const noexcept;
   bool any_can_succeed(const State& state) const noexcept;
 
+  // The choice of an allocator when no skeleton can succeed any more (every choice is as
+  // good): the lowest-index skeleton with actions left, else 0.
+  int first_with_work_left(const State& state) const noexcept;
+
   // P(the next step of effort on `action` finds a motion | `spent` steps did not).
   double hazard(int action, Steps spent) const noexcept {
     return spent < deadline_ ? hazards_[static_cast<std::size_t>(action) * static_cast<std::size_t>(deadline_) + static_cast<std::size_t>(spent)] : 0.0;
@@ -163,12 +167,9 @@ Observation Mdp::sample_observation(const State& state, int choice, Generator& g
   const double found = hazard(action, state.spent[static_cast<std::size_t>(choice)]);
   if (!(uniform01(generator) < found)) return Observation::not_yet();
   const auto& outcomes = execution_outcomes_[static_cast<std::size_t>(action)];
-  double u = uniform01(generator);
-  for (const ExecutionOutcome& outcome : outcomes) {
-    if (u < outcome.probability) return Observation::found(outcome.steps);
-    u -= outcome.probability;
-  }
-  return Observation::found(outcomes.back().steps);  // rounding: u beyond the summed masses
+  const std::size_t drawn =
+      sample_index(outcomes.size(), [&outcomes](std::size_t i) { return outcomes[i].probability; }, generator);
+  return Observation::found(outcomes[drawn].steps);
 }
 
 }  // namespace ontime

@@ -2,7 +2,7 @@
 // Everything of the OnTime library.
 
 #include "ontime/allocator.hpp"
-#include "ontime/allocators.hpp"
+#include "ontime/allocator_registry.hpp"
 #include "ontime/allocators/dp.hpp"
 #include "ontime/allocators/dp_rerun.hpp"
 #include "ontime/allocators/greedy.hpp"

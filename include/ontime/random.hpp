@@ -8,6 +8,7 @@
 // numbers with another standard library. SplitMix64 (Steele, Lea, Flood 2014) is a
 // 64-bit-state generator that passes BigCrush and can be seeded in O(1) per episode.
 
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 
@@ -37,6 +38,20 @@ class SplitMix64 {
 template <class Generator>
 constexpr double uniform01(Generator& generator) noexcept {
   return static_cast<double>(generator() >> 11) * 0x1.0p-53;
+}
+
+// The one inverse-CDF draw of the library: an index in [0, count) (count >= 1) where index i
+// has probability `probability(i)` (the probabilities sum to about 1). One uniform draw; when
+// rounding leaves it beyond the summed masses, the last index.
+template <class Probability, class Generator>
+constexpr std::size_t sample_index(std::size_t count, Probability&& probability, Generator& generator) {
+  double u = uniform01(generator);
+  for (std::size_t i = 0; i + 1 < count; ++i) {
+    const double mass = probability(i);
+    if (u < mass) return i;
+    u -= mass;
+  }
+  return count - 1;
 }
 
 // The seed of stream `index` derived from a master seed: episodes, threads and rollouts

@@ -36,6 +36,8 @@ class Session {
   // or a decision is still waiting for its report; UsageError when the allocator returns a
   // skeleton index out of range.
   Decision choose();
+  // The same within `budget` (anytime allocators; an unset budget: the allocator's own).
+  Decision choose(const DecisionBudget& budget);
 
   // Reports the outcome of the step just decided. Throws std::logic_error without a
   // pending decision, and UsageError for a refinement reported on an idle step or a negative

@@ -46,6 +46,6 @@ struct EpisodeResult {
 // Runs one episode of `allocator` in the hidden world drawn from `seed`; the allocator's own
 // randomness is seeded from another stream of the same seed.
 EpisodeResult run_episode(const Mdp& mdp, Allocator& allocator, std::uint64_t seed,
-                          DecisionTimer* timer = nullptr);
+                          DecisionTimer* timer = nullptr, const DecisionBudget& budget = {});
 
 }  // namespace ontime

@@ -1,5 +1,7 @@
 #include "ontime/allocators/dp.hpp"
 
+#include "ontime/allocator_registry.hpp"
+
 namespace ontime {
 namespace {
 
@@ -20,5 +22,16 @@ int best_single_skeleton(const Mdp& mdp) {
 }  // namespace
 
 DpAllocator::DpAllocator(const Mdp& mdp) : chosen_(best_single_skeleton(mdp)) {}
+
+AllocatorKind dp_kind() {
+  return {.name = "dp",
+          .summary = "the paper's DP: the single skeleton most likely to succeed alone, refined for the whole episode",
+          .capabilities = {Capability::stationary},
+          .parameters = {},
+          .make = [](const Mdp& mdp, const ParameterReader&) -> AllocatorFactory {
+            const int chosen = DpAllocator(mdp).chosen_skeleton();
+            return [chosen] { return std::make_unique<DpAllocator>(chosen); };
+          }};
+}
 
 }  // namespace ontime

@@ -1,5 +1,7 @@
 #include "ontime/allocators/dp_rerun.hpp"
 
+#include "ontime/allocator_registry.hpp"
+
 namespace ontime {
 
 DpRerunAllocator::DpRerunAllocator(const Mdp& mdp, Aggregation aggregation)
@@ -20,6 +22,18 @@ int DpRerunAllocator::choose(const State& state) {
     }
   }
   return best < 0 ? 0 : best;
+}
+
+AllocatorKind dp_rerun_kind() {
+  return {.name = "dp-rerun",
+          .summary = "the paper's DP_Rerun: Eq. (1) re-evaluated before every step, the most promising skeleton refined",
+          .capabilities = {Capability::stationary},
+          .parameters = {Parameter::choice("aggregation", "sum", {"sum", "max", "self"},
+                                           "how Eq. (1) combines the skeletons sharing an action")},
+          .make = [](const Mdp& mdp, const ParameterReader& parameters) -> AllocatorFactory {
+            auto table = std::make_shared<const ContiguousSuccessTable>(mdp, parse_aggregation(parameters.text("aggregation")));
+            return [model = &mdp, table] { return std::make_unique<DpRerunAllocator>(*model, table); };
+          }};
 }
 
 }  // namespace ontime

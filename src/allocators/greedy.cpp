@@ -1,5 +1,7 @@
 #include "ontime/allocators/greedy.hpp"
 
+#include "ontime/allocator_registry.hpp"
+
 #include <limits>
 
 namespace ontime {
@@ -24,5 +26,15 @@ int fastest_on_average(const Problem& problem) {
 }  // namespace
 
 GreedyAllocator::GreedyAllocator(const Mdp& mdp) : chosen_(fastest_on_average(mdp.problem())) {}
+
+AllocatorKind greedy_kind() {
+  return {.name = "greedy",
+          .summary = "baseline: the skeleton with the least mean planning and execution time, refined throughout",
+          .capabilities = {Capability::stationary},
+          .parameters = {},
+          .make = [](const Mdp& mdp, const ParameterReader&) -> AllocatorFactory {
+            return [model = &mdp] { return std::make_unique<GreedyAllocator>(*model); };
+          }};
+}
 
 }  // namespace ontime

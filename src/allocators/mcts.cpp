@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
+#include "ontime/allocator_registry.hpp"
 #include "ontime/error.hpp"
 
 namespace ontime {
@@ -138,15 +140,10 @@ bool MctsAllocator::iterate() {
     path_.push_back(e);
 
     const Edge& edge = edges_[e];
-    std::uint32_t picked = edge.first_outcome + edge.outcome_count - 1U;
-    double u = uniform01(generator_);
-    for (std::uint32_t o = edge.first_outcome; o < edge.first_outcome + edge.outcome_count; ++o) {
-      if (u < outcomes_[o].probability) {
-        picked = o;
-        break;
-      }
-      u -= outcomes_[o].probability;
-    }
+    const std::uint32_t first = edge.first_outcome;
+    const std::uint32_t picked =
+        first + static_cast<std::uint32_t>(sample_index(
+                    edge.outcome_count, [&](std::size_t o) { return outcomes_[first + o].probability; }, generator_));
     const Outcome& outcome = outcomes_[picked];
     if (outcome.status != Status::running) {
       reward = outcome.status == Status::success ? 1.0 : 0.0;
@@ -177,13 +174,7 @@ int MctsAllocator::choose(const State& state) { return choose(state, options_.bu
 int MctsAllocator::choose(const State& state, const DecisionBudget& budget) {
   if (!has_tree_ || !(state == root_state_)) reset(state);
   const ChoiceList choices = mdp_->useful_choices(state);
-  if (choices.empty()) {
-    // Nothing can succeed any more: any choice is as good; prefer one with work left.
-    for (int k = 0; k < mdp_->skeleton_count(); ++k) {
-      if (mdp_->next_action(state, k) >= 0) return k;
-    }
-    return 0;
-  }
+  if (choices.empty()) return mdp_->first_with_work_left(state);
   if (choices.size() == 1) return choices[0];
 
   ++counters_.searches;
@@ -290,6 +281,43 @@ std::vector<MctsAllocator::RootChoice> MctsAllocator::root_choices() const {
     result.push_back({edge.choice, edge.visits, estimate(edge)});
   }
   return result;
+}
+
+AllocatorKind mcts_kind() {
+  return {.name = "mcts",
+          .summary = "Monte Carlo tree search (UCT with chance nodes) sampling the model before every step",
+          .capabilities = {Capability::randomised, Capability::anytime},
+          .parameters = {Parameter::integer("iterations", 10'000, 1, Parameter::kNoLimit,
+                                            "search iterations per decision (no limit when only time-budget is given)"),
+                         Parameter::real("time-budget", 0, 0, Parameter::kNoLimit,
+                                         "seconds per decision, 0: none (with iterations, whichever ends first)"),
+                         Parameter::real("exploration", 0.5, 0, Parameter::kNoLimit, "exploration constant C of UCT"),
+                         Parameter::text("rollout", "random",
+                                         "rollout policy: 'random' or a stationary allocator (e.g. dp-rerun)"),
+                         Parameter::integer("max-tree-mib", 1024, 1, 1 << 24,
+                                            "memory cap of the search tree in MiB; a search stops there with its best "
+                                            "answer")},
+          .make = [](const Mdp& mdp, const ParameterReader& parameters) -> AllocatorFactory {
+            MctsOptions options;
+            options.exploration = parameters.real("exploration");
+            const double seconds = parameters.real("time-budget");
+            const std::uint64_t iterations = seconds > 0 && !parameters.given("iterations")
+                                                 ? std::numeric_limits<std::uint64_t>::max()
+                                                 : parameters.integer("iterations");
+            options.budget =
+                seconds > 0 ? DecisionBudget::either(iterations, seconds) : DecisionBudget::iterations(iterations);
+            options.max_tree_bytes = static_cast<std::size_t>(parameters.integer("max-tree-mib")) << 20;
+            const std::string rollout = parameters.text("rollout");
+            if (rollout != "random") {
+              if (!allocator_registry().find(rollout).capabilities.has(Capability::stationary)) {
+                throw UsageError("parameter 'rollout': the rollout policy of mcts must choose by the state alone; '" +
+                                 rollout + "' does not");
+              }
+              options.rollout = allocator_registry().make_factory(rollout, mdp, parameters.values());
+            }
+            MctsAllocator probe(mdp, options);  // checks the options once, before any episode
+            return [model = &mdp, options] { return std::make_unique<MctsAllocator>(*model, options); };
+          }};
 }
 
 }  // namespace ontime

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "../expectimax.hpp"
+#include "ontime/allocator_registry.hpp"
 
 namespace ontime {
 namespace {
@@ -111,6 +112,28 @@ int OptimalAllocator::choose(const State& state) {
   private_->solve(state);
   // No choice at all means no skeleton can succeed; any choice is as good as another.
   return private_->best_choice(state).value_or(0);
+}
+
+std::size_t max_states_of(const ParameterValues& values) {
+  const AllocatorKind& optimal = allocator_registry().find("optimal");
+  for (const Parameter& parameter : optimal.parameters) {
+    if (const std::string* value = values.find(parameter.name)) parameter.check(*value);
+  }
+  return ParameterReader(optimal, values).integer("max-states");
+}
+
+AllocatorKind optimal_kind() {
+  return {.name = "optimal",
+          .summary = "exact expectimax over the reachable MDP: the highest success probability any allocator can reach",
+          .capabilities = {Capability::stationary, Capability::optimal},
+          .parameters = {Parameter::integer("max-states", OptimalSolver::kDefaultMaxStates, 1, Parameter::kNoLimit,
+                                            "cap on the states the exact solver and the exact evaluation may hold")},
+          .make = [](const Mdp& mdp, const ParameterReader& parameters) -> AllocatorFactory {
+            auto solver = std::make_shared<OptimalSolver>(mdp, parameters.integer("max-states"));
+            solver->solve(mdp.start());
+            std::shared_ptr<const OptimalSolver> solved = std::move(solver);
+            return [model = &mdp, solved] { return std::make_unique<OptimalAllocator>(*model, solved); };
+          }};
 }
 
 }  // namespace ontime

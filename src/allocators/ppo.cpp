@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include "ontime/allocator_registry.hpp"
 #include "ontime/error.hpp"
 
 namespace ontime {
@@ -34,12 +35,7 @@ PpoAllocator::PpoAllocator(const Mdp& mdp, std::shared_ptr<const PpoPolicy> poli
 
 int PpoAllocator::choose(const State& state) {
   const ChoiceList choices = mdp_->useful_choices(state);
-  if (choices.empty()) {
-    for (int k = 0; k < mdp_->skeleton_count(); ++k) {
-      if (mdp_->next_action(state, k) >= 0) return k;
-    }
-    return 0;
-  }
+  if (choices.empty()) return mdp_->first_with_work_left(state);
   state_features(*mdp_, state, features_);
   const PolicyNetwork::Vector& logits = actor_.evaluate(features_);
   int best = choices[0];
@@ -47,6 +43,22 @@ int PpoAllocator::choose(const State& state) {
     if (logits(choice) > logits(best)) best = choice;
   }
   return best;
+}
+
+AllocatorKind ppo_kind() {
+  return {.name = "ppo",
+          .summary = "a policy learned by Proximal Policy Optimization from episodes alone, acting greedily",
+          .capabilities = {Capability::stationary, Capability::needs_policy},
+          .parameters = {Parameter::path("policy",
+                                         "trained policy file (JSON); for several instances, one per instance in order")},
+          .make = [](const Mdp& mdp, const ParameterReader& parameters) -> AllocatorFactory {
+            if (!parameters.given("policy")) {
+              throw UsageError("ppo needs a trained policy: its parameter 'policy' names the file of a policy trained for this instance");
+            }
+            auto policy = std::make_shared<const PpoPolicy>(load_ppo_policy(parameters.text("policy")));
+            PpoAllocator probe(mdp, policy);  // fails here when the policy is for another instance
+            return [model = &mdp, policy] { return std::make_unique<PpoAllocator>(*model, policy); };
+          }};
 }
 
 }  // namespace ontime

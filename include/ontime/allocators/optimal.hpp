@@ -58,6 +58,12 @@ class OptimalSolver {
   std::unique_ptr<Impl> impl_;
 };
 
+class ParameterValues;
+
+// The state cap `max-states` (the optimal kind's parameter, also the cap of exact evaluation)
+// given in `values`, or its default. Throws UsageError for a bad value.
+std::size_t max_states_of(const ParameterValues& values);
+
 // Follows the optimal policy. The solve from the start state is done once and shared by all
 // allocators a factory makes; a state outside it (a session resumed elsewhere) is solved on
 // demand by a private solver.

@@ -1,0 +1,17 @@
+#include "ontime/allocators/round_robin.hpp"
+
+#include "ontime/allocator_registry.hpp"
+
+namespace ontime {
+
+AllocatorKind round_robin_kind() {
+  return {.name = "round-robin",
+          .summary = "baseline: skeleton CT mod K at step CT, whatever its prospects",
+          .capabilities = {Capability::stationary},
+          .parameters = {},
+          .make = [](const Mdp& mdp, const ParameterReader&) -> AllocatorFactory {
+            return [count = mdp.skeleton_count()] { return std::make_unique<RoundRobinAllocator>(count); };
+          }};
+}
+
+}  // namespace ontime
