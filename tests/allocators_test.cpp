@@ -6,7 +6,9 @@
 #include "ontime/allocators/dp.hpp"
 #include "ontime/allocators/dp_rerun.hpp"
 #include "ontime/allocators/greedy.hpp"
+#include "ontime/allocators/optimal.hpp"
 #include "ontime/allocators/round_robin.hpp"
+#include "ontime/allocators/thompson.hpp"
 #include "ontime/error.hpp"
 #include "ontime/evaluation.hpp"
 #include "support/paper.hpp"
@@ -108,6 +110,60 @@ TEST(Allocators, FactoryKnowsEveryNameAndRejectsOthers) {
     EXPECT_EQ(allocator->is_stationary(), registry.find(name).capabilities.has(Capability::stationary)) << name;
   }
   EXPECT_THROW(make_allocator_factory("mcts-typo", mdp), UsageError);
+}
+
+}  // namespace
+}  // namespace ontime
+
+namespace ontime {
+namespace {
+
+// Skeleton 0 plans in 1 step or in 10 (half each), skeleton 1 in exactly 5; both execute in 0.
+Problem one_or_ten_against_five() {
+  const Action either{"either", Distribution::from_pmf({0, 0.5, 0, 0, 0, 0, 0, 0, 0, 0, 0.5}),
+                      Distribution::from_pmf({1.0})};
+  const Action five{"five", Distribution::from_pmf({0, 0, 0, 0, 0, 1.0}), Distribution::from_pmf({1.0})};
+  return Problem("one-or-ten", 20, 1.0, {either, five}, {{0}, {1}});
+}
+
+TEST(Thompson, SpendsTheStepWhereTheDrawnWorldFinishesSoonest) {
+  const Problem problem = one_or_ten_against_five();
+  const Mdp mdp(problem);
+  ThompsonAllocator thompson(mdp);
+  // At the start skeleton 0 finishes at 1 or 10, skeleton 1 at 5: skeleton 0 in half the draws.
+  int zero = 0;
+  for (std::uint64_t seed = 0; seed < 2'000; ++seed) {
+    thompson.begin_episode(seed);
+    zero += thompson.choose(mdp.start()) == 0 ? 1 : 0;
+  }
+  EXPECT_NEAR(zero / 2'000.0, 0.5, 4 * std::sqrt(0.25 / 2'000));
+  // One step on skeleton 0 found nothing: its planning time is 10, 9 more steps, conditioned on
+  // the step spent; skeleton 1 (5) is sooner in every draw.
+  State after = mdp.start();
+  ASSERT_EQ(mdp.apply(after, 0, Observation::not_yet()), Status::running);
+  for (std::uint64_t seed = 0; seed < 200; ++seed) {
+    thompson.begin_episode(seed);
+    EXPECT_EQ(thompson.choose(after), 1) << seed;
+  }
+}
+
+TEST(Thompson, SameSeedSameSuccessesForAnyThreadCountAndNeverAboveTheOptimum) {
+  for (int i = 1; i <= 5; ++i) {
+    const Problem problem = testing::paper_instance("instance" + std::to_string(i));
+    const Mdp mdp(problem);
+    const AllocatorFactory factory = make_allocator_factory("thompson", mdp);
+    MonteCarloOptions options;
+    options.episodes = 4'000;
+    options.seed = 7;
+    options.threads = 1;
+    const MonteCarloResult one = run_monte_carlo(mdp, factory, options);
+    options.threads = 2;
+    const MonteCarloResult two = run_monte_carlo(mdp, factory, options);
+    EXPECT_EQ(one.successes, two.successes) << i;
+    const double optimum = OptimalSolver(mdp).solve(mdp.start());
+    EXPECT_LE(one.success_rate, optimum + 4 * std::sqrt(optimum * (1 - optimum) / 4'000) + 1e-12) << i;
+    EXPECT_FALSE(factory()->is_stationary());
+  }
 }
 
 }  // namespace

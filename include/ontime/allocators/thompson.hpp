@@ -1,0 +1,53 @@
+#pragma once
+// `thompson`: Thompson-sampling-style allocation.
+//
+// Before every step, draws one possible world from the model: for every action still ahead
+// of a skeleton that can still succeed, a planning time (the current action's conditioned on
+// the PT_k steps already spent on it: T - PT_k given T > PT_k) and an execution time; an
+// action shared by several skeletons is drawn once. In that world skeleton k would finish at
+// CT + ET_k + the drawn planning and execution times of its remaining actions; the step goes
+// to the skeleton that would finish soonest (ties: lowest index; a draw of "never" is later
+// than any finite time). If no skeleton can still succeed, the lowest-index skeleton with
+// work left (any choice is as good).
+//
+// It is randomised (one draw per decision from the episode's seed), so its success is
+// sampled, not computed exactly. It spends effort where a plausible world says the deadline
+// is met soonest, which explores a skeleton in proportion to the chance that it is the
+// fastest, instead of committing to one estimate (dp-rerun) or searching (mcts).
+// No optimality guarantee.
+// Cost per decision: one inverse-CDF draw (a binary search over D + 1 steps) per remaining
+// action of the live skeletons, O(sum of remaining actions * log D); no allocation (the
+// per-action draws live in arrays sized once).
+
+#include <cstdint>
+#include <vector>
+
+#include "ontime/allocator.hpp"
+#include "ontime/mdp.hpp"
+#include "ontime/random.hpp"
+
+namespace ontime {
+
+class ThompsonAllocator final : public Allocator {
+ public:
+  // The Mdp must outlive the allocator.
+  explicit ThompsonAllocator(const Mdp& mdp);
+
+  std::string_view name() const noexcept override { return "thompson"; }
+  void begin_episode(std::uint64_t seed) override { generator_ = SplitMix64(seed); }
+  int choose(const State& state) override;
+  bool is_stationary() const noexcept override { return false; }
+
+ private:
+  // Planning plus execution steps of `action` in this decision's draw (kNever: never), the
+  // planning time conditioned on `spent` steps already spent on it.
+  std::int64_t drawn_time(int action, Steps spent);
+
+  const Mdp* mdp_;
+  SplitMix64 generator_{0};
+  std::uint64_t decision_ = 0;             // numbers the draws: an action is drawn once per decision
+  std::vector<std::uint64_t> drawn_at_;    // per action: the decision of its last draw
+  std::vector<std::int64_t> drawn_time_;   // per action: its draw in that decision
+};
+
+}  // namespace ontime

@@ -1,0 +1,68 @@
+#include "ontime/allocators/thompson.hpp"
+
+#include <limits>
+
+#include "ontime/allocator_registry.hpp"
+
+namespace ontime {
+namespace {
+
+constexpr std::int64_t kNeverFinishes = std::numeric_limits<std::int64_t>::max();
+
+}  // namespace
+
+ThompsonAllocator::ThompsonAllocator(const Mdp& mdp)
+    : mdp_(&mdp),
+      drawn_at_(static_cast<std::size_t>(mdp.problem().action_count()), 0),
+      drawn_time_(static_cast<std::size_t>(mdp.problem().action_count()), 0) {}
+
+std::int64_t ThompsonAllocator::drawn_time(int action, Steps spent) {
+  const auto slot = static_cast<std::size_t>(action);
+  if (drawn_at_[slot] == decision_) return drawn_time_[slot];
+  const Action& model = mdp_->problem().action(action);
+  // T - spent given T > spent, by inverting the CDF above F(spent).
+  const double below = model.planning.cdf(spent);
+  const Steps planning = model.planning.quantile(below + uniform01(generator_) * (1.0 - below));
+  const Steps execution = model.execution.sample(generator_);
+  drawn_at_[slot] = decision_;
+  drawn_time_[slot] = planning == kNever || execution == kNever
+                          ? kNeverFinishes
+                          : std::int64_t{planning} - spent + std::int64_t{execution};
+  return drawn_time_[slot];
+}
+
+int ThompsonAllocator::choose(const State& state) {
+  ++decision_;
+  const Problem& problem = mdp_->problem();
+  int best = -1;
+  std::int64_t best_finish = kNeverFinishes;
+  for (int k = 0; k < mdp_->skeleton_count(); ++k) {
+    if (!mdp_->can_succeed(state, k)) continue;
+    const auto slot = static_cast<std::size_t>(k);
+    std::int64_t finish = std::int64_t{state.time} + state.execution[slot];
+    const std::span<const int> actions = problem.skeleton(k);
+    for (std::size_t position = state.refined[slot]; position < actions.size() && finish != kNeverFinishes;
+         ++position) {
+      const Steps spent = position == state.refined[slot] ? static_cast<Steps>(state.spent[slot]) : 0;
+      const std::int64_t time = drawn_time(actions[position], spent);
+      finish = time == kNeverFinishes ? kNeverFinishes : finish + time;
+    }
+    if (best < 0 || finish < best_finish) {
+      best = k;
+      best_finish = finish;
+    }
+  }
+  return best >= 0 ? best : mdp_->first_with_work_left(state);
+}
+
+AllocatorKind thompson_kind() {
+  return {.name = "thompson",
+          .summary = "Thompson-style: one world drawn from the model per step, the skeleton finishing soonest in it",
+          .capabilities = {Capability::randomised},
+          .parameters = {},
+          .make = [](const Mdp& mdp, const ParameterReader&) -> AllocatorFactory {
+            return [model = &mdp] { return std::make_unique<ThompsonAllocator>(*model); };
+          }};
+}
+
+}  // namespace ontime
