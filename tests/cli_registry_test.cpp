@@ -11,6 +11,7 @@
 #include "ontime/allocators/round_robin.hpp"
 #include "ontime/error.hpp"
 #include "support/paper.hpp"
+#include "support/process.hpp"
 
 namespace ontime {
 namespace {
@@ -66,6 +67,23 @@ TEST(CliRegistry, ATestKindsParameterAppearsInHelpAndIsPassedThrough) {
     FAIL() << "expected UsageError";
   } catch (const UsageError& error) {
     EXPECT_STREQ(error.what(), "--test-knob-level: must be a finite number in [0, 1] (got '2')");
+  }
+}
+
+TEST(CliRegistry, EveryCommandAndStudyHasHelp) {
+  const auto app = cli::make_app();
+  std::vector<std::vector<std::string>> commands;
+  for (const CLI::App* command : app->get_subcommands({})) {
+    commands.push_back({command->get_name()});
+    for (const CLI::App* sub : command->get_subcommands({})) commands.push_back({command->get_name(), sub->get_name()});
+  }
+  EXPECT_GE(commands.size(), 16U);  // 13 commands and 3 studies
+  for (std::vector<std::string> arguments : commands) {
+    arguments.insert(arguments.begin(), ONTIME_CLI);
+    arguments.emplace_back("--help");
+    const auto result = testing::run_process(arguments);
+    EXPECT_EQ(result.exit_code, 0) << arguments[1];
+    EXPECT_NE(result.out.find("--help"), std::string::npos) << arguments[1];
   }
 }
 

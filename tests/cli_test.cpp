@@ -415,7 +415,7 @@ TEST(Cli, MapDrawsTheWorldAndOneMotionPerSkeleton) {
 }
 
 TEST(Cli, HelpIsAvailableForEveryCommand) {
-  for (const char* command : {"collect", "map"}) {
+  for (const char* command : {"collect", "map", "run"}) {
     const auto result = ontime({command, "--help"});
     EXPECT_EQ(result.exit_code, 0) << command;
     EXPECT_NE(result.out.find("--domain"), std::string::npos) << command;
@@ -425,7 +425,7 @@ TEST(Cli, HelpIsAvailableForEveryCommand) {
     EXPECT_EQ(result.exit_code, 0) << command;
     EXPECT_NE(result.out.find("--output"), std::string::npos) << command;
   }
-  for (const char* command : {"solve", "evaluate", "table", "train", "reduce-knapsack"}) {
+  for (const char* command : {"solve", "evaluate", "table", "train", "reduce-knapsack", "study", "allocators"}) {
     const auto result = ontime({command, "--help"});
     EXPECT_EQ(result.exit_code, 0) << command;
     EXPECT_NE(result.out.find("--help"), std::string::npos) << command;

@@ -7,9 +7,6 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
-#include <cstring>
-#include <functional>
-#include <string_view>
 
 #include "ontime/problem.hpp"
 
@@ -26,14 +23,7 @@ struct State {
   friend bool operator==(const State&, const State&) = default;
 };
 
-static_assert(sizeof(State) == 2 + 16 + 32 + 32, "State must have no padding: it is hashed as bytes");
-
-struct StateHash {
-  std::size_t operator()(const State& state) const noexcept {
-    return std::hash<std::string_view>{}(
-        std::string_view(reinterpret_cast<const char*>(&state), sizeof(State)));
-  }
-};
+static_assert(sizeof(State) == 2 + 16 + 32 + 32, "State must have no padding: it is packed and compared as bytes");
 
 enum class Status : std::uint8_t { running, success, failure };
 

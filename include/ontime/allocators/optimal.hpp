@@ -76,7 +76,6 @@ class OptimalAllocator final : public Allocator {
   std::string_view name() const noexcept override { return "optimal"; }
   int choose(const State& state) override;
 
-  const OptimalSolver& solver() const noexcept { return *solved_; }
 
  private:
   const Mdp* mdp_;
