@@ -2,12 +2,13 @@
 
 #include <cmath>
 
+#include "neural_network.hpp"  // private to the library (src/), as is ppo_networks.hpp
 #include "ontime/allocators.hpp"
 #include "ontime/allocators/ppo.hpp"
 #include "ontime/error.hpp"
 #include "ontime/evaluation.hpp"
-#include "ontime/neural_network.hpp"
 #include "ontime/ppo_training.hpp"
+#include "ppo_networks.hpp"
 #include "support/paper.hpp"
 
 namespace ontime {

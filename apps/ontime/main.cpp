@@ -1,12 +1,14 @@
 // The `ontime` command-line tool: parses arguments, calls the library, prints.
 // Exit codes: 0 success, 2 bad input or usage (message names the file, the place, the rule),
-// 1 internal error.
+// 1 internal error. The domain commands (collect, map, run) exist only in the domains build
+// (ONTIME_BUILD_DOMAINS, which needs OMPL, FCL and KDL); without it they are listed and refused.
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
 #include <fmt/core.h>
 #include <new>
+#include <string>
 
 #include "common.hpp"
 #include "ontime/error.hpp"
@@ -20,6 +22,20 @@ int report(const char* kind, const char* message, int code) {
   fmt::print(stderr, "ontime: {}: {}\n", kind, message);
   return code;
 }
+
+#if !ONTIME_WITH_DOMAINS
+// A domain command in a build without the domains: listed in --help, refused with exit 2.
+void add_unavailable_domain_command(CLI::App& app, const std::string& name) {
+  CLI::App* command =
+      app.add_subcommand(name, "(needs the domains build: this ontime was built with ONTIME_BUILD_DOMAINS=OFF)");
+  command->allow_extras();
+  command->callback([name] {
+    throw ontime::UsageError("'" + name +
+                             "' needs the domains build (OMPL, FCL, KDL): this ontime was built with "
+                             "ONTIME_BUILD_DOMAINS=OFF");
+  });
+}
+#endif
 
 }  // namespace
 
@@ -38,9 +54,13 @@ int main(int argc, char** argv) {
   ontime::cli::add_fit_command(app);
   ontime::cli::add_sample_log_command(app);
   ontime::cli::add_plot_command(app);
+#if ONTIME_WITH_DOMAINS
   ontime::cli::add_collect_command(app);
   ontime::cli::add_map_command(app);
   ontime::cli::add_run_command(app);
+#else
+  for (const char* name : {"collect", "map", "run"}) add_unavailable_domain_command(app, name);
+#endif
 
   try {
     app.parse(argc, argv);
