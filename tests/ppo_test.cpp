@@ -164,6 +164,11 @@ TEST(Ppo, PolicyFilesRoundTripAndAreValidated) {
   EXPECT_THROW(make_allocator_factory("ppo", other_mdp, options), UsageError);
   EXPECT_THROW(make_allocator_factory("ppo", mdp), UsageError);  // no policy at all
   EXPECT_NO_THROW(make_allocator_factory("ppo", mdp, options));
+  // A policy handle without trained networks is refused, not dereferenced.
+  PpoPolicy empty = copy;
+  empty.networks.reset();
+  EXPECT_THROW(PpoAllocator(mdp, std::make_shared<const PpoPolicy>(empty)), UsageError);
+  EXPECT_THROW(ppo_policy_to_json(empty), UsageError);
 }
 
 }  // namespace

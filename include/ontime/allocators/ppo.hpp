@@ -54,7 +54,7 @@ struct PpoPolicy {
 };
 
 // Policy files (JSON). Saving is atomic; loading validates every field and raises InputError
-// naming the file, the JSON path and the rule.
+// naming the file, the JSON path and the rule. Writing a policy without networks is a UsageError.
 void save_ppo_policy(const PpoPolicy& policy, const std::filesystem::path& path);
 std::string ppo_policy_to_json(const PpoPolicy& policy);
 PpoPolicy load_ppo_policy(const std::filesystem::path& path);
