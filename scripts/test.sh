@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Sets up the machine, builds OnTime with warnings as errors and runs every test; then builds
+# Sets up the machine, builds OnTime with warnings as errors and runs every test; then the core
+# alone without OMPL, FCL and KDL (build-core/: build, tests, install, consumer); then builds
 # the suite again with AddressSanitizer and UndefinedBehaviorSanitizer (build-sanitize/) and
 # runs it there too (warnings are checked by the first build; GCC warns falsely inside the
 # standard library when it is instrumented).
@@ -8,6 +9,18 @@ cd "$(dirname "$0")/.."
 ./scripts/setup.sh
 ./scripts/build.sh -DONTIME_WARNINGS_AS_ERRORS=ON
 ctest --test-dir build --parallel "$(nproc)" --output-on-failure
+
+# The core without the domains: configured with OMPL, FCL and KDL hidden from find_package, it
+# builds, passes its tests, installs, and an outside project builds against the install (the
+# install_and_consume test, core component only, with Eigen hidden from the consumer).
+generator=()
+if command -v ninja >/dev/null 2>&1 && [ ! -f build-core/CMakeCache.txt ]; then generator=(-G Ninja); fi
+# (--no-warn-unused-cli: that nothing reads the CMAKE_DISABLE_FIND_PACKAGE_ variables is the point.)
+cmake -S . -B build-core "${generator[@]}" --no-warn-unused-cli -DCMAKE_BUILD_TYPE=Release -DONTIME_WARNINGS_AS_ERRORS=ON \
+  -DONTIME_BUILD_DOMAINS=OFF -DONTIME_BUILD_BENCHMARKS=OFF \
+  -DCMAKE_DISABLE_FIND_PACKAGE_ompl=ON -DCMAKE_DISABLE_FIND_PACKAGE_fcl=ON -DCMAKE_DISABLE_FIND_PACKAGE_orocos_kdl=ON
+cmake --build build-core --parallel "$(nproc)"
+ctest --test-dir build-core --parallel "$(nproc)" --output-on-failure
 
 generator=()
 if command -v ninja >/dev/null 2>&1 && [ ! -f build-sanitize/CMakeCache.txt ]; then generator=(-G Ninja); fi

@@ -184,10 +184,10 @@ class Expectimax {
     }
     if (memo_.size() >= max_states_) {
       throw ResourceLimitError(what_ + ": reached the cap of " + std::to_string(max_states_) +
-                               " states before finishing (about " + std::to_string(memo_bytes() >> 20) +
-                               " MiB held, " + std::to_string((memo_bytes() + memo_bytes() / 2) >> 20) +
-                               " MiB while the table last doubled); raise the cap (--max-states) or use an "
-                               "approximate allocator");
+                               " states (the max-states parameter) before finishing (about " +
+                               std::to_string(memo_bytes() >> 20) + " MiB held, " +
+                               std::to_string((memo_bytes() + memo_bytes() / 2) >> 20) +
+                               " MiB while the table last doubled); raise the cap or use an approximate allocator");
     }
     memo_.emplace(frame.key, best);
     items_.resize(frame.begin);

@@ -3,11 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
 
-#include "json_path.hpp"
 #include "ontime/error.hpp"
+#include "ontime/json_input.hpp"
 
 namespace ontime {
 namespace {

@@ -12,10 +12,10 @@
 #include <utility>
 #include <vector>
 
-#include "json_path.hpp"
-#include "skeleton_list.hpp"
 #include "ontime/atomic_file.hpp"
 #include "ontime/error.hpp"
+#include "ontime/json_input.hpp"
+#include "skeleton_list.hpp"
 
 namespace ontime {
 namespace {

@@ -5,8 +5,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "json_path.hpp"
 #include "ontime/error.hpp"
+#include "ontime/json_input.hpp"
 
 namespace ontime {
 namespace {

@@ -1,4 +1,4 @@
-#include "ontime/neural_network.hpp"
+#include "neural_network.hpp"
 
 #include <cmath>
 #include <stdexcept>

@@ -1,11 +1,12 @@
 #include "ontime/planner_log.hpp"
 
 #include <cmath>
+#include <nlohmann/json.hpp>
 #include <regex>
 
-#include "json_path.hpp"
 #include "ontime/atomic_file.hpp"
 #include "ontime/error.hpp"
+#include "ontime/json_input.hpp"
 
 namespace ontime {
 namespace {

@@ -2,10 +2,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "json_path.hpp"
 #include "ontime/allocators/ppo.hpp"
 #include "ontime/atomic_file.hpp"
 #include "ontime/error.hpp"
+#include "ontime/json_input.hpp"
+#include "ppo_networks.hpp"
 
 namespace ontime {
 namespace {
@@ -68,8 +69,8 @@ class PolicyReader {
     h.target_kl = number_at(hyper, "target_kl", "hyperparameters");
 
     const int inputs = feature_count(policy.skeleton_count);
-    policy.actor = network_at(root, "actor", inputs, policy.skeleton_count);
-    policy.critic = network_at(root, "critic", inputs, 1);
+    policy.networks = std::make_shared<const PpoNetworks>(
+        PpoNetworks{network_at(root, "actor", inputs, policy.skeleton_count), network_at(root, "critic", inputs, 1)});
     return policy;
   }
 
@@ -191,8 +192,9 @@ std::string ppo_policy_to_json(const PpoPolicy& policy) {
                              {"steps_per_epoch", h.steps_per_epoch},
                              {"max_episode_steps", h.max_episode_steps},
                              {"target_kl", h.target_kl}};
-  root["actor"] = network_to_json(policy.actor);
-  root["critic"] = network_to_json(policy.critic);
+  if (!policy.networks) throw UsageError("a ppo policy without trained networks cannot be written");
+  root["actor"] = network_to_json(policy.networks->actor);
+  root["critic"] = network_to_json(policy.networks->critic);
   return root.dump(1) + "\n";
 }
 

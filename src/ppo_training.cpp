@@ -8,6 +8,7 @@
 #include "ontime/error.hpp"
 #include "ontime/random.hpp"
 #include "ontime/simulator.hpp"
+#include "ppo_networks.hpp"
 
 namespace ontime {
 namespace {
@@ -135,10 +136,9 @@ PpoTraining train_ppo(const Mdp& mdp, std::uint64_t episodes, std::uint64_t seed
   actor_sizes.push_back(count);
   critic_sizes.push_back(1);
   SplitMix64 initialisation(stream_seed(seed, 0));
-  policy.actor = PolicyNetwork(actor_sizes, initialisation);
-  policy.critic = PolicyNetwork(critic_sizes, initialisation);
-  Adam<float> actor_optimiser(policy.actor, h.actor_learning_rate);
-  Adam<float> critic_optimiser(policy.critic, h.critic_learning_rate);
+  PpoNetworks networks{PolicyNetwork(actor_sizes, initialisation), PolicyNetwork(critic_sizes, initialisation)};
+  Adam<float> actor_optimiser(networks.actor, h.actor_learning_rate);
+  Adam<float> critic_optimiser(networks.critic, h.critic_learning_rate);
   SplitMix64 sampling(stream_seed(seed, 1));
   const std::uint64_t world_seed = stream_seed(seed, 2);
 
@@ -162,9 +162,9 @@ PpoTraining train_ppo(const Mdp& mdp, std::uint64_t episodes, std::uint64_t seed
         const ChoiceList choices = mdp.useful_choices(state);
         std::uint8_t valid[Problem::kMaxSkeletons] = {};
         for (const int choice : choices) valid[choice] = 1;
-        const Vector& logits = policy.actor.evaluate(features);
+        const Vector& logits = networks.actor.evaluate(features);
         masked_log_softmax(logits, valid, count, log_probabilities.data());
-        const double value = policy.critic.evaluate(features)(0);
+        const double value = networks.critic.evaluate(features)(0);
         const auto probability = [&](std::size_t i) {
           return std::exp(log_probabilities[static_cast<std::size_t>(choices[i])]);
         };
@@ -186,7 +186,7 @@ PpoTraining train_ppo(const Mdp& mdp, std::uint64_t episodes, std::uint64_t seed
       double next_value = 0;
       if (status == Status::running) {
         state_features(mdp, state, features);
-        next_value = policy.critic.evaluate(features)(0);
+        next_value = networks.critic.evaluate(features)(0);
       }
       const std::size_t last = batch.steps();
       batch.advantages.resize(last);
@@ -217,24 +217,24 @@ PpoTraining train_ppo(const Mdp& mdp, std::uint64_t episodes, std::uint64_t seed
     inputs_matrix = Eigen::Map<const Matrix>(batch.features.data(), inputs, static_cast<Eigen::Index>(steps));
     int actor_steps = 0;
     for (int iteration = 0; iteration < h.train_iterations; ++iteration) {
-      const Matrix& logits = policy.actor.forward(inputs_matrix);
+      const Matrix& logits = networks.actor.forward(inputs_matrix);
       double kl = 0;
       clipped_surrogate_loss<float>(logits, batch.valid, batch.actions, batch.log_probabilities, batch.advantages, h.clip,
                                     logits_gradient, kl);
       if (kl > 1.5 * h.target_kl) break;
-      policy.actor.backward(logits_gradient);
-      actor_optimiser.step(policy.actor);
+      networks.actor.backward(logits_gradient);
+      actor_optimiser.step(networks.actor);
       ++actor_steps;
     }
     for (int iteration = 0; iteration < h.train_iterations; ++iteration) {
-      const Matrix& values = policy.critic.forward(inputs_matrix);
+      const Matrix& values = networks.critic.forward(inputs_matrix);
       value_gradient.resize(1, static_cast<Eigen::Index>(steps));
       for (std::size_t n = 0; n < steps; ++n) {
         value_gradient(0, static_cast<Eigen::Index>(n)) = static_cast<float>(
             2.0 * (values(0, static_cast<Eigen::Index>(n)) - batch.returns[n]) / static_cast<double>(steps));
       }
-      policy.critic.backward(value_gradient);
-      critic_optimiser.step(policy.critic);
+      networks.critic.backward(value_gradient);
+      critic_optimiser.step(networks.critic);
     }
 
     LearningCurvePoint point;
@@ -248,6 +248,7 @@ PpoTraining train_ppo(const Mdp& mdp, std::uint64_t episodes, std::uint64_t seed
     training.curve.push_back(point);
     if (progress) progress(episodes_done, episodes);
   }
+  policy.networks = std::make_shared<const PpoNetworks>(std::move(networks));
   return training;
 }
 

@@ -1,10 +1,11 @@
 #include "ontime/skeleton_file.hpp"
 
 #include <map>
+#include <nlohmann/json.hpp>
 #include <optional>
 
-#include "json_path.hpp"
 #include "ontime/error.hpp"
+#include "ontime/json_input.hpp"
 #include "skeleton_list.hpp"
 
 namespace ontime {

@@ -1,10 +1,11 @@
 #include "skeleton_list.hpp"
 
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 
-#include "json_path.hpp"
 #include "ontime/error.hpp"
+#include "ontime/json_input.hpp"
 #include "ontime/problem.hpp"
 
 namespace ontime::detail {

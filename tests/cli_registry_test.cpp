@@ -49,7 +49,7 @@ TEST(CliRegistry, ATestKindsParameterAppearsInHelpAndIsPassedThrough) {
   EXPECT_EQ(help_of("evaluate").find("--test-knob-level"), std::string::npos);
   double seen = -1;
   const TestKind added(knob_kind(&seen));
-  for (const std::string command : {"evaluate", "table", "run"}) {
+  for (const std::string command : {"evaluate", "table"}) {
     const std::string help = help_of(command);
     EXPECT_NE(help.find("--test-knob-level"), std::string::npos) << command << help;
     EXPECT_NE(help.find("test-knob: how far the test knob is turned (default 0.25)"), std::string::npos) << help;

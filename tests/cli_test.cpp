@@ -414,6 +414,38 @@ TEST(Cli, MapDrawsTheWorldAndOneMotionPerSkeleton) {
   EXPECT_GT(drawing["polygons"].size(), 13u);
 }
 
+// Without output options, collect writes into the current directory's data/, and run takes its
+// model from there once it exists, else the instance that comes with ontime.
+TEST(Cli, CollectWritesWhereRunLooksForItsModel) {
+  const std::filesystem::path dir = scratch("defaults");
+  const std::string world = (dir / "mini.json").string();
+  std::ofstream(world) << testing::kMiniWorld;
+  const auto in_dir = [&](std::vector<std::string> arguments) {
+    arguments.insert(arguments.begin(), {"/usr/bin/env", "-C", dir.string(), ONTIME_CLI});
+    return testing::run_process(arguments);
+  };
+  const std::vector<std::string> run{"run",        "--domain", "navigation", "--solver", "dp",
+                                     "--episodes", "1",        "--threads",  "1",        "--json"};
+  const auto before = in_dir(run);
+  ASSERT_EQ(before.exit_code, 0) << before.err;
+  EXPECT_EQ(std::filesystem::path(json::parse(before.out)["instance"].get<std::string>()),
+            testing::source_path("data/instances/navigation.json"));
+
+  const auto collected = in_dir({"collect", "--domain", "navigation", "--world", world, "--trials", "2", "--json"});
+  ASSERT_EQ(collected.exit_code, 0) << collected.err;
+  const json out = json::parse(collected.out);
+  EXPECT_EQ(out["log"], "data/logs/navigation.jsonl");
+  EXPECT_EQ(out["instance"], "data/instances/navigation.json");
+  EXPECT_EQ(line_count(dir / "data" / "logs" / "navigation.jsonl"), out["attempts"].get<std::size_t>());
+  EXPECT_TRUE(std::filesystem::is_regular_file(dir / "data" / "instances" / "navigation.json"));
+
+  std::vector<std::string> on_collected = run;
+  on_collected.insert(on_collected.end(), {"--world", world});
+  const auto after = in_dir(on_collected);
+  ASSERT_EQ(after.exit_code, 0) << after.err;
+  EXPECT_EQ(json::parse(after.out)["instance"], "data/instances/navigation.json");
+}
+
 TEST(Cli, HelpIsAvailableForEveryCommand) {
   for (const char* command : {"collect", "map", "run"}) {
     const auto result = ontime({command, "--help"});

@@ -111,6 +111,9 @@ TEST(Optimal, StopsAtTheStateCapWithAClearError) {
     FAIL() << "expected ResourceLimitError";
   } catch (const ResourceLimitError& error) {
     EXPECT_NE(std::string(error.what()).find("cap of 50 states"), std::string::npos) << error.what();
+    // The library names its parameter, not a command-line flag.
+    EXPECT_NE(std::string(error.what()).find("(the max-states parameter)"), std::string::npos) << error.what();
+    EXPECT_EQ(std::string(error.what()).find("--"), std::string::npos) << error.what();
   }
   EXPECT_LE(solver.states(), 50U);
   EXPECT_THROW(make_allocator_factory("optimal", mdp, {{"max-states", "50"}}), ResourceLimitError);

@@ -3,12 +3,13 @@
 #include <cmath>
 #include <filesystem>
 
+#include "neural_network.hpp"  // private to the library (src/), as is ppo_networks.hpp
 #include "ontime/allocator_registry.hpp"
 #include "ontime/allocators/ppo.hpp"
 #include "ontime/error.hpp"
 #include "ontime/evaluation.hpp"
-#include "ontime/neural_network.hpp"
 #include "ontime/ppo_training.hpp"
+#include "ppo_networks.hpp"
 #include "support/paper.hpp"
 
 namespace ontime {
@@ -166,6 +167,11 @@ TEST(Ppo, PolicyFilesRoundTripAndAreValidated) {
   EXPECT_THROW(make_allocator_factory("ppo", mdp), UsageError);  // no policy at all
   EXPECT_NO_THROW(make_allocator_factory("ppo", mdp, options));
   std::filesystem::remove(file);
+  // A policy handle without trained networks is refused, not dereferenced.
+  PpoPolicy empty = copy;
+  empty.networks.reset();
+  EXPECT_THROW(PpoAllocator(mdp, std::make_shared<const PpoPolicy>(empty)), UsageError);
+  EXPECT_THROW(ppo_policy_to_json(empty), UsageError);
 }
 
 }  // namespace

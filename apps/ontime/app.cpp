@@ -1,8 +1,30 @@
-// The whole `ontime` command line: every command registered on one CLI::App.
+// The whole `ontime` command line: every command registered on one CLI::App. The domain
+// commands (collect, map, run) exist only in the domains build (ONTIME_BUILD_DOMAINS, which
+// needs OMPL, FCL and KDL); without it they are listed and refused.
+
+#include <string>
 
 #include "common.hpp"
+#include "ontime/error.hpp"
 
 namespace ontime::cli {
+namespace {
+
+#if !ONTIME_WITH_DOMAINS
+// A domain command in a build without the domains: listed in --help, refused with exit 2.
+void add_unavailable_domain_command(CLI::App& app, const std::string& name) {
+  CLI::App* command =
+      app.add_subcommand(name, "(needs the domains build: this ontime was built with ONTIME_BUILD_DOMAINS=OFF)");
+  command->allow_extras();
+  command->callback([name] {
+    throw UsageError("'" + name +
+                     "' needs the domains build (OMPL, FCL, KDL): this ontime was built with "
+                     "ONTIME_BUILD_DOMAINS=OFF");
+  });
+}
+#endif
+
+}  // namespace
 
 std::unique_ptr<CLI::App> make_app() {
   auto app = std::make_unique<CLI::App>(
@@ -20,9 +42,13 @@ std::unique_ptr<CLI::App> make_app() {
   add_fit_command(*app);
   add_sample_log_command(*app);
   add_plot_command(*app);
+#if ONTIME_WITH_DOMAINS
   add_collect_command(*app);
   add_map_command(*app);
   add_run_command(*app);
+#else
+  for (const char* name : {"collect", "map", "run"}) add_unavailable_domain_command(*app, name);
+#endif
   add_allocators_command(*app);
   return app;
 }

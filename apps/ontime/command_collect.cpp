@@ -85,8 +85,11 @@ void add_collect_command(CLI::App& app) {
                       "Nominal collision checks per second of the checks unit (default: the world file's)")
       ->check(CLI::PositiveNumber);
   command->add_option("--laplace", options->laplace, "Laplace smoothing of the fit")->check(CLI::NonNegativeNumber)->capture_default_str();
-  command->add_option("--log", options->log, "Planner log to write (default: data/logs/DOMAIN.jsonl)");
-  command->add_option("-o,--instance", options->instance, "Instance to write (default: data/instances/DOMAIN.json)");
+  command->add_option("--log", options->log,
+                      "Planner log to write (default: data/logs/DOMAIN.jsonl in the current directory)");
+  command->add_option(
+      "-o,--instance", options->instance,
+      "Instance to write (default: data/instances/DOMAIN.json in the current directory, where run looks first)");
   command->add_option("--checkpoint", options->checkpoint,
                       "Journal of finished trials, kept until the outputs are written (default: LOG.checkpoint)");
   command->add_flag("--resume", options->resume,
@@ -96,8 +99,10 @@ void add_collect_command(CLI::App& app) {
     const std::filesystem::path world = options->world.empty() ? default_world_file(options->domain) : std::filesystem::path(options->world);
     const domains::LoadedDomain loaded = domains::load_domain(options->domain, world);
     const domains::CollectionDefaults& defaults = loaded.defaults.collection;
-    const std::filesystem::path log_path = options->log.empty() ? std::filesystem::path("data/logs") / (options->domain + ".jsonl") : std::filesystem::path(options->log);
-    const std::filesystem::path instance_path = options->instance.empty() ? std::filesystem::path("data/instances") / (options->domain + ".json") : std::filesystem::path(options->instance);
+    const std::filesystem::path log_path =
+        options->log.empty() ? collected_log_file(options->domain) : std::filesystem::path(options->log);
+    const std::filesystem::path instance_path =
+        options->instance.empty() ? collected_instance_file(options->domain) : std::filesystem::path(options->instance);
 
     domains::CollectionOptions collection;
     collection.trials = options->trials;
@@ -113,6 +118,11 @@ void add_collect_command(CLI::App& app) {
     const std::filesystem::path checkpoint_path =
         options->checkpoint.empty() ? std::filesystem::path(log_path.string() + ".checkpoint") : std::filesystem::path(options->checkpoint);
     prepare_output(checkpoint_path);
+    // The journal refuses this too; the command's refusal names the option that resumes.
+    if (!options->resume && std::filesystem::exists(checkpoint_path)) {
+      throw UsageError(checkpoint_path.string() +
+                       ": the checkpoint of an unfinished collection is there; resume it (--resume) or delete it");
+    }
     domains::CollectionJournal journal(checkpoint_path, *loaded.domain, collection, file_text(world), options->resume);
     collection.journal = &journal;
     const std::size_t resumed = journal.finished().size();

@@ -34,7 +34,9 @@ void add_run_command(CLI::App& app) {
   CLI::App* command = app.add_subcommand("run", "Episodes in which an allocator drives a domain's real motion planner");
   command->add_option("--domain", options->domain, "Domain")->required();
   add_solver_option(*command, options->solver);
-  command->add_option("--instance", options->instance, "The allocator's model (default: data/instances/DOMAIN.json)");
+  command->add_option("--instance", options->instance,
+                      "The allocator's model (default: data/instances/DOMAIN.json in the current directory, as collect "
+                      "writes it, else the one installed with ontime)");
   command->add_option("--world", options->world, "World file (default: data/domains/DOMAIN.json)");
   command->add_option("--episodes", options->episodes, "Episodes")->check(CLI::PositiveNumber)->capture_default_str();
   command->add_option("--seed", options->seed, "Seed (episode e uses stream e)")->capture_default_str();
@@ -55,9 +57,8 @@ void add_run_command(CLI::App& app) {
     check_solver_names({options->solver});
     const std::filesystem::path world =
         options->world.empty() ? default_world_file(options->domain) : std::filesystem::path(options->world);
-    const std::filesystem::path instance = options->instance.empty()
-                                               ? data_directory() / "instances" / (options->domain + ".json")
-                                               : std::filesystem::path(options->instance);
+    const std::filesystem::path instance =
+        options->instance.empty() ? default_model_file(options->domain) : std::filesystem::path(options->instance);
     const domains::LoadedDomain loaded = domains::load_domain(options->domain, world);
     const Problem problem = load_problem(instance);
     const Mdp mdp(problem);

@@ -15,4 +15,19 @@ std::filesystem::path default_world_file(const std::string& domain) {
   return data_directory() / "domains" / (domain + ".json");
 }
 
+std::filesystem::path collected_log_file(const std::string& domain) {
+  return std::filesystem::path("data") / "logs" / (domain + ".jsonl");
+}
+
+std::filesystem::path collected_instance_file(const std::string& domain) {
+  return std::filesystem::path("data") / "instances" / (domain + ".json");
+}
+
+std::filesystem::path default_model_file(const std::string& domain) {
+  const std::filesystem::path collected = collected_instance_file(domain);
+  std::error_code error;
+  if (std::filesystem::is_regular_file(collected, error)) return collected;
+  return data_directory() / "instances" / (domain + ".json");
+}
+
 }  // namespace ontime::cli

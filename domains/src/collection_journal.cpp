@@ -5,12 +5,13 @@
 
 #include <cerrno>
 #include <cstring>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <stdexcept>
 
-#include "json_path.hpp"
 #include "ontime/domains/collection.hpp"
 #include "ontime/error.hpp"
+#include "ontime/json_input.hpp"
 
 namespace ontime::domains {
 namespace {
@@ -68,7 +69,8 @@ CollectionJournal::CollectionJournal(std::filesystem::path path, const Domain& d
   const bool exists = std::filesystem::exists(path_, error);
   std::size_t keep = 0;  // bytes of the existing file to keep (whole lines)
   if (exists && !resume) {
-    throw UsageError(source + ": the checkpoint of an unfinished collection is there; resume it (--resume) or delete it");
+    throw UsageError(source +
+                     ": the checkpoint of an unfinished collection is there; resume the collection or delete it");
   }
   if (exists) {
     const std::string text = ontime::detail::read_text_file(path_);

@@ -2,13 +2,17 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <string>
+
+#include "ontime/error.hpp"
 
 namespace ontime::domains {
 
 EffortUnit parse_effort_unit(std::string_view name) {
   if (name == "checks") return EffortUnit::collision_checks;
   if (name == "wall") return EffortUnit::wall_clock;
-  throw std::invalid_argument("unknown effort unit '" + std::string(name) + "' (known: checks, wall)");
+  static const std::string kKnown[] = {"checks", "wall"};
+  throw unknown_name_error("effort unit", name, kKnown);
 }
 
 std::string_view effort_unit_name(EffortUnit unit) noexcept {

@@ -8,7 +8,7 @@
 #include "manipulation_refinement.hpp"
 #include "ompl_support.hpp"
 #include "ontime/domains/manipulation_collision.hpp"
-#include "ontime/domains/navigation.hpp"
+#include "ontime/domains/world_types.hpp"
 #include "ontime/random.hpp"
 
 namespace ontime::domains {

@@ -50,15 +50,6 @@ Configuration NavigationDomain::fallback_start(const std::string& action, std::u
   throw std::runtime_error("no collision-free pose found in room " + room.id);
 }
 
-double drive_seconds(const std::vector<Pose>& poses, double linear_speed, double angular_speed) {
-  double length = 0, rotation = 0;
-  for (std::size_t i = 1; i < poses.size(); ++i) {
-    length += std::hypot(poses[i].x - poses[i - 1].x, poses[i].y - poses[i - 1].y);
-    rotation += std::abs(std::remainder(poses[i].theta - poses[i - 1].theta, 2 * std::numbers::pi));
-  }
-  return length / linear_speed + rotation / angular_speed;
-}
-
 double NavigationDomain::execution_seconds(const std::vector<Pose>& poses) const {
   return drive_seconds(poses, world_.robot.linear_speed, world_.robot.angular_speed);
 }

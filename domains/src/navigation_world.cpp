@@ -304,17 +304,6 @@ class WorldReader : detail::WorldFields {
 
 }  // namespace
 
-std::array<std::array<double, 2>, 4> Rectangle::corners() const {
-  const double c = std::cos(angle), s = std::sin(angle);
-  std::array<std::array<double, 2>, 4> result{};
-  const double signs[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
-  for (std::size_t i = 0; i < 4; ++i) {
-    const double dx = signs[i][0] * length / 2, dy = signs[i][1] * width / 2;
-    result[i] = {x + c * dx - s * dy, y + s * dx + c * dy};
-  }
-  return result;
-}
-
 int NavigationWorld::room_index(std::string_view id) const noexcept {
   for (std::size_t i = 0; i < rooms.size(); ++i) {
     if (rooms[i].id == id) return static_cast<int>(i);

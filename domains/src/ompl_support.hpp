@@ -31,7 +31,7 @@
 #include <vector>
 
 #include "ontime/domains/effort.hpp"
-#include "ontime/domains/navigation_world.hpp"
+#include "ontime/domains/world_types.hpp"
 #include "ontime/random.hpp"
 
 namespace ontime::domains::detail {

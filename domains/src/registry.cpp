@@ -25,9 +25,7 @@ LoadedDomain load_domain(std::string_view name, const std::filesystem::path& wor
     const DomainDefaults defaults{world.collection};
     return LoadedDomain{std::make_unique<ManipulationDomain>(std::move(world)), defaults};
   }
-  std::string known;
-  for (const std::string& candidate : domain_names()) known += (known.empty() ? "" : ", ") + candidate;
-  throw UsageError("unknown domain '" + std::string(name) + "' (known: " + known + ")");
+  throw unknown_name_error("domain", name, domain_names());
 }
 
 }  // namespace ontime::domains

@@ -4,14 +4,15 @@
 
 #include <cmath>
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
 #include <vector>
 
-#include "json_path.hpp"
 #include "ontime/distribution.hpp"
-#include "ontime/domains/navigation_world.hpp"
+#include "ontime/domains/world_types.hpp"
 #include "ontime/error.hpp"
+#include "ontime/json_input.hpp"
 #include "ontime/problem.hpp"
 
 namespace ontime::domains::detail {

@@ -20,7 +20,6 @@
 #include "ontime/knapsack.hpp"
 #include "ontime/log_sampling.hpp"
 #include "ontime/mdp.hpp"
-#include "ontime/neural_network.hpp"
 #include "ontime/planner_log.hpp"
 #include "ontime/ppo_training.hpp"
 #include "ontime/problem.hpp"

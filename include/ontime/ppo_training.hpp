@@ -39,15 +39,4 @@ PpoTraining train_ppo(const Mdp& mdp, std::uint64_t episodes, std::uint64_t seed
                       const PpoHyperparameters& hyperparameters = {},
                       const std::function<void(std::uint64_t done, std::uint64_t total)>& progress = {});
 
-// The clipped surrogate loss of PPO, -mean(min(r A, clip(r, 1 - e, 1 + e) A)) with
-// r = exp(log pi(a | s) - old log pi), over a batch of logits (one column per sample) with
-// invalid choices masked (valid[k + K n] != 0). Writes dLoss/dlogits (same shape) and the
-// approximate KL mean(old log pi - log pi). Exposed for its gradient test.
-template <class Scalar>
-double clipped_surrogate_loss(const Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>& logits,
-                              const std::vector<std::uint8_t>& valid, const std::vector<int>& actions,
-                              const std::vector<double>& old_log_probabilities, const std::vector<double>& advantages,
-                              double clip, Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>& gradient,
-                              double& approximate_kl);
-
 }  // namespace ontime

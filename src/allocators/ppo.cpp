@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include "../ppo_networks.hpp"
 #include "ontime/allocator_registry.hpp"
 #include "ontime/error.hpp"
 
@@ -23,21 +24,30 @@ void state_features(const Mdp& mdp, const State& state, PolicyNetwork::Vector& f
   }
 }
 
+struct PpoAllocator::Evaluation {
+  PolicyNetwork actor;
+  PolicyNetwork::Vector features;
+};
+
 PpoAllocator::PpoAllocator(const Mdp& mdp, std::shared_ptr<const PpoPolicy> policy)
-    : mdp_(&mdp), policy_(std::move(policy)), actor_(policy_->actor) {
+    : mdp_(&mdp), policy_(std::move(policy)) {
+  if (!policy_ || !policy_->networks) throw UsageError("the ppo policy holds no trained networks");
   if (policy_->skeleton_count != mdp.skeleton_count() || policy_->deadline != mdp.deadline()) {
     throw UsageError("the ppo policy was trained for " + std::to_string(policy_->skeleton_count) +
                      " skeletons and deadline " + std::to_string(policy_->deadline) + " ('" + policy_->instance +
                      "'), not for this instance (" + std::to_string(mdp.skeleton_count()) + " skeletons, deadline " +
                      std::to_string(mdp.deadline()) + ")");
   }
+  evaluation_ = std::make_unique<Evaluation>(Evaluation{policy_->networks->actor, {}});
 }
+
+PpoAllocator::~PpoAllocator() = default;
 
 int PpoAllocator::choose(const State& state) {
   const ChoiceList choices = mdp_->useful_choices(state);
   if (choices.empty()) return mdp_->first_with_work_left(state);
-  state_features(*mdp_, state, features_);
-  const PolicyNetwork::Vector& logits = actor_.evaluate(features_);
+  state_features(*mdp_, state, evaluation_->features);
+  const PolicyNetwork::Vector& logits = evaluation_->actor.evaluate(evaluation_->features);
   int best = choices[0];
   for (const int choice : choices) {
     if (logits(choice) > logits(best)) best = choice;

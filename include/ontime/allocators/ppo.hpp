@@ -12,21 +12,16 @@
 // No guarantee: as good as the training made it. Cost per decision: one forward pass of a
 // 3 x 64 tanh network (a few microseconds), no allocation.
 
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include "ontime/allocator.hpp"
 #include "ontime/mdp.hpp"
-#include "ontime/neural_network.hpp"
 
 namespace ontime {
-
-using PolicyNetwork = Mlp<float>;
-
-// Fills the feature vector of a state (size 1 + 3K).
-void state_features(const Mdp& mdp, const State& state, PolicyNetwork::Vector& features);
-int feature_count(int skeleton_count) noexcept;
 
 struct PpoHyperparameters {
   int hidden_layers = 3;
@@ -42,7 +37,12 @@ struct PpoHyperparameters {
   double target_kl = 0.01;       // actor steps stop early past 1.5 x this KL
 };
 
-// A trained actor and critic, and what they were trained for.
+// The actor and critic networks; defined inside the library (they are Eigen matrices, which
+// stay private to it), so that a policy is an opaque handle here.
+struct PpoNetworks;
+
+// A trained actor and critic, and what they were trained for. Made by `train_ppo` or
+// `load_ppo_policy`; copies share the (immutable) networks.
 struct PpoPolicy {
   std::string instance;          // name of the instance it was trained on
   int skeleton_count = 0;
@@ -50,12 +50,11 @@ struct PpoPolicy {
   std::uint64_t seed = 0;
   std::uint64_t episodes = 0;    // training episodes
   PpoHyperparameters hyperparameters;
-  PolicyNetwork actor;
-  PolicyNetwork critic;
+  std::shared_ptr<const PpoNetworks> networks;
 };
 
 // Policy files (JSON). Saving is atomic; loading validates every field and raises InputError
-// naming the file, the JSON path and the rule.
+// naming the file, the JSON path and the rule. Writing a policy without networks is a UsageError.
 void save_ppo_policy(const PpoPolicy& policy, const std::filesystem::path& path);
 std::string ppo_policy_to_json(const PpoPolicy& policy);
 PpoPolicy load_ppo_policy(const std::filesystem::path& path);
@@ -63,17 +62,20 @@ PpoPolicy parse_ppo_policy(std::string_view text, std::string_view source);
 
 class PpoAllocator final : public Allocator {
  public:
-  // Throws UsageError when the policy was trained for another number of skeletons or deadline.
+  // Throws UsageError when the policy holds no networks or was trained for another number of
+  // skeletons or deadline.
   PpoAllocator(const Mdp& mdp, std::shared_ptr<const PpoPolicy> policy);
+  ~PpoAllocator() override;
 
   std::string_view name() const noexcept override { return "ppo"; }
   int choose(const State& state) override;
 
  private:
+  struct Evaluation;  // own copy of the actor (evaluation uses per-network scratch buffers), features
+
   const Mdp* mdp_;
   std::shared_ptr<const PpoPolicy> policy_;
-  PolicyNetwork actor_;  // own copy: evaluation uses per-network scratch buffers
-  PolicyNetwork::Vector features_;
+  std::unique_ptr<Evaluation> evaluation_;
 };
 
 }  // namespace ontime

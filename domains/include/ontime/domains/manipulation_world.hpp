@@ -22,8 +22,8 @@
 #include <string_view>
 #include <vector>
 
-#include "ontime/domains/navigation_world.hpp"
 #include "ontime/domains/pr2_arm.hpp"
+#include "ontime/domains/world_types.hpp"
 
 namespace ontime::domains {
 

@@ -11,10 +11,6 @@
 
 namespace ontime::domains {
 
-// The time a base needs to drive through these poses in straight segments: length over
-// `linear_speed` plus rotation (shortest angle at each segment) over `angular_speed`.
-double drive_seconds(const std::vector<Pose>& poses, double linear_speed, double angular_speed);
-
 class NavigationDomain final : public Domain {
  public:
   explicit NavigationDomain(NavigationWorld world);

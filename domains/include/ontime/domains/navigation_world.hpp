@@ -15,16 +15,9 @@
 #include <string_view>
 #include <vector>
 
-#include "ontime/distribution.hpp"
+#include "ontime/domains/world_types.hpp"
 
 namespace ontime::domains {
-
-// A rectangle of size `length` x `width` (along its own x and y axes), centred at (x, y),
-// turned by `angle` radians.
-struct Rectangle {
-  double x = 0, y = 0, length = 0, width = 0, angle = 0;
-  std::array<std::array<double, 2>, 4> corners() const;
-};
 
 struct Room {
   std::string id;
@@ -44,10 +37,6 @@ struct Obstacle {
   Rectangle shape;
 };
 
-struct Pose {
-  double x = 0, y = 0, theta = 0;
-};
-
 struct RobotModel {
   double length = 0, width = 0;  // footprint, along and across its heading
   double clearance = 0;          // padding kept from walls and furniture while planning
@@ -58,12 +47,6 @@ struct RobotModel {
 struct PlannerSettings {
   double range = 0;       // RRT-Connect's longest extension, in state-space distance
   double resolution = 0;  // distance between collision checks along a motion, in metres
-};
-
-struct CollectionDefaults {
-  Steps deadline = 1;
-  double step_seconds = 1;
-  double checks_per_second = 1000;  // nominal collision-checker speed of the checks unit
 };
 
 struct NavigationWorld {

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "ontime/domains/domain.hpp"
-#include "ontime/domains/navigation_world.hpp"
+#include "ontime/domains/world_types.hpp"
 
 namespace ontime::domains {
 

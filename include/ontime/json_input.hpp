@@ -1,19 +1,21 @@
 #pragma once
-// Internal: JSON paths for error messages, strict parsing (duplicate keys are errors, not
-// silently overwritten) and reading whole files. Shared by every reader of JSON input.
+// Support for readers of JSON input files, shared by the core and the domains library: JSON
+// paths for error messages, strict parsing (duplicate keys are errors, not silently
+// overwritten) and reading whole files, every failure an InputError naming the file, the place
+// and the rule. Not part of the allocation API (hence `detail`). The templates take the JSON
+// type (nlohmann::json or nlohmann::ordered_json) as a parameter, so that this header needs
+// nlohmann_json only where a reader includes <nlohmann/json.hpp> itself.
 
 #include <algorithm>
 #include <cctype>
-#include <initializer_list>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <set>
 #include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "ontime/error.hpp"
 
@@ -164,7 +166,8 @@ Json parse_json_strict(std::string_view text, const std::string& source) {
       }
     }
     const std::size_t reason = message.find("] ");
-    throw InputError(source, place, "invalid JSON: " + (reason == std::string::npos ? message : message.substr(reason + 2)));
+    throw InputError(source, place,
+                     "invalid JSON: " + (reason == std::string::npos ? message : message.substr(reason + 2)));
   }
 }
 
