@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <limits>
 
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/error.hpp"
@@ -40,8 +39,9 @@ class ProgressTracker {
  public:
   ProgressTracker(const StudySettings& settings, std::uint64_t total) : settings_(settings), total_(total) {}
 
-  MonteCarloResult run(const Mdp& mdp, const AllocatorFactory& factory) {
+  MonteCarloResult run(const Mdp& mdp, const AllocatorFactory& factory, const DecisionBudget& budget = {}) {
     MonteCarloOptions options;
+    options.decision_budget = budget;
     options.episodes = settings_.episodes;
     options.seed = settings_.seed;
     options.threads = settings_.threads;
@@ -61,12 +61,6 @@ class ProgressTracker {
   std::uint64_t total_;
   std::uint64_t done_ = 0;
 };
-
-AllocatorFactory mcts_with_time(const Mdp& mdp, AllocatorOptions options, double seconds) {
-  options.seconds = seconds;
-  options.iterations = std::numeric_limits<std::uint64_t>::max();
-  return make_allocator_factory("mcts", mdp, options);
-}
 
 }  // namespace
 
@@ -109,7 +103,8 @@ EqualTimeStudy equal_time_study(const Mdp& mdp, const StudySettings& settings) {
   const AllocatorFactory dp_rerun = make_allocator_factory("dp-rerun", mdp, settings.allocator);
   study.dp_rerun_decision_seconds = mean_decision_seconds(mdp, dp_rerun, settings.seed);
   study.dp_rerun = tracker.run(mdp, dp_rerun);
-  study.mcts = tracker.run(mdp, mcts_with_time(mdp, settings.allocator, study.dp_rerun_decision_seconds));
+  study.mcts = tracker.run(mdp, make_allocator_factory("mcts", mdp, settings.allocator),
+                           DecisionBudget::seconds(study.dp_rerun_decision_seconds));
   return study;
 }
 
@@ -126,11 +121,12 @@ AnytimeStudy anytime_study(const Mdp& mdp, const std::vector<double>& log10_mult
   study.dp_rerun_decision_seconds = mean_decision_seconds(mdp, dp_rerun, settings.seed);
   study.optimum = OptimalSolver(mdp, settings.allocator.max_states).solve(mdp.start());
   study.dp_rerun = tracker.run(mdp, dp_rerun);
+  const AllocatorFactory mcts = make_allocator_factory("mcts", mdp, settings.allocator);
   for (const double exponent : log10_multipliers) {
     AnytimePoint point;
     point.log10_multiplier = exponent;
     point.seconds_per_decision = study.dp_rerun_decision_seconds * std::pow(10.0, exponent);
-    point.mcts = tracker.run(mdp, mcts_with_time(mdp, settings.allocator, point.seconds_per_decision));
+    point.mcts = tracker.run(mdp, mcts, DecisionBudget::seconds(point.seconds_per_decision));
     study.points.push_back(std::move(point));
   }
   return study;
