@@ -45,9 +45,11 @@ EpisodeResult run_episode(const Mdp& mdp, Allocator& allocator, World& world, st
 struct MonteCarloOptions {
   std::uint64_t episodes = 10'000;
   std::uint64_t seed = 1;
-  unsigned threads = 0;            // 0: one per hardware thread
-  bool time_decisions = true;      // measure each decision (adds ~40 ns of clock reads)
-  DecisionBudget decision_budget;  // passed to every decision; unset: each allocator's own budget
+  unsigned threads = 0;        // 0: one per hardware thread
+  bool time_decisions = true;  // measure each decision (adds ~40 ns of clock reads)
+  // Passed to every decision (unset: each allocator's own budget); all threads share it, so a
+  // stop condition must be thread-safe.
+  DecisionBudget decision_budget;
   // Called now and then with the number of episodes done (from one thread at a time).
   std::function<void(std::uint64_t done, std::uint64_t total)> progress;
 };
