@@ -33,8 +33,9 @@ std::vector<ontime::State> decision_states(const ontime::Mdp& mdp, ontime::Alloc
   };
   std::vector<ontime::State> states;
   Recorder recorder(allocator, states);
+  ontime::HiddenWorld world(mdp.problem(), 9);
   for (int episode = 0; episode < episodes; ++episode) {
-    ontime::run_episode(mdp, recorder, ontime::stream_seed(9, static_cast<std::uint64_t>(episode)));
+    ontime::run_episode(mdp, recorder, world, ontime::stream_seed(9, static_cast<std::uint64_t>(episode)));
   }
   return states;
 }

@@ -22,6 +22,10 @@ class StateRecorder final : public Allocator {
     states_->push_back(state);
     return inner_->choose(state);
   }
+  int choose(const State& state, const DecisionBudget& budget) override {
+    states_->push_back(state);
+    return inner_->choose(state, budget);
+  }
   void observe(const State& before, int choice, const State& after, Status status) override {
     inner_->observe(before, choice, after, status);
   }
@@ -44,7 +48,9 @@ class ProgressTracker {
     options.threads = settings_.threads;
     const std::uint64_t before = done_;
     if (settings_.progress) {
-      options.progress = [this, before](std::uint64_t done, std::uint64_t) { settings_.progress(before + done, total_); };
+      options.progress = [this, before](std::uint64_t done, std::uint64_t) {
+        settings_.progress(before + done, total_);
+      };
     }
     MonteCarloResult result = run_monte_carlo(mdp, factory, options);
     done_ += settings_.episodes;
@@ -88,8 +94,9 @@ double mean_decision_seconds(const Mdp& mdp, const AllocatorFactory& factory, st
   const std::unique_ptr<Allocator> allocator = factory();
   std::vector<State> states;
   StateRecorder recorder(*allocator, states);
+  HiddenWorld world(mdp.problem(), seed);
   for (std::uint64_t episode = 0; episode < episodes; ++episode) {
-    run_episode(mdp, recorder, stream_seed(seed, episode));
+    run_episode(mdp, recorder, world, stream_seed(seed, episode));
   }
   if (states.empty()) return 0.0;
   // Enough passes over the recorded states for the clock's resolution not to matter.
@@ -126,7 +133,8 @@ EqualTimeStudy equal_time_study(const Mdp& mdp, const StudySettings& settings) {
   return study;
 }
 
-AnytimeStudy anytime_study(const Mdp& mdp, const std::vector<double>& log10_multipliers, const StudySettings& settings) {
+AnytimeStudy anytime_study(const Mdp& mdp, const std::vector<double>& log10_multipliers,
+                           const StudySettings& settings) {
   for (const double exponent : log10_multipliers) {
     if (!std::isfinite(exponent) || exponent < -3 || exponent > 9) {
       throw UsageError("log10 time multipliers must lie within [-3, 9]");

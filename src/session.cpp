@@ -12,18 +12,15 @@ Session::Session(const Mdp& mdp, Allocator& allocator, std::uint64_t seed)
   allocator_->begin_episode(seed);
 }
 
-Decision Session::choose() {
-  static const DecisionBudget kOwnBudget;
-  return choose(kOwnBudget);
-}
+Decision Session::choose() { return choose(DecisionBudget{}); }
 
 Decision Session::choose(const DecisionBudget& budget) {
   if (status_ != Status::running) throw std::logic_error("the session is over; nothing more to choose");
   if (pending_ >= 0) throw std::logic_error("the last decision has not been reported yet");
-  const int choice = budget.is_set() ? allocator_->choose(state_, budget) : allocator_->choose(state_);
+  const int choice = allocator_->choose(state_, budget);
   if (choice < 0 || choice >= mdp_->skeleton_count()) {
-    throw UsageError("allocator '" + std::string(allocator_->name()) + "' chose skeleton " +
-                     std::to_string(choice) + ", outside [0, " + std::to_string(mdp_->skeleton_count()) + ")");
+    throw UsageError("allocator '" + std::string(allocator_->name()) + "' chose skeleton " + std::to_string(choice) +
+                     ", outside [0, " + std::to_string(mdp_->skeleton_count()) + ")");
   }
   pending_ = choice;
   return Decision{choice, mdp_->next_action(state_, choice)};

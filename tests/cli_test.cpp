@@ -1,14 +1,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
-#include <csignal>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "ontime/allocators/ppo.hpp"
-
 #include "support/bad_inputs.hpp"
 #include "support/bad_logs.hpp"
 #include "support/mini_world.hpp"
@@ -40,8 +39,8 @@ TEST(Cli, SolveReportsTheFigureOneOptimum) {
 }
 
 TEST(Cli, EvaluateWritesTheDocumentedKeys) {
-  const auto result = ontime({"evaluate", paper("instance4"), "--solver", "dp-rerun", "--episodes", "2000",
-                              "--seed", "3", "--threads", "2", "--exact", "--json"});
+  const auto result = ontime({"evaluate", paper("instance4"), "--solver", "dp-rerun", "--episodes", "2000", "--seed",
+                              "3", "--threads", "2", "--exact", "--json"});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const json out = json::parse(result.out);
   EXPECT_EQ(out["solver"], "dp-rerun");
@@ -52,15 +51,17 @@ TEST(Cli, EvaluateWritesTheDocumentedKeys) {
   EXPECT_NEAR(out["ci95"].get<double>(), 1.96 * std::sqrt(rate * (1 - rate) / 2000), 1e-12);
   EXPECT_TRUE(out["decision_time_us"].contains("median"));
   EXPECT_TRUE(out["decision_time_us"].contains("p99"));
+  EXPECT_GE(out["decision_time_us"]["max"].get<double>(), out["decision_time_us"]["p99"].get<double>());
+  EXPECT_GT(out["decision_time_us"]["max"].get<double>(), 0.0);
   // Same seed with one thread: the same successes.
-  const auto single = ontime({"evaluate", paper("instance4"), "--solver", "dp-rerun", "--episodes", "2000",
-                              "--seed", "3", "--threads", "1", "--json"});
+  const auto single = ontime({"evaluate", paper("instance4"), "--solver", "dp-rerun", "--episodes", "2000", "--seed",
+                              "3", "--threads", "1", "--json"});
   EXPECT_EQ(json::parse(single.out)["successes"], out["successes"]);
 }
 
 TEST(Cli, TablePrintsOneRowPerInstanceAndTheOptimum) {
-  const auto result = ontime({"table", paper("instance2"), paper("instance4"), "--episodes", "500", "--exact",
-                              "--solvers", "dp,greedy"});
+  const auto result = ontime(
+      {"table", paper("instance2"), paper("instance4"), "--episodes", "500", "--exact", "--solvers", "dp,greedy"});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_NE(result.out.find("| instance "), std::string::npos) << result.out;
   EXPECT_NE(result.out.find("| instance2 "), std::string::npos);
@@ -123,8 +124,8 @@ std::size_t line_count(const std::filesystem::path& path) {
 TEST(Cli, TrainWritesAPolicyThatEvaluateAndTableUse) {
   const auto directory = scratch("train");
   const std::string policy = (directory / "instance4.json").string();
-  const auto trained = ontime({"train", paper("instance4"), "--solver", "ppo", "--episodes", "300", "--seed", "2",
-                               "--out", policy, "--json"});
+  const auto trained = ontime(
+      {"train", paper("instance4"), "--solver", "ppo", "--episodes", "300", "--seed", "2", "--out", policy, "--json"});
   ASSERT_EQ(trained.exit_code, 0) << trained.err;
   const json report = json::parse(trained.out);
   EXPECT_TRUE(std::filesystem::exists(policy));
@@ -136,7 +137,8 @@ TEST(Cli, TrainWritesAPolicyThatEvaluateAndTableUse) {
   ASSERT_EQ(evaluated.exit_code, 0) << evaluated.err;
   EXPECT_DOUBLE_EQ(json::parse(evaluated.out)["exact_success_probability"].get<double>(),
                    report["exact_success_probability"].get<double>());
-  const auto table = ontime({"table", paper("instance4"), "--solvers", "ppo,dp", "--policy", policy, "--episodes", "200"});
+  const auto table =
+      ontime({"table", paper("instance4"), "--solvers", "ppo,dp", "--policy", policy, "--episodes", "200"});
   ASSERT_EQ(table.exit_code, 0) << table.err;
   EXPECT_NE(table.out.find("| ppo"), std::string::npos) << table.out;
 
@@ -171,7 +173,8 @@ TEST(Cli, StudiesWriteTheirCsvAndPlot) {
 TEST(Cli, KnapsackReductionWritesASolvableInstance) {
   const auto directory = scratch("knapsack");
   const std::string instance = (directory / "example.json").string();
-  const auto reduced = ontime({"reduce-knapsack", testing::source_path("data/knapsack/example.json").string(), "--out", instance});
+  const auto reduced =
+      ontime({"reduce-knapsack", testing::source_path("data/knapsack/example.json").string(), "--out", instance});
   ASSERT_EQ(reduced.exit_code, 0) << reduced.err;
   const auto solved = ontime({"solve", instance, "--json"});
   ASSERT_EQ(solved.exit_code, 0) << solved.err;
@@ -196,7 +199,8 @@ TEST(Cli, InterruptedTrainingLeavesTheOldFile) {
   std::size_t entries = 0;
   for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(directory)) ++entries;
   EXPECT_EQ(entries, 1U);  // no partial or temporary file
-  const auto complete = ontime({"train", paper("instance4"), "--episodes", "100", "--out", policy.string(), "--no-plot"});
+  const auto complete =
+      ontime({"train", paper("instance4"), "--episodes", "100", "--out", policy.string(), "--no-plot"});
   ASSERT_EQ(complete.exit_code, 0) << complete.err;
   EXPECT_NO_THROW(load_ppo_policy(policy));
 }
@@ -220,8 +224,8 @@ TEST(Cli, SampledLogFitsBackToTheOptimumWithinOneHundredth) {
   const std::string fitted = (dir / "fitted.json").string();
   const auto sampled = ontime({"sample-log", paper("instance1"), "--attempts", "20000", "--seed", "3", "-o", log});
   ASSERT_EQ(sampled.exit_code, 0) << sampled.err;
-  const auto fit = ontime({"fit", log, "--step", "1", "--deadline", "14", "--skeletons", paper("instance1"), "-o", fitted,
-                           "--json"});
+  const auto fit = ontime(
+      {"fit", log, "--step", "1", "--deadline", "14", "--skeletons", paper("instance1"), "-o", fitted, "--json"});
   ASSERT_EQ(fit.exit_code, 0) << fit.err;
   const json report = json::parse(fit.out);
   EXPECT_EQ(report["records"].get<int>(), 9 * 20000);  // instance 1 uses 9 actions
@@ -239,7 +243,8 @@ TEST(Cli, FitRejectsEveryBadLogWithOneLineNamingFileLineAndRule) {
   for (const testing::BadInput& bad : testing::kBadLogs) {
     const std::string path = testing::source_path("tests/data/bad_logs/" + bad.file).string();
     const std::string output = (dir / "never-written.json").string();
-    const auto result = ontime({"fit", path, "--step", "1", "--deadline", "5", "--skeletons", paper("figure1"), "-o", output});
+    const auto result =
+        ontime({"fit", path, "--step", "1", "--deadline", "5", "--skeletons", paper("figure1"), "-o", output});
     EXPECT_EQ(result.exit_code, 2) << bad.file;
     EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << bad.file << ": " << result.err;
     EXPECT_NE(result.err.find(path + ": " + bad.place + ": "), std::string::npos) << result.err;
@@ -258,10 +263,16 @@ TEST(Cli, FitNamesTheSkeletonActionMissingFromTheLog) {
   EXPECT_NE(result.err.find(paper("instance1") + ": skeletons[0][0]: action 'a1_1' has no record in the log " + log),
             std::string::npos)
       << result.err;
-  EXPECT_EQ(ontime({"fit", log, "--step", "0", "--deadline", "5", "--skeletons", paper("figure1"), "-o", "x.json"}).exit_code, 2);
-  EXPECT_EQ(ontime({"fit", log, "--step", "1", "--deadline", "0", "--skeletons", paper("figure1"), "-o", "x.json"}).exit_code, 2);
+  EXPECT_EQ(
+      ontime({"fit", log, "--step", "0", "--deadline", "5", "--skeletons", paper("figure1"), "-o", "x.json"}).exit_code,
+      2);
+  EXPECT_EQ(
+      ontime({"fit", log, "--step", "1", "--deadline", "0", "--skeletons", paper("figure1"), "-o", "x.json"}).exit_code,
+      2);
   EXPECT_EQ(ontime({"fit", log, "--step", "1", "--deadline", "5", "--skeletons", paper("figure1"), "-o", "x.json",
-                    "--laplace", "-1"}).exit_code, 2);
+                    "--laplace", "-1"})
+                .exit_code,
+            2);
 }
 
 TEST(Cli, PlotWritesTheHistogramsAndTheirData) {
@@ -354,9 +365,13 @@ TEST(Cli, AnInterruptedCollectionResumesToTheSameFiles) {
   const std::string world = (dir / "mini.json").string();
   std::ofstream(world) << testing::kMiniWorld;
   const auto collect = [&](const std::string& name, const std::vector<std::string>& extra) {
-    std::vector<std::string> arguments{ONTIME_CLI, "collect", "--domain", "navigation", "--world", world, "--trials", "300",
-                                       "--seed", "8", "--log", (dir / (name + ".jsonl")).string(), "-o",
-                                       (dir / (name + ".json")).string()};
+    std::vector<std::string> arguments{ONTIME_CLI, "collect",
+                                       "--domain", "navigation",
+                                       "--world",  world,
+                                       "--trials", "300",
+                                       "--seed",   "8",
+                                       "--log",    (dir / (name + ".jsonl")).string(),
+                                       "-o",       (dir / (name + ".json")).string()};
     arguments.insert(arguments.end(), extra.begin(), extra.end());
     return arguments;
   };
@@ -380,7 +395,8 @@ TEST(Cli, AnInterruptedCollectionResumesToTheSameFiles) {
   // Another cut-off is another collection: refused, naming the setting.
   const auto other = testing::run_process(collect("cut", {"--resume", "--budget", "5"}));
   EXPECT_EQ(other.exit_code, 2);
-  EXPECT_NE(other.err.find("line 1: the checkpoint of another collection ('budget_steps'"), std::string::npos) << other.err;
+  EXPECT_NE(other.err.find("line 1: the checkpoint of another collection ('budget_steps'"), std::string::npos)
+      << other.err;
   const auto resumed = testing::run_process(collect("cut", {"--resume", "--threads", "1", "--json"}));
   ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
   EXPECT_EQ(json::parse(resumed.out)["resumed_attempts"].get<std::size_t>(), saved - 1);

@@ -1,12 +1,17 @@
+#include "ontime/evaluation.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <mutex>
+#include <vector>
 
 #include "ontime/allocator_registry.hpp"
+#include "ontime/episode_runner.hpp"
 #include "ontime/error.hpp"
-#include "ontime/evaluation.hpp"
 #include "ontime/random.hpp"
 #include "ontime/simulator.hpp"
+#include "ontime/world.hpp"
 #include "support/paper.hpp"
 #include "support/random_instances.hpp"
 
@@ -51,7 +56,8 @@ TEST(Evaluation, MonteCarloAgreesWithExactEvaluation) {
       }
       ++cases;
       inside += deviation <= 1.96 * standard_error;
-      EXPECT_LE(deviation, 4.0 * standard_error) << name << " instance" << i << ": " << sampled.success_rate << " vs " << exact;
+      EXPECT_LE(deviation, 4.0 * standard_error)
+          << name << " instance" << i << ": " << sampled.success_rate << " vs " << exact;
     }
   }
   // At least 19 of 25 within 1.96 standard errors (a binomial(25, 0.95) falls below that with
@@ -116,8 +122,8 @@ TEST(Evaluation, ExactEvaluationNeedsAStationaryAllocator) {
   EXPECT_THROW(evaluate_exactly(mdp, random), UsageError);
   MonteCarloOptions options;
   options.episodes = 200;
-  const MonteCarloResult sampled =
-      run_monte_carlo(mdp, [] { return std::make_unique<RandomAllocator>(3); }, options);
+  const MonteCarloResult sampled = run_monte_carlo(
+      mdp, [] { return std::make_unique<RandomAllocator>(3); }, options);
   EXPECT_LE(sampled.success_rate, 0.5625 + 4 * std::sqrt(0.25 / 200));
 }
 
@@ -136,6 +142,164 @@ TEST(Evaluation, ErrorsInsideWorkersReachTheCaller) {
   options.threads = 2;
   const AllocatorFactory broken = [] { return std::make_unique<RandomAllocator>(9); };  // out of range
   EXPECT_THROW(run_monte_carlo(mdp, broken, options), UsageError);
+}
+
+// A world of the test's own: each step on an action finds a motion with probability 1/4,
+// executed in 0 to 2 steps, all drawn from the episode's seed, the action and the step.
+class CoinWorld final : public World {
+ public:
+  void begin_episode(std::uint64_t seed) override {
+    seed_ = seed;
+    ++episodes_;
+  }
+  Observation step(int action, Steps spent) override {
+    ++steps_;
+    SplitMix64 generator(
+        stream_seed(stream_seed(seed_, static_cast<std::uint64_t>(action)), static_cast<std::uint64_t>(spent)));
+    if (generator() % 4 != 0) return Observation::not_yet();
+    return Observation::found(static_cast<Steps>(generator() % 3));
+  }
+  void collect_statistics(Statistics& statistics) const override {
+    statistics.add("episodes", static_cast<double>(episodes_));
+    statistics.add("steps", static_cast<double>(steps_));
+  }
+
+ private:
+  std::uint64_t seed_ = 0;
+  std::uint64_t episodes_ = 0;
+  std::uint64_t steps_ = 0;
+};
+
+// Chooses uniformly at random from the seed of each episode, and counts its decisions.
+class SeededRandomAllocator final : public Allocator {
+ public:
+  explicit SeededRandomAllocator(int skeletons) : skeletons_(skeletons) {}
+  std::string_view name() const noexcept override { return "seeded-random"; }
+  void begin_episode(std::uint64_t seed) override { generator_ = SplitMix64(seed); }
+  int choose(const State&) override {
+    ++decisions_;
+    return static_cast<int>(generator_() % static_cast<std::uint64_t>(skeletons_));
+  }
+  bool is_stationary() const noexcept override { return false; }
+  void collect_statistics(Statistics& statistics) const override {
+    statistics.add("decisions", static_cast<double>(decisions_));
+  }
+
+ private:
+  int skeletons_;
+  SplitMix64 generator_{0};
+  std::uint64_t decisions_ = 0;
+};
+
+TEST(EpisodeRunner, AWorldOfTheCallersOwnGivesTheSameResultsOnOneAndTwoThreads) {
+  const Problem problem = testing::paper_instance("instance3");
+  const Mdp mdp(problem);
+  const WorldFactory worlds = [] { return std::make_unique<CoinWorld>(); };
+  const int skeletons = mdp.skeleton_count();
+  const AllocatorFactory allocators = [skeletons] { return std::make_unique<SeededRandomAllocator>(skeletons); };
+  MonteCarloOptions options;
+  options.episodes = 3'000;
+  options.seed = 11;
+  options.threads = 1;
+  const MonteCarloResult one = run_episodes(mdp, worlds, allocators, options);
+  options.threads = 2;
+  const MonteCarloResult two = run_episodes(mdp, worlds, allocators, options);
+
+  EXPECT_GT(one.successes, 0U);
+  EXPECT_LT(one.successes, options.episodes);
+  EXPECT_EQ(two.successes, one.successes);
+  EXPECT_EQ(two.decision_time.decisions, one.decision_time.decisions);
+  EXPECT_EQ(one.world_statistics.find("episodes"), 3'000.0);
+  EXPECT_EQ(two.world_statistics.find("episodes"), 3'000.0);
+  EXPECT_EQ(two.world_statistics.find("steps"), one.world_statistics.find("steps"));
+  EXPECT_GT(one.world_statistics.find("steps").value_or(0), 3'000.0);
+  // Every decision reached the allocator; the world saw those that were not idle.
+  EXPECT_EQ(one.statistics.find("decisions"), static_cast<double>(one.decision_time.decisions));
+  EXPECT_EQ(two.statistics.find("decisions"), static_cast<double>(one.decision_time.decisions));
+  EXPECT_LE(one.world_statistics.find("steps").value_or(0), static_cast<double>(one.decision_time.decisions));
+  options.seed = 12;
+  EXPECT_NE(run_episodes(mdp, worlds, allocators, options).successes, one.successes);
+}
+
+// Records the seeds its episodes begin with.
+class SeedRecorder final : public Allocator {
+ public:
+  explicit SeedRecorder(std::vector<std::uint64_t>& seeds) : seeds_(&seeds) {}
+  std::string_view name() const noexcept override { return "seed-recorder"; }
+  void begin_episode(std::uint64_t seed) override { seeds_->push_back(seed); }
+  int choose(const State&) override { return 0; }
+
+ private:
+  std::vector<std::uint64_t>* seeds_;
+};
+
+class SeedRecordingWorld final : public World {
+ public:
+  explicit SeedRecordingWorld(std::vector<std::uint64_t>& seeds) : seeds_(&seeds) {}
+  void begin_episode(std::uint64_t seed) override { seeds_->push_back(seed); }
+  Observation step(int, Steps) override { return Observation::not_yet(); }
+
+ private:
+  std::vector<std::uint64_t>* seeds_;
+};
+
+TEST(EpisodeRunner, EpisodeEHasItsOwnSeedForTheWorldAndAnotherStreamForTheAllocator) {
+  const Problem problem = testing::paper_instance("figure1");
+  const Mdp mdp(problem);
+  std::vector<std::uint64_t> world_seeds, allocator_seeds;
+  MonteCarloOptions options;
+  options.episodes = 3;
+  options.seed = 42;
+  options.threads = 1;
+  run_episodes(
+      mdp, [&] { return std::make_unique<SeedRecordingWorld>(world_seeds); },
+      [&] { return std::make_unique<SeedRecorder>(allocator_seeds); }, options);
+  ASSERT_EQ(world_seeds.size(), 3U);
+  ASSERT_EQ(allocator_seeds.size(), 3U);
+  for (std::uint64_t e = 0; e < 3; ++e) {
+    EXPECT_EQ(world_seeds[e], stream_seed(42, e));
+    EXPECT_EQ(allocator_seeds[e], stream_seed(stream_seed(42, e), 1));
+  }
+}
+
+// Decides as dp-rerun does, and counts the decisions that came with a budget of 7 iterations.
+class BudgetRecorder final : public Allocator {
+ public:
+  explicit BudgetRecorder(std::unique_ptr<Allocator> inner) : inner_(std::move(inner)) {}
+  std::string_view name() const noexcept override { return "budget-recorder"; }
+  int choose(const State& state) override { return inner_->choose(state); }
+  int choose(const State& state, const DecisionBudget& budget) override {
+    ++decisions_;
+    if (budget.max_iterations() == 7U) ++seven_iterations_;
+    return inner_->choose(state, budget);
+  }
+  void collect_statistics(Statistics& statistics) const override {
+    statistics.add("decisions", static_cast<double>(decisions_));
+    statistics.add("with seven iterations", static_cast<double>(seven_iterations_));
+  }
+
+ private:
+  std::unique_ptr<Allocator> inner_;
+  std::uint64_t decisions_ = 0, seven_iterations_ = 0;
+};
+
+TEST(EpisodeRunner, ThePerDecisionBudgetReachesTheAllocator) {
+  const Problem problem = testing::paper_instance("instance2");
+  const Mdp mdp(problem);
+  const AllocatorFactory dp_rerun = make_allocator_factory("dp-rerun", mdp);
+  const AllocatorFactory recording = [&] { return std::make_unique<BudgetRecorder>(dp_rerun()); };
+  MonteCarloOptions options;
+  options.episodes = 500;
+  options.threads = 2;
+  const MonteCarloResult unset = run_monte_carlo(mdp, recording, options);
+  EXPECT_EQ(unset.statistics.find("decisions"), static_cast<double>(unset.decision_time.decisions));
+  EXPECT_EQ(unset.statistics.find("with seven iterations"), 0.0);
+
+  options.decision_budget = DecisionBudget::iterations(7);
+  const MonteCarloResult budgeted = run_monte_carlo(mdp, recording, options);
+  EXPECT_GT(budgeted.decision_time.decisions, 500U);
+  EXPECT_EQ(budgeted.statistics.find("with seven iterations"), static_cast<double>(budgeted.decision_time.decisions));
+  EXPECT_EQ(budgeted.successes, unset.successes);  // dp-rerun has no use for a budget
 }
 
 }  // namespace

@@ -56,6 +56,7 @@ void add_evaluate_command(CLI::App& app) {
       out["decision_time_us"] = {{"median", result.decision_time.median_us},
                                  {"p99", result.decision_time.p99_us},
                                  {"mean", result.decision_time.mean_us},
+                                 {"max", result.decision_time.max_us},
                                  {"decisions", result.decision_time.decisions}};
       out["seconds"] = result.seconds;
       if (exact) {
@@ -70,9 +71,9 @@ void add_evaluate_command(CLI::App& app) {
     fmt::print("success rate    {:.4f} ± {:.4f}  ({} of {} episodes, seed {})\n", result.success_rate, result.ci95,
                result.successes, result.episodes, options->monte_carlo.seed);
     if (exact) fmt::print("exact           {:.6f}  ({} states)\n", exact->success_probability, exact->states);
-    fmt::print("decision time   median {:.3f} µs, p99 {:.3f} µs, mean {:.3f} µs over {} decisions\n",
+    fmt::print("decision time   median {:.3f} µs, p99 {:.3f} µs, mean {:.3f} µs, max {:.3f} µs over {} decisions\n",
                result.decision_time.median_us, result.decision_time.p99_us, result.decision_time.mean_us,
-               result.decision_time.decisions);
+               result.decision_time.max_us, result.decision_time.decisions);
   });
 }
 

@@ -2,14 +2,16 @@
 // real motion planner step by step (several refinements interleaved), against the success the
 // allocator expects from the fitted instance.
 
-#include <filesystem>
 #include <fmt/format.h>
+
+#include <filesystem>
 
 #include "common.hpp"
 #include "ontime/allocators/optimal.hpp"
 #include "data_paths.hpp"
-#include "ontime/domains/online.hpp"
+#include "ontime/domains/planner_world.hpp"
 #include "ontime/domains/registry.hpp"
+#include "ontime/episode_runner.hpp"
 #include "ontime/instance_io.hpp"
 
 namespace ontime::cli {
@@ -40,16 +42,20 @@ void add_run_command(CLI::App& app) {
   command->add_option("--world", options->world, "World file (default: data/domains/DOMAIN.json)");
   command->add_option("--episodes", options->episodes, "Episodes")->check(CLI::PositiveNumber)->capture_default_str();
   command->add_option("--seed", options->seed, "Seed (episode e uses stream e)")->capture_default_str();
-  command->add_option("--threads", options->threads, "Worker threads (0: one per hardware thread); results do not depend on it")
+  command
+      ->add_option("--threads", options->threads,
+                   "Worker threads (0: one per hardware thread); results do not depend on it")
       ->capture_default_str();
   command->add_option("--effort", options->effort, "Effort unit: checks (deterministic) or wall")
       ->check(CLI::IsMember({"checks", "wall"}))
       ->capture_default_str();
-  command->add_option("--checks-per-second", options->checks_per_second,
-                      "Nominal collision checks per second of the checks unit (default: the world file's)")
+  command
+      ->add_option("--checks-per-second", options->checks_per_second,
+                   "Nominal collision checks per second of the checks unit (default: the world file's)")
       ->check(CLI::PositiveNumber);
-  command->add_flag("--independent-starts", options->independent_starts,
-                    "Start every action after the first from a fresh pose in its room, not where the previous refinement ended");
+  command->add_flag(
+      "--independent-starts", options->independent_starts,
+      "Start every action after the first from a fresh pose in its room, not where the previous refinement ended");
   command->add_flag("--exact", options->exact, "Also the exact success the allocator expects from the instance");
   command->add_flag("--json", options->json, "Print JSON");
   options->allocator.add_to(*command);
@@ -64,13 +70,19 @@ void add_run_command(CLI::App& app) {
     const Mdp mdp(problem);
     const ParameterValues parameters = options->allocator.values();
     const AllocatorFactory factory = make_allocator_factory(options->solver, mdp, parameters);
-    domains::OnlineOptions online;
-    online.effort.unit = domains::parse_effort_unit(options->effort);
-    online.effort.checks_per_second =
+    domains::PlannerWorldOptions planner;
+    planner.effort.unit = domains::parse_effort_unit(options->effort);
+    planner.effort.checks_per_second =
         options->checks_per_second > 0 ? options->checks_per_second : loaded.defaults.collection.checks_per_second;
-    online.independent_starts = options->independent_starts;
-    const domains::OnlineSummary summary =
-        domains::run_online(*loaded.domain, mdp, factory, options->episodes, options->seed, options->threads, online);
+    planner.independent_starts = options->independent_starts;
+    MonteCarloOptions episodes;
+    episodes.episodes = options->episodes;
+    episodes.seed = options->seed;
+    episodes.threads = options->threads;
+    const MonteCarloResult summary =
+        run_episodes(mdp, domains::planner_worlds(*loaded.domain, problem, planner), factory, episodes);
+    const double refinements_started =
+        summary.world_statistics.find("refinements_started").value_or(0.0) / static_cast<double>(summary.episodes);
     std::optional<ExactEvaluation> exact;
     if (options->exact) {
       const auto allocator = factory();
@@ -88,16 +100,17 @@ void add_run_command(CLI::App& app) {
       out["success_rate"] = summary.success_rate;
       out["ci95"] = summary.ci95;
       out["independent_starts"] = options->independent_starts;
-      out["refinements_started"] = summary.mean_actions_started;
+      out["refinements_started"] = refinements_started;
       out["seconds"] = summary.seconds;
       if (exact) out["model_exact_success_probability"] = exact->success_probability;
       print_json(out);
       return;
     }
-    fmt::print("solver               {} on the {} domain (model {})\n", options->solver, options->domain, instance.string());
+    fmt::print("solver               {} on the {} domain (model {})\n", options->solver, options->domain,
+               instance.string());
     fmt::print("real planner         {:.4f} ± {:.4f}  ({} of {} episodes, seed {}, {:.1f} s)\n", summary.success_rate,
                summary.ci95, summary.successes, summary.episodes, options->seed, summary.seconds);
-    fmt::print("refinements started  {:.2f} per episode\n", summary.mean_actions_started);
+    fmt::print("refinements started  {:.2f} per episode\n", refinements_started);
     if (exact) fmt::print("model, exact         {:.4f}\n", exact->success_probability);
   });
 }

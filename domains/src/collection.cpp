@@ -9,8 +9,8 @@
 
 #include "ontime/domains/collection_journal.hpp"
 #include "ontime/error.hpp"
+#include "ontime/parallel.hpp"
 #include "ontime/random.hpp"
-#include "parallel.hpp"
 
 namespace ontime::domains {
 namespace {
@@ -81,7 +81,8 @@ CollectionResult collect(const Domain& domain, const CollectionOptions& options)
   std::mutex progress_mutex;
 
   // Trials an earlier, interrupted run finished: resumed[a][t].
-  std::vector<std::vector<const JournalTrial*>> resumed(tree.size(), std::vector<const JournalTrial*>(options.trials, nullptr));
+  std::vector<std::vector<const JournalTrial*>> resumed(tree.size(),
+                                                        std::vector<const JournalTrial*>(options.trials, nullptr));
   if (options.journal != nullptr) {
     for (const JournalTrial& trial : options.journal->finished()) {
       resumed.at(trial.action).at(trial.attempt.trial.value()) = &trial;
@@ -97,27 +98,31 @@ CollectionResult collect(const Domain& domain, const CollectionOptions& options)
     const std::uint64_t action_seed = stream_seed(options.seed, a);
     const std::vector<Configuration>* starts = node.parent < 0 ? nullptr : &ends[static_cast<std::size_t>(node.parent)];
     std::vector<Outcome> outcomes(options.trials);
-    detail::for_each_index(options.trials, options.threads, [&] {
-      return [&](std::uint64_t t) {
-        if (const JournalTrial* earlier = resumed[a][t]) {
-          outcomes[t] = Outcome{earlier->attempt, earlier->end};
-          return;
-        }
-        const std::uint64_t trial_seed = stream_seed(action_seed, t);
-        Configuration start;
-        if (starts == nullptr) {
-          start = domain.initial_configuration();
-        } else if (!starts->empty()) {
-          start = (*starts)[t % starts->size()];
-        } else {
-          start = domain.fallback_start(node.action, stream_seed(trial_seed, 1));
-        }
-        outcomes[t] = attempt_once(domain, node.action, start, stream_seed(trial_seed, 0), options);
-        outcomes[t].attempt.trial = t;
-        if (options.journal != nullptr) options.journal->record(JournalTrial{a, outcomes[t].attempt, outcomes[t].end});
-        if (options.progress) {
-          const std::lock_guard lock(progress_mutex);
-          options.progress(++finished, total);
+    // A trial is seconds of planning: hand them out one by one.
+    for_each_block(options.trials, options.threads, 1, [&](unsigned) {
+      return [&](std::uint64_t begin, std::uint64_t end) {
+        for (std::uint64_t t = begin; t < end; ++t) {
+          if (const JournalTrial* earlier = resumed[a][t]) {
+            outcomes[t] = Outcome{earlier->attempt, earlier->end};
+            continue;
+          }
+          const std::uint64_t trial_seed = stream_seed(action_seed, t);
+          Configuration start;
+          if (starts == nullptr) {
+            start = domain.initial_configuration();
+          } else if (!starts->empty()) {
+            start = (*starts)[t % starts->size()];
+          } else {
+            start = domain.fallback_start(node.action, stream_seed(trial_seed, 1));
+          }
+          outcomes[t] = attempt_once(domain, node.action, start, stream_seed(trial_seed, 0), options);
+          outcomes[t].attempt.trial = t;
+          if (options.journal != nullptr)
+            options.journal->record(JournalTrial{a, outcomes[t].attempt, outcomes[t].end});
+          if (options.progress) {
+            const std::lock_guard lock(progress_mutex);
+            options.progress(++finished, total);
+          }
         }
       };
     });
@@ -136,7 +141,7 @@ std::vector<std::vector<Configuration>> refine_skeleton(const Domain& domain, co
                                                         int attempts) {
   check_options(options);
   std::vector<std::vector<Configuration>> motions;  // motions[l]: the motion refined for position l
-  std::vector<Configuration> ends;                   // ends[l]: where it ended
+  std::vector<Configuration> ends;                  // ends[l]: where it ended
   std::vector<std::uint64_t> tried(skeleton.size(), 0), restarts(skeleton.size(), 0);
   while (motions.size() < skeleton.size()) {
     const std::size_t l = motions.size();

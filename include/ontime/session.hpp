@@ -12,12 +12,13 @@
 //
 // The session keeps the MDP state, asks the allocator before every step, and reports
 // success (with the skeleton to execute) or failure: the deadline passed, or no skeleton can
-// still meet it, so that no more effort is wasted. The Monte Carlo simulator drives the same
-// API with hidden sampled outcomes.
+// still meet it, so that no more effort is wasted. The episode runner (episode_runner.hpp)
+// drives the same API against a World.
 
 #include <cstdint>
 
 #include "ontime/allocator.hpp"
+#include "ontime/decision_budget.hpp"
 #include "ontime/mdp.hpp"
 
 namespace ontime {
@@ -36,7 +37,7 @@ class Session {
   // or a decision is still waiting for its report; UsageError when the allocator returns a
   // skeleton index out of range.
   Decision choose();
-  // The same within `budget` (anytime allocators; an unset budget: the allocator's own).
+  // The same within `budget` (an anytime allocator's budget for this decision; unset: its own).
   Decision choose(const DecisionBudget& budget);
 
   // Reports the outcome of the step just decided. Throws std::logic_error without a

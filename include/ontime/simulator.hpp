@@ -1,22 +1,26 @@
 #pragma once
 // Simulated episodes (SPEC §4): the true planning and execution time of every action is
 // drawn at the start of the episode and hidden from the allocator, which sees only the
-// states of a Session. All actions are drawn in a fixed order, so the same seed and episode
-// index give every allocator the same hidden world (common random numbers).
+// states of a Session. All actions are drawn in a fixed order, so the same seed gives every
+// allocator the same hidden world (common random numbers). The episode runner
+// (episode_runner.hpp) runs allocators in these worlds.
 
 #include <cstdint>
 #include <vector>
 
-#include "ontime/allocator.hpp"
 #include "ontime/mdp.hpp"
-#include "ontime/random.hpp"
+#include "ontime/world.hpp"
 
 namespace ontime {
 
-// The hidden outcomes of one episode.
-class HiddenWorld {
+// The hidden outcomes of one episode, redrawn by begin_episode.
+class HiddenWorld final : public World {
  public:
+  // The world drawn from `seed`.
   HiddenWorld(const Problem& problem, std::uint64_t seed);
+
+  void begin_episode(std::uint64_t seed) override;
+  Observation step(int action, Steps spent) override { return observe(action, spent); }
 
   Steps planning_time(int action) const { return planning_.at(static_cast<std::size_t>(action)); }
   Steps execution_time(int action) const { return execution_.at(static_cast<std::size_t>(action)); }
@@ -25,27 +29,12 @@ class HiddenWorld {
   Observation observe(int action, Steps spent) const;
 
  private:
+  const Problem* problem_;
   std::vector<Steps> planning_;
   std::vector<Steps> execution_;
 };
 
-// Receives the duration of each decision of an episode, in nanoseconds.
-class DecisionTimer {
- public:
-  virtual ~DecisionTimer() = default;
-  virtual void record(std::int64_t nanoseconds) = 0;
-};
-
-struct EpisodeResult {
-  Status status = Status::failure;
-  int solution = -1;      // skeleton executed on success
-  Steps steps_used = 0;   // steps of effort spent
-  int decisions = 0;
-};
-
-// Runs one episode of `allocator` in the hidden world drawn from `seed`; the allocator's own
-// randomness is seeded from another stream of the same seed.
-EpisodeResult run_episode(const Mdp& mdp, Allocator& allocator, std::uint64_t seed,
-                          DecisionTimer* timer = nullptr, const DecisionBudget& budget = {});
+// One hidden world per thread, for the episode runner. `problem` must outlive the worlds.
+WorldFactory hidden_worlds(const Problem& problem);
 
 }  // namespace ontime

@@ -1,0 +1,42 @@
+#pragma once
+// The world an episode happens in: what one step of refinement effort on an action reveals.
+//
+// An allocator decides which action gets the next step; a World answers "not yet" or "refined,
+// with execution time x". The hidden sampled world of the simulator (simulator.hpp) is one
+// World, a domain's real motion planner another (ontime::domains::PlannerWorld); a caller can
+// implement its own, e.g. around a planner of its own.
+//
+// One World object serves one episode at a time and is not thread-safe; it is reused from
+// episode to episode (begin_episode), so it may keep resources that are costly to build, such
+// as a planner's collision checkers. A WorldFactory makes one World per thread.
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+
+#include "ontime/mdp.hpp"
+#include "ontime/statistics.hpp"
+
+namespace ontime {
+
+class World {
+ public:
+  virtual ~World() = default;
+
+  // Starts a new episode: its outcomes are drawn from `seed` and nothing else, so that an
+  // episode does not depend on which thread ran the episodes before it.
+  virtual void begin_episode(std::uint64_t seed) = 0;
+
+  // One step of effort on `action`, which has already had `spent` steps in this episode: not
+  // yet, or refined with its execution time in steps (kNever: the motion cannot be executed).
+  // The action is one whose parent action, if any, is already refined in this episode.
+  virtual Observation step(int action, Steps spent) = 0;
+
+  // Adds this world's counters (work done since it was made, e.g. refinements started) to
+  // `statistics`; a sampled world has none.
+  virtual void collect_statistics(Statistics& statistics) const { (void)statistics; }
+};
+
+using WorldFactory = std::function<std::unique_ptr<World>()>;
+
+}  // namespace ontime
