@@ -17,4 +17,4 @@ for i in 1 2 3 4 5; do
   build/ontime train "data/instances/paper/instance$i.json" --solver ppo --episodes 10000 --seed 1 \
     --out "build/policies/instance$i.json" --no-plot
 done
-build/ontime table "${instances[@]}" --solvers mcts,dp,dp-rerun,ppo,round-robin,greedy "${policies[@]}" --exact
+build/ontime table "${instances[@]}" --solvers mcts,dp,dp-rerun,ppo,round-robin,greedy,thompson "${policies[@]}" --exact
