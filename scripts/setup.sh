@@ -11,7 +11,7 @@ packages=(
   libompl-dev libfcl-dev liborocos-kdl-dev
   libboost-serialization-dev libboost-filesystem-dev libboost-system-dev
   python3 python3-matplotlib python3-numpy
-  clang libclang-rt-14-dev
+  clang libclang-rt-14-dev clang-format
 )
 
 missing=()

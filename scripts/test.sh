@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Sets up the machine, builds OnTime with warnings as errors and runs every test; then the core
+# Sets up the machine, checks the C++ formatting (clang-format, .clang-format), builds OnTime
+# with warnings as errors and runs every test; then the core
 # alone without OMPL, FCL and KDL (build-core/: build, tests, install, consumer); then builds
 # the suite again with AddressSanitizer and UndefinedBehaviorSanitizer (build-sanitize/) and
 # runs it there too (warnings are checked by the first build; GCC warns falsely inside the
@@ -7,6 +8,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/setup.sh
+./scripts/check-format.sh
 ./scripts/build.sh -DONTIME_WARNINGS_AS_ERRORS=ON
 ctest --test-dir build --parallel "$(nproc)" --output-on-failure
 

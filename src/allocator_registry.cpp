@@ -15,15 +15,6 @@ namespace {
 constexpr Capability kAllCapabilities[] = {Capability::stationary, Capability::randomised, Capability::anytime,
                                            Capability::needs_policy, Capability::optimal};
 
-std::string range_text(const Parameter& parameter) {
-  const bool low = std::isfinite(parameter.minimum);
-  const bool high = std::isfinite(parameter.maximum);
-  if (low && high) return fmt::format(" in [{}, {}]", parameter.minimum, parameter.maximum);
-  if (low) return fmt::format(" >= {}", parameter.minimum);
-  if (high) return fmt::format(" <= {}", parameter.maximum);
-  return "";
-}
-
 // The whole text as a number of the parameter's type, or nothing.
 std::optional<double> parse_number(const Parameter& parameter, std::string_view text) {
   const char* first = text.data();
@@ -98,6 +89,17 @@ Parameter Parameter::path(std::string name, std::string help) {
   return Parameter{std::move(name), ParameterType::path, "", -kNoLimit, kNoLimit, {}, std::move(help)};
 }
 
+std::string Parameter::allowed() const {
+  if (type == ParameterType::choice) return fmt::format("one of {}", fmt::join(choices, ", "));
+  if (type != ParameterType::integer && type != ParameterType::real) return "";
+  const bool low = std::isfinite(minimum);
+  const bool high = std::isfinite(maximum);
+  if (low && high) return fmt::format("in [{}, {}]", minimum, maximum);
+  if (low) return fmt::format(">= {}", minimum);
+  if (high) return fmt::format("<= {}", maximum);
+  return "";
+}
+
 std::optional<std::string> Parameter::violation(std::string_view value) const {
   const auto rule = [&](const std::string& text) { return fmt::format("{} (got '{}')", text, value); };
   switch (type) {
@@ -105,12 +107,13 @@ std::optional<std::string> Parameter::violation(std::string_view value) const {
     case ParameterType::real: {
       const std::optional<double> number = parse_number(*this, value);
       const std::string what = type == ParameterType::integer ? "a whole number" : "a finite number";
-      if (!number || *number < minimum || *number > maximum) return rule("must be " + what + range_text(*this));
+      const std::string range = allowed();
+      if (!number || *number < minimum || *number > maximum) return rule("must be " + what + (range.empty() ? "" : " " + range));
       return std::nullopt;
     }
     case ParameterType::choice:
       if (std::find(choices.begin(), choices.end(), value) == choices.end()) {
-        return rule(fmt::format("must be one of {}", fmt::join(choices, ", ")));
+        return rule("must be " + allowed());
       }
       return std::nullopt;
     case ParameterType::path:

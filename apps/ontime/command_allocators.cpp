@@ -35,16 +35,6 @@ Json kinds_json() {
   return out;
 }
 
-std::string allowed_text(const Parameter& parameter) {
-  if (!parameter.choices.empty()) return fmt::format("{}", fmt::join(parameter.choices, ", "));
-  const bool low = std::isfinite(parameter.minimum);
-  const bool high = std::isfinite(parameter.maximum);
-  if (low && high) return fmt::format("{} to {}", parameter.minimum, parameter.maximum);
-  if (low) return fmt::format("≥ {}", parameter.minimum);
-  if (high) return fmt::format("≤ {}", parameter.maximum);
-  return "";
-}
-
 }  // namespace
 
 std::string allocators_markdown() {
@@ -57,7 +47,7 @@ std::string allocators_markdown() {
   for (const Parameter& parameter : registry.parameters()) {
     parameters.push_back({"`--" + parameter.name + "`", fmt::format("{}", fmt::join(registry.kinds_with_parameter(parameter.name), ", ")),
                           std::string(to_string(parameter.type)),
-                          parameter.default_value.empty() ? "none" : parameter.default_value, allowed_text(parameter),
+                          parameter.default_value.empty() ? "none" : parameter.default_value, parameter.allowed(),
                           parameter.help});
   }
   return render_markdown({"allocator", "capabilities", "what it does"}, kinds) + "\n" +

@@ -78,6 +78,10 @@ struct Parameter {
   std::string help;
   static constexpr double kNoLimit = std::numeric_limits<double>::infinity();
 
+  // The values allowed, in words: ">= 1", "in [0, 1]", "one of sum, max, self"; empty for
+  // free text.
+  std::string allowed() const;
+
   // The rule `value` breaks ("must be a whole number >= 1 (got '0')"), or nothing when it is of
   // the parameter's type, range and choices.
   std::optional<std::string> violation(std::string_view value) const;
