@@ -94,7 +94,7 @@ TEST(AtomicFile, AFifoIsWrittenDirectlyAndStaysAFifo) {
   EXPECT_EQ(entry_count(directory), 1U);
 }
 
-// Needs root (mknod): a copy of /dev/null in a scratch folder must stay a character device.
+// Needs root (mknod): copies of /dev/null and /dev/full in a scratch folder stay character devices.
 TEST(AtomicFile, ACharacterDeviceIsWrittenDirectlyAndStaysADevice) {
   if (::geteuid() != 0) GTEST_SKIP() << "creating a device node needs root";
   const fs::path directory = scratch("device");
@@ -102,7 +102,17 @@ TEST(AtomicFile, ACharacterDeviceIsWrittenDirectlyAndStaysADevice) {
   ASSERT_EQ(::mknod(device.c_str(), S_IFCHR | 0666, ::makedev(1, 3)), 0);
   write_file_atomically(device, "discarded");
   EXPECT_TRUE(fs::is_character_file(device));
-  EXPECT_EQ(entry_count(directory), 1U);
+  // A copy of /dev/full: every write fails for want of space, which is the user's to fix.
+  const fs::path full = directory / "full";
+  ASSERT_EQ(::mknod(full.c_str(), S_IFCHR | 0666, ::makedev(1, 7)), 0);
+  try {
+    write_file_atomically(full, "no room");
+    ADD_FAILURE() << "nothing thrown";
+  } catch (const ResourceLimitError& error) {
+    EXPECT_EQ(std::string(error.what()), full.string() + ": cannot write: No space left on device");
+  }
+  EXPECT_TRUE(fs::is_character_file(full));
+  EXPECT_EQ(entry_count(directory), 2U);
 }
 
 TEST(AtomicFile, ASymbolicLinkIsFollowed) {

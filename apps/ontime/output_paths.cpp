@@ -1,9 +1,7 @@
 #include "output_paths.hpp"
 
-#include <sys/stat.h>
 #include <unistd.h>
 
-#include <optional>
 #include <system_error>
 
 #include "ontime/error.hpp"
@@ -12,12 +10,6 @@ namespace ontime::cli {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::optional<struct stat> status_of(const fs::path& path) {
-  struct stat status {};
-  if (::stat(path.c_str(), &status) != 0) return std::nullopt;
-  return status;
-}
 
 fs::path folder_of(const fs::path& path) { return path.has_parent_path() ? path.parent_path() : fs::path("."); }
 
@@ -48,27 +40,26 @@ void check_folder(const OutputFile& output, const fs::path& folder, MissingFolde
 }
 
 void check_output(const OutputFile& output, const std::vector<fs::path>& inputs, MissingFolder missing_folder) {
-  const std::optional<struct stat> existing = status_of(output.path);
-  if (!existing) {
-    std::error_code error;
-    if (fs::is_symlink(output.path, error)) refuse(output, "is a symbolic link to a missing file");
+  std::error_code error;
+  const fs::file_status status = fs::status(output.path, error);  // a link is followed
+  if (!fs::exists(status)) {
+    if (fs::is_symlink(fs::symlink_status(output.path, error))) refuse(output, "is a symbolic link to a missing file");
     check_folder(output, folder_of(output.path), missing_folder);
     return;
   }
-  if (S_ISDIR(existing->st_mode)) refuse(output, "is a directory");
+  if (fs::is_directory(status)) refuse(output, "is a directory");
   for (const fs::path& input : inputs) {
-    const std::optional<struct stat> read = status_of(input);
-    if (read && read->st_dev == existing->st_dev && read->st_ino == existing->st_ino) {
+    // Same device and inode: another name, a hard link or a symbolic link is the same file.
+    if (fs::equivalent(input, output.path, error)) {
       refuse(output, "is the input " + input.string() + "; writing it would destroy it");
     }
   }
-  if (S_ISCHR(existing->st_mode) || S_ISFIFO(existing->st_mode)) {
+  if (fs::is_character_file(status) || fs::is_fifo(status)) {
     if (::access(output.path.c_str(), W_OK) != 0) refuse(output, "is not writable");
     return;
   }
-  if (!S_ISREG(existing->st_mode)) refuse(output, "is neither a regular file, a character device nor a FIFO");
+  if (!fs::is_regular_file(status)) refuse(output, "is neither a regular file, a character device nor a FIFO");
   // A regular file is replaced by a new file in the folder of the file itself (a link is followed).
-  std::error_code error;
   const fs::path target = fs::canonical(output.path, error);
   check_folder(output, folder_of(error ? output.path : target), missing_folder);
 }
