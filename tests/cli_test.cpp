@@ -423,7 +423,8 @@ TEST(Cli, MapDrawsTheWorldAndOneMotionPerSkeleton) {
 class OutputPaths : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir = scratch("outputs");
+    // A folder per test: ctest runs the tests of this fixture in parallel.
+    dir = scratch(std::string("outputs_") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
     instance = (dir / "instance.json").string();
     std::filesystem::copy_file(paper("figure1"), instance);
     log = (dir / "figure1.jsonl").string();
