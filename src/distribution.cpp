@@ -3,8 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <stdexcept>
 #include <string>
+
+#include "ontime/error.hpp"
 
 namespace ontime {
 
@@ -12,17 +13,17 @@ Distribution::Distribution() { finish(); }
 
 Distribution Distribution::from_pmf(std::vector<double> masses) {
   if (masses.size() > static_cast<std::size_t>(kMaxStep) + 1) {
-    throw std::invalid_argument("distribution lists steps beyond " + std::to_string(kMaxStep));
+    throw UsageError("distribution lists steps beyond " + std::to_string(kMaxStep));
   }
   double total = 0;
   for (const double mass : masses) {
     if (!(mass >= 0.0 && mass <= 1.0)) {
-      throw std::invalid_argument("probability outside [0, 1]: " + std::to_string(mass));
+      throw UsageError("probability outside [0, 1]: " + std::to_string(mass));
     }
     total += mass;
   }
   if (total > 1.0 + kSumTolerance) {
-    throw std::invalid_argument("probabilities sum to " + std::to_string(total) + " > 1");
+    throw UsageError("probabilities sum to " + std::to_string(total) + " > 1");
   }
   Distribution distribution;
   distribution.masses_ = std::move(masses);
@@ -36,7 +37,7 @@ Distribution Distribution::from_cdf(const std::vector<double>& cumulative) {
   for (std::size_t t = 0; t < cumulative.size(); ++t) {
     const double value = cumulative[t];
     if (!(value >= 0.0 && value <= 1.0 + kSumTolerance) || value < previous) {
-      throw std::invalid_argument("a CDF must be non-decreasing within [0, 1]");
+      throw UsageError("a CDF must be non-decreasing within [0, 1]");
     }
     masses[t] = value - previous;
     previous = value;

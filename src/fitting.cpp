@@ -4,7 +4,6 @@
 #include <cmath>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <stdexcept>
 #include <string>
 
 #include "ontime/error.hpp"
@@ -18,16 +17,18 @@ constexpr double kRelativeSlack = 1e-9;
 constexpr double kLargestStep = static_cast<double>(Distribution::kMaxStep) + 1;
 
 double steps_exactly(double seconds, double step_seconds) {
-  if (!(std::isfinite(step_seconds) && step_seconds > 0)) throw std::invalid_argument("the step must be a positive number of seconds");
-  if (!(seconds >= 0)) throw std::invalid_argument("a time must be a number of seconds >= 0");
+  if (!(std::isfinite(step_seconds) && step_seconds > 0)) {
+    throw UsageError("the step must be a positive number of seconds");
+  }
+  if (!(seconds >= 0)) throw UsageError("a time must be a number of seconds >= 0");
   return std::min(seconds / step_seconds, kLargestStep);
 }
 
 void check_estimation_options(Steps deadline, double laplace) {
   if (deadline < 1 || deadline > Problem::kMaxDeadline) {
-    throw std::invalid_argument("the deadline must be between 1 and " + std::to_string(Problem::kMaxDeadline) + " steps");
+    throw UsageError("the deadline must be between 1 and " + std::to_string(Problem::kMaxDeadline) + " steps");
   }
-  if (!(std::isfinite(laplace) && laplace >= 0)) throw std::invalid_argument("the Laplace smoothing alpha must be >= 0");
+  if (!(std::isfinite(laplace) && laplace >= 0)) throw UsageError("the Laplace smoothing alpha must be >= 0");
 }
 
 }  // namespace
@@ -49,7 +50,7 @@ Distribution estimate_planning(const PlanningSample& sample, Steps deadline, dou
   std::vector<double> leaving_at(size, 0.0);   // attempts last at risk at step t (cut off after t steps)
   double at_risk = 0;                          // n_1
   for (const Steps t : sample.found) {
-    if (t < 1) throw std::invalid_argument("a planning time is at least 1 step");
+    if (t < 1) throw UsageError("a planning time is at least 1 step");
     // Found after the deadline: within the deadline it only survived, like a cut-off attempt.
     if (t <= deadline) {
       found_at[static_cast<std::size_t>(t)] += 1;
@@ -59,7 +60,7 @@ Distribution estimate_planning(const PlanningSample& sample, Steps deadline, dou
     at_risk += 1;
   }
   for (const Steps c : sample.censored) {
-    if (c < 0) throw std::invalid_argument("a cut-off attempt survived at least 0 steps");
+    if (c < 0) throw UsageError("a cut-off attempt survived at least 0 steps");
     leaving_at[static_cast<std::size_t>(std::min(c, deadline))] += 1;
     at_risk += 1;
   }
@@ -83,7 +84,7 @@ Distribution estimate_execution(std::span<const Steps> execution_steps, Steps de
   const auto size = static_cast<std::size_t>(deadline) + 1;
   std::vector<double> counts(size, 0.0);
   for (const Steps x : execution_steps) {
-    if (x < 0) throw std::invalid_argument("an execution time is at least 0 steps");
+    if (x < 0) throw UsageError("an execution time is at least 0 steps");
     if (x <= deadline) counts[static_cast<std::size_t>(x)] += 1;  // beyond D: "never"
   }
   const double total = static_cast<double>(execution_steps.size()) + laplace * static_cast<double>(deadline + 2);

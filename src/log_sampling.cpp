@@ -1,7 +1,6 @@
 #include "ontime/log_sampling.hpp"
 
-#include <stdexcept>
-
+#include "ontime/error.hpp"
 #include "ontime/random.hpp"
 
 namespace ontime {
@@ -18,7 +17,7 @@ double seconds_within_step(Steps steps, double step_seconds, Generator& generato
 }  // namespace
 
 std::vector<RefinementAttempt> sample_planner_log(const Problem& problem, const LogSamplingOptions& options) {
-  if (options.cutoff_steps < 0) throw std::invalid_argument("the cut-off must be >= 0 steps");
+  if (options.cutoff_steps < 0) throw UsageError("the cut-off must be >= 0 steps");
   const Steps cutoff = options.cutoff_steps > 0 ? options.cutoff_steps : problem.deadline();
   const double step = problem.step_seconds();
   std::vector<RefinementAttempt> log;

@@ -1,8 +1,9 @@
 #include "ontime/mdp.hpp"
 
 #include <limits>
-#include <stdexcept>
 #include <string>
+
+#include "ontime/error.hpp"
 
 namespace ontime {
 namespace {
@@ -126,25 +127,25 @@ ChoiceList Mdp::useful_choices(const State& state) const noexcept {
 
 Status Mdp::apply(State& state, int choice, const Observation& observation) const {
   if (choice < 0 || choice >= skeleton_count_) {
-    throw std::invalid_argument("skeleton index " + std::to_string(choice) + " out of range [0, " +
-                                std::to_string(skeleton_count_) + ")");
+    throw UsageError("skeleton index " + std::to_string(choice) + " out of range [0, " +
+                     std::to_string(skeleton_count_) + ")");
   }
   const int action = next_action(state, choice);
+  // Checked before the state changes, so that a rejected observation leaves it as it was.
+  if (observation.refined && action < 0) {
+    throw UsageError("skeleton " + std::to_string(choice) + " has nothing left to refine; its step was idle");
+  }
+  if (observation.refined && observation.execution < 0) {
+    throw UsageError("execution time must be >= 0 steps (got " + std::to_string(observation.execution) + ")");
+  }
   ++state.time;
-  if (action < 0) {
-    if (observation.refined) {
-      throw std::invalid_argument("skeleton " + std::to_string(choice) +
-                                  " is fully refined: its step is idle and cannot refine anything");
-    }
-  } else if (!observation.refined) {
+  // An idle step (action < 0) only spends time.
+  if (action >= 0 && !observation.refined) {
     for (const int member : problem_->members(action)) {
       std::uint16_t& spent = state.spent[static_cast<std::size_t>(member)];
       if (spent <= deadline_) ++spent;
     }
-  } else {
-    if (observation.execution < 0) {
-      throw std::invalid_argument("execution time must be >= 0 steps");
-    }
+  } else if (action >= 0) {
     const std::int64_t total = observation.execution == kNever
                                    ? std::int64_t{deadline_} + 1
                                    : std::int64_t{state.execution[static_cast<std::size_t>(choice)]} + observation.execution;

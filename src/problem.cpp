@@ -3,14 +3,15 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
-#include <stdexcept>
 #include <string>
 #include <utility>
+
+#include "ontime/error.hpp"
 
 namespace ontime {
 namespace {
 
-[[noreturn]] void reject(const std::string& rule) { throw std::invalid_argument(rule); }
+[[noreturn]] void reject(const std::string& rule) { throw UsageError(rule); }
 
 }  // namespace
 

@@ -33,12 +33,6 @@ Status Session::report_refined(Steps execution_steps) { return report(Observatio
 Status Session::report(const Observation& observation) {
   if (pending_ < 0) throw std::logic_error("report without a decision: call choose() first");
   const int choice = pending_;
-  if (observation.refined && mdp_->next_action(state_, choice) < 0) {
-    throw UsageError("skeleton " + std::to_string(choice) + " has nothing left to refine; its step was idle");
-  }
-  if (observation.refined && observation.execution < 0) {
-    throw UsageError("execution time must be >= 0 steps (got " + std::to_string(observation.execution) + ")");
-  }
   const State before = state_;
   status_ = mdp_->apply(state_, choice, observation);
   pending_ = -1;

@@ -1,9 +1,11 @@
+#include "ontime/distribution.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <stdexcept>
 
-#include "ontime/distribution.hpp"
+#include "ontime/error.hpp"
 #include "ontime/random.hpp"
 
 namespace ontime {
@@ -75,14 +77,14 @@ TEST(Distribution, FromCdfDifferencesTheSteps) {
   EXPECT_DOUBLE_EQ(d.pmf(2), 0.1);
   EXPECT_DOUBLE_EQ(d.pmf(3), 0.8);
   EXPECT_NEAR(d.pmf(4), 0.1, 1e-15);
-  EXPECT_THROW(Distribution::from_cdf({0.0, 0.5, 0.4}), std::invalid_argument);
+  EXPECT_THROW(Distribution::from_cdf({0.0, 0.5, 0.4}), UsageError);
 }
 
 TEST(Distribution, RejectsInvalidMasses) {
-  EXPECT_THROW(Distribution::from_pmf({-0.1, 0.5}), std::invalid_argument);
-  EXPECT_THROW(Distribution::from_pmf({0.0, 1.5}), std::invalid_argument);
-  EXPECT_THROW(Distribution::from_pmf({0.6, 0.6}), std::invalid_argument);
-  EXPECT_THROW(Distribution::from_pmf({std::nan("")}), std::invalid_argument);
+  EXPECT_THROW(Distribution::from_pmf({-0.1, 0.5}), UsageError);
+  EXPECT_THROW(Distribution::from_pmf({0.0, 1.5}), UsageError);
+  EXPECT_THROW(Distribution::from_pmf({0.6, 0.6}), UsageError);
+  EXPECT_THROW(Distribution::from_pmf({std::nan("")}), UsageError);
   EXPECT_NO_THROW(Distribution::from_pmf({0.5, 0.5 + 1e-10}));
 }
 

@@ -180,10 +180,10 @@ TEST(Fitting, RecoversAKnownExecutionDistributionWithinTheDkwBound) {
 }
 
 TEST(Fitting, RejectsBadEstimationOptions) {
-  EXPECT_THROW(estimate_planning({{1}, {}}, 0), std::invalid_argument);
-  EXPECT_THROW(estimate_planning({{1}, {}}, 5, -1.0), std::invalid_argument);
-  EXPECT_THROW(estimate_planning({{0}, {}}, 5), std::invalid_argument);
-  EXPECT_THROW(estimate_execution(std::vector<Steps>{-1}, 5), std::invalid_argument);
+  EXPECT_THROW(estimate_planning({{1}, {}}, 0), UsageError);
+  EXPECT_THROW(estimate_planning({{1}, {}}, 5, -1.0), UsageError);
+  EXPECT_THROW(estimate_planning({{0}, {}}, 5), UsageError);
+  EXPECT_THROW(estimate_execution(std::vector<Steps>{-1}, 5), UsageError);
 }
 
 SkeletonList skeletons(std::vector<std::vector<std::string>> list) { return SkeletonList{"skeletons.json", std::move(list)}; }

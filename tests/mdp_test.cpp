@@ -1,9 +1,11 @@
+#include "ontime/mdp.hpp"
+
 #include <gtest/gtest.h>
 
 #include <stdexcept>
 #include <vector>
 
-#include "ontime/mdp.hpp"
+#include "ontime/error.hpp"
 #include "ontime/random.hpp"
 #include "support/paper.hpp"
 #include "support/random_instances.hpp"
@@ -112,10 +114,11 @@ TEST_F(FigureOne, FailsAsSoonAsNoSkeletonCanSucceed) {
 
 TEST_F(FigureOne, RejectsImpossibleObservations) {
   State state = mdp.start();
-  EXPECT_THROW(mdp.apply(state, 3, Observation::not_yet()), std::invalid_argument);
-  EXPECT_THROW(mdp.apply(state, -1, Observation::not_yet()), std::invalid_argument);
+  EXPECT_THROW(mdp.apply(state, 3, Observation::not_yet()), UsageError);
+  EXPECT_THROW(mdp.apply(state, -1, Observation::not_yet()), UsageError);
   State negative = mdp.start();
-  EXPECT_THROW(mdp.apply(negative, 0, Observation::found(-2)), std::invalid_argument);
+  EXPECT_THROW(mdp.apply(negative, 0, Observation::found(-2)), UsageError);
+  EXPECT_EQ(negative, mdp.start());  // a rejected observation changes nothing
 }
 
 TEST(Mdp, IdleStepOnAFullyRefinedSkeleton) {
@@ -134,7 +137,8 @@ TEST(Mdp, IdleStepOnAFullyRefinedSkeleton) {
   EXPECT_EQ(result[0].next.time, 2);
   EXPECT_EQ(result[0].next.refined, state.refined);
   State idle = state;
-  EXPECT_THROW(mdp.apply(idle, 0, Observation::found(1)), std::invalid_argument);
+  EXPECT_THROW(mdp.apply(idle, 0, Observation::found(1)), UsageError);
+  EXPECT_EQ(idle, state);
 }
 
 TEST(Mdp, FailsAtTheDeadline) {

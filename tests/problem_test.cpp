@@ -1,8 +1,10 @@
+#include "ontime/problem.hpp"
+
 #include <gtest/gtest.h>
 
 #include <stdexcept>
 
-#include "ontime/problem.hpp"
+#include "ontime/error.hpp"
 #include "support/paper.hpp"
 
 namespace ontime {
@@ -45,18 +47,18 @@ TEST(Problem, RejectsBrokenRules) {
   };
   EXPECT_NO_THROW(make({{0, 1}, {0, 2}}));
   EXPECT_NO_THROW(make({{0}, {0, 1}}));  // a skeleton may be a prefix of another
-  EXPECT_THROW(make({{0, 1}, {0, 1}}), std::invalid_argument);   // listed twice
-  EXPECT_THROW(make({{0, 1, 0}}), std::invalid_argument);        // repeats an action
-  EXPECT_THROW(make({{0, 1}, {2, 1}}), std::invalid_argument);   // shared after different prefixes
-  EXPECT_THROW(make({{0, 1}, {1}}), std::invalid_argument);      // shared at another position
-  EXPECT_THROW(make({{}}), std::invalid_argument);               // empty skeleton
-  EXPECT_THROW(make({{3}}), std::invalid_argument);              // unknown action
-  EXPECT_THROW(make({{0}}, 0), std::invalid_argument);           // deadline below 1
-  EXPECT_THROW(make({{0}}, Problem::kMaxDeadline + 1), std::invalid_argument);
-  EXPECT_THROW(make({}), std::invalid_argument);                 // no skeleton
-  EXPECT_THROW(Problem("p", 5, 1.0, {simple("a"), simple("a")}, {{0}}), std::invalid_argument);  // duplicate id
+  EXPECT_THROW(make({{0, 1}, {0, 1}}), UsageError);  // listed twice
+  EXPECT_THROW(make({{0, 1, 0}}), UsageError);       // repeats an action
+  EXPECT_THROW(make({{0, 1}, {2, 1}}), UsageError);  // shared after different prefixes
+  EXPECT_THROW(make({{0, 1}, {1}}), UsageError);     // shared at another position
+  EXPECT_THROW(make({{}}), UsageError);              // empty skeleton
+  EXPECT_THROW(make({{3}}), UsageError);             // unknown action
+  EXPECT_THROW(make({{0}}, 0), UsageError);          // deadline below 1
+  EXPECT_THROW(make({{0}}, Problem::kMaxDeadline + 1), UsageError);
+  EXPECT_THROW(make({}), UsageError);                                                 // no skeleton
+  EXPECT_THROW(Problem("p", 5, 1.0, {simple("a"), simple("a")}, {{0}}), UsageError);  // duplicate id
   Action zero_planning{"z", Distribution::from_pmf({0.5, 0.5}), Distribution::from_pmf({1.0})};
-  EXPECT_THROW(Problem("p", 5, 1.0, {zero_planning}, {{0}}), std::invalid_argument);
+  EXPECT_THROW(Problem("p", 5, 1.0, {zero_planning}, {{0}}), UsageError);
 }
 
 }  // namespace

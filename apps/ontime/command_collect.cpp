@@ -3,11 +3,11 @@
 // finished trial goes to a checkpoint first, so that an interrupted collection can be resumed
 // (--resume) with the same result; the checkpoint is deleted once the outputs are written.
 
-#include <filesystem>
 #include <fmt/format.h>
+
+#include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <unistd.h>
 
 #include "common.hpp"
 #include "data_paths.hpp"
@@ -15,24 +15,13 @@
 #include "ontime/domains/collection.hpp"
 #include "ontime/domains/collection_journal.hpp"
 #include "ontime/domains/registry.hpp"
-#include "ontime/error.hpp"
 #include "ontime/fitting.hpp"
 #include "ontime/instance_io.hpp"
+#include "output_paths.hpp"
+#include "thread_limit.hpp"
 
 namespace ontime::cli {
 namespace {
-
-// Creates the directory an output goes to and checks that it can be written, so that a bad
-// path stops the command before the collection, not after it.
-void prepare_output(const std::filesystem::path& path) {
-  const std::filesystem::path directory = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
-  std::error_code error;
-  std::filesystem::create_directories(directory, error);
-  if (error || ::access(directory.c_str(), W_OK) != 0) {
-    throw UsageError(path.string() + ": cannot write into " + directory.string() +
-                     (error ? " (" + error.message() + ")" : std::string(" (not writable)")));
-  }
-}
 
 std::string file_text(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -70,7 +59,10 @@ void add_collect_command(CLI::App& app) {
   command->add_option("--world", options->world, "World file (default: data/domains/DOMAIN.json)");
   command->add_option("--trials", options->trials, "Attempts per action")->check(CLI::PositiveNumber)->capture_default_str();
   command->add_option("--seed", options->seed, "Seed (trial t of action a uses stream t of stream a)")->capture_default_str();
-  command->add_option("--threads", options->threads, "Worker threads (0: one per hardware thread); the log does not depend on it")
+  command
+      ->add_option("--threads", options->threads,
+                   "Worker threads (0: one per hardware thread); the log does not depend on it")
+      ->check(CLI::Range(0U, kMaxThreads))
       ->capture_default_str();
   command->add_option("--effort", options->effort, "Effort unit: checks (deterministic) or wall (wall-clock seconds)")
       ->check(CLI::IsMember({"checks", "wall"}))
@@ -113,11 +105,11 @@ void add_collect_command(CLI::App& app) {
     collection.step_seconds = options->step_seconds > 0 ? options->step_seconds : defaults.step_seconds;
     const Steps deadline = options->deadline > 0 ? options->deadline : defaults.deadline;
     collection.budget_steps = options->budget > 0 ? options->budget : deadline;
-    prepare_output(log_path);
-    prepare_output(instance_path);
     const std::filesystem::path checkpoint_path =
         options->checkpoint.empty() ? std::filesystem::path(log_path.string() + ".checkpoint") : std::filesystem::path(options->checkpoint);
-    prepare_output(checkpoint_path);
+    // The checkpoint is read back on --resume, but it is the collection's own file, not an input.
+    check_outputs({{"--log", log_path}, {"--instance", instance_path}, {"--checkpoint", checkpoint_path}}, {world},
+                  MissingFolder::create);
     // The journal refuses this too; the command's refusal names the option that resumes.
     if (!options->resume && std::filesystem::exists(checkpoint_path)) {
       throw UsageError(checkpoint_path.string() +

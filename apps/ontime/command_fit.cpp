@@ -1,14 +1,16 @@
 // `ontime fit LOG --step S --deadline D --skeletons FILE --output INSTANCE`: learns each
 // action's planning and execution distributions from a planner log and writes the instance.
 
-#include <filesystem>
 #include <fmt/format.h>
+
+#include <filesystem>
 
 #include "common.hpp"
 #include "fit_report.hpp"
 #include "ontime/fitting.hpp"
 #include "ontime/instance_io.hpp"
 #include "ontime/planner_log.hpp"
+#include "output_paths.hpp"
 
 namespace ontime::cli {
 
@@ -46,6 +48,7 @@ void add_fit_command(CLI::App& app) {
   command->callback([options] {
     const SkeletonList skeletons = load_skeleton_file(options->skeletons);
     const std::vector<RefinementAttempt> attempts = load_planner_log(options->log);
+    check_outputs({{"--output", options->output}}, {options->log, options->skeletons});
     FitOptions fit_options;
     fit_options.step_seconds = options->step_seconds;
     fit_options.deadline = options->deadline;

@@ -1,14 +1,16 @@
 // `ontime map --domain NAME`: a picture of the domain's world with one refined motion per
 // skeleton. The drawing primitives are written first as JSON beside the PNG.
 
-#include <filesystem>
 #include <fmt/format.h>
+
+#include <filesystem>
 
 #include "common.hpp"
 #include "data_paths.hpp"
 #include "ontime/atomic_file.hpp"
 #include "ontime/domains/collection.hpp"
 #include "ontime/domains/registry.hpp"
+#include "output_paths.hpp"
 #include "python_runner.hpp"
 
 namespace ontime::cli {
@@ -45,6 +47,11 @@ void add_map_command(CLI::App& app) {
     settings.step_seconds = loaded.defaults.collection.step_seconds;
     settings.budget_steps = loaded.defaults.collection.deadline;
     settings.effort.checks_per_second = loaded.defaults.collection.checks_per_second;
+    const std::filesystem::path png = options->output.empty() ? std::filesystem::path(options->domain + "-map.png")
+                                                              : std::filesystem::path(options->output);
+    std::filesystem::path data = png;
+    data.replace_extension(".json");
+    check_outputs({{"--output", png}, {"--output (drawing)", data}}, {world});
 
     const domains::Scene scene = domain.scene();
     Json drawing;
@@ -68,10 +75,6 @@ void add_map_command(CLI::App& app) {
                                   {"points", points_json(points)},
                                   {"end", points_json(domain.outline(last.back()))}});
     }
-    const std::filesystem::path png = options->output.empty() ? std::filesystem::path(options->domain + "-map.png")
-                                                              : std::filesystem::path(options->output);
-    std::filesystem::path data = png;
-    data.replace_extension(".json");
     write_file_atomically(data, drawing.dump(1) + "\n");
     run_python_script("plot_map.py", {"--data", data.string(), "--output", png.string()});
     fmt::print("Wrote {} (data: {}).\n", png.string(), data.string());

@@ -2,12 +2,14 @@
 // paper's Appendix C), "never" as a bar of its own, in one PNG. The plotted numbers are
 // written first, as CSV beside the PNG, so they survive a missing plotting stack.
 
-#include <filesystem>
 #include <fmt/format.h>
+
+#include <filesystem>
 
 #include "common.hpp"
 #include "ontime/atomic_file.hpp"
 #include "ontime/instance_io.hpp"
+#include "output_paths.hpp"
 #include "python_runner.hpp"
 
 namespace ontime::cli {
@@ -53,6 +55,7 @@ void add_plot_command(CLI::App& app) {
                                     : std::filesystem::path(options->output);
     std::filesystem::path csv = png;
     csv.replace_extension(".csv");
+    check_outputs({{"--output", png}, {"--output (plotted data)", csv}}, {options->instance});
     write_file_atomically(csv, histogram_csv(problem));
     run_python_script("plot_histograms.py",
                       {"--data", csv.string(), "--output", png.string(), "--title",

@@ -6,6 +6,7 @@
 #include "common.hpp"
 #include "ontime/instance_io.hpp"
 #include "ontime/knapsack.hpp"
+#include "output_paths.hpp"
 
 namespace ontime::cli {
 
@@ -28,6 +29,7 @@ void add_reduce_knapsack_command(CLI::App& app) {
       fmt::print("{}", problem_to_json(problem));
       return;
     }
+    check_outputs({{"--out", options->out}}, {options->knapsack});
     save_problem(problem, options->out);
     fmt::print("wrote {}: {} single-action skeletons, deadline {}, eps = 1/(H^2 K^3) = {:.6g}\n", options->out,
                problem.skeleton_count(), problem.deadline(), reduction_epsilon(knapsack));

@@ -7,6 +7,7 @@
 #include "ontime/instance_io.hpp"
 #include "ontime/log_sampling.hpp"
 #include "ontime/planner_log.hpp"
+#include "output_paths.hpp"
 
 namespace ontime::cli {
 
@@ -30,6 +31,7 @@ void add_sample_log_command(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   command->callback([options] {
     const Problem problem = load_problem(options->instance);
+    check_outputs({{"--output", options->output}}, {options->instance});
     const std::vector<RefinementAttempt> log = sample_planner_log(problem, options->sampling);
     save_planner_log(log, options->output);
     fmt::print("Wrote {} records ({} attempts per action, seed {}) to {}.\n", log.size(),

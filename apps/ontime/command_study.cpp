@@ -2,8 +2,9 @@
 // the paper's Figs. 4-6. Each writes a CSV (atomically) and a PNG drawn from it, and prints
 // where they are.
 
-#include <filesystem>
 #include <fmt/format.h>
+
+#include <filesystem>
 #include <limits>
 
 #include "common.hpp"
@@ -11,7 +12,9 @@
 #include "ontime/error.hpp"
 #include "ontime/experiments.hpp"
 #include "ontime/instance_io.hpp"
+#include "output_paths.hpp"
 #include "python_runner.hpp"
+#include "thread_limit.hpp"
 
 namespace ontime::cli {
 namespace {
@@ -54,22 +57,29 @@ std::vector<double> parse_multipliers(const std::string& text) {
   return values;
 }
 
-// Loads every instance first, so that a bad file stops the study before any computation.
-std::vector<Problem> load_all(const std::vector<std::string>& paths) {
+// The CSV and PNG a study writes into --out: DIR/STEM.csv and DIR/STEM.png.
+std::filesystem::path output_of(const StudyOptions& options, const std::string& kind, const char* extension) {
+  const std::string stem = kind == "compute-time" ? "compute_time" : kind == "equal-time" ? "equal_time" : "anytime";
+  return std::filesystem::path(options.out) / (stem + extension);
+}
+
+// Loads every instance and checks the outputs (creating --out) first, so that a bad file or
+// path stops the study before any computation.
+std::vector<Problem> prepare(const StudyOptions& options, const std::string& kind) {
   std::vector<Problem> problems;
-  for (const std::string& path : paths) problems.push_back(load_problem(path));
+  for (const std::string& path : options.instances) problems.push_back(load_problem(path));
+  std::vector<OutputFile> outputs{{"--out", output_of(options, kind, ".csv")}};
+  if (!options.no_plot) outputs.push_back({"--out", output_of(options, kind, ".png")});
+  check_outputs(outputs, {options.instances.begin(), options.instances.end()}, MissingFolder::create);
   return problems;
 }
 
 void finish(const StudyOptions& options, const std::string& kind, const std::string& csv) {
-  const std::filesystem::path directory(options.out);
-  std::filesystem::create_directories(directory);
-  const std::string stem = kind == "compute-time" ? "compute_time" : kind == "equal-time" ? "equal_time" : "anytime";
-  const std::string csv_path = (directory / (stem + ".csv")).string();
+  const std::string csv_path = output_of(options, kind, ".csv").string();
   write_file_atomically(csv_path, csv);
   fmt::print("wrote {}\n", csv_path);
   if (options.no_plot) return;
-  const std::string png_path = (directory / (stem + ".png")).string();
+  const std::string png_path = output_of(options, kind, ".png").string();
   run_python_script("plot_study.py", {kind, csv_path, png_path});
   fmt::print("wrote {}\n", png_path);
 }
@@ -89,7 +99,7 @@ StudySettings settings_of(const StudyOptions& options, ProgressBar& bar, std::si
 }
 
 void run_compute_time(const StudyOptions& options) {
-  const std::vector<Problem> problems = load_all(options.instances);
+  const std::vector<Problem> problems = prepare(options, "compute-time");
   std::string csv =
       "instance,solver,episodes,success_rate,ci95,mean_episode_seconds,median_episode_seconds,"
       "p99_episode_seconds,mean_decision_seconds,iterations_per_search\n";
@@ -110,7 +120,7 @@ void run_compute_time(const StudyOptions& options) {
 }
 
 void run_equal_time(const StudyOptions& options) {
-  const std::vector<Problem> problems = load_all(options.instances);
+  const std::vector<Problem> problems = prepare(options, "equal-time");
   std::string csv =
       "instance,episodes,dp_rerun_decision_seconds,dp_rerun_success_rate,dp_rerun_ci95,mcts_success_rate,"
       "mcts_ci95,mcts_iterations_per_search\n";
@@ -127,7 +137,7 @@ void run_equal_time(const StudyOptions& options) {
 
 void run_anytime(const StudyOptions& options) {
   const std::vector<double> multipliers = parse_multipliers(options.multipliers);
-  const std::vector<Problem> problems = load_all(options.instances);
+  const std::vector<Problem> problems = prepare(options, "anytime");
   std::string csv =
       "instance,episodes,log10_multiplier,seconds_per_decision,success_rate,ci95,iterations_per_search,"
       "dp_rerun_decision_seconds,dp_rerun_success_rate,optimum\n";
@@ -161,6 +171,7 @@ void add_study_command(CLI::App& app) {
         ->capture_default_str();
     command->add_option("--seed", options->seed, "Seed of the hidden worlds")->capture_default_str();
     command->add_option("--threads", options->threads, "Worker threads (0: one per hardware thread)")
+        ->check(CLI::Range(0U, kMaxThreads))
         ->capture_default_str();
     command->add_flag("--no-plot", options->no_plot, "Write the CSV only");
     command

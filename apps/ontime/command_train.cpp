@@ -2,15 +2,17 @@
 // episodes, writes it (atomically) with its learning curve (CSV and PNG), and reports the exact
 // success probability of the trained policy.
 
+#include <fmt/format.h>
+
 #include <chrono>
 #include <filesystem>
-#include <fmt/format.h>
 
 #include "common.hpp"
 #include "ontime/atomic_file.hpp"
 #include "ontime/error.hpp"
 #include "ontime/instance_io.hpp"
 #include "ontime/ppo_training.hpp"
+#include "output_paths.hpp"
 #include "python_runner.hpp"
 
 namespace ontime::cli {
@@ -37,12 +39,18 @@ void add_train_command(CLI::App& app) {
   command->callback([options] {
     const Problem problem = load_problem(options->instance);
     const Mdp mdp(problem);
+    const std::filesystem::path policy_path(options->out);
+    std::filesystem::path curve_csv = policy_path;
+    curve_csv.replace_extension(".curve.csv");
+    std::filesystem::path curve_png = policy_path;
+    curve_png.replace_extension(".curve.png");
+    std::vector<OutputFile> outputs{{"--out", policy_path}, {"--out (learning curve)", curve_csv}};
+    if (!options->no_plot) outputs.push_back({"--out (learning curve plot)", curve_png});
+    check_outputs(outputs, {options->instance}, MissingFolder::create);
     ProgressBar bar("train ppo");
     const PpoTraining training =
         train_ppo(mdp, options->episodes, options->seed, PpoHyperparameters{},
                   [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); });
-    const std::filesystem::path policy_path(options->out);
-    if (policy_path.has_parent_path()) std::filesystem::create_directories(policy_path.parent_path());
     save_ppo_policy(training.policy, policy_path);
 
     std::string csv = "epoch,episodes,steps,success_rate,mean_episode_length,actor_steps,seconds\n";
@@ -50,11 +58,7 @@ void add_train_command(CLI::App& app) {
       csv += fmt::format("{},{},{},{},{},{},{:.6f}\n", point.epoch, point.episodes, point.steps, point.success_rate,
                          point.mean_episode_length, point.actor_steps, point.seconds);
     }
-    std::filesystem::path curve_csv = policy_path;
-    curve_csv.replace_extension(".curve.csv");
     write_file_atomically(curve_csv, csv);
-    std::filesystem::path curve_png = policy_path;
-    curve_png.replace_extension(".curve.png");
     if (!options->no_plot) run_python_script("plot_learning_curve.py", {curve_csv.string(), curve_png.string()});
 
     PpoAllocator trained(mdp, std::make_shared<const PpoPolicy>(training.policy));

@@ -1,14 +1,19 @@
 #pragma once
 // Writing output files so that an interruption never leaves a half-written file: the content
 // goes to a temporary file in the same directory, is flushed, and is renamed over the target.
+// Only regular files (or paths that do not exist yet) are replaced that way: a character
+// device or a FIFO (/dev/null, a named pipe) is opened and written directly, so it stays what
+// it is. A symbolic link is followed: the file it points to is replaced, the link is kept.
 
 #include <filesystem>
 #include <string_view>
 
 namespace ontime {
 
-// Throws std::runtime_error (with the path and the system's reason) when writing fails; the
-// target is then left as it was.
+// Throws UsageError (with the path and the system's reason) when the file cannot be created or
+// replaced where asked (a missing or unwritable folder, a directory in the way, a dangling
+// link), ResourceLimitError when the disk or quota is full, std::runtime_error for any other
+// failure of the system; the target is then left as it was.
 void write_file_atomically(const std::filesystem::path& path, std::string_view content);
 
 }  // namespace ontime

@@ -29,13 +29,13 @@ class Distribution {
   // All mass on "never".
   Distribution();
 
-  // masses[t] is the probability of exactly t steps. Throws std::invalid_argument when a
+  // masses[t] is the probability of exactly t steps. Throws UsageError when a
   // mass is negative, NaN or above 1, when they sum above 1 + kSumTolerance, or when the
   // table is longer than kMaxStep + 1. Input files are validated before this with the
   // place of each error; this check guards programmatic use.
   static Distribution from_pmf(std::vector<double> masses);
 
-  // cumulative[t] is P(T <= t). Throws std::invalid_argument when it decreases or leaves [0, 1].
+  // cumulative[t] is P(T <= t). Throws UsageError when it decreases or leaves [0, 1].
   static Distribution from_cdf(const std::vector<double>& cumulative);
 
   double pmf(Steps t) const noexcept;

@@ -28,7 +28,8 @@ class InputError : public std::runtime_error {
 };
 
 // A request that cannot be served as asked: an unknown allocator name, an option out of
-// range, an exact evaluation of an allocator whose choices are not a function of the state.
+// range, an exact evaluation of an allocator whose choices are not a function of the state,
+// an invalid problem or observation built in code, an output path that cannot be written.
 class UsageError : public std::invalid_argument {
  public:
   using std::invalid_argument::invalid_argument;
@@ -37,8 +38,9 @@ class UsageError : public std::invalid_argument {
 // The error for a name that is not one of `known`: "unknown WHAT 'NAME' (known: a, b, c)".
 UsageError unknown_name_error(std::string_view what, std::string_view name, std::span<const std::string> known);
 
-// A computation reached a cap the caller configured (states, memory) before finishing.
-// Raised instead of letting the process be killed for running out of memory.
+// A computation reached a cap the caller configured (states, memory) before finishing, or a
+// file could not be written for want of disk space or quota. Raised instead of letting the
+// process be killed for running out of memory.
 class ResourceLimitError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;

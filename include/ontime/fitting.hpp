@@ -43,7 +43,7 @@ struct PlanningSample {
   std::vector<Steps> censored;  // steps survived by each attempt cut off without a motion, >= 0
 };
 
-// The estimators described above. Throws std::invalid_argument for a deadline out of range,
+// The estimators described above. Throws UsageError for a deadline out of range,
 // a negative alpha, or observations out of range.
 Distribution estimate_planning(const PlanningSample& sample, Steps deadline, double laplace = 0);
 Distribution estimate_execution(std::span<const Steps> execution_steps, Steps deadline, double laplace = 0);

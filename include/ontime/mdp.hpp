@@ -66,8 +66,8 @@ class Mdp {
   }
 
   // Applies one step of effort on skeleton `choice` with its observed result, in place.
-  // Throws std::invalid_argument when the observation is impossible (a refinement reported
-  // for an idle choice, a negative execution time).
+  // Throws UsageError when the choice or the observation is impossible (a refinement reported
+  // for an idle choice, a negative execution time); `state` is then left as it was.
   Status apply(State& state, int choice, const Observation& observation) const;
 
   // The skeleton that succeeded in the last `apply` that returned success: the lowest-index

@@ -27,7 +27,7 @@ class Problem {
   static constexpr int kMaxSkeletons = 16;        // fixed-size MDP states (see State)
   static constexpr int kMaxSkeletonLength = 255;  // l_k is stored in 8 bits
 
-  // skeletons[k] lists indices into `actions`. Throws std::invalid_argument when a rule of
+  // skeletons[k] lists indices into `actions`. Throws UsageError when a rule of
   // SPEC §1 is broken (bad deadline, empty or repeating skeleton, duplicate skeleton, sharing
   // that does not follow a common prefix, planning mass at step 0, too many skeletons).
   Problem(std::string name, Steps deadline, double step_seconds, std::vector<Action> actions,
