@@ -7,22 +7,38 @@ compute-time (Fig. 4): total decision time per episode of mcts and dp-rerun, log
 equal-time   (Fig. 5): success of dp-rerun and of mcts held to dp-rerun's time per decision.
 anytime      (Fig. 6): mcts success against log10 of the time multiplier, one panel per
                         instance, the exact optimum and dp-rerun as horizontal lines.
+
+Instance labels are shortened for drawing. Exit statuses: see ontime_plotting.
 """
 
-import csv
 import sys
 
-import matplotlib
+# Sets the Agg backend: import it first.
+from ontime_plotting import BadInput, bad_input, number, read_csv_rows, run, save_atomically, shorten
 
-matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 COLORS = {"mcts": "#c0504d", "dp-rerun": "#4f81bd", "optimum": "#333333"}
 
 
-def read_rows(path):
-    with open(path, newline="") as handle:
-        return list(csv.DictReader(handle))
+COLUMNS = {
+    "compute-time": ["instance", "solver", "mean_episode_seconds", "success_rate"],
+    "equal-time": ["instance", "dp_rerun_success_rate", "dp_rerun_ci95", "mcts_success_rate", "mcts_ci95",
+                   "dp_rerun_decision_seconds"],
+    "anytime": ["instance", "log10_multiplier", "success_rate", "ci95", "optimum", "dp_rerun_success_rate",
+                "dp_rerun_decision_seconds"],
+}
+
+
+def read_rows(path, kind):
+    """The rows, every number column checked, instance labels shortened for drawing."""
+    rows = read_csv_rows(path, COLUMNS[kind])
+    for row_number, row in enumerate(rows, 1):
+        for column in COLUMNS[kind]:
+            if column not in ("instance", "solver"):
+                number(path, row_number, column, row[column])
+        row["instance"] = shorten(row["instance"], 30)
+    return rows
 
 
 def instances_in_order(rows):
@@ -40,7 +56,9 @@ def compute_time(rows, png):
     for offset, solver in ((-width / 2, "mcts"), (width / 2, "dp-rerun")):
         values, labels = [], []
         for instance in instances:
-            row = next(r for r in rows if r["instance"] == instance and r["solver"] == solver)
+            row = next((r for r in rows if r["instance"] == instance and r["solver"] == solver), None)
+            if row is None:
+                raise BadInput(f"no {solver} row for instance {instance}")
             values.append(float(row["mean_episode_seconds"]))
             labels.append(f'{float(row["success_rate"]):.2f}')
         positions = [i + offset for i in range(len(instances))]
@@ -54,7 +72,7 @@ def compute_time(rows, png):
     ax.set_title("Meta-level computation per episode (labels: success rate)")
     ax.legend()
     fig.tight_layout()
-    fig.savefig(png, dpi=130)
+    save_atomically(fig, png, dpi=130)
 
 
 def equal_time(rows, png):
@@ -73,7 +91,7 @@ def equal_time(rows, png):
     ax.set_title("Same time per decision as dp-rerun (below each instance)")
     ax.legend()
     fig.tight_layout()
-    fig.savefig(png, dpi=130)
+    save_atomically(fig, png, dpi=130)
 
 
 def anytime(rows, png):
@@ -104,20 +122,18 @@ def anytime(rows, png):
         axes[index // columns][index % columns].axis("off")
     fig.suptitle("mcts with 10^m times dp-rerun's time per decision")
     fig.tight_layout()
-    fig.savefig(png, dpi=130)
+    save_atomically(fig, png, dpi=130)
 
 
-def main(argv):
-    if len(argv) != 4 or argv[1] not in ("compute-time", "equal-time", "anytime"):
-        sys.stderr.write(__doc__)
-        return 2
-    rows = read_rows(argv[2])
+def main():
+    argv = sys.argv
+    if len(argv) != 4 or argv[1] not in COLUMNS:
+        raise BadInput("usage: plot_study.py compute-time|equal-time|anytime CSV PNG")
+    rows = read_rows(argv[2], argv[1])
     if not rows:
-        sys.stderr.write(f"{argv[2]}: no rows to plot\n")
-        return 2
+        raise bad_input(argv[2], "no rows to plot")
     {"compute-time": compute_time, "equal-time": equal_time, "anytime": anytime}[argv[1]](rows, argv[3])
-    return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    run(main)
