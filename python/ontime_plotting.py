@@ -1,5 +1,5 @@
 """Shared by the plotting scripts: matplotlib on the Agg backend, atomic PNG output, labels
-shortened for drawing, and one-line errors.
+shortened (and escaped) for drawing, and one-line errors.
 
 Exit statuses of every script: 0 drawn; 65 (sysexits' EX_DATAERR) the input data is bad
 (unreadable, a missing column, a value that is not a number): the user can fix it; 70
@@ -44,6 +44,12 @@ def shorten(text, limit=LABEL_CHARACTERS):
     """`text` cut to at most `limit` characters, an ellipsis marking the cut."""
     text = str(text)
     return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+def label(text, limit=LABEL_CHARACTERS):
+    """`text` shortened for drawing, its dollar signs escaped: matplotlib reads text between two
+    of them as mathematical notation and fails on most ids that contain them."""
+    return shorten(text, limit).replace("$", r"\$")
 
 
 def bad_input(path, what):

@@ -15,7 +15,7 @@ import collections
 import math
 
 # Sets the Agg backend: import it first.
-from ontime_plotting import TITLE_CHARACTERS, bad_input, number, read_csv_rows, run, save_atomically, shorten
+from ontime_plotting import TITLE_CHARACTERS, bad_input, label, number, read_csv_rows, run, save_atomically
 
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.ticker import MaxNLocator  # noqa: E402
@@ -79,7 +79,7 @@ def main():
     arguments = parser.parse_args()
 
     histograms = read_histograms(arguments.data)
-    title = shorten(arguments.title, TITLE_CHARACTERS)
+    title = label(arguments.title, TITLE_CHARACTERS)
     if len(histograms) > MAX_ACTIONS_DRAWN:
         title += f" (first {MAX_ACTIONS_DRAWN} of {len(histograms)} actions; all are in the CSV)"
         histograms = collections.OrderedDict(list(histograms.items())[:MAX_ACTIONS_DRAWN])
@@ -96,7 +96,7 @@ def main():
             axes = grid[row][2 * pair + column]
             axes.set_visible(True)
             masses, never = distributions.get(kind, [{}, 1.0])
-            draw_panel(axes, masses, never, arguments.deadline, colour, f"{shorten(action, 32)}: {kind}", first_step)
+            draw_panel(axes, masses, never, arguments.deadline, colour, f"{label(action, 32)}: {kind}", first_step)
             if row == rows - 1 or index + pairs_per_row >= len(histograms):
                 axes.set_xlabel("steps", fontsize=7)
     figure.suptitle(title, fontsize=11)

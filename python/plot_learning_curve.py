@@ -12,14 +12,14 @@ import os
 import sys
 
 # Sets the Agg backend: import it first.
-from ontime_plotting import BadInput, bad_input, number, read_csv_rows, run, save_atomically, shorten
+from ontime_plotting import BadInput, bad_input, label, number, read_csv_rows, run, save_atomically
 
 import matplotlib.pyplot as plt  # noqa: E402
 
 
-def label_of(path):
+def curve_label(path):
     name = os.path.basename(path)
-    return shorten(name[: -len(".curve.csv")] if name.endswith(".curve.csv") else os.path.splitext(name)[0])
+    return label(name[: -len(".curve.csv")] if name.endswith(".curve.csv") else os.path.splitext(name)[0])
 
 
 def main():
@@ -33,7 +33,7 @@ def main():
             raise bad_input(path, "no epochs to plot")
         episodes = [number(path, i, "episodes", row["episodes"], int) for i, row in enumerate(rows, 1)]
         success = [number(path, i, "success_rate", row["success_rate"]) for i, row in enumerate(rows, 1)]
-        ax.plot(episodes, success, marker=".", label=label_of(path))
+        ax.plot(episodes, success, marker=".", label=curve_label(path))
     ax.set_xlabel("training episodes")
     ax.set_ylabel("success rate of the epoch's episodes")
     ax.set_ylim(0, 1.05)

@@ -13,7 +13,7 @@ ontime_plotting.
 import argparse
 
 # Sets the Agg backend: import it first.
-from ontime_plotting import TITLE_CHARACTERS, bad_input, read_json, run, save_atomically, shorten
+from ontime_plotting import TITLE_CHARACTERS, bad_input, label, read_json, run, save_atomically
 
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.patches import Polygon  # noqa: E402
@@ -30,11 +30,11 @@ STYLE = {
 PATH_COLOURS = ["#1f77b4", "#d62728", "#9467bd", "#ff7f0e", "#17becf", "#8c564b", "#e377c2", "#7f7f7f"]
 
 
-def label(axes, polygon):
+def draw_label(axes, polygon):
     xs = [point[0] for point in polygon["points"]]
     ys = [point[1] for point in polygon["points"]]
     kind = polygon["kind"]
-    text = shorten(polygon["label"], 30)
+    text = label(polygon["label"], 30)
     if kind == "room":
         # Rooms are labelled in their top-left corner, clear of furniture in the middle.
         axes.text(min(xs) + 0.15, max(ys) - 0.15, text, ha="left", va="top", fontsize=12, color="#7a7a7a",
@@ -51,7 +51,7 @@ def draw(axes, polygons):
     for polygon in polygons:
         axes.add_patch(Polygon(polygon["points"], closed=True, **STYLE.get(polygon["kind"], STYLE["obstacle"])))
         if polygon["label"]:
-            label(axes, polygon)
+            draw_label(axes, polygon)
     xs = [point[0] for polygon in polygons for point in polygon["points"]]
     ys = [point[1] for polygon in polygons for point in polygon["points"]]
     axes.set_xlim(min(xs) - 0.2, max(xs) + 0.2)
@@ -106,10 +106,10 @@ def main():
     for index, path in enumerate(drawing["paths"]):
         colour = PATH_COLOURS[index % len(PATH_COLOURS)]
         axes.plot([point[0] for point in path["points"]], [point[1] for point in path["points"]], color=colour,
-                  linewidth=1.8, label=shorten(path["label"]), zorder=3)
+                  linewidth=1.8, label=label(path["label"]), zorder=3)
         axes.add_patch(Polygon(path["end"], closed=True, facecolor=colour, edgecolor=colour, alpha=0.35, zorder=3))
     axes.set_ylabel("y (m)")
-    axes.set_title(shorten(drawing["title"], TITLE_CHARACTERS) + (" — seen from above" if front else ""))
+    axes.set_title(label(drawing["title"], TITLE_CHARACTERS) + (" — seen from above" if front else ""))
     if drawing["paths"]:
         axes.legend(loc="upper center", bbox_to_anchor=(0.5, -0.07 if not front else -0.12), ncol=2, fontsize=8,
                     frameon=False)

@@ -14,7 +14,7 @@ Instance labels are shortened for drawing. Exit statuses: see ontime_plotting.
 import sys
 
 # Sets the Agg backend: import it first.
-from ontime_plotting import BadInput, bad_input, number, read_csv_rows, run, save_atomically, shorten
+from ontime_plotting import BadInput, bad_input, label, number, read_csv_rows, run, save_atomically, shorten
 
 import matplotlib.pyplot as plt  # noqa: E402
 
@@ -31,13 +31,12 @@ COLUMNS = {
 
 
 def read_rows(path, kind):
-    """The rows, every number column checked, instance labels shortened for drawing."""
+    """The rows, every number column checked."""
     rows = read_csv_rows(path, COLUMNS[kind])
     for row_number, row in enumerate(rows, 1):
         for column in COLUMNS[kind]:
             if column not in ("instance", "solver"):
                 number(path, row_number, column, row[column])
-        row["instance"] = shorten(row["instance"], 30)
     return rows
 
 
@@ -58,16 +57,16 @@ def compute_time(rows, png):
         for instance in instances:
             row = next((r for r in rows if r["instance"] == instance and r["solver"] == solver), None)
             if row is None:
-                raise BadInput(f"no {solver} row for instance {instance}")
+                raise BadInput(f"no {solver} row for instance {shorten(instance)}")
             values.append(float(row["mean_episode_seconds"]))
             labels.append(f'{float(row["success_rate"]):.2f}')
         positions = [i + offset for i in range(len(instances))]
         bars = ax.bar(positions, values, width, label=solver, color=COLORS[solver])
-        for bar, label in zip(bars, labels):
-            ax.annotate(label, (bar.get_x() + bar.get_width() / 2, bar.get_height()), ha="center",
+        for bar, rate in zip(bars, labels):
+            ax.annotate(rate, (bar.get_x() + bar.get_width() / 2, bar.get_height()), ha="center",
                         va="bottom", fontsize=8)
     ax.set_yscale("log")
-    ax.set_xticks(range(len(instances)), instances)
+    ax.set_xticks(range(len(instances)), [label(instance, 30) for instance in instances])
     ax.set_ylabel("decision time per episode (s, log scale)")
     ax.set_title("Meta-level computation per episode (labels: success rate)")
     ax.legend()
@@ -84,7 +83,7 @@ def equal_time(rows, png):
         errors = [float(row[f"{prefix}_ci95"]) for row in rows]
         positions = [i + offset for i in range(len(instances))]
         ax.bar(positions, rates, width, yerr=errors, capsize=3, label=solver, color=COLORS[solver])
-    labels = [f'{row["instance"]}\n{float(row["dp_rerun_decision_seconds"]) * 1e9:.0f} ns' for row in rows]
+    labels = [f'{label(row["instance"], 30)}\n{float(row["dp_rerun_decision_seconds"]) * 1e9:.0f} ns' for row in rows]
     ax.set_xticks(range(len(instances)), labels)
     ax.set_ylim(0, 1.05)
     ax.set_ylabel("success rate (95% interval)")
@@ -112,7 +111,7 @@ def anytime(rows, png):
         ax.axhline(float(points[0]["dp_rerun_success_rate"]), color=COLORS["dp-rerun"], linestyle=":",
                    label="dp-rerun")
         base = float(points[0]["dp_rerun_decision_seconds"])
-        ax.set_title(f"{instance} (base {base * 1e9:.0f} ns)", fontsize=10)
+        ax.set_title(f"{label(instance, 30)} (base {base * 1e9:.0f} ns)", fontsize=10)
         ax.set_xlabel("log10 time multiplier")
         ax.set_ylabel("success rate")
         ax.set_ylim(0, 1.05)

@@ -500,13 +500,14 @@ std::string instance4_renamed(const std::string& id, const std::string& name) {
   return instance.dump();
 }
 
-// Valid instances whatever the length of their ids and name: the labels are shortened for drawing,
-// the data CSV keeps them whole.
+// Valid instances whatever their ids and name: the labels are shortened for drawing (and their dollar
+// signs escaped: matplotlib reads $...$ as mathematical notation), the data CSV keeps them whole.
 TEST(Cli, PlotDrawsInstancesWithHugeIdsAndNames) {
   const std::filesystem::path dir = scratch("plot_long");
   const std::vector<std::pair<std::string, std::string>> cases{{std::string(65'536, 'a'), std::string(1'000'000, 'n')},
                                                                {std::string(1'000'000, 'b'), "short"},
-                                                               {"a1_1", std::string(10'000'000, 'm')}};
+                                                               {"a1_1", std::string(10'000'000, 'm')},
+                                                               {"a$\\foo$", "cost $5 $\\nope$"}};
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const std::string instance = (dir / ("long" + std::to_string(i) + ".json")).string();
     std::ofstream(instance) << instance4_renamed(cases[i].first, cases[i].second);
