@@ -6,7 +6,7 @@ Reads the CSV that `ontime plot` writes (action,distribution,step,probability; s
 for the mass beyond every deadline) and draws one panel per action and distribution, planning
 and execution side by side, into one PNG (written to a temporary file, then renamed). Labels
 are shortened; at most MAX_ACTIONS_DRAWN actions are drawn (the title says so), and long step
-ranges are drawn as one outline instead of a bar per step, so that any valid instance gives a
+ranges are drawn as one line per step with mass instead of a bar per step, so that any valid instance gives a
 figure of bounded size. Exit statuses: see ontime_plotting.
 """
 
@@ -23,8 +23,8 @@ from matplotlib.ticker import MaxNLocator  # noqa: E402
 PLANNING_COLOUR = "#3b6ea8"
 EXECUTION_COLOUR = "#d08a2c"
 NEVER_COLOUR = "#9b2f2f"
-MAX_ACTIONS_DRAWN = 48  # 12 rows of 4 panels
-MAX_BARS = 120  # steps drawn as separate bars; more are drawn as one outline
+MAX_ACTIONS_DRAWN = 32  # 16 rows of 4 panels
+MAX_BARS = 120  # steps drawn as separate bars; more are drawn as lines
 
 
 def read_histograms(path):
@@ -49,14 +49,17 @@ def draw_panel(axes, masses, never, deadline, colour, title, first_step):
     last = max([deadline] + list(masses))
     steps = list(range(first_step, last + 1))
     heights = [masses.get(step, 0.0) for step in steps]
-    never_position = last + 2 + len(steps) // 50  # clear of the last step at any scale
+    margin = len(steps) // 50  # keeps the first and last steps clear of the frame at any scale
+    never_position = last + 2 + margin
     if len(steps) <= MAX_BARS:
         axes.bar(steps, heights, width=0.85, color=colour)
         ticks = [step for step in steps if step % 5 == 0 or step == first_step]
     else:
-        axes.stairs(heights, [step - 0.5 for step in steps] + [last + 0.5], fill=True, color=colour)
-        locator = MaxNLocator(nbins=6, integer=True)
-        ticks = [int(tick) for tick in locator.tick_values(first_step, last) if first_step <= tick <= last]
+        # One line per step with mass: a single artist, and a lone spike stays visible at any width.
+        spikes = [step for step in steps if masses.get(step, 0.0) > 0]
+        axes.vlines(spikes, 0, [masses[step] for step in spikes], color=colour, linewidth=1)
+        locator = MaxNLocator(nbins=5, integer=True)
+        ticks = [int(tick) for tick in locator.tick_values(first_step, last) if first_step <= tick <= 0.9 * last]
     axes.bar([never_position], [never], width=max(0.85, len(steps) / 60), color=NEVER_COLOUR)
     if never > 0:
         axes.annotate(f"{never:.2f}", (never_position, never), ha="center", va="bottom", fontsize=6)
@@ -64,7 +67,7 @@ def draw_panel(axes, masses, never, deadline, colour, title, first_step):
     ticks.append(never_position)
     axes.set_xticks(ticks)
     axes.set_xticklabels([str(step) for step in ticks[:-1]] + ["never"], fontsize=7)
-    axes.set_xlim(first_step - 1, never_position + 1 + len(steps) // 50)
+    axes.set_xlim(first_step - 1 - margin, never_position + 1 + margin)
     axes.set_ylim(0, 1.15 * max([never] + list(masses.values()) + [1e-9]))
     axes.tick_params(axis="y", labelsize=7)
     axes.set_title(title, fontsize=8)
