@@ -647,5 +647,19 @@ TEST(Cli, AFailingPlotScriptIsReportedInOneLine) {
                             ": row 1, column probability: 'abc' is not a number\n");
 }
 
+// The figure is drawn in a folder of $TMPDIR: without one, a usage error naming it, and no figure.
+TEST(Cli, PlotWithoutATemporaryFolderIsAUsageError) {
+  const std::filesystem::path dir = scratch("plot_tmpdir");
+  for (const std::string& temporary : {std::string("/nonexistent"), (dir / "file").string()}) {
+    std::ofstream(dir / "file") << "not a folder";
+    const auto result = testing::run_process({"/usr/bin/env", "TMPDIR=" + temporary, ONTIME_CLI, "plot",
+                                              paper("figure1"), "-o", (dir / "figure1.png").string()});
+    EXPECT_EQ(result.exit_code, 2) << result.err;
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+    EXPECT_NE(result.err.find("($TMPDIR)"), std::string::npos) << result.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "figure1.png"));
+  }
+}
+
 }  // namespace
 }  // namespace ontime

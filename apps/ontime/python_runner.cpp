@@ -68,9 +68,13 @@ class SignalForwarding {
 class TemporaryDirectory {
  public:
   TemporaryDirectory() {
-    std::string pattern = (std::filesystem::temp_directory_path() / "ontime-plot-XXXXXX").string();
+    std::error_code error;
+    const std::filesystem::path base = std::filesystem::temp_directory_path(error);
+    if (error) throw UsageError("cannot draw: no temporary folder ($TMPDIR): " + error.message());
+    std::string pattern = (base / "ontime-plot-XXXXXX").string();
     if (::mkdtemp(pattern.data()) == nullptr) {
-      throw std::runtime_error("cannot create a temporary directory " + pattern + ": " + std::strerror(errno));
+      throw UsageError("cannot draw: cannot create a folder in the temporary folder " + base.string() +
+                       " ($TMPDIR): " + std::strerror(errno));
     }
     path_ = pattern;
   }
@@ -130,7 +134,8 @@ void run_python_script(const std::string& script, const std::filesystem::path& o
   const std::string interpreter = interpreter_override != nullptr ? interpreter_override : "/usr/bin/python3";
   const std::string path = (std::filesystem::path(python_script_directory()) / script).string();
   if (::access(interpreter.c_str(), X_OK) != 0) {
-    throw std::runtime_error("plotting needs " + interpreter + " with matplotlib (scripts/setup.sh installs it)");
+    throw UsageError("plotting needs " + interpreter +
+                     " with matplotlib (scripts/setup.sh installs it; $ONTIME_PYTHON names another interpreter)");
   }
   if (::access(path.c_str(), R_OK) != 0) throw std::runtime_error("cannot read the plotting script " + path);
 

@@ -33,8 +33,8 @@ std::string shortened_label(std::string_view text, std::size_t max_characters);
 // Runs `python3 DIR/script arguments(drawing)...`, where `drawing` is the path the script must
 // write its figure to; on success the figure is written to `output`. Failures are reported with
 // the last line the script wrote on stderr: ontime::InputError when the script exits with
-// kScriptBadInputExit, std::runtime_error otherwise or when the interpreter ($ONTIME_PYTHON,
-// default /usr/bin/python3) is missing.
+// kScriptBadInputExit, std::runtime_error otherwise. ontime::UsageError when the interpreter
+// ($ONTIME_PYTHON, default /usr/bin/python3) is missing or no temporary folder ($TMPDIR) can be used.
 void run_python_script(const std::string& script, const std::filesystem::path& output,
                        const std::function<std::vector<std::string>(const std::string& drawing)>& arguments);
 
