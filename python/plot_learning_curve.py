@@ -4,38 +4,36 @@
     plot_learning_curve.py CURVE.csv [CURVE.csv ...] OUT.png
 
 Success rate of each epoch's training episodes (sampled choices) against the episodes seen,
-one line per curve file, labelled by the file's name.
+one line per curve file, labelled by the file's name (shortened). Exit statuses: see
+ontime_plotting.
 """
 
-import csv
 import os
 import sys
 
-import matplotlib
+# Sets the Agg backend: import it first.
+from ontime_plotting import BadInput, bad_input, label, number, read_csv_rows, run, save_atomically
 
-matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 
-def label_of(path):
+def curve_label(path):
     name = os.path.basename(path)
-    return name[: -len(".curve.csv")] if name.endswith(".curve.csv") else os.path.splitext(name)[0]
+    return label(name[: -len(".curve.csv")] if name.endswith(".curve.csv") else os.path.splitext(name)[0])
 
 
-def main(argv):
+def main():
+    argv = sys.argv
     if len(argv) < 3:
-        sys.stderr.write(__doc__)
-        return 2
+        raise BadInput("usage: plot_learning_curve.py CURVE.csv [CURVE.csv ...] OUT.png")
     fig, ax = plt.subplots(figsize=(6.8, 4.0))
     for path in argv[1:-1]:
-        with open(path, newline="") as handle:
-            rows = list(csv.DictReader(handle))
+        rows = read_csv_rows(path, ["episodes", "success_rate"])
         if not rows:
-            sys.stderr.write(f"{path}: no epochs to plot\n")
-            return 2
-        episodes = [int(row["episodes"]) for row in rows]
-        success = [float(row["success_rate"]) for row in rows]
-        ax.plot(episodes, success, marker=".", label=label_of(path))
+            raise bad_input(path, "no epochs to plot")
+        episodes = [number(path, i, "episodes", row["episodes"], int) for i, row in enumerate(rows, 1)]
+        success = [number(path, i, "success_rate", row["success_rate"]) for i, row in enumerate(rows, 1)]
+        ax.plot(episodes, success, marker=".", label=curve_label(path))
     ax.set_xlabel("training episodes")
     ax.set_ylabel("success rate of the epoch's episodes")
     ax.set_ylim(0, 1.05)
@@ -44,9 +42,8 @@ def main(argv):
         ax.legend(fontsize=8, loc="lower right")
     ax.set_title("PPO learning curves")
     fig.tight_layout()
-    fig.savefig(argv[-1], dpi=130)
-    return 0
+    save_atomically(fig, argv[-1], dpi=130)
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    run(main)

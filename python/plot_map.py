@@ -6,12 +6,14 @@ top-left corner), "wall", "obstacle", "region" (a placement region), "object" (a
 "caption" (a label only) and "robot". Polygons of view "top" (the default) are drawn seen from
 above, those of view "front" in a second panel seen from the front (x and z). Each path is drawn
 in its own colour in the top view, with the robot's footprint where it ends. Writes the PNG
-through a temporary file.
+through a temporary file. Labels and the title are shortened for drawing. Exit statuses: see
+ontime_plotting.
 """
 
 import argparse
-import json
-from ontime_plotting import save_atomically  # sets the Agg backend: import it first
+
+# Sets the Agg backend: import it first.
+from ontime_plotting import TITLE_CHARACTERS, bad_input, label, read_json, run, save_atomically
 
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.patches import Polygon  # noqa: E402
@@ -28,19 +30,20 @@ STYLE = {
 PATH_COLOURS = ["#1f77b4", "#d62728", "#9467bd", "#ff7f0e", "#17becf", "#8c564b", "#e377c2", "#7f7f7f"]
 
 
-def label(axes, polygon):
+def draw_label(axes, polygon):
     xs = [point[0] for point in polygon["points"]]
     ys = [point[1] for point in polygon["points"]]
     kind = polygon["kind"]
+    text = label(polygon["label"], 30)
     if kind == "room":
         # Rooms are labelled in their top-left corner, clear of furniture in the middle.
-        axes.text(min(xs) + 0.15, max(ys) - 0.15, polygon["label"], ha="left", va="top", fontsize=12, color="#7a7a7a",
+        axes.text(min(xs) + 0.15, max(ys) - 0.15, text, ha="left", va="top", fontsize=12, color="#7a7a7a",
                   fontweight="bold", zorder=5)
     elif kind == "region":
-        axes.text(max(xs), max(ys), polygon["label"], ha="right", va="bottom", fontsize=8, color="#1f5a1f",
+        axes.text(max(xs), max(ys), text, ha="right", va="bottom", fontsize=8, color="#1f5a1f",
                   fontweight="bold", zorder=5)
     else:
-        axes.text((min(xs) + max(xs)) / 2, (min(ys) + max(ys)) / 2, polygon["label"], ha="center", va="center",
+        axes.text((min(xs) + max(xs)) / 2, (min(ys) + max(ys)) / 2, text, ha="center", va="center",
                   fontsize=7 if kind == "object" else 9, color="#222222", zorder=6)
 
 
@@ -48,7 +51,7 @@ def draw(axes, polygons):
     for polygon in polygons:
         axes.add_patch(Polygon(polygon["points"], closed=True, **STYLE.get(polygon["kind"], STYLE["obstacle"])))
         if polygon["label"]:
-            label(axes, polygon)
+            draw_label(axes, polygon)
     xs = [point[0] for polygon in polygons for point in polygon["points"]]
     ys = [point[1] for polygon in polygons for point in polygon["points"]]
     axes.set_xlim(min(xs) - 0.2, max(xs) + 0.2)
@@ -58,13 +61,33 @@ def draw(axes, polygons):
     return max(xs) - min(xs), max(ys) - min(ys)
 
 
+def check_drawing(drawing):
+    """Raises KeyError, TypeError or ValueError unless `drawing` has the fields described above."""
+    str(drawing["title"])
+    if not any(polygon.get("view", "top") == "top" for polygon in drawing["polygons"]):
+        raise ValueError("no polygon seen from above")
+    for polygon in drawing["polygons"]:
+        str(polygon["kind"]), str(polygon["label"])
+        if not polygon["points"]:
+            raise ValueError("a polygon without points")
+        for x, y in polygon["points"]:
+            float(x), float(y)
+    for path in drawing["paths"]:
+        str(path["label"])
+        for x, y in path["points"] + path["end"]:
+            float(x), float(y)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--data", required=True)
     parser.add_argument("--output", required=True)
     arguments = parser.parse_args()
-    with open(arguments.data, encoding="utf-8") as handle:
-        drawing = json.load(handle)
+    drawing = read_json(arguments.data)
+    try:
+        check_drawing(drawing)
+    except (KeyError, TypeError, ValueError, IndexError) as error:
+        raise bad_input(arguments.data, f"not a drawing ({type(error).__name__}: {error})") from None
 
     top = [polygon for polygon in drawing["polygons"] if polygon.get("view", "top") == "top"]
     front = [polygon for polygon in drawing["polygons"] if polygon.get("view", "top") == "front"]
@@ -83,10 +106,10 @@ def main():
     for index, path in enumerate(drawing["paths"]):
         colour = PATH_COLOURS[index % len(PATH_COLOURS)]
         axes.plot([point[0] for point in path["points"]], [point[1] for point in path["points"]], color=colour,
-                  linewidth=1.8, label=path["label"], zorder=3)
+                  linewidth=1.8, label=label(path["label"]), zorder=3)
         axes.add_patch(Polygon(path["end"], closed=True, facecolor=colour, edgecolor=colour, alpha=0.35, zorder=3))
     axes.set_ylabel("y (m)")
-    axes.set_title(drawing["title"] + (" — seen from above" if front else ""))
+    axes.set_title(label(drawing["title"], TITLE_CHARACTERS) + (" — seen from above" if front else ""))
     if drawing["paths"]:
         axes.legend(loc="upper center", bbox_to_anchor=(0.5, -0.07 if not front else -0.12), ncol=2, fontsize=8,
                     frameon=False)
@@ -100,4 +123,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    run(main)

@@ -7,22 +7,37 @@ compute-time (Fig. 4): total decision time per episode of mcts and dp-rerun, log
 equal-time   (Fig. 5): success of dp-rerun and of mcts held to dp-rerun's time per decision.
 anytime      (Fig. 6): mcts success against log10 of the time multiplier, one panel per
                         instance, the exact optimum and dp-rerun as horizontal lines.
+
+Instance labels are shortened for drawing. Exit statuses: see ontime_plotting.
 """
 
-import csv
 import sys
 
-import matplotlib
+# Sets the Agg backend: import it first.
+from ontime_plotting import BadInput, bad_input, label, number, read_csv_rows, run, save_atomically, shorten
 
-matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 COLORS = {"mcts": "#c0504d", "dp-rerun": "#4f81bd", "optimum": "#333333"}
 
 
-def read_rows(path):
-    with open(path, newline="") as handle:
-        return list(csv.DictReader(handle))
+COLUMNS = {
+    "compute-time": ["instance", "solver", "mean_episode_seconds", "success_rate"],
+    "equal-time": ["instance", "dp_rerun_success_rate", "dp_rerun_ci95", "mcts_success_rate", "mcts_ci95",
+                   "dp_rerun_decision_seconds"],
+    "anytime": ["instance", "log10_multiplier", "success_rate", "ci95", "optimum", "dp_rerun_success_rate",
+                "dp_rerun_decision_seconds"],
+}
+
+
+def read_rows(path, kind):
+    """The rows, every number column checked."""
+    rows = read_csv_rows(path, COLUMNS[kind])
+    for row_number, row in enumerate(rows, 1):
+        for column in COLUMNS[kind]:
+            if column not in ("instance", "solver"):
+                number(path, row_number, column, row[column])
+    return rows
 
 
 def instances_in_order(rows):
@@ -40,21 +55,23 @@ def compute_time(rows, png):
     for offset, solver in ((-width / 2, "mcts"), (width / 2, "dp-rerun")):
         values, labels = [], []
         for instance in instances:
-            row = next(r for r in rows if r["instance"] == instance and r["solver"] == solver)
+            row = next((r for r in rows if r["instance"] == instance and r["solver"] == solver), None)
+            if row is None:
+                raise BadInput(f"no {solver} row for instance {shorten(instance)}")
             values.append(float(row["mean_episode_seconds"]))
             labels.append(f'{float(row["success_rate"]):.2f}')
         positions = [i + offset for i in range(len(instances))]
         bars = ax.bar(positions, values, width, label=solver, color=COLORS[solver])
-        for bar, label in zip(bars, labels):
-            ax.annotate(label, (bar.get_x() + bar.get_width() / 2, bar.get_height()), ha="center",
+        for bar, rate in zip(bars, labels):
+            ax.annotate(rate, (bar.get_x() + bar.get_width() / 2, bar.get_height()), ha="center",
                         va="bottom", fontsize=8)
     ax.set_yscale("log")
-    ax.set_xticks(range(len(instances)), instances)
+    ax.set_xticks(range(len(instances)), [label(instance, 30) for instance in instances])
     ax.set_ylabel("decision time per episode (s, log scale)")
     ax.set_title("Meta-level computation per episode (labels: success rate)")
     ax.legend()
     fig.tight_layout()
-    fig.savefig(png, dpi=130)
+    save_atomically(fig, png, dpi=130)
 
 
 def equal_time(rows, png):
@@ -66,14 +83,14 @@ def equal_time(rows, png):
         errors = [float(row[f"{prefix}_ci95"]) for row in rows]
         positions = [i + offset for i in range(len(instances))]
         ax.bar(positions, rates, width, yerr=errors, capsize=3, label=solver, color=COLORS[solver])
-    labels = [f'{row["instance"]}\n{float(row["dp_rerun_decision_seconds"]) * 1e9:.0f} ns' for row in rows]
+    labels = [f'{label(row["instance"], 30)}\n{float(row["dp_rerun_decision_seconds"]) * 1e9:.0f} ns' for row in rows]
     ax.set_xticks(range(len(instances)), labels)
     ax.set_ylim(0, 1.05)
     ax.set_ylabel("success rate (95% interval)")
     ax.set_title("Same time per decision as dp-rerun (below each instance)")
     ax.legend()
     fig.tight_layout()
-    fig.savefig(png, dpi=130)
+    save_atomically(fig, png, dpi=130)
 
 
 def anytime(rows, png):
@@ -94,7 +111,7 @@ def anytime(rows, png):
         ax.axhline(float(points[0]["dp_rerun_success_rate"]), color=COLORS["dp-rerun"], linestyle=":",
                    label="dp-rerun")
         base = float(points[0]["dp_rerun_decision_seconds"])
-        ax.set_title(f"{instance} (base {base * 1e9:.0f} ns)", fontsize=10)
+        ax.set_title(f"{label(instance, 30)} (base {base * 1e9:.0f} ns)", fontsize=10)
         ax.set_xlabel("log10 time multiplier")
         ax.set_ylabel("success rate")
         ax.set_ylim(0, 1.05)
@@ -104,20 +121,18 @@ def anytime(rows, png):
         axes[index // columns][index % columns].axis("off")
     fig.suptitle("mcts with 10^m times dp-rerun's time per decision")
     fig.tight_layout()
-    fig.savefig(png, dpi=130)
+    save_atomically(fig, png, dpi=130)
 
 
-def main(argv):
-    if len(argv) != 4 or argv[1] not in ("compute-time", "equal-time", "anytime"):
-        sys.stderr.write(__doc__)
-        return 2
-    rows = read_rows(argv[2])
+def main():
+    argv = sys.argv
+    if len(argv) != 4 or argv[1] not in COLUMNS:
+        raise BadInput("usage: plot_study.py compute-time|equal-time|anytime CSV PNG")
+    rows = read_rows(argv[2], argv[1])
     if not rows:
-        sys.stderr.write(f"{argv[2]}: no rows to plot\n")
-        return 2
+        raise bad_input(argv[2], "no rows to plot")
     {"compute-time": compute_time, "equal-time": equal_time, "anytime": anytime}[argv[1]](rows, argv[3])
-    return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    run(main)

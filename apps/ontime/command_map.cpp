@@ -76,7 +76,9 @@ void add_map_command(CLI::App& app) {
                                   {"end", points_json(domain.outline(last.back()))}});
     }
     write_file_atomically(data, drawing.dump(1) + "\n");
-    run_python_script("plot_map.py", {"--data", data.string(), "--output", png.string()});
+    run_python_script("plot_map.py", png, [&](const std::string& figure) {
+      return std::vector<std::string>{"--data", data.string(), "--output", figure};
+    });
     fmt::print("Wrote {} (data: {}).\n", png.string(), data.string());
   });
 }

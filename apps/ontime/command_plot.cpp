@@ -57,11 +57,13 @@ void add_plot_command(CLI::App& app) {
     csv.replace_extension(".csv");
     check_outputs({{"--output", png}, {"--output (plotted data)", csv}}, {options->instance});
     write_file_atomically(csv, histogram_csv(problem));
-    run_python_script("plot_histograms.py",
-                      {"--data", csv.string(), "--output", png.string(), "--title",
-                       fmt::format("{}: deadline {} steps of {} s", problem.name(), problem.deadline(),
-                                   problem.step_seconds()),
-                       "--deadline", std::to_string(problem.deadline())});
+    // The name is shortened here already: a command-line argument is limited to 128 KiB.
+    const std::string title = fmt::format("{}: deadline {} steps of {} s", shortened_label(problem.name(), 200),
+                                          problem.deadline(), problem.step_seconds());
+    run_python_script("plot_histograms.py", png, [&](const std::string& drawing) {
+      return std::vector<std::string>{"--data",  csv.string(), "--output",   drawing,
+                                      "--title", title,        "--deadline", std::to_string(problem.deadline())};
+    });
     fmt::print("Wrote {} (data: {}).\n", png.string(), csv.string());
   });
 }

@@ -80,7 +80,9 @@ void finish(const StudyOptions& options, const std::string& kind, const std::str
   fmt::print("wrote {}\n", csv_path);
   if (options.no_plot) return;
   const std::string png_path = output_of(options, kind, ".png").string();
-  run_python_script("plot_study.py", {kind, csv_path, png_path});
+  run_python_script("plot_study.py", png_path, [&](const std::string& drawing) {
+    return std::vector<std::string>{kind, csv_path, drawing};
+  });
   fmt::print("wrote {}\n", png_path);
 }
 

@@ -59,7 +59,11 @@ void add_train_command(CLI::App& app) {
                          point.mean_episode_length, point.actor_steps, point.seconds);
     }
     write_file_atomically(curve_csv, csv);
-    if (!options->no_plot) run_python_script("plot_learning_curve.py", {curve_csv.string(), curve_png.string()});
+    if (!options->no_plot) {
+      run_python_script("plot_learning_curve.py", curve_png, [&](const std::string& drawing) {
+        return std::vector<std::string>{curve_csv.string(), drawing};
+      });
+    }
 
     PpoAllocator trained(mdp, std::make_shared<const PpoPolicy>(training.policy));
     const ExactEvaluation exact = evaluate_exactly(mdp, trained);
