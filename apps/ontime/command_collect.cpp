@@ -15,6 +15,7 @@
 #include "ontime/domains/collection.hpp"
 #include "ontime/domains/collection_journal.hpp"
 #include "ontime/domains/registry.hpp"
+#include "ontime/error.hpp"
 #include "ontime/fitting.hpp"
 #include "ontime/instance_io.hpp"
 #include "output_paths.hpp"
