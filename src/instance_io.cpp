@@ -223,7 +223,7 @@ Problem parse_problem(std::string_view text, std::string_view source) {
 }
 
 Problem load_problem(const std::filesystem::path& path) {
-  return parse_problem(detail::read_text_file(path), path.string());
+  return parse_problem(read_input_file(path, "instance"), path.string());
 }
 
 std::string problem_to_json(const Problem& problem) {

@@ -67,7 +67,7 @@ Knapsack parse_knapsack(std::string_view text, std::string_view source_view) {
 }
 
 Knapsack load_knapsack(const std::filesystem::path& path) {
-  return parse_knapsack(detail::read_text_file(path), path.string());
+  return parse_knapsack(read_input_file(path, "knapsack"), path.string());
 }
 
 double reduction_epsilon(const Knapsack& knapsack) {

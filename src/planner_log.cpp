@@ -109,7 +109,7 @@ std::vector<RefinementAttempt> parse_planner_log(std::string_view text, std::str
 }
 
 std::vector<RefinementAttempt> load_planner_log(const std::filesystem::path& path) {
-  return parse_planner_log(detail::read_text_file(path), path.string());
+  return parse_planner_log(read_input_file(path, "planner log"), path.string());
 }
 
 std::string planner_log_line(const RefinementAttempt& attempt) {

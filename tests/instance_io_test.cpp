@@ -1,3 +1,5 @@
+#include "ontime/instance_io.hpp"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -6,7 +8,7 @@
 #include <set>
 
 #include "ontime/error.hpp"
-#include "ontime/instance_io.hpp"
+#include "ontime/input_file.hpp"
 #include "support/bad_inputs.hpp"
 #include "support/paper.hpp"
 
@@ -26,8 +28,8 @@ TEST(InstanceIo, LoadsFigureOne) {
 }
 
 TEST(InstanceIo, LoadsEveryPaperInstanceWithItsDeadline) {
-  const std::map<std::string, Steps> deadlines{{"instance1", 14}, {"instance2", 9}, {"instance3", 20},
-                                               {"instance4", 4},  {"instance5", 14}};
+  const std::map<std::string, Steps> deadlines{
+      {"instance1", 14}, {"instance2", 9}, {"instance3", 20}, {"instance4", 4}, {"instance5", 14}};
   for (const auto& [name, deadline] : deadlines) {
     EXPECT_EQ(testing::paper_instance(name).deadline(), deadline) << name;
   }
@@ -135,6 +137,58 @@ TEST(InstanceIo, EveryBadFileNamesItsPlaceAndRule) {
     EXPECT_TRUE(covered.contains(entry.path().filename().string()))
         << entry.path().filename() << " has no expectation in support/bad_inputs.hpp";
   }
+}
+
+// Restores the process-wide input size limit when a test ends.
+struct InputLimitGuard {
+  explicit InputLimitGuard(std::uint64_t bytes) { set_max_input_bytes(bytes); }
+  ~InputLimitGuard() { set_max_input_bytes(std::nullopt); }
+  InputLimitGuard(const InputLimitGuard&) = delete;
+  InputLimitGuard& operator=(const InputLimitGuard&) = delete;
+};
+
+TEST(InputFile, ADeviceWithoutEndIsReadOnlyUpToTheLimit) {
+  const InputLimitGuard limit(std::uint64_t{1} << 20);
+  try {
+    load_problem("/dev/zero");
+    ADD_FAILURE() << "/dev/zero was accepted";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.source(), "/dev/zero");
+    EXPECT_EQ(error.place(), "file");
+    EXPECT_EQ(error.rule(),
+              "the instance file is larger than the input size limit of 1048576 bytes (1 MiB) (set "
+              "ONTIME_MAX_INPUT_BYTES to raise it)");
+  }
+}
+
+TEST(InputFile, ARegularFileAboveTheLimitIsRefusedAndOneAtTheLimitIsRead) {
+  const auto path = std::filesystem::temp_directory_path() / "ontime_input_limit_test.json";
+  const std::string text = read_input_file(testing::source_path("data/instances/paper/figure1.json"), "instance");
+  {
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+  }
+  {
+    const InputLimitGuard limit(text.size());
+    EXPECT_EQ(read_input_file(path, "instance"), text);
+    EXPECT_EQ(load_problem(path).name(), "paper-figure-1");
+  }
+  {
+    const InputLimitGuard limit(text.size() - 1);
+    EXPECT_THROW(load_problem(path), InputError);
+  }
+  std::filesystem::remove(path);
+}
+
+TEST(InputFile, TheLimitComesFromTheEnvironmentWhenNotSet) {
+  ASSERT_EQ(::setenv("ONTIME_MAX_INPUT_BYTES", "4096", 1), 0);
+  EXPECT_EQ(max_input_bytes(), 4096U);
+  ASSERT_EQ(::setenv("ONTIME_MAX_INPUT_BYTES", "4k", 1), 0);
+  EXPECT_THROW(max_input_bytes(), UsageError);
+  ASSERT_EQ(::setenv("ONTIME_MAX_INPUT_BYTES", "0", 1), 0);
+  EXPECT_THROW(max_input_bytes(), UsageError);
+  ASSERT_EQ(::unsetenv("ONTIME_MAX_INPUT_BYTES"), 0);
+  EXPECT_EQ(max_input_bytes(), kDefaultMaxInputBytes);
 }
 
 }  // namespace

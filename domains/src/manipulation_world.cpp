@@ -374,7 +374,7 @@ ManipulationWorld parse_manipulation_world(std::string_view text, std::string_vi
 }
 
 ManipulationWorld load_manipulation_world(const std::filesystem::path& path) {
-  return parse_manipulation_world(detail::read_text_file(path), path.string());
+  return parse_manipulation_world(read_input_file(path, "world"), path.string());
 }
 
 }  // namespace ontime::domains

@@ -22,7 +22,7 @@ using ontime::detail::describe_json_type;
 using ontime::detail::json_index;
 using ontime::detail::json_member;
 using ontime::detail::parse_json_strict;
-using ontime::detail::read_text_file;
+using ontime::read_input_file;
 
 // "%g" of a number, for messages.
 std::string number_text(double value);

@@ -1,10 +1,10 @@
 #pragma once
 // Support for readers of JSON input files, shared by the core and the domains library: JSON
 // paths for error messages, strict parsing (duplicate keys are errors, not silently
-// overwritten) and reading whole files, every failure an InputError naming the file, the place
-// and the rule. Not part of the allocation API (hence `detail`). The templates take the JSON
-// type (nlohmann::json or nlohmann::ordered_json) as a parameter, so that this header needs
-// nlohmann_json only where a reader includes <nlohmann/json.hpp> itself.
+// overwritten; files are read through read_input_file, ontime/input_file.hpp), every failure an InputError naming the
+// file, the place and the rule. Not part of the allocation API (hence `detail`). The templates take the JSON type
+// (nlohmann::json or nlohmann::ordered_json) as a parameter, so that this header needs nlohmann_json only where a
+// reader includes <nlohmann/json.hpp> itself.
 
 #include <algorithm>
 #include <cctype>
@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "ontime/error.hpp"
+#include "ontime/input_file.hpp"
 
 namespace ontime::detail {
 
@@ -64,19 +65,6 @@ void check_known_keys(const Json& object, const std::string& path, std::initiali
     for (const std::string_view name : allowed) expected += (expected.empty() ? "'" : ", '") + std::string(name) + "'";
     throw InputError(source, json_member(path, key), "unknown key (expected " + expected + ")");
   }
-}
-
-inline std::string read_text_file(const std::filesystem::path& path) {
-  std::error_code error;
-  if (std::filesystem::is_directory(path, error)) {
-    throw InputError(path.string(), "file", "is a directory, not a file");
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string(), "file", "cannot be opened for reading (missing or unreadable)");
-  std::ostringstream content;
-  content << in.rdbuf();
-  if (in.bad()) throw InputError(path.string(), "file", "could not be read");
-  return content.str();
 }
 
 // Parses JSON text; malformed text raises InputError at `line L, column C`, and a key that
