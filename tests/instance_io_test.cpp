@@ -191,5 +191,60 @@ TEST(InputFile, TheLimitComesFromTheEnvironmentWhenNotSet) {
   EXPECT_EQ(max_input_bytes(), kDefaultMaxInputBytes);
 }
 
+constexpr const char* kOneAction = R"("a": {"planning": {"pmf": {"1": 1.0}}, "execution": {"pmf": {"1": 1.0}}})";
+
+TEST(InstanceIo, ANulByteAfterTheInstanceIsRefusedWithItsPlace) {
+  using namespace std::string_literals;
+  const std::string text =
+      "{\"deadline\": 3, \"actions\": {"s + kOneAction + "}, \"skeletons\": [[\"a\"]]}\n\0garbage"s;
+  try {
+    parse_problem(text, "nul.json");
+    ADD_FAILURE() << "trailing NUL and garbage were accepted";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.place(), "line 2, column 1");
+    EXPECT_NE(error.rule().find("NUL byte"), std::string::npos) << error.rule();
+  }
+}
+
+TEST(InstanceIo, AControlByteInAKeyIsShownEscapedAndTheRuleKept) {
+  const std::string text = R"({"dead\u0000line": 3})";
+  try {
+    parse_problem(text, "key.json");
+    ADD_FAILURE() << "an unknown key was accepted";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.place(), R"("dead\u0000line")");
+    const std::string message = error.what();
+    EXPECT_EQ(message.find('\0'), std::string::npos);
+    EXPECT_NE(message.find(R"(key.json: "dead\u0000line": unknown key (expected 'name')"), std::string::npos)
+        << message;
+  }
+}
+
+// Loading is linear in the size of the file (bench/ontime_bench.cpp measures it); here: a large
+// object is read whole, in order, and a duplicate at its end is still found with its path.
+TEST(InstanceIo, AnObjectOfManyKeysIsReadInOrderAndDuplicatesAreFound) {
+  constexpr int kUnused = 100000;
+  std::string actions = kOneAction;
+  for (int i = 0; i < kUnused; ++i) {
+    actions +=
+        ", \"u" + std::to_string(i) + R"(": {"planning": {"pmf": {"2": 0.5}}, "execution": {"pmf": {"1": 1.0}}})";
+  }
+  const std::string text = R"({"deadline": 3, "actions": {)" + actions + R"(}, "skeletons": [["a"]]})";
+  const Problem problem = parse_problem(text, "many.json");
+  ASSERT_EQ(problem.action_count(), kUnused + 1);
+  EXPECT_EQ(problem.action(0).id, "a");
+  EXPECT_EQ(problem.action(kUnused).id, "u" + std::to_string(kUnused - 1));
+  EXPECT_DOUBLE_EQ(problem.action(kUnused).planning.pmf(2), 0.5);
+
+  const std::string duplicated = R"({"deadline": 3, "actions": {)" + actions + ", " + kOneAction + "}}";
+  try {
+    parse_problem(duplicated, "many.json");
+    ADD_FAILURE() << "a duplicate key was accepted";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.place(), "actions.a");
+    EXPECT_NE(error.rule().find("duplicate key"), std::string::npos) << error.rule();
+  }
+}
+
 }  // namespace
 }  // namespace ontime
