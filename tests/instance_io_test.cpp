@@ -246,5 +246,36 @@ TEST(InstanceIo, AnObjectOfManyKeysIsReadInOrderAndDuplicatesAreFound) {
   }
 }
 
+std::string instance_with(const std::string& members) {
+  return "{" + members + R"(, "actions": {)" + kOneAction + R"(}, "skeletons": [["a"]]})";
+}
+
+std::string rule_for(const std::string& text) {
+  try {
+    parse_problem(text, "x.json");
+  } catch (const InputError& error) {
+    return error.place() + ": " + error.rule();
+  }
+  return "accepted";
+}
+
+TEST(InstanceIo, AWholeNumberWrittenWithAZeroFractionIsAnInteger) {
+  EXPECT_EQ(parse_problem(instance_with(R"("deadline": 4.0)"), "x.json").deadline(), 4);
+  EXPECT_EQ(parse_problem(instance_with(R"("deadline": 4e0)"), "x.json").deadline(), 4);
+  EXPECT_EQ(rule_for(instance_with(R"("deadline": 4.5)")), "deadline: must be a whole number of steps (got 4.5)");
+  EXPECT_EQ(rule_for(instance_with(R"("deadline": 1e300)")),
+            "deadline: must be between 1 and 10000 steps (got 1e+300)");
+  EXPECT_EQ(rule_for(instance_with(R"("deadline": 18446744073709551615)")),
+            "deadline: must be between 1 and 10000 steps (got 18446744073709551615)");
+}
+
+TEST(InstanceIo, StepSecondsKeepEveryTimeFinite) {
+  EXPECT_EQ(rule_for(instance_with(R"("deadline": 3, "step_seconds": 1e308)")),
+            "step_seconds: must be a positive number of seconds, at most 1e300 so that times in seconds stay finite "
+            "(got 1e+308)");
+  EXPECT_DOUBLE_EQ(parse_problem(instance_with(R"("deadline": 3, "step_seconds": 1e300)"), "x.json").step_seconds(),
+                   1e300);
+}
+
 }  // namespace
 }  // namespace ontime

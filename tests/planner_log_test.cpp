@@ -71,5 +71,13 @@ TEST(PlannerLog, ANulByteInALineIsRefusedWithItsLineAndColumn) {
   }
 }
 
+TEST(PlannerLog, CountsMayBeWrittenWithAZeroFraction) {
+  const auto log = parse_planner_log(R"({"action": "a", "planning_seconds": 1, "found": false, "trial": 3.0})", "log");
+  ASSERT_TRUE(log.at(0).trial.has_value());
+  EXPECT_EQ(*log.at(0).trial, 3U);
+  EXPECT_THROW(parse_planner_log(R"({"action": "a", "planning_seconds": 1, "found": false, "trial": 3.5})", "log"),
+               InputError);
+}
+
 }  // namespace
 }  // namespace ontime

@@ -8,8 +8,11 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <initializer_list>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <unordered_set>
@@ -55,6 +58,31 @@ std::string describe_json_type(const Json& value) {
   if (value.is_string()) return "a string";
   if (value.is_array()) return "an array";
   return "an object";
+}
+
+// The value of a JSON number that is a whole number, written as an integer (`4`) or with a
+// zero fraction part (`4.0`, as Python's json module writes floats), if it lies within
+// [lowest, highest]; std::nullopt for anything else (not a number, a fraction, out of range).
+template <class Json>
+std::optional<std::int64_t> json_whole_number(const Json& value, std::int64_t lowest, std::int64_t highest) {
+  if (value.is_number_unsigned()) {
+    const auto number = value.template get<std::uint64_t>();
+    if (highest < 0 || number > static_cast<std::uint64_t>(highest)) return std::nullopt;
+    return static_cast<std::int64_t>(number) >= lowest ? std::optional<std::int64_t>(static_cast<std::int64_t>(number))
+                                                       : std::nullopt;
+  }
+  if (value.is_number_integer()) {
+    const auto number = value.template get<std::int64_t>();
+    return number >= lowest && number <= highest ? std::optional<std::int64_t>(number) : std::nullopt;
+  }
+  if (!value.is_number_float()) return std::nullopt;
+  const double number = value.template get<double>();
+  // Compared as doubles: every int64 bound is within about 1e3 of a double, far below a step.
+  if (!(std::trunc(number) == number && number >= static_cast<double>(lowest) &&
+        number <= static_cast<double>(highest))) {
+    return std::nullopt;
+  }
+  return static_cast<std::int64_t>(number);
 }
 
 inline std::string json_index(const std::string& parent, std::size_t index) {
