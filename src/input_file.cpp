@@ -58,15 +58,16 @@ std::string read_input_file(const std::filesystem::path& path, std::string_view 
                       "the " + kind + " file is larger than the input size limit of " + describe_bytes(limit) +
                           " (set " + kLimitVariable + " to raise it)");
   };
+  std::string content;
   // A regular file's size is known: refuse before reading. Devices and FIFOs report no size
   // (or a wrong one) and are read up to the limit, never beyond.
   if (std::filesystem::is_regular_file(status)) {
     const std::uintmax_t size = std::filesystem::file_size(path, error);
     if (!error && size > limit) throw too_large();
+    if (!error) content.reserve(static_cast<std::size_t>(size) + 1);  // one allocation, not a doubling series
   }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(source, "file", "cannot be opened for reading (missing or unreadable)");
-  std::string content;
   constexpr std::size_t kChunk = std::size_t{1} << 16;
   while (in) {
     const std::size_t before = content.size();
