@@ -1,9 +1,11 @@
 // Speed targets of the core (docs/performance.md): dp-rerun decision latency, exact solve
-// time, Monte Carlo throughput and the Table I workload. Run a Release build:
+// time, Monte Carlo throughput, the Table I workload and the cost of loading large inputs
+// (linear in their size: the BigO fits below report it). Run a Release build:
 //   build/ontime_bench --benchmark_repetitions=10 --benchmark_report_aggregates_only=true
 
 #include <benchmark/benchmark.h>
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -147,6 +149,61 @@ void BM_TableOneWorkload(benchmark::State& bench) {
   }
 }
 BENCHMARK(BM_TableOneWorkload)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// An instance whose `actions` object has `keys` members (one used, the others unused).
+std::string instance_with_actions(std::int64_t keys) {
+  std::string text =
+      R"({"deadline": 3, "actions": {"a": {"planning": {"pmf": {"1": 1.0}}, "execution": {"pmf": {"1": 1.0}}})";
+  for (std::int64_t i = 1; i < keys; ++i) {
+    text += ", \"u" + std::to_string(i) + R"(": {"planning": {"pmf": {"2": 0.5}}, "execution": {"pmf": {"1": 1.0}}})";
+  }
+  return text + R"(}, "skeletons": [["a"]]})";
+}
+
+// Loading an instance of 10k, 100k and 1M action keys.
+void BM_LoadManyActions(benchmark::State& bench) {
+  const std::string text = instance_with_actions(bench.range(0));
+  for (auto _ : bench) benchmark::DoNotOptimize(ontime::parse_problem(text, "many-actions.json"));
+  bench.SetComplexityN(bench.range(0));
+  bench.SetBytesProcessed(static_cast<std::int64_t>(bench.iterations()) * static_cast<std::int64_t>(text.size()));
+}
+BENCHMARK(BM_LoadManyActions)
+    ->Arg(10'000)
+    ->Arg(100'000)
+    ->Arg(1'000'000)
+    ->Complexity(benchmark::oN)
+    ->Unit(benchmark::kMillisecond);
+
+// Loading one PMF of 10k and 100k keys (steps are capped at Distribution::kMaxStep).
+void BM_LoadLongPmf(benchmark::State& bench) {
+  std::string pmf;
+  for (std::int64_t step = 1; step <= bench.range(0); ++step) {
+    pmf += (step == 1 ? "\"" : ", \"") + std::to_string(step) + "\": 1e-6";
+  }
+  const std::string text = R"({"deadline": 3, "actions": {"a": {"planning": {"pmf": {)" + pmf +
+                           R"(}}, "execution": {"pmf": {"1": 1.0}}}}, "skeletons": [["a"]]})";
+  for (auto _ : bench) benchmark::DoNotOptimize(ontime::parse_problem(text, "long-pmf.json"));
+  bench.SetComplexityN(bench.range(0));
+}
+BENCHMARK(BM_LoadLongPmf)->Arg(10'000)->Arg(100'000)->Complexity(benchmark::oN)->Unit(benchmark::kMillisecond);
+
+// Reading a planner log of 10k, 100k and 1M lines.
+void BM_LoadPlannerLog(benchmark::State& bench) {
+  std::string text;
+  for (std::int64_t line = 0; line < bench.range(0); ++line) {
+    text += R"({"action": "a)" + std::to_string(line % 100) +
+            R"(", "planning_seconds": 1.5, "found": false})"
+            "\n";
+  }
+  for (auto _ : bench) benchmark::DoNotOptimize(ontime::parse_planner_log(text, "log.jsonl"));
+  bench.SetComplexityN(bench.range(0));
+}
+BENCHMARK(BM_LoadPlannerLog)
+    ->Arg(10'000)
+    ->Arg(100'000)
+    ->Arg(1'000'000)
+    ->Complexity(benchmark::oN)
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

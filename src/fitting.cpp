@@ -1,5 +1,7 @@
 #include "ontime/fitting.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -24,11 +26,23 @@ double steps_exactly(double seconds, double step_seconds) {
   return std::min(seconds / step_seconds, kLargestStep);
 }
 
+// Above this, alpha swamps any log a planner can write (the estimates are then the uniform
+// distribution, whatever the data), and alpha times the categories may overflow to infinity,
+// which would empty the fitted PMFs.
+constexpr double kMaxLaplace = 1e6;
+
+std::string laplace_rule(double laplace) {
+  return fmt::format(
+      "laplace: the Laplace smoothing alpha must be between 0 and {:g}, larger values swamp the log "
+      "(got {:g})",
+      kMaxLaplace, laplace);
+}
+
 void check_estimation_options(Steps deadline, double laplace) {
   if (deadline < 1 || deadline > Problem::kMaxDeadline) {
     throw UsageError("the deadline must be between 1 and " + std::to_string(Problem::kMaxDeadline) + " steps");
   }
-  if (!(std::isfinite(laplace) && laplace >= 0)) throw UsageError("the Laplace smoothing alpha must be >= 0");
+  if (!(laplace >= 0 && laplace <= kMaxLaplace)) throw UsageError(laplace_rule(laplace));
 }
 
 }  // namespace
@@ -46,9 +60,9 @@ Steps whole_steps_within(double seconds, double step_seconds) {
 Distribution estimate_planning(const PlanningSample& sample, Steps deadline, double laplace) {
   check_estimation_options(deadline, laplace);
   const auto size = static_cast<std::size_t>(deadline) + 1;
-  std::vector<double> found_at(size, 0.0);     // d_t, t <= D
-  std::vector<double> leaving_at(size, 0.0);   // attempts last at risk at step t (cut off after t steps)
-  double at_risk = 0;                          // n_1
+  std::vector<double> found_at(size, 0.0);    // d_t, t <= D
+  std::vector<double> leaving_at(size, 0.0);  // attempts last at risk at step t (cut off after t steps)
+  double at_risk = 0;                         // n_1
   for (const Steps t : sample.found) {
     if (t < 1) throw UsageError("a planning time is at least 1 step");
     // Found after the deadline: within the deadline it only survived, like a cut-off attempt.
@@ -103,7 +117,7 @@ FitResult fit_problem(std::span<const RefinementAttempt> attempts, std::string_v
   if (options.deadline < 1 || options.deadline > Problem::kMaxDeadline) {
     throw UsageError("the deadline must be between 1 and " + std::to_string(Problem::kMaxDeadline) + " steps");
   }
-  if (!(std::isfinite(options.laplace) && options.laplace >= 0)) throw UsageError("the Laplace alpha must be >= 0");
+  if (!(options.laplace >= 0 && options.laplace <= kMaxLaplace)) throw UsageError(laplace_rule(options.laplace));
 
   std::map<std::string, int> index_of;
   std::vector<std::vector<int>> skeleton_indices;
@@ -125,7 +139,8 @@ FitResult fit_problem(std::span<const RefinementAttempt> attempts, std::string_v
     ++fits[slot].attempts;
     if (attempt.found) {
       ++fits[slot].found;
-      planning[slot].found.push_back(std::max<Steps>(1, steps_to_complete(attempt.planning_seconds, options.step_seconds)));
+      planning[slot].found.push_back(
+          std::max<Steps>(1, steps_to_complete(attempt.planning_seconds, options.step_seconds)));
       execution[slot].push_back(steps_to_complete(attempt.execution_seconds, options.step_seconds));
     } else {
       ++fits[slot].censored;

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <fstream>
 #include <map>
-#include <optional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -22,6 +22,10 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 
+// Any time of up to Distribution::kMaxStep steps is then a finite number of seconds, with
+// room to spare (planner logs written from the instance never hold an infinity).
+constexpr double kMaxStepSeconds = 1e300;
+
 std::string format_number(double value) {
   std::ostringstream out;
   out.precision(12);
@@ -35,7 +39,8 @@ class InstanceReader {
 
   Problem read(std::string_view text) {
     const Json root = detail::parse_json_strict<Json>(text, source_);
-    if (!root.is_object()) fail("top level", "an instance must be a JSON object (got " + detail::describe_json_type(root) + ")");
+    if (!root.is_object())
+      fail("top level", "an instance must be a JSON object (got " + detail::describe_json_type(root) + ")");
     check_keys(root, "", {"name", "description", "deadline", "step_seconds", "actions", "skeletons"});
 
     std::string name = std::filesystem::path(source_).stem().string();
@@ -45,13 +50,15 @@ class InstanceReader {
 
     if (!root.contains("deadline")) fail("top level", "missing required key 'deadline'");
     const Json& deadline_json = root["deadline"];
-    if (!deadline_json.is_number_integer()) {
-      fail("deadline", "must be a whole number of steps (got " + deadline_json.dump() + ")");
-    }
-    const auto deadline = deadline_json.get<std::int64_t>();
-    if (deadline < 1 || deadline > Problem::kMaxDeadline) {
+    // A whole number, written `4` or `4.0` (as Python writes floats); the value as written in messages.
+    const bool whole =
+        deadline_json.is_number_integer() ||
+        (deadline_json.is_number_float() && std::trunc(deadline_json.get<double>()) == deadline_json.get<double>());
+    if (!whole) fail("deadline", "must be a whole number of steps (got " + deadline_json.dump() + ")");
+    const std::optional<std::int64_t> deadline = detail::json_whole_number(deadline_json, 1, Problem::kMaxDeadline);
+    if (!deadline) {
       fail("deadline", "must be between 1 and " + std::to_string(Problem::kMaxDeadline) + " steps (got " +
-                           std::to_string(deadline) + ")");
+                           deadline_json.dump() + ")");
     }
 
     double step_seconds = 1.0;
@@ -59,15 +66,17 @@ class InstanceReader {
       const Json& value = root["step_seconds"];
       if (!value.is_number()) fail("step_seconds", "must be a number (got " + detail::describe_json_type(value) + ")");
       step_seconds = value.get<double>();
-      if (!(std::isfinite(step_seconds) && step_seconds > 0)) {
-        fail("step_seconds", "must be a positive number of seconds (got " + value.dump() + ")");
+      if (!(std::isfinite(step_seconds) && step_seconds > 0 && step_seconds <= kMaxStepSeconds)) {
+        fail("step_seconds",
+             "must be a positive number of seconds, at most 1e300 so that times in seconds stay finite (got " +
+                 value.dump() + ")");
       }
     }
 
     std::vector<Action> actions = read_actions(root);
     std::vector<std::vector<int>> skeletons = read_skeletons(root, actions);
     try {
-      return Problem(std::move(name), static_cast<Steps>(deadline), step_seconds, std::move(actions),
+      return Problem(std::move(name), static_cast<Steps>(*deadline), step_seconds, std::move(actions),
                      std::move(skeletons), std::move(description));
     } catch (const std::invalid_argument& error) {
       fail("top level", error.what());  // every rule is checked above with its place; kept as a guard
@@ -92,14 +101,17 @@ class InstanceReader {
     if (!root.contains("actions")) fail("top level", "missing required key 'actions'");
     const Json& actions_json = root["actions"];
     if (!actions_json.is_object()) {
-      fail("actions", "must be an object mapping action ids to distributions (got " + detail::describe_json_type(actions_json) + ")");
+      fail("actions", "must be an object mapping action ids to distributions (got " +
+                          detail::describe_json_type(actions_json) + ")");
     }
     if (actions_json.empty()) fail("actions", "at least one action is needed");
     std::vector<Action> actions;
     for (const auto& [id, value] : actions_json.items()) {
       const std::string path = detail::json_member("actions", id);
       if (id.empty()) fail(path, "action ids must be non-empty");
-      if (!value.is_object()) fail(path, "an action must be an object with 'planning' and 'execution' (got " + detail::describe_json_type(value) + ")");
+      if (!value.is_object())
+        fail(path, "an action must be an object with 'planning' and 'execution' (got " +
+                       detail::describe_json_type(value) + ")");
       check_keys(value, path, {"planning", "execution"});
       for (const char* required : {"planning", "execution"}) {
         if (!value.contains(required)) fail(path, std::string("missing required key '") + required + "'");
@@ -118,7 +130,8 @@ class InstanceReader {
     const bool digits = !key.empty() && key.size() <= 9 &&
                         std::all_of(key.begin(), key.end(), [](char c) { return c >= '0' && c <= '9'; });
     if (!digits || (key.size() > 1 && key[0] == '0')) {
-      fail(path, std::string("keys must be whole numbers of steps, written without sign or leading zeros (got '") + key + "')");
+      fail(path, std::string("keys must be whole numbers of steps, written without sign or leading zeros (got '") +
+                     key + "')");
     }
     const long step = std::stol(key);
     if (step < first) {
@@ -131,7 +144,8 @@ class InstanceReader {
   }
 
   double read_probability(const Json& value, const std::string& path) const {
-    if (!value.is_number()) fail(path, "a probability must be a number (got " + detail::describe_json_type(value) + ")");
+    if (!value.is_number())
+      fail(path, "a probability must be a number (got " + detail::describe_json_type(value) + ")");
     const double probability = value.get<double>();
     if (!(probability >= 0.0 && probability <= 1.0 + Distribution::kSumTolerance)) {
       fail(path, "a probability must be within [0, 1] (got " + value.dump() + ")");
@@ -141,7 +155,8 @@ class InstanceReader {
 
   Distribution read_distribution(const Json& value, const std::string& path, Steps first, const char* kind) const {
     if (!value.is_object()) {
-      fail(path, "a distribution must be an object {\"pmf\": {...}} or {\"cdf\": {...}} (got " + detail::describe_json_type(value) + ")");
+      fail(path, "a distribution must be an object {\"pmf\": {...}} or {\"cdf\": {...}} (got " +
+                     detail::describe_json_type(value) + ")");
     }
     check_keys(value, path, {"pmf", "cdf"});
     const bool has_pmf = value.contains("pmf");
@@ -151,7 +166,8 @@ class InstanceReader {
     const std::string table_path = detail::json_member(path, form);
     const Json& table = value[form];
     if (!table.is_object()) {
-      fail(table_path, "must be an object mapping steps to probabilities (got " + detail::describe_json_type(table) + ")");
+      fail(table_path,
+           "must be an object mapping steps to probabilities (got " + detail::describe_json_type(table) + ")");
     }
     std::map<Steps, std::pair<double, std::string>> entries;  // numeric order
     for (const auto& [key, probability] : table.items()) {
@@ -223,7 +239,7 @@ Problem parse_problem(std::string_view text, std::string_view source) {
 }
 
 Problem load_problem(const std::filesystem::path& path) {
-  return parse_problem(detail::read_text_file(path), path.string());
+  return parse_problem(read_input_file(path, "instance"), path.string());
 }
 
 std::string problem_to_json(const Problem& problem) {

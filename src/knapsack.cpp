@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
 #include "ontime/error.hpp"
@@ -15,9 +17,12 @@ using Json = nlohmann::ordered_json;
 
 std::int64_t positive_integer(const Json& value, const std::string& source, const std::string& path,
                               std::int64_t maximum) {
-  if (!value.is_number_integer()) throw InputError(source, path, "must be a positive whole number (got " + value.dump() + ")");
-  const auto number = value.get<std::int64_t>();
-  if (number < 1) throw InputError(source, path, "must be a positive whole number (got " + value.dump() + ")");
+  // Whole numbers may be written with a zero fraction part (`4.0`).
+  const std::optional<std::int64_t> whole = detail::json_whole_number(value, std::numeric_limits<std::int64_t>::min(),
+                                                                      std::numeric_limits<std::int64_t>::max());
+  if (!whole || *whole < 1)
+    throw InputError(source, path, "must be a positive whole number (got " + value.dump() + ")");
+  const std::int64_t number = *whole;
   if (number > maximum) {
     throw InputError(source, path, "must be at most " + std::to_string(maximum) + " (got " + value.dump() + ")");
   }
@@ -57,7 +62,8 @@ Knapsack parse_knapsack(std::string_view text, std::string_view source_view) {
       }
     }
     for (const char* required : {"weight", "value"}) {
-      if (!item.contains(required)) throw InputError(source, path, std::string("missing required key '") + required + "'");
+      if (!item.contains(required))
+        throw InputError(source, path, std::string("missing required key '") + required + "'");
     }
     knapsack.items.push_back(
         {positive_integer(item["weight"], source, detail::json_member(path, "weight"), Distribution::kMaxStep - 1),
@@ -67,7 +73,7 @@ Knapsack parse_knapsack(std::string_view text, std::string_view source_view) {
 }
 
 Knapsack load_knapsack(const std::filesystem::path& path) {
-  return parse_knapsack(detail::read_text_file(path), path.string());
+  return parse_knapsack(read_input_file(path, "knapsack"), path.string());
 }
 
 double reduction_epsilon(const Knapsack& knapsack) {
@@ -94,7 +100,8 @@ Problem reduce_knapsack(const Knapsack& knapsack, std::string name) {
     planning[static_cast<std::size_t>(knapsack.capacity) + 1] += 1.0 - early;
     std::string id = "item";
     id += std::to_string(k + 1);
-    actions.push_back(Action{std::move(id), Distribution::from_pmf(std::move(planning)), Distribution::from_pmf({1.0})});
+    actions.push_back(
+        Action{std::move(id), Distribution::from_pmf(std::move(planning)), Distribution::from_pmf({1.0})});
     skeletons.push_back({static_cast<int>(k)});
   }
   return Problem(std::move(name), deadline, 1.0, std::move(actions), std::move(skeletons),

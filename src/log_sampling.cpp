@@ -1,5 +1,10 @@
 #include "ontime/log_sampling.hpp"
 
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
 #include "ontime/error.hpp"
 #include "ontime/random.hpp"
 
@@ -20,6 +25,18 @@ std::vector<RefinementAttempt> sample_planner_log(const Problem& problem, const 
   if (options.cutoff_steps < 0) throw UsageError("the cut-off must be >= 0 steps");
   const Steps cutoff = options.cutoff_steps > 0 ? options.cutoff_steps : problem.deadline();
   const double step = problem.step_seconds();
+  // Every time written is at most `longest` steps: the log holds only finite seconds.
+  Steps longest = std::max(cutoff, problem.deadline() + 1);
+  for (const Action& action : problem.actions()) {
+    longest = std::max({longest, static_cast<Steps>(action.planning.masses().size()),
+                        static_cast<Steps>(action.execution.masses().size())});
+  }
+  if (!std::isfinite(static_cast<double>(longest) * step)) {
+    throw UsageError(
+        fmt::format("the times of this log (up to {} steps of {:g} seconds) are not finite numbers of seconds; "
+                    "use a smaller step_seconds or cut-off",
+                    longest, step));
+  }
   std::vector<RefinementAttempt> log;
   for (int a = 0; a < problem.action_count(); ++a) {
     if (problem.position(a) < 0) continue;  // no skeleton uses it

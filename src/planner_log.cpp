@@ -1,7 +1,9 @@
 #include "ontime/planner_log.hpp"
 
 #include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <regex>
 
 #include "ontime/atomic_file.hpp"
@@ -25,15 +27,18 @@ class LineReader {
       // The parser counts lines within this one line; name the line of the file instead.
       static const std::regex column(R"(line \d+, (column \d+))");
       std::smatch match;
-      if (std::regex_match(error.place(), match, column)) throw InputError(source_, place() + ", " + match[1].str(), error.rule());
+      if (std::regex_match(error.place(), match, column))
+        throw InputError(source_, place() + ", " + match[1].str(), error.rule());
       throw InputError(source_, place() + ": " + error.place(), error.rule());
     }
-    if (!record.is_object()) fail("", "a record must be a JSON object (got " + detail::describe_json_type(record) + ")");
+    if (!record.is_object())
+      fail("", "a record must be a JSON object (got " + detail::describe_json_type(record) + ")");
     for (const auto& [key, value] : record.items()) {
       if (key != "action" && key != "planning_seconds" && key != "found" && key != "execution_seconds" &&
           key != "trial" && key != "collision_checks") {
-        fail(key, "unknown key (expected 'action', 'planning_seconds', 'found', 'execution_seconds', 'trial', "
-                  "'collision_checks')");
+        fail(key,
+             "unknown key (expected 'action', 'planning_seconds', 'found', 'execution_seconds', 'trial', "
+             "'collision_checks')");
       }
     }
     RefinementAttempt attempt;
@@ -54,7 +59,8 @@ class LineReader {
       fail("execution_seconds", "only a found motion has an execution time ('found' is false)");
     }
     if (record.contains("trial")) attempt.trial = count(record["trial"], "trial");
-    if (record.contains("collision_checks")) attempt.collision_checks = count(record["collision_checks"], "collision_checks");
+    if (record.contains("collision_checks"))
+      attempt.collision_checks = count(record["collision_checks"], "collision_checks");
     return attempt;
   }
 
@@ -73,15 +79,18 @@ class LineReader {
   double seconds(const Json& value, const char* key) const {
     if (!value.is_number()) fail(key, "must be a number of seconds (got " + detail::describe_json_type(value) + ")");
     const double result = value.get<double>();
-    if (!(std::isfinite(result) && result >= 0)) fail(key, "must be a finite number of seconds >= 0 (got " + value.dump() + ")");
+    if (!(std::isfinite(result) && result >= 0))
+      fail(key, "must be a finite number of seconds >= 0 (got " + value.dump() + ")");
     return result;
   }
 
+  // A whole number >= 0, written as an integer or with a zero fraction part (`3.0`).
   std::uint64_t count(const Json& value, const char* key) const {
-    if (!value.is_number_unsigned() && !(value.is_number_integer() && value.get<std::int64_t>() >= 0)) {
-      fail(key, "must be a whole number >= 0 (got " + value.dump() + ")");
-    }
-    return value.get<std::uint64_t>();
+    if (value.is_number_unsigned()) return value.get<std::uint64_t>();
+    const std::optional<std::int64_t> number =
+        detail::json_whole_number(value, 0, std::numeric_limits<std::int64_t>::max());
+    if (!number) fail(key, "must be a whole number >= 0 (got " + value.dump() + ")");
+    return static_cast<std::uint64_t>(*number);
   }
 
   std::string source_;
@@ -109,7 +118,7 @@ std::vector<RefinementAttempt> parse_planner_log(std::string_view text, std::str
 }
 
 std::vector<RefinementAttempt> load_planner_log(const std::filesystem::path& path) {
-  return parse_planner_log(detail::read_text_file(path), path.string());
+  return parse_planner_log(read_input_file(path, "planner log"), path.string());
 }
 
 std::string planner_log_line(const RefinementAttempt& attempt) {

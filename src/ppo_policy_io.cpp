@@ -207,7 +207,7 @@ PpoPolicy parse_ppo_policy(std::string_view text, std::string_view source) {
 }
 
 PpoPolicy load_ppo_policy(const std::filesystem::path& path) {
-  return parse_ppo_policy(detail::read_text_file(path), path.string());
+  return parse_ppo_policy(read_input_file(path, "policy"), path.string());
 }
 
 }  // namespace ontime

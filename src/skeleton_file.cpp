@@ -39,7 +39,7 @@ SkeletonList parse_skeleton_file(std::string_view text, std::string_view source)
 }
 
 SkeletonList load_skeleton_file(const std::filesystem::path& path) {
-  return parse_skeleton_file(detail::read_text_file(path), path.string());
+  return parse_skeleton_file(read_input_file(path, "skeleton"), path.string());
 }
 
 }  // namespace ontime

@@ -835,5 +835,43 @@ TEST(Cli, PlotWithoutATemporaryFolderIsAUsageError) {
   }
 }
 
+// Input files are read through one bounded reader: a device without end is read up to the
+// limit (256 MiB by default, ONTIME_MAX_INPUT_BYTES overrides it) and refused with exit 2.
+TEST(Cli, AnInputWithoutEndIsRefusedAtTheSizeLimit) {
+  const auto instance = ontime({"solve", "/dev/zero"});
+  EXPECT_EQ(instance.exit_code, 2) << instance.err;
+  EXPECT_NE(instance.err.find("/dev/zero: file: the instance file is larger than the input size limit of 268435456 "
+                              "bytes (256 MiB)"),
+            std::string::npos)
+      << instance.err;
+
+  ASSERT_EQ(::setenv("ONTIME_MAX_INPUT_BYTES", "65536", 1), 0);
+  const auto log = ontime({"fit", "/dev/urandom", "--step", "1", "--deadline", "5", "--skeletons", paper("figure1"),
+                           "-o", (scratch("urandom") / "fit.json").string()});
+  const auto policy = ontime({"evaluate", paper("figure1"), "--solver", "ppo", "--policy", "/dev/zero"});
+  ASSERT_EQ(::unsetenv("ONTIME_MAX_INPUT_BYTES"), 0);
+  EXPECT_EQ(log.exit_code, 2) << log.err;
+  EXPECT_NE(log.err.find("/dev/urandom: file: the planner log file is larger than the input size limit of 65536 bytes"),
+            std::string::npos)
+      << log.err;
+  EXPECT_EQ(policy.exit_code, 2) << policy.err;
+  EXPECT_NE(policy.err.find("/dev/zero: file: the policy file is larger than the input size limit of 65536 bytes"),
+            std::string::npos)
+      << policy.err;
+}
+
+TEST(Cli, ALaplaceAlphaThatSwampsTheLogIsAUsageError) {
+  const auto directory = scratch("laplace");
+  const auto sampled = ontime({"sample-log", paper("figure1"), "-o", (directory / "log.jsonl").string()});
+  ASSERT_EQ(sampled.exit_code, 0) << sampled.err;
+  const auto fitted = ontime({"fit", (directory / "log.jsonl").string(), "--step", "1", "--deadline", "5",
+                              "--skeletons", paper("figure1"), "--laplace", "1e308", "-o",
+                              (directory / "fit.json").string()});
+  EXPECT_EQ(fitted.exit_code, 2) << fitted.err;
+  EXPECT_NE(fitted.err.find("laplace: the Laplace smoothing alpha must be between 0 and 1e+06"), std::string::npos)
+      << fitted.err;
+  EXPECT_FALSE(std::filesystem::exists(directory / "fit.json"));
+}
+
 }  // namespace
 }  // namespace ontime

@@ -1,3 +1,5 @@
+#include "ontime/fitting.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -5,7 +7,6 @@
 
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/error.hpp"
-#include "ontime/fitting.hpp"
 #include "ontime/log_sampling.hpp"
 #include "ontime/random.hpp"
 #include "support/paper.hpp"
@@ -34,7 +35,9 @@ double truncated_cdf(const Distribution& distribution, Steps t, Steps deadline) 
 
 // Dvoretzky-Kiefer-Wolfowitz (Massart's constant): with n independent draws, the empirical CDF
 // is everywhere within this distance of the true CDF except with probability at most delta.
-double dkw_bound(std::size_t n, double delta) { return std::sqrt(std::log(2.0 / delta) / (2.0 * static_cast<double>(n))); }
+double dkw_bound(std::size_t n, double delta) {
+  return std::sqrt(std::log(2.0 / delta) / (2.0 * static_cast<double>(n)));
+}
 
 TEST(Fitting, RoundsTimesUpToWholeSteps) {
   EXPECT_EQ(steps_to_complete(0.0, 1.0), 0);
@@ -44,7 +47,7 @@ TEST(Fitting, RoundsTimesUpToWholeSteps) {
   EXPECT_EQ(steps_to_complete(0.1 + 0.2, 0.1), 3);  // 0.30000000000000004 s is 3 steps of 0.1 s
   EXPECT_EQ(whole_steps_within(2.0, 1.0), 2);
   EXPECT_EQ(whole_steps_within(1.999, 1.0), 1);
-  EXPECT_EQ(whole_steps_within(0.3, 0.1), 3);       // 0.3 / 0.1 = 2.9999999999999996
+  EXPECT_EQ(whole_steps_within(0.3, 0.1), 3);  // 0.3 / 0.1 = 2.9999999999999996
   EXPECT_EQ(whole_steps_within(0.05, 0.1), 0);
   EXPECT_EQ(steps_to_complete(1e300, 1.0), Distribution::kMaxStep + 1);  // clamped, beyond every deadline
 }
@@ -166,8 +169,8 @@ TEST(Fitting, RecoversAKnownDistributionFromCensoredData) {
 
 TEST(Fitting, RecoversAKnownExecutionDistributionWithinTheDkwBound) {
   const Steps deadline = 22;
-  const Distribution truth = Distribution::from_pmf({0.05, 0.1, 0.3, 0.25, 0.1, 0.05, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0,
-                                                     0, 0, 0, 0, 0, 0, 0, 0, 0.05, 0.05});
+  const Distribution truth = Distribution::from_pmf(
+      {0.05, 0.1, 0.3, 0.25, 0.1, 0.05, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0.05, 0.05});
   const std::size_t n = 20'000;
   std::vector<Steps> sample;
   for (const Steps x : draw(truth, n, 13)) sample.push_back(x == kNever ? deadline + 1 : x);
@@ -186,14 +189,16 @@ TEST(Fitting, RejectsBadEstimationOptions) {
   EXPECT_THROW(estimate_execution(std::vector<Steps>{-1}, 5), UsageError);
 }
 
-SkeletonList skeletons(std::vector<std::vector<std::string>> list) { return SkeletonList{"skeletons.json", std::move(list)}; }
+SkeletonList skeletons(std::vector<std::vector<std::string>> list) {
+  return SkeletonList{"skeletons.json", std::move(list)};
+}
 
 TEST(Fitting, FitsAProblemForTheSkeletons) {
   const std::vector<RefinementAttempt> log{
-      {"a", 0.4, true, 1.5, std::nullopt, std::nullopt},  // 1 step, executes in 2
-      {"a", 1.6, true, 0.0, std::nullopt, std::nullopt},  // 2 steps, executes in 0
-      {"a", 3.0, false, 0.0, std::nullopt, std::nullopt}, // cut off after 3 steps
-      {"b", 0.9, true, 9.0, std::nullopt, std::nullopt},  // executes in 9 > D: never
+      {"a", 0.4, true, 1.5, std::nullopt, std::nullopt},   // 1 step, executes in 2
+      {"a", 1.6, true, 0.0, std::nullopt, std::nullopt},   // 2 steps, executes in 0
+      {"a", 3.0, false, 0.0, std::nullopt, std::nullopt},  // cut off after 3 steps
+      {"b", 0.9, true, 9.0, std::nullopt, std::nullopt},   // executes in 9 > D: never
       {"unused", 1.0, true, 1.0, std::nullopt, std::nullopt},
   };
   FitOptions options;
@@ -280,6 +285,72 @@ TEST(Fitting, SampledLogsFitBackToTheInstanceOptimum) {
         std::abs(original_solver.solve(original_mdp.start()) - fitted_solver.solve(fitted_mdp.start()));
     EXPECT_LE(difference, coupling_bound) << name;
     EXPECT_LE(difference, 0.01) << name;
+  }
+}
+
+// Whatever the step, the log sampled from an instance is one the log reader accepts.
+TEST(Fitting, SampledLogsAlwaysParseWithTheLogReader) {
+  const Problem paper = testing::paper_instance("instance1");
+  for (const double step : {1e300, 1e-300, 4.9e-324, 0.37}) {
+    const Problem scaled(paper.name(), paper.deadline(), step, {paper.actions().begin(), paper.actions().end()},
+                         [&paper] {
+                           std::vector<std::vector<int>> skeletons;
+                           for (int k = 0; k < paper.skeleton_count(); ++k) {
+                             const auto skeleton = paper.skeleton(k);
+                             skeletons.emplace_back(skeleton.begin(), skeleton.end());
+                           }
+                           return skeletons;
+                         }());
+    LogSamplingOptions sampling;
+    sampling.attempts_per_action = 200;
+    const std::vector<RefinementAttempt> log = sample_planner_log(scaled, sampling);
+    std::string text;
+    for (const RefinementAttempt& attempt : log) text += planner_log_line(attempt);
+    EXPECT_EQ(parse_planner_log(text, "sampled").size(), log.size()) << step;
+  }
+}
+
+TEST(Fitting, ATimeBeyondTheLargestDoubleIsRefusedBeforeSampling) {
+  const Problem paper = testing::paper_instance("figure1");
+  std::vector<std::vector<int>> skeletons;
+  for (int k = 0; k < paper.skeleton_count(); ++k) {
+    const auto skeleton = paper.skeleton(k);
+    skeletons.emplace_back(skeleton.begin(), skeleton.end());
+  }
+  const Problem scaled(paper.name(), paper.deadline(), 1e300, {paper.actions().begin(), paper.actions().end()},
+                       skeletons);
+  LogSamplingOptions sampling;
+  sampling.cutoff_steps = 2'000'000'000;
+  EXPECT_THROW(sample_planner_log(scaled, sampling), UsageError);
+}
+
+TEST(Fitting, ALaplaceAlphaThatSwampsTheLogIsRefused) {
+  const Problem paper = testing::paper_instance("figure1");
+  LogSamplingOptions sampling;
+  sampling.attempts_per_action = 50;
+  const std::vector<RefinementAttempt> log = sample_planner_log(paper, sampling);
+  SkeletonList list{"instance", {}};
+  for (int k = 0; k < paper.skeleton_count(); ++k) {
+    std::vector<std::string>& ids = list.skeletons.emplace_back();
+    for (const int action : paper.skeleton(k)) ids.push_back(paper.action(action).id);
+  }
+  FitOptions options;
+  options.deadline = paper.deadline();
+  options.laplace = 1e308;
+  try {
+    fit_problem(log, "log", list, options);
+    ADD_FAILURE() << "alpha 1e308 was accepted";
+  } catch (const UsageError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "--laplace: the Laplace smoothing alpha must be between 0 and 1e+06, larger values swamp the log (got "
+              "1e+308)");
+  }
+  options.laplace = 1e6;  // the largest alpha: the fitted PMFs keep their mass
+  const Problem fitted = fit_problem(log, "log", list, options).problem;
+  for (const Action& action : fitted.actions()) {
+    double planning = 0;
+    for (const double mass : action.planning.masses()) planning += mass;
+    EXPECT_GT(planning, 0.1) << action.id;
   }
 }
 

@@ -105,6 +105,7 @@ TEST(Knapsack, RejectsInvalidFiles) {
     return std::string("accepted");
   };
   EXPECT_EQ(place_of(R"({"capacity": 5, "items": [{"weight": 2, "value": 3}]})"), "accepted");
+  EXPECT_EQ(place_of(R"({"capacity": 5.0, "items": [{"weight": 2.0, "value": 3e0}]})"), "accepted");  // as Python writes
   EXPECT_EQ(place_of(R"({"items": [{"weight": 2, "value": 3}]})"), "top level: missing required key 'capacity'");
   EXPECT_EQ(place_of(R"({"capacity": 0, "items": [{"weight": 2, "value": 3}]})").substr(0, 10), "capacity: ");
   EXPECT_EQ(place_of(R"({"capacity": 10001, "items": [{"weight": 2, "value": 3}]})").substr(0, 10), "capacity: ");

@@ -1,9 +1,10 @@
+#include "ontime/planner_log.hpp"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
 
 #include "ontime/error.hpp"
-#include "ontime/planner_log.hpp"
 #include "support/bad_logs.hpp"
 #include "support/paper.hpp"
 
@@ -14,7 +15,8 @@ TEST(PlannerLog, ReadsEveryFieldAndSkipsBlankLines) {
   const std::vector<RefinementAttempt> log = parse_planner_log(
       "{\"action\": \"move(R1,R5)\", \"planning_seconds\": 1.25, \"found\": true, \"execution_seconds\": 6.5}\n"
       "\n"
-      "{\"action\": \"move(R5,R8)\", \"trial\": 7, \"planning_seconds\": 44, \"found\": false, \"collision_checks\": 88000}\n",
+      "{\"action\": \"move(R5,R8)\", \"trial\": 7, \"planning_seconds\": 44, \"found\": false, \"collision_checks\": "
+      "88000}\n",
       "log");
   ASSERT_EQ(log.size(), 2u);
   EXPECT_EQ(log[0].action, "move(R1,R5)");
@@ -52,8 +54,29 @@ TEST(PlannerLog, EveryBadLogNamesItsLineAndRule) {
   }
 }
 
-TEST(PlannerLog, AMissingFileIsAnInputError) {
-  EXPECT_THROW(load_planner_log("/nonexistent/log.jsonl"), InputError);
+TEST(PlannerLog, AMissingFileIsAnInputError) { EXPECT_THROW(load_planner_log("/nonexistent/log.jsonl"), InputError); }
+
+// nlohmann reads a NUL byte as the end of the input: a line cut there must not pass.
+TEST(PlannerLog, ANulByteInALineIsRefusedWithItsLineAndColumn) {
+  using namespace std::string_literals;
+  const std::string text =
+      "{\"action\": \"a\", \"planning_seconds\": 1, \"found\": false}\n"
+      "{\"action\": \"a\", \"planning_seconds\": 1, \"found\": false}\0garbage\n"s;
+  try {
+    parse_planner_log(text, "log");
+    ADD_FAILURE() << "a NUL byte was accepted";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.place(), "line 2, column 55");
+    EXPECT_NE(error.rule().find("NUL byte"), std::string::npos) << error.rule();
+  }
+}
+
+TEST(PlannerLog, CountsMayBeWrittenWithAZeroFraction) {
+  const auto log = parse_planner_log(R"({"action": "a", "planning_seconds": 1, "found": false, "trial": 3.0})", "log");
+  ASSERT_TRUE(log.at(0).trial.has_value());
+  EXPECT_EQ(*log.at(0).trial, 3U);
+  EXPECT_THROW(parse_planner_log(R"({"action": "a", "planning_seconds": 1, "found": false, "trial": 3.5})", "log"),
+               InputError);
 }
 
 }  // namespace

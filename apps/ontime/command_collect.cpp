@@ -6,8 +6,6 @@
 #include <fmt/format.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "common.hpp"
 #include "data_paths.hpp"
@@ -17,21 +15,12 @@
 #include "ontime/domains/registry.hpp"
 #include "ontime/error.hpp"
 #include "ontime/fitting.hpp"
+#include "ontime/input_file.hpp"
 #include "ontime/instance_io.hpp"
 #include "output_paths.hpp"
 #include "thread_limit.hpp"
 
 namespace ontime::cli {
-namespace {
-
-std::string file_text(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-}  // namespace
 
 void add_collect_command(CLI::App& app) {
   struct Options {
@@ -116,7 +105,7 @@ void add_collect_command(CLI::App& app) {
       throw UsageError(checkpoint_path.string() +
                        ": the checkpoint of an unfinished collection is there; resume it (--resume) or delete it");
     }
-    domains::CollectionJournal journal(checkpoint_path, *loaded.domain, collection, file_text(world), options->resume);
+    domains::CollectionJournal journal(checkpoint_path, *loaded.domain, collection, read_input_file(world, "world"), options->resume);
     collection.journal = &journal;
     const std::size_t resumed = journal.finished().size();
     ProgressBar bar("collect " + options->domain);

@@ -73,7 +73,7 @@ CollectionJournal::CollectionJournal(std::filesystem::path path, const Domain& d
                      ": the checkpoint of an unfinished collection is there; resume the collection or delete it");
   }
   if (exists) {
-    const std::string text = ontime::detail::read_text_file(path_);
+    const std::string text = ontime::read_input_file(path_, "collection journal");
     std::set<std::pair<std::size_t, std::uint64_t>> seen;
     std::size_t start = 0, number = 0;
     while (start < text.size()) {

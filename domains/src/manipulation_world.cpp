@@ -60,10 +60,9 @@ class KitchenReader : detail::WorldFields {
   }
 
   int whole(const Json& value, const std::string& path, int low, int high) const {
-    if (!value.is_number_integer() || value.get<std::int64_t>() < low || value.get<std::int64_t>() > high) {
-      fail(path, "must be a whole number between " + std::to_string(low) + " and " + std::to_string(high));
-    }
-    return static_cast<int>(value.get<std::int64_t>());
+    const std::optional<std::int64_t> number = ontime::detail::json_whole_number(value, low, high);
+    if (!number) fail(path, "must be a whole number between " + std::to_string(low) + " and " + std::to_string(high));
+    return static_cast<int>(*number);
   }
 
   void read_floor(const Json& floor, const Json& walls, ManipulationWorld& world) const {
@@ -374,7 +373,7 @@ ManipulationWorld parse_manipulation_world(std::string_view text, std::string_vi
 }
 
 ManipulationWorld load_manipulation_world(const std::filesystem::path& path) {
-  return parse_manipulation_world(detail::read_text_file(path), path.string());
+  return parse_manipulation_world(read_input_file(path, "world"), path.string());
 }
 
 }  // namespace ontime::domains

@@ -377,7 +377,7 @@ NavigationWorld parse_navigation_world(std::string_view text, std::string_view s
 }
 
 NavigationWorld load_navigation_world(const std::filesystem::path& path) {
-  return parse_navigation_world(detail::read_text_file(path), path.string());
+  return parse_navigation_world(read_input_file(path, "world"), path.string());
 }
 
 }  // namespace ontime::domains

@@ -22,7 +22,7 @@ using ontime::detail::describe_json_type;
 using ontime::detail::json_index;
 using ontime::detail::json_member;
 using ontime::detail::parse_json_strict;
-using ontime::detail::read_text_file;
+using ontime::read_input_file;
 
 // "%g" of a number, for messages.
 std::string number_text(double value);
@@ -82,11 +82,11 @@ class WorldFields {
     check_keys(value, "collection", {"deadline", "step_seconds", "checks_per_second"});
     CollectionDefaults collection;
     const Json& deadline = member(value, "collection", "deadline");
-    if (!deadline.is_number_integer() || deadline.get<std::int64_t>() < 1 ||
-        deadline.get<std::int64_t>() > Problem::kMaxDeadline) {
+    const std::optional<std::int64_t> steps = ontime::detail::json_whole_number(deadline, 1, Problem::kMaxDeadline);
+    if (!steps) {
       fail("collection.deadline", "must be a whole number of steps between 1 and " + std::to_string(Problem::kMaxDeadline));
     }
-    collection.deadline = static_cast<Steps>(deadline.get<std::int64_t>());
+    collection.deadline = static_cast<Steps>(*steps);
     collection.step_seconds = positive(member(value, "collection", "step_seconds"), "collection.step_seconds");
     collection.checks_per_second = positive(member(value, "collection", "checks_per_second"), "collection.checks_per_second");
     return collection;
