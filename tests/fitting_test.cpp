@@ -342,7 +342,7 @@ TEST(Fitting, ALaplaceAlphaThatSwampsTheLogIsRefused) {
     ADD_FAILURE() << "alpha 1e308 was accepted";
   } catch (const UsageError& error) {
     EXPECT_EQ(std::string(error.what()),
-              "--laplace: the Laplace smoothing alpha must be between 0 and 1e+06, larger values swamp the log (got "
+              "laplace: the Laplace smoothing alpha must be between 0 and 1e+06, larger values swamp the log (got "
               "1e+308)");
   }
   options.laplace = 1e6;  // the largest alpha: the fitted PMFs keep their mass
