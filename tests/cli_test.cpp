@@ -482,5 +482,35 @@ TEST(Cli, HelpIsAvailableForEveryCommand) {
   EXPECT_EQ(ontime({"--version"}).exit_code, 0);
 }
 
+// `train` on valid instances where success is impossible (no useful choice from the start)
+// exits 0 with a policy, the same bytes in repeated runs, and the policy evaluates to 0.
+TEST(Cli, TrainsTheSamePolicyOnInstancesWhereSuccessIsImpossible) {
+  const auto directory = scratch("impossible");
+  for (const std::string name : {"never_planning", "deadline_one", "never_execution"}) {
+    SCOPED_TRACE(name);
+    const std::string instance = testing::source_path("tests/data/impossible/" + name + ".json").string();
+    std::vector<std::string> policies;
+    for (const std::string run : {"first", "second"}) {
+      const std::string policy = (directory / (name + "-" + run + ".json")).string();
+      const auto trained = ontime({"train", instance, "--episodes", "200", "--out", policy, "--no-plot", "--json"});
+      ASSERT_EQ(trained.exit_code, 0) << trained.err;
+      EXPECT_EQ(json::parse(trained.out)["exact_success_probability"].get<double>(), 0.0);
+      policies.push_back(read_file(policy));
+      // One epoch of 200 episodes that all ended before a choice: no step, no gradient step.
+      std::ifstream curve(directory / (name + "-" + run + ".curve.csv"));
+      std::string header, epoch;
+      std::getline(curve, header);
+      std::getline(curve, epoch);
+      EXPECT_EQ(epoch.rfind("1,200,0,0,0,0,", 0), 0U) << epoch;
+    }
+    EXPECT_FALSE(policies[0].empty());
+    EXPECT_EQ(policies[0], policies[1]);
+    const auto evaluated = ontime({"evaluate", instance, "--solver", "ppo", "--policy",
+                                   (directory / (name + "-first.json")).string(), "--episodes", "100", "--json"});
+    ASSERT_EQ(evaluated.exit_code, 0) << evaluated.err;
+    EXPECT_EQ(json::parse(evaluated.out)["successes"].get<int>(), 0);
+  }
+}
+
 }  // namespace
 }  // namespace ontime

@@ -1,3 +1,5 @@
+#include "ontime/allocators/ppo.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -5,9 +7,9 @@
 
 #include "neural_network.hpp"  // private to the library (src/), as is ppo_networks.hpp
 #include "ontime/allocator_registry.hpp"
-#include "ontime/allocators/ppo.hpp"
 #include "ontime/error.hpp"
 #include "ontime/evaluation.hpp"
+#include "ontime/instance_io.hpp"
 #include "ontime/ppo_training.hpp"
 #include "ppo_networks.hpp"
 #include "support/paper.hpp"
@@ -79,7 +81,8 @@ TEST(Ppo, SurrogateGradientMatchesFiniteDifferences) {
     for (int k = 0; k < kChoices; ++k) {
       if (valid[static_cast<std::size_t>(n * kChoices + k)] != 0) total += std::exp(logits(k, n));
     }
-    const double ratio = std::exp(logits(actions[static_cast<std::size_t>(n)], n) - std::log(total) - old_log[static_cast<std::size_t>(n)]);
+    const double ratio = std::exp(logits(actions[static_cast<std::size_t>(n)], n) - std::log(total) -
+                                  old_log[static_cast<std::size_t>(n)]);
     below += ratio < 0.8;
     above += ratio > 1.2;
     inside += ratio >= 0.8 && ratio <= 1.2;
@@ -93,9 +96,11 @@ TEST(Ppo, SurrogateGradientMatchesFiniteDifferences) {
     MatrixD ignored;
     double ignored_kl = 0;
     shifted.data()[i] += kStep;
-    const double up = clipped_surrogate_loss<double>(shifted, valid, actions, old_log, advantages, 0.2, ignored, ignored_kl);
+    const double up =
+        clipped_surrogate_loss<double>(shifted, valid, actions, old_log, advantages, 0.2, ignored, ignored_kl);
     shifted.data()[i] -= 2 * kStep;
-    const double down = clipped_surrogate_loss<double>(shifted, valid, actions, old_log, advantages, 0.2, ignored, ignored_kl);
+    const double down =
+        clipped_surrogate_loss<double>(shifted, valid, actions, old_log, advantages, 0.2, ignored, ignored_kl);
     EXPECT_NEAR(gradient.data()[i], (up - down) / (2 * kStep), 1e-7) << "entry " << i;
   }
   // Masked choices get no gradient.
@@ -128,6 +133,28 @@ TEST(Ppo, SameSeedSamePolicyByteForByte) {
   const std::string second = ppo_policy_to_json(train_ppo(mdp, 300, 9, small).policy);
   EXPECT_EQ(first, second);
   EXPECT_NE(first, ppo_policy_to_json(train_ppo(mdp, 300, 10, small).policy));
+}
+
+// Instances where success is impossible from the start (every planning PMF "never", deadline 1,
+// every execution "never") offer no useful choice: every episode is lost before its first step.
+// Training takes no step, writes the untrained policy, and does so the same way every time.
+TEST(Ppo, TrainsOnInstancesWhereSuccessIsImpossible) {
+  for (const std::string name : {"never_planning", "deadline_one", "never_execution"}) {
+    SCOPED_TRACE(name);
+    const Problem problem = load_problem(testing::source_path("tests/data/impossible/" + name + ".json"));
+    const Mdp mdp(problem);
+    ASSERT_TRUE(mdp.useful_choices(mdp.start()).empty());
+    const PpoTraining training = train_ppo(mdp, 50, 3);
+    ASSERT_EQ(training.curve.size(), 1U);
+    EXPECT_EQ(training.curve[0].episodes, 50U);
+    EXPECT_EQ(training.curve[0].steps, 0U);
+    EXPECT_EQ(training.curve[0].success_rate, 0.0);
+    EXPECT_EQ(training.curve[0].actor_steps, 0);
+    const std::string policy = ppo_policy_to_json(training.policy);
+    EXPECT_EQ(policy, ppo_policy_to_json(train_ppo(mdp, 50, 3).policy));
+    PpoAllocator allocator(mdp, std::make_shared<const PpoPolicy>(training.policy));
+    EXPECT_EQ(evaluate_exactly(mdp, allocator).success_probability, 0.0);
+  }
 }
 
 TEST(Ppo, PolicyFilesRoundTripAndAreValidated) {
