@@ -123,6 +123,7 @@ PpoTraining train_ppo(const Mdp& mdp, std::uint64_t episodes, std::uint64_t seed
   PpoTraining training;
   PpoPolicy& policy = training.policy;
   policy.instance = mdp.problem().name();
+  policy.instance_digest = instance_digest(mdp.problem());
   policy.skeleton_count = count;
   policy.deadline = mdp.deadline();
   policy.seed = seed;

@@ -512,5 +512,40 @@ TEST(Cli, TrainsTheSamePolicyOnInstancesWhereSuccessIsImpossible) {
   }
 }
 
+// A policy is used only on the instance it was trained on (its digest), unless --policy-check
+// shape; unknown keys in policy files are refused by name. Both exit 2 with one line.
+TEST(Cli, APolicyOfAnotherInstanceIsRefusedUnlessTheShapeSuffices) {
+  const auto directory = scratch("digest");
+  const std::string policy = (directory / "instance4.json").string();
+  const auto trained = ontime({"train", paper("instance4"), "--episodes", "100", "--out", policy, "--no-plot"});
+  ASSERT_EQ(trained.exit_code, 0) << trained.err;
+  std::string other_text = read_file(paper("instance4"));
+  other_text.replace(other_text.find("\"1\": 0.3"), 8, "\"1\": 0.2");
+  const std::string other = (directory / "other.json").string();
+  std::ofstream(other) << other_text;
+  const auto evaluate = [&](const std::string& instance, const std::string& policy_file, const std::string& check) {
+    std::vector<std::string> arguments{"evaluate", instance,    "--solver",   "ppo",
+                                       "--policy", policy_file, "--episodes", "10"};
+    if (!check.empty()) arguments.insert(arguments.end(), {"--policy-check", check});
+    return ontime(arguments);
+  };
+  EXPECT_EQ(evaluate(paper("instance4"), policy, "").exit_code, 0);
+  const auto refused = evaluate(other, policy, "");
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_NE(refused.err.find(policy + " was trained on another instance ('paper-instance-4', fnv1a64:"),
+            std::string::npos)
+      << refused.err;
+  EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+  EXPECT_EQ(evaluate(other, policy, "shape").exit_code, 0);
+
+  std::string with_unknown_key = read_file(policy);
+  with_unknown_key.insert(with_unknown_key.find('{') + 1, "\"trained_on\": \"elsewhere\",");
+  const std::string tampered = (directory / "tampered.json").string();
+  std::ofstream(tampered) << with_unknown_key;
+  const auto unknown = evaluate(paper("instance4"), tampered, "shape");
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.err.find(tampered + ": trained_on: unknown key"), std::string::npos) << unknown.err;
+}
+
 }  // namespace
 }  // namespace ontime

@@ -157,6 +157,70 @@ TEST(Ppo, TrainsOnInstancesWhereSuccessIsImpossible) {
   }
 }
 
+// A policy records the digest of the instance it was trained on; the registry's `ppo` refuses a
+// policy of another instance of the same shape, or one without a digest, unless policy-check is
+// 'shape'. Labels (name, description) are not part of the digest.
+TEST(Ppo, PoliciesAreUsedOnlyOnTheInstanceTheyWereTrainedOn) {
+  const Problem problem = testing::paper_instance("instance4");
+  const Mdp mdp(problem);
+  PpoHyperparameters small;
+  small.steps_per_epoch = 200;
+  const PpoPolicy policy = train_ppo(mdp, 50, 4, small).policy;
+  EXPECT_EQ(policy.instance_digest, instance_digest(problem));
+  EXPECT_EQ(policy.instance_digest.size(), 24U);
+  EXPECT_EQ(policy.instance_digest.rfind("fnv1a64:", 0), 0U);
+  EXPECT_NE(ppo_policy_to_json(policy).find("\"instance_digest\": \"" + policy.instance_digest + "\""),
+            std::string::npos);
+
+  std::string text = problem_to_json(problem);
+  text.replace(text.find("paper-instance-4"), 16, "renamed-instance");
+  const Problem renamed = parse_problem(text, "renamed.json");
+  EXPECT_EQ(instance_digest(renamed), policy.instance_digest);
+  text.replace(text.find("\"step_seconds\": 1.0"), 19, "\"step_seconds\": 2.0");
+  const Problem slower = parse_problem(text, "slower.json");
+  ASSERT_EQ(slower.skeleton_count(), problem.skeleton_count());
+  ASSERT_EQ(slower.deadline(), problem.deadline());
+  EXPECT_NE(instance_digest(slower), policy.instance_digest);
+  std::string other_text = problem_to_json(problem);
+  other_text.replace(other_text.find("0.3"), 3, "0.2");  // a1_1 plans in one step less often
+  const Problem other = parse_problem(other_text, "other.json");
+  EXPECT_NE(instance_digest(other), policy.instance_digest);
+
+  const std::filesystem::path file = std::filesystem::temp_directory_path() / "ontime-ppo-test-digest.json";
+  save_ppo_policy(policy, file);
+  const auto refusal = [&file](const Problem& instance, const std::string& check) {
+    const Mdp instance_mdp(instance);
+    ParameterValues values{{"policy", file.string()}};
+    if (!check.empty()) values.set("policy-check", check);
+    try {
+      make_allocator_factory("ppo", instance_mdp, values);
+    } catch (const UsageError& error) {
+      return std::string(error.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(refusal(problem, ""), "accepted");
+  EXPECT_EQ(refusal(renamed, ""), "accepted");
+  for (const Problem* foreign : {&slower, &other}) {
+    const std::string message = refusal(*foreign, "");
+    EXPECT_NE(message.find("was trained on another instance ('paper-instance-4', " + policy.instance_digest),
+              std::string::npos)
+        << message;
+    EXPECT_NE(message.find("--policy-check shape"), std::string::npos) << message;
+    EXPECT_EQ(refusal(*foreign, "shape"), "accepted");
+  }
+  // A policy written before digests were recorded: refused, saying what to do, unless 'shape'.
+  PpoPolicy undigested = policy;
+  undigested.instance_digest.clear();
+  save_ppo_policy(undigested, file);
+  EXPECT_EQ(load_ppo_policy(file).instance_digest, "");
+  const std::string message = refusal(problem, "digest");
+  EXPECT_NE(message.find("records no digest"), std::string::npos) << message;
+  EXPECT_NE(message.find("retrain"), std::string::npos) << message;
+  EXPECT_EQ(refusal(problem, "shape"), "accepted");
+  std::filesystem::remove(file);
+}
+
 TEST(Ppo, PolicyFilesRoundTripAndAreValidated) {
   const Problem problem = testing::paper_instance("instance4");
   const Mdp mdp(problem);
@@ -183,6 +247,23 @@ TEST(Ppo, PolicyFilesRoundTripAndAreValidated) {
   wrong_size.replace(wrong_size.find("\"skeletons\": 2"), 14, "\"skeletons\": 3");
   EXPECT_EQ(place_of(wrong_size), "actor.sizes");
   EXPECT_EQ(place_of(text.substr(0, text.size() / 2)).rfind("line ", 0), 0U);
+  // Unknown keys are refused by name, at every level.
+  const auto with_key = [&text](const std::string& after, const std::string& key) {
+    std::string changed = text;
+    const std::size_t at = changed.find(after);
+    changed.insert(at + after.size(), "\"" + key + "\": 1, ");
+    return changed;
+  };
+  EXPECT_EQ(place_of(with_key("{\n", "trained_on")), "trained_on");
+  EXPECT_EQ(place_of(with_key("\"hyperparameters\": {", "entropy")), "hyperparameters.entropy");
+  EXPECT_EQ(place_of(with_key("\"actor\": {", "activation")), "actor.activation");
+  EXPECT_EQ(place_of(with_key("\"critic\": {", "bias")), "critic.bias");
+  std::string layer_key = text;
+  layer_key.insert(layer_key.find("\"weights\""), "\"dropout\": 0.5, ");
+  EXPECT_EQ(place_of(layer_key), "actor.layers[0].dropout");
+  std::string bad_digest = text;
+  bad_digest.replace(bad_digest.find("fnv1a64:"), 8, "sha256::");
+  EXPECT_EQ(place_of(bad_digest), "instance_digest");
 
   // A policy trained for another instance is refused when used.
   const Problem other = testing::paper_instance("instance1");
