@@ -547,5 +547,63 @@ TEST(Cli, APolicyOfAnotherInstanceIsRefusedUnlessTheShapeSuffices) {
   EXPECT_NE(unknown.err.find(tampered + ": trained_on: unknown key"), std::string::npos) << unknown.err;
 }
 
+// The policy, its curve CSV and its curve PNG are one output: an interrupted `train` leaves the
+// previous three files, byte for byte, and nothing else; a run cut off just as the new policy
+// appears leaves the new three or the old three, never a mix; a run without a plot removes the
+// previous PNG, which belonged to another training.
+TEST(Cli, InterruptedTrainingLeavesTheOldSetOrTheNewSetNeverAMix) {
+  const auto directory = scratch("output_set");
+  const auto policy = directory / "policy.json";
+  const auto csv = directory / "policy.curve.csv";
+  const auto png = directory / "policy.curve.png";
+  const auto train = [&](const std::string& episodes, bool plot) {
+    std::vector<std::string> arguments{ONTIME_CLI, "train", paper("instance4"), "--episodes", episodes, "--seed",
+                                       "5",        "--out", policy.string()};
+    if (!plot) arguments.push_back("--no-plot");
+    return arguments;
+  };
+  ASSERT_EQ(testing::run_process(train("100", true)).exit_code, 0);
+  const std::vector<std::string> old_set{read_file(policy), read_file(csv), read_file(png)};
+  const auto entries = [&directory] {
+    std::vector<std::string> names;
+    for (const auto& entry : std::filesystem::directory_iterator(directory)) {
+      names.push_back(entry.path().filename().string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+  };
+  const std::vector<std::string> expected_names{"policy.curve.csv", "policy.curve.png", "policy.json"};
+  ASSERT_EQ(entries(), expected_names);
+
+  // Cut off while the new files are being written (the plot is drawn last).
+  const auto staging = testing::run_process(train("200", true), [&] {
+    for (const std::string& name : entries()) {
+      if (name.rfind(".ontime-output-", 0) == 0) return true;
+    }
+    return false;
+  });
+  EXPECT_EQ(staging.exit_code, 128 + SIGINT) << staging.err;
+  EXPECT_EQ(entries(), expected_names);
+  // (Compared as booleans: a failure would print whole files.)
+  EXPECT_TRUE(read_file(policy) == old_set[0]);
+  EXPECT_TRUE(read_file(csv) == old_set[1]);
+  EXPECT_TRUE(read_file(png) == old_set[2]);
+
+  // Cut off as soon as a new policy shows: the curve beside it is new too.
+  const std::vector<std::string> before{read_file(policy), read_file(csv), read_file(png)};
+  testing::run_process(train("300", true), [&] { return read_file(policy) != before[0]; });
+  EXPECT_EQ(entries(), expected_names);
+  const std::vector<std::string> now{read_file(policy), read_file(csv), read_file(png)};
+  if (now[0] == before[0]) {
+    EXPECT_TRUE(now == before);
+  } else {
+    EXPECT_TRUE(now[1] != before[1]) << "a new policy beside the old curve CSV";
+    EXPECT_TRUE(now[2] != before[2]) << "a new policy beside the old curve PNG";
+  }
+
+  ASSERT_EQ(testing::run_process(train("400", false)).exit_code, 0);
+  EXPECT_EQ(entries(), (std::vector<std::string>{"policy.curve.csv", "policy.json"}));
+}
+
 }  // namespace
 }  // namespace ontime
