@@ -24,9 +24,12 @@ char staged_paths[kMaxMembers + 1][kMaxPath];
 std::size_t staged_count = 0;  // the last entry is the directory
 struct sigaction previous_actions[std::size(kTerminationSignals)];
 
+void check_length(const std::filesystem::path& path) {
+  if (path.string().size() >= kMaxPath) throw std::runtime_error(path.string() + ": path too long for an output file");
+}
+
 void copy_path(char* slot, const std::filesystem::path& path) {
   const std::string text = path.string();
-  if (text.size() >= kMaxPath) throw std::runtime_error(text + ": path too long for an output file");
   std::memcpy(slot, text.c_str(), text.size() + 1);
 }
 
@@ -73,12 +76,15 @@ sigset_t termination_set() {
 
 // Rebuilds the handler's list: the staged members, then the directory (last).
 void publish(const std::vector<std::filesystem::path>& members, const std::filesystem::path& staging) {
+  check_length(staging);
+  for (const std::filesystem::path& member : members) check_length(staging / member.filename());
   const sigset_t blocked = termination_set();
   sigset_t previous;
   ::pthread_sigmask(SIG_BLOCK, &blocked, &previous);
   staged_count = 0;
-  for (const std::filesystem::path& member : members)
+  for (const std::filesystem::path& member : members) {
     copy_path(staged_paths[staged_count++], staging / member.filename());
+  }
   copy_path(staged_paths[staged_count++], staging);
   ::pthread_sigmask(SIG_SETMASK, &previous, nullptr);
 }
@@ -87,6 +93,7 @@ void publish(const std::vector<std::filesystem::path>& members, const std::files
 
 OutputSet::OutputSet(const std::filesystem::path& directory) : directory_(directory.empty() ? "." : directory) {
   std::string pattern = (directory_ / ".ontime-output-XXXXXX").string();
+  check_length(pattern);
   if (::mkdtemp(pattern.data()) == nullptr) {
     throw std::runtime_error(directory_.string() + ": cannot create a staging directory: " + std::strerror(errno));
   }
