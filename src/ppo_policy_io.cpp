@@ -1,10 +1,13 @@
 // Reading and writing trained PPO policies (JSON).
 
+#include <algorithm>
+#include <cstdio>
 #include <nlohmann/json.hpp>
 
 #include "ontime/allocators/ppo.hpp"
 #include "ontime/atomic_file.hpp"
 #include "ontime/error.hpp"
+#include "ontime/instance_io.hpp"
 #include "ontime/json_input.hpp"
 #include "ppo_networks.hpp"
 
@@ -32,6 +35,28 @@ Json network_to_json(const PolicyNetwork& network) {
   return Json{{"sizes", network.sizes()}, {"layers", std::move(layers)}};
 }
 
+constexpr std::string_view kDigestPrefix = "fnv1a64:";
+
+// FNV-1a, 64 bits. Written here (a few lines) rather than taken from a library: the standard
+// library's std::hash may change between builds, and no dependency of the project offers a
+// stable hash; the digest only tells instances apart, it is no protection against forgery.
+std::uint64_t fnv1a64(std::string_view text) noexcept {
+  std::uint64_t hash = 0xcbf29ce484222325ULL;
+  for (const char c : text) {
+    hash ^= static_cast<unsigned char>(c);
+    hash *= 0x100000001b3ULL;
+  }
+  return hash;
+}
+
+bool is_digest(const std::string& text) {
+  if (text.size() != kDigestPrefix.size() + 16 || text.compare(0, kDigestPrefix.size(), kDigestPrefix) != 0) {
+    return false;
+  }
+  return std::all_of(text.begin() + static_cast<std::ptrdiff_t>(kDigestPrefix.size()), text.end(),
+                     [](char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'); });
+}
+
 class PolicyReader {
  public:
   explicit PolicyReader(std::string source) : source_(std::move(source)) {}
@@ -45,8 +70,18 @@ class PolicyReader {
     if (!root.contains("version") || !root["version"].is_number_integer() || root["version"].get<int>() != kVersion) {
       fail("version", "this version of ontime reads policy files of version " + std::to_string(kVersion));
     }
+    detail::check_known_keys(root, "",
+                             {"format", "version", "instance", "instance_digest", "skeletons", "deadline", "seed",
+                              "episodes", "features", "hyperparameters", "actor", "critic"},
+                             source_);
     PpoPolicy policy;
     policy.instance = text_at(root, "instance");
+    if (root.contains("instance_digest")) {
+      policy.instance_digest = text_at(root, "instance_digest");
+      if (!is_digest(policy.instance_digest)) {
+        fail("instance_digest", "must be \"fnv1a64:\" followed by 16 lower-case hexadecimal digits");
+      }
+    }
     policy.skeleton_count = static_cast<int>(integer_at(root, "skeletons", 1, Problem::kMaxSkeletons));
     policy.deadline = static_cast<Steps>(integer_at(root, "deadline", 1, Problem::kMaxDeadline));
     policy.seed = static_cast<std::uint64_t>(integer_at(root, "seed", 0, INT64_MAX));
@@ -55,6 +90,11 @@ class PolicyReader {
       fail("hyperparameters", "missing or not an object");
     }
     const Json& hyper = root["hyperparameters"];
+    detail::check_known_keys(
+        hyper, "hyperparameters",
+        {"hidden_layers", "hidden_units", "clip", "gamma", "lambda", "actor_learning_rate", "critic_learning_rate",
+         "train_iterations", "steps_per_epoch", "max_episode_steps", "target_kl"},
+        source_);
     PpoHyperparameters& h = policy.hyperparameters;
     h.hidden_layers = static_cast<int>(integer_at(hyper, "hidden_layers", 1, 16, "hyperparameters"));
     h.hidden_units = static_cast<int>(integer_at(hyper, "hidden_units", 1, 4096, "hyperparameters"));
@@ -104,6 +144,7 @@ class PolicyReader {
   PolicyNetwork network_at(const Json& root, const char* key, int inputs, int outputs) const {
     if (!root.contains(key) || !root[key].is_object()) fail(key, "missing or not an object");
     const Json& network = root[key];
+    detail::check_known_keys(network, key, {"sizes", "layers"}, source_);
     const std::string sizes_path = detail::json_member(key, "sizes");
     if (!network.contains("sizes") || !network["sizes"].is_array() || network["sizes"].size() < 2) {
       fail(sizes_path, "must list at least the input and output sizes");
@@ -130,6 +171,7 @@ class PolicyReader {
       const std::string layer_path = detail::json_index(layers_path, layer);
       const Json& entry = network["layers"][layer];
       if (!entry.is_object()) fail(layer_path, "must be an object with 'weights' and 'biases'");
+      detail::check_known_keys(entry, layer_path, {"weights", "biases"}, source_);
       const auto rows = static_cast<std::size_t>(sizes[layer + 1]);
       const auto columns = static_cast<std::size_t>(sizes[layer]);
       const std::string weights_path = detail::json_member(layer_path, "weights");
@@ -170,12 +212,22 @@ class PolicyReader {
 
 }  // namespace
 
+std::string instance_digest(const Problem& problem) {
+  Json content = Json::parse(problem_to_json(problem));
+  content.erase("name");
+  content.erase("description");
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(fnv1a64(content.dump())));
+  return std::string(kDigestPrefix) + hex;
+}
+
 std::string ppo_policy_to_json(const PpoPolicy& policy) {
   const PpoHyperparameters& h = policy.hyperparameters;
   Json root;
   root["format"] = kFormat;
   root["version"] = kVersion;
   root["instance"] = policy.instance;
+  if (!policy.instance_digest.empty()) root["instance_digest"] = policy.instance_digest;
   root["skeletons"] = policy.skeleton_count;
   root["deadline"] = policy.deadline;
   root["seed"] = policy.seed;

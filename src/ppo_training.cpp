@@ -42,8 +42,8 @@ void check(const PpoHyperparameters& h) {
 
 // One epoch's experience, one column per step.
 struct Batch {
-  std::vector<float> features;         // feature_count x steps, column-major
-  std::vector<std::uint8_t> valid;     // K x steps
+  std::vector<float> features;      // feature_count x steps, column-major
+  std::vector<std::uint8_t> valid;  // K x steps
   std::vector<int> actions;
   std::vector<double> log_probabilities;
   std::vector<double> values;
@@ -80,7 +80,8 @@ double clipped_surrogate_loss(const Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen:
   const double scale = 1.0 / static_cast<double>(samples);
   for (std::size_t n = 0; n < samples; ++n) {
     const auto column = static_cast<Eigen::Index>(n);
-    masked_log_softmax(logits.col(column), &valid[n * static_cast<std::size_t>(count)], count, log_probabilities.data());
+    masked_log_softmax(logits.col(column), &valid[n * static_cast<std::size_t>(count)], count,
+                       log_probabilities.data());
     const int action = actions[n];
     const double log_probability = log_probabilities[static_cast<std::size_t>(action)];
     const double ratio = std::exp(log_probability - old_log_probabilities[n]);
@@ -122,6 +123,7 @@ PpoTraining train_ppo(const Mdp& mdp, std::uint64_t episodes, std::uint64_t seed
   PpoTraining training;
   PpoPolicy& policy = training.policy;
   policy.instance = mdp.problem().name();
+  policy.instance_digest = instance_digest(mdp.problem());
   policy.skeleton_count = count;
   policy.deadline = mdp.deadline();
   policy.seed = seed;
@@ -158,8 +160,15 @@ PpoTraining train_ppo(const Mdp& mdp, std::uint64_t episodes, std::uint64_t seed
       const std::size_t first = batch.steps();
       Status status = Status::running;
       for (int step = 0; step < h.max_episode_steps && status == Status::running; ++step) {
-        state_features(mdp, state, features);
         const ChoiceList choices = mdp.useful_choices(state);
+        // No skeleton can succeed any more (the start state of an instance where success is
+        // impossible: `apply` reports this as failure only after a step): the episode is lost
+        // whatever the learner does, and a step without a choice teaches it nothing.
+        if (choices.empty()) {
+          status = Status::failure;
+          break;
+        }
+        state_features(mdp, state, features);
         std::uint8_t valid[Problem::kMaxSkeletons] = {};
         for (const int choice : choices) valid[choice] = 1;
         const Vector& logits = networks.actor.evaluate(features);
@@ -170,8 +179,7 @@ PpoTraining train_ppo(const Mdp& mdp, std::uint64_t episodes, std::uint64_t seed
         };
         const int action = choices[sample_index(choices.size(), probability, sampling)];
         const int refining = mdp.next_action(state, action);
-        const Observation observation =
-            world.observe(refining, state.spent[static_cast<std::size_t>(action)]);
+        const Observation observation = world.observe(refining, state.spent[static_cast<std::size_t>(action)]);
         status = mdp.apply(state, action, observation);
 
         batch.features.insert(batch.features.end(), features.data(), features.data() + inputs);
@@ -207,34 +215,37 @@ PpoTraining train_ppo(const Mdp& mdp, std::uint64_t episodes, std::uint64_t seed
     }
 
     const std::size_t steps = batch.steps();
-    double mean = 0, square = 0;
-    for (const double a : batch.advantages) mean += a;
-    mean /= static_cast<double>(steps);
-    for (const double a : batch.advantages) square += (a - mean) * (a - mean);
-    const double deviation = std::sqrt(square / static_cast<double>(steps));
-    for (double& a : batch.advantages) a = (a - mean) / (deviation + 1e-8);
-
-    inputs_matrix = Eigen::Map<const Matrix>(batch.features.data(), inputs, static_cast<Eigen::Index>(steps));
     int actor_steps = 0;
-    for (int iteration = 0; iteration < h.train_iterations; ++iteration) {
-      const Matrix& logits = networks.actor.forward(inputs_matrix);
-      double kl = 0;
-      clipped_surrogate_loss<float>(logits, batch.valid, batch.actions, batch.log_probabilities, batch.advantages, h.clip,
-                                    logits_gradient, kl);
-      if (kl > 1.5 * h.target_kl) break;
-      networks.actor.backward(logits_gradient);
-      actor_optimiser.step(networks.actor);
-      ++actor_steps;
-    }
-    for (int iteration = 0; iteration < h.train_iterations; ++iteration) {
-      const Matrix& values = networks.critic.forward(inputs_matrix);
-      value_gradient.resize(1, static_cast<Eigen::Index>(steps));
-      for (std::size_t n = 0; n < steps; ++n) {
-        value_gradient(0, static_cast<Eigen::Index>(n)) = static_cast<float>(
-            2.0 * (values(0, static_cast<Eigen::Index>(n)) - batch.returns[n]) / static_cast<double>(steps));
+    // An epoch of episodes that all ended before their first choice holds nothing to learn from.
+    if (steps > 0) {
+      double mean = 0, square = 0;
+      for (const double a : batch.advantages) mean += a;
+      mean /= static_cast<double>(steps);
+      for (const double a : batch.advantages) square += (a - mean) * (a - mean);
+      const double deviation = std::sqrt(square / static_cast<double>(steps));
+      for (double& a : batch.advantages) a = (a - mean) / (deviation + 1e-8);
+
+      inputs_matrix = Eigen::Map<const Matrix>(batch.features.data(), inputs, static_cast<Eigen::Index>(steps));
+      for (int iteration = 0; iteration < h.train_iterations; ++iteration) {
+        const Matrix& logits = networks.actor.forward(inputs_matrix);
+        double kl = 0;
+        clipped_surrogate_loss<float>(logits, batch.valid, batch.actions, batch.log_probabilities, batch.advantages,
+                                      h.clip, logits_gradient, kl);
+        if (kl > 1.5 * h.target_kl) break;
+        networks.actor.backward(logits_gradient);
+        actor_optimiser.step(networks.actor);
+        ++actor_steps;
       }
-      networks.critic.backward(value_gradient);
-      critic_optimiser.step(networks.critic);
+      for (int iteration = 0; iteration < h.train_iterations; ++iteration) {
+        const Matrix& values = networks.critic.forward(inputs_matrix);
+        value_gradient.resize(1, static_cast<Eigen::Index>(steps));
+        for (std::size_t n = 0; n < steps; ++n) {
+          value_gradient(0, static_cast<Eigen::Index>(n)) = static_cast<float>(
+              2.0 * (values(0, static_cast<Eigen::Index>(n)) - batch.returns[n]) / static_cast<double>(steps));
+        }
+        networks.critic.backward(value_gradient);
+        critic_optimiser.step(networks.critic);
+      }
     }
 
     LearningCurvePoint point;

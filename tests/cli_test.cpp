@@ -873,5 +873,128 @@ TEST(Cli, ALaplaceAlphaThatSwampsTheLogIsAUsageError) {
   EXPECT_FALSE(std::filesystem::exists(directory / "fit.json"));
 }
 
+// `train` on valid instances where success is impossible (no useful choice from the start)
+// exits 0 with a policy, the same bytes in repeated runs, and the policy evaluates to 0.
+TEST(Cli, TrainsTheSamePolicyOnInstancesWhereSuccessIsImpossible) {
+  const auto directory = scratch("impossible");
+  for (const std::string name : {"never_planning", "deadline_one", "never_execution"}) {
+    SCOPED_TRACE(name);
+    const std::string instance = testing::source_path("tests/data/impossible/" + name + ".json").string();
+    std::vector<std::string> policies;
+    for (const std::string run : {"first", "second"}) {
+      const std::string policy = (directory / (name + "-" + run + ".json")).string();
+      const auto trained = ontime({"train", instance, "--episodes", "200", "--out", policy, "--no-plot", "--json"});
+      ASSERT_EQ(trained.exit_code, 0) << trained.err;
+      EXPECT_EQ(json::parse(trained.out)["exact_success_probability"].get<double>(), 0.0);
+      policies.push_back(read_file(policy));
+      // One epoch of 200 episodes that all ended before a choice: no step, no gradient step.
+      std::ifstream curve(directory / (name + "-" + run + ".curve.csv"));
+      std::string header, epoch;
+      std::getline(curve, header);
+      std::getline(curve, epoch);
+      EXPECT_EQ(epoch.rfind("1,200,0,0,0,0,", 0), 0U) << epoch;
+    }
+    EXPECT_FALSE(policies[0].empty());
+    EXPECT_EQ(policies[0], policies[1]);
+    const auto evaluated = ontime({"evaluate", instance, "--solver", "ppo", "--policy",
+                                   (directory / (name + "-first.json")).string(), "--episodes", "100", "--json"});
+    ASSERT_EQ(evaluated.exit_code, 0) << evaluated.err;
+    EXPECT_EQ(json::parse(evaluated.out)["successes"].get<int>(), 0);
+  }
+}
+
+// A policy is used only on the instance it was trained on (its digest), unless --policy-check
+// shape; unknown keys in policy files are refused by name. Both exit 2 with one line.
+TEST(Cli, APolicyOfAnotherInstanceIsRefusedUnlessTheShapeSuffices) {
+  const auto directory = scratch("digest");
+  const std::string policy = (directory / "instance4.json").string();
+  const auto trained = ontime({"train", paper("instance4"), "--episodes", "100", "--out", policy, "--no-plot"});
+  ASSERT_EQ(trained.exit_code, 0) << trained.err;
+  std::string other_text = read_file(paper("instance4"));
+  other_text.replace(other_text.find("\"1\": 0.3"), 8, "\"1\": 0.2");
+  const std::string other = (directory / "other.json").string();
+  std::ofstream(other) << other_text;
+  const auto evaluate = [&](const std::string& instance, const std::string& policy_file, const std::string& check) {
+    std::vector<std::string> arguments{"evaluate", instance,    "--solver",   "ppo",
+                                       "--policy", policy_file, "--episodes", "10"};
+    if (!check.empty()) arguments.insert(arguments.end(), {"--policy-check", check});
+    return ontime(arguments);
+  };
+  EXPECT_EQ(evaluate(paper("instance4"), policy, "").exit_code, 0);
+  const auto refused = evaluate(other, policy, "");
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_NE(refused.err.find(policy + " was trained on another instance ('paper-instance-4', fnv1a64:"),
+            std::string::npos)
+      << refused.err;
+  EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+  EXPECT_EQ(evaluate(other, policy, "shape").exit_code, 0);
+
+  std::string with_unknown_key = read_file(policy);
+  with_unknown_key.insert(with_unknown_key.find('{') + 1, "\"trained_on\": \"elsewhere\",");
+  const std::string tampered = (directory / "tampered.json").string();
+  std::ofstream(tampered) << with_unknown_key;
+  const auto unknown = evaluate(paper("instance4"), tampered, "shape");
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.err.find(tampered + ": trained_on: unknown key"), std::string::npos) << unknown.err;
+}
+
+// The policy, its curve CSV and its curve PNG are one output: an interrupted `train` leaves the
+// previous three files, byte for byte, and nothing else; a run cut off just as the new policy
+// appears leaves the new three or the old three, never a mix; a run without a plot removes the
+// previous PNG, which belonged to another training.
+TEST(Cli, InterruptedTrainingLeavesTheOldSetOrTheNewSetNeverAMix) {
+  const auto directory = scratch("output_set");
+  const auto policy = directory / "policy.json";
+  const auto csv = directory / "policy.curve.csv";
+  const auto png = directory / "policy.curve.png";
+  const auto train = [&](const std::string& episodes, bool plot) {
+    std::vector<std::string> arguments{ONTIME_CLI, "train", paper("instance4"), "--episodes", episodes, "--seed",
+                                       "5",        "--out", policy.string()};
+    if (!plot) arguments.push_back("--no-plot");
+    return arguments;
+  };
+  ASSERT_EQ(testing::run_process(train("100", true)).exit_code, 0);
+  const std::vector<std::string> old_set{read_file(policy), read_file(csv), read_file(png)};
+  const auto entries = [&directory] {
+    std::vector<std::string> names;
+    for (const auto& entry : std::filesystem::directory_iterator(directory)) {
+      names.push_back(entry.path().filename().string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+  };
+  const std::vector<std::string> expected_names{"policy.curve.csv", "policy.curve.png", "policy.json"};
+  ASSERT_EQ(entries(), expected_names);
+
+  // Cut off while the new files are being written (the plot is drawn last).
+  const auto staging = testing::run_process(train("200", true), [&] {
+    for (const std::string& name : entries()) {
+      if (name.rfind(".ontime-output-", 0) == 0) return true;
+    }
+    return false;
+  });
+  EXPECT_EQ(staging.exit_code, 128 + SIGINT) << staging.err;
+  EXPECT_EQ(entries(), expected_names);
+  // (Compared as booleans: a failure would print whole files.)
+  EXPECT_TRUE(read_file(policy) == old_set[0]);
+  EXPECT_TRUE(read_file(csv) == old_set[1]);
+  EXPECT_TRUE(read_file(png) == old_set[2]);
+
+  // Cut off as soon as a new policy shows: the curve beside it is new too.
+  const std::vector<std::string> before{read_file(policy), read_file(csv), read_file(png)};
+  testing::run_process(train("300", true), [&] { return read_file(policy) != before[0]; });
+  EXPECT_EQ(entries(), expected_names);
+  const std::vector<std::string> now{read_file(policy), read_file(csv), read_file(png)};
+  if (now[0] == before[0]) {
+    EXPECT_TRUE(now == before);
+  } else {
+    EXPECT_TRUE(now[1] != before[1]) << "a new policy beside the old curve CSV";
+    EXPECT_TRUE(now[2] != before[2]) << "a new policy beside the old curve PNG";
+  }
+
+  ASSERT_EQ(testing::run_process(train("400", false)).exit_code, 0);
+  EXPECT_EQ(entries(), (std::vector<std::string>{"policy.curve.csv", "policy.json"}));
+}
+
 }  // namespace
 }  // namespace ontime

@@ -1,3 +1,5 @@
+#include "ontime/allocators/ppo.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -5,9 +7,9 @@
 
 #include "neural_network.hpp"  // private to the library (src/), as is ppo_networks.hpp
 #include "ontime/allocator_registry.hpp"
-#include "ontime/allocators/ppo.hpp"
 #include "ontime/error.hpp"
 #include "ontime/evaluation.hpp"
+#include "ontime/instance_io.hpp"
 #include "ontime/ppo_training.hpp"
 #include "ppo_networks.hpp"
 #include "support/paper.hpp"
@@ -79,7 +81,8 @@ TEST(Ppo, SurrogateGradientMatchesFiniteDifferences) {
     for (int k = 0; k < kChoices; ++k) {
       if (valid[static_cast<std::size_t>(n * kChoices + k)] != 0) total += std::exp(logits(k, n));
     }
-    const double ratio = std::exp(logits(actions[static_cast<std::size_t>(n)], n) - std::log(total) - old_log[static_cast<std::size_t>(n)]);
+    const double ratio = std::exp(logits(actions[static_cast<std::size_t>(n)], n) - std::log(total) -
+                                  old_log[static_cast<std::size_t>(n)]);
     below += ratio < 0.8;
     above += ratio > 1.2;
     inside += ratio >= 0.8 && ratio <= 1.2;
@@ -93,9 +96,11 @@ TEST(Ppo, SurrogateGradientMatchesFiniteDifferences) {
     MatrixD ignored;
     double ignored_kl = 0;
     shifted.data()[i] += kStep;
-    const double up = clipped_surrogate_loss<double>(shifted, valid, actions, old_log, advantages, 0.2, ignored, ignored_kl);
+    const double up =
+        clipped_surrogate_loss<double>(shifted, valid, actions, old_log, advantages, 0.2, ignored, ignored_kl);
     shifted.data()[i] -= 2 * kStep;
-    const double down = clipped_surrogate_loss<double>(shifted, valid, actions, old_log, advantages, 0.2, ignored, ignored_kl);
+    const double down =
+        clipped_surrogate_loss<double>(shifted, valid, actions, old_log, advantages, 0.2, ignored, ignored_kl);
     EXPECT_NEAR(gradient.data()[i], (up - down) / (2 * kStep), 1e-7) << "entry " << i;
   }
   // Masked choices get no gradient.
@@ -130,6 +135,92 @@ TEST(Ppo, SameSeedSamePolicyByteForByte) {
   EXPECT_NE(first, ppo_policy_to_json(train_ppo(mdp, 300, 10, small).policy));
 }
 
+// Instances where success is impossible from the start (every planning PMF "never", deadline 1,
+// every execution "never") offer no useful choice: every episode is lost before its first step.
+// Training takes no step, writes the untrained policy, and does so the same way every time.
+TEST(Ppo, TrainsOnInstancesWhereSuccessIsImpossible) {
+  for (const std::string name : {"never_planning", "deadline_one", "never_execution"}) {
+    SCOPED_TRACE(name);
+    const Problem problem = load_problem(testing::source_path("tests/data/impossible/" + name + ".json"));
+    const Mdp mdp(problem);
+    ASSERT_TRUE(mdp.useful_choices(mdp.start()).empty());
+    const PpoTraining training = train_ppo(mdp, 50, 3);
+    ASSERT_EQ(training.curve.size(), 1U);
+    EXPECT_EQ(training.curve[0].episodes, 50U);
+    EXPECT_EQ(training.curve[0].steps, 0U);
+    EXPECT_EQ(training.curve[0].success_rate, 0.0);
+    EXPECT_EQ(training.curve[0].actor_steps, 0);
+    const std::string policy = ppo_policy_to_json(training.policy);
+    EXPECT_EQ(policy, ppo_policy_to_json(train_ppo(mdp, 50, 3).policy));
+    PpoAllocator allocator(mdp, std::make_shared<const PpoPolicy>(training.policy));
+    EXPECT_EQ(evaluate_exactly(mdp, allocator).success_probability, 0.0);
+  }
+}
+
+// A policy records the digest of the instance it was trained on; the registry's `ppo` refuses a
+// policy of another instance of the same shape, or one without a digest, unless policy-check is
+// 'shape'. Labels (name, description) are not part of the digest.
+TEST(Ppo, PoliciesAreUsedOnlyOnTheInstanceTheyWereTrainedOn) {
+  const Problem problem = testing::paper_instance("instance4");
+  const Mdp mdp(problem);
+  PpoHyperparameters small;
+  small.steps_per_epoch = 200;
+  const PpoPolicy policy = train_ppo(mdp, 50, 4, small).policy;
+  EXPECT_EQ(policy.instance_digest, instance_digest(problem));
+  EXPECT_EQ(policy.instance_digest.size(), 24U);
+  EXPECT_EQ(policy.instance_digest.rfind("fnv1a64:", 0), 0U);
+  EXPECT_NE(ppo_policy_to_json(policy).find("\"instance_digest\": \"" + policy.instance_digest + "\""),
+            std::string::npos);
+
+  std::string text = problem_to_json(problem);
+  text.replace(text.find("paper-instance-4"), 16, "renamed-instance");
+  const Problem renamed = parse_problem(text, "renamed.json");
+  EXPECT_EQ(instance_digest(renamed), policy.instance_digest);
+  text.replace(text.find("\"step_seconds\": 1.0"), 19, "\"step_seconds\": 2.0");
+  const Problem slower = parse_problem(text, "slower.json");
+  ASSERT_EQ(slower.skeleton_count(), problem.skeleton_count());
+  ASSERT_EQ(slower.deadline(), problem.deadline());
+  EXPECT_NE(instance_digest(slower), policy.instance_digest);
+  std::string other_text = problem_to_json(problem);
+  other_text.replace(other_text.find("0.3"), 3, "0.2");  // a1_1 plans in one step less often
+  const Problem other = parse_problem(other_text, "other.json");
+  EXPECT_NE(instance_digest(other), policy.instance_digest);
+
+  const std::filesystem::path file = std::filesystem::temp_directory_path() / "ontime-ppo-test-digest.json";
+  save_ppo_policy(policy, file);
+  const auto refusal = [&file](const Problem& instance, const std::string& check) {
+    const Mdp instance_mdp(instance);
+    ParameterValues values{{"policy", file.string()}};
+    if (!check.empty()) values.set("policy-check", check);
+    try {
+      make_allocator_factory("ppo", instance_mdp, values);
+    } catch (const UsageError& error) {
+      return std::string(error.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(refusal(problem, ""), "accepted");
+  EXPECT_EQ(refusal(renamed, ""), "accepted");
+  for (const Problem* foreign : {&slower, &other}) {
+    const std::string message = refusal(*foreign, "");
+    EXPECT_NE(message.find("was trained on another instance ('paper-instance-4', " + policy.instance_digest),
+              std::string::npos)
+        << message;
+    EXPECT_NE(message.find("--policy-check shape"), std::string::npos) << message;
+    EXPECT_EQ(refusal(*foreign, "shape"), "accepted");
+  }
+  // A policy written before digests were recorded: refused, saying what to do, unless 'shape'.
+  PpoPolicy undigested = policy;
+  undigested.instance_digest.clear();
+  save_ppo_policy(undigested, file);
+  EXPECT_EQ(load_ppo_policy(file).instance_digest, "");
+  const std::string message = refusal(problem, "digest");
+  EXPECT_NE(message.find("records no digest"), std::string::npos) << message;
+  EXPECT_NE(message.find("retrain"), std::string::npos) << message;
+  EXPECT_EQ(refusal(problem, "shape"), "accepted");
+  std::filesystem::remove(file);
+}
+
 TEST(Ppo, PolicyFilesRoundTripAndAreValidated) {
   const Problem problem = testing::paper_instance("instance4");
   const Mdp mdp(problem);
@@ -156,6 +247,23 @@ TEST(Ppo, PolicyFilesRoundTripAndAreValidated) {
   wrong_size.replace(wrong_size.find("\"skeletons\": 2"), 14, "\"skeletons\": 3");
   EXPECT_EQ(place_of(wrong_size), "actor.sizes");
   EXPECT_EQ(place_of(text.substr(0, text.size() / 2)).rfind("line ", 0), 0U);
+  // Unknown keys are refused by name, at every level.
+  const auto with_key = [&text](const std::string& after, const std::string& key) {
+    std::string changed = text;
+    const std::size_t at = changed.find(after);
+    changed.insert(at + after.size(), "\"" + key + "\": 1, ");
+    return changed;
+  };
+  EXPECT_EQ(place_of(with_key("{\n", "trained_on")), "trained_on");
+  EXPECT_EQ(place_of(with_key("\"hyperparameters\": {", "entropy")), "hyperparameters.entropy");
+  EXPECT_EQ(place_of(with_key("\"actor\": {", "activation")), "actor.activation");
+  EXPECT_EQ(place_of(with_key("\"critic\": {", "bias")), "critic.bias");
+  std::string layer_key = text;
+  layer_key.insert(layer_key.find("\"weights\""), "\"dropout\": 0.5, ");
+  EXPECT_EQ(place_of(layer_key), "actor.layers[0].dropout");
+  std::string bad_digest = text;
+  bad_digest.replace(bad_digest.find("fnv1a64:"), 8, "sha256::");
+  EXPECT_EQ(place_of(bad_digest), "instance_digest");
 
   // A policy trained for another instance is refused when used.
   const Problem other = testing::paper_instance("instance1");

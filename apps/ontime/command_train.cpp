@@ -1,6 +1,6 @@
 // `ontime train INSTANCE --solver ppo --out POLICY`: learns a policy by PPO from simulated
-// episodes, writes it (atomically) with its learning curve (CSV and PNG), and reports the exact
-// success probability of the trained policy.
+// episodes, writes it with its learning curve (CSV and PNG) as one set (OutputSet: all or
+// nothing), and reports the exact success probability of the trained policy.
 
 #include <fmt/format.h>
 
@@ -8,9 +8,9 @@
 #include <filesystem>
 
 #include "common.hpp"
-#include "ontime/atomic_file.hpp"
 #include "ontime/error.hpp"
 #include "ontime/instance_io.hpp"
+#include "ontime/output_set.hpp"
 #include "ontime/ppo_training.hpp"
 #include "output_paths.hpp"
 #include "python_runner.hpp"
@@ -30,10 +30,16 @@ void add_train_command(CLI::App& app) {
   auto options = std::make_shared<Options>();
   CLI::App* command = app.add_subcommand("train", "Learn a model-free policy (ppo) from simulated episodes");
   command->add_option("INSTANCE", options->instance, "Instance file (JSON, SPEC §5)")->required();
-  command->add_option("--solver", options->solver, "Learner (only ppo)")->check(CLI::IsMember({"ppo"}))->capture_default_str();
-  command->add_option("--episodes", options->episodes, "Training episodes")->check(CLI::PositiveNumber)->capture_default_str();
-  command->add_option("--seed", options->seed, "Seed of initialisation, sampling and hidden worlds")->capture_default_str();
-  command->add_option("--out", options->out, "Policy file to write (JSON); the learning curve goes beside it")->required();
+  command->add_option("--solver", options->solver, "Learner (only ppo)")
+      ->check(CLI::IsMember({"ppo"}))
+      ->capture_default_str();
+  command->add_option("--episodes", options->episodes, "Training episodes")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  command->add_option("--seed", options->seed, "Seed of initialisation, sampling and hidden worlds")
+      ->capture_default_str();
+  command->add_option("--out", options->out, "Policy file to write (JSON); the learning curve goes beside it")
+      ->required();
   command->add_flag("--no-plot", options->no_plot, "Write the learning curve CSV only");
   command->add_flag("--json", options->json, "Print JSON");
   command->callback([options] {
@@ -51,19 +57,26 @@ void add_train_command(CLI::App& app) {
     const PpoTraining training =
         train_ppo(mdp, options->episodes, options->seed, PpoHyperparameters{},
                   [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); });
-    save_ppo_policy(training.policy, policy_path);
 
     std::string csv = "epoch,episodes,steps,success_rate,mean_episode_length,actor_steps,seconds\n";
     for (const LearningCurvePoint& point : training.curve) {
       csv += fmt::format("{},{},{},{},{},{},{:.6f}\n", point.epoch, point.episodes, point.steps, point.success_rate,
                          point.mean_episode_length, point.actor_steps, point.seconds);
     }
-    write_file_atomically(curve_csv, csv);
-    if (!options->no_plot) {
-      run_python_script("plot_learning_curve.py", curve_png, [&](const std::string& drawing) {
-        return std::vector<std::string>{curve_csv.string(), drawing};
+    // The three files are one output: all are staged, then renamed together, so that an
+    // interruption leaves the previous set or this one. Without a plot, an older PNG beside the
+    // policy would describe another training: it goes.
+    OutputSet files(policy_path.has_parent_path() ? policy_path.parent_path() : std::filesystem::path("."));
+    files.write(policy_path, ppo_policy_to_json(training.policy));
+    const std::filesystem::path staged_csv = files.write(curve_csv, csv);
+    if (options->no_plot) {
+      files.remove_on_commit(curve_png);
+    } else {
+      run_python_script("plot_learning_curve.py", files.stage(curve_png), [&](const std::string& drawing) {
+        return std::vector<std::string>{staged_csv.string(), drawing};
       });
     }
+    files.commit();
 
     PpoAllocator trained(mdp, std::make_shared<const PpoPolicy>(training.policy));
     const ExactEvaluation exact = evaluate_exactly(mdp, trained);

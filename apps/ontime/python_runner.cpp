@@ -97,13 +97,16 @@ std::string last_line(std::string_view text) {
   return shortened_label(newline == std::string_view::npos ? text : text.substr(newline + 1), 1000);
 }
 
-// Dies of `signal_number` the way an unhandled signal kills (exit status 128 + signal number).
+// Dies of `signal_number`. The disposition in force before the script ran handles it first (a
+// caller's handler, e.g. train's OutputSet removing its staged files before it ends the
+// process); if that returns, the default action ends the process (exit status 128 + number).
 [[noreturn]] void die_of(int signal_number) {
-  std::signal(signal_number, SIG_DFL);
   sigset_t only;
   sigemptyset(&only);
   sigaddset(&only, signal_number);
   ::pthread_sigmask(SIG_UNBLOCK, &only, nullptr);
+  std::raise(signal_number);
+  std::signal(signal_number, SIG_DFL);
   std::raise(signal_number);
   std::_Exit(128 + signal_number);
 }

@@ -55,18 +55,48 @@ int PpoAllocator::choose(const State& state) {
   return best;
 }
 
+namespace {
+
+// Refuses a policy unless it records the digest of `problem` (what it was trained on).
+void check_trained_on(const PpoPolicy& policy, const Problem& problem, const std::string& file) {
+  constexpr const char* kOverride =
+      "; to use it anyway on an instance of the same skeleton count and deadline, set "
+      "the parameter 'policy-check' to 'shape' (--policy-check shape)";
+  if (policy.instance_digest.empty()) {
+    throw UsageError("policy " + file +
+                     " records no digest of the instance it was trained on (it predates digests): retrain it with "
+                     "'ontime train'" +
+                     kOverride);
+  }
+  const std::string digest = instance_digest(problem);
+  if (policy.instance_digest != digest) {
+    throw UsageError("policy " + file + " was trained on another instance ('" + policy.instance + "', " +
+                     policy.instance_digest + ") than this one ('" + problem.name() + "', " + digest +
+                     "): retrain it on this instance" + kOverride);
+  }
+}
+
+}  // namespace
+
 AllocatorKind ppo_kind() {
   return {.name = "ppo",
           .summary = "a policy learned by Proximal Policy Optimization from episodes alone, acting greedily",
           .capabilities = {Capability::stationary, Capability::needs_policy},
-          .parameters = {Parameter::path("policy",
-                                         "trained policy file (JSON); for several instances, one per instance in order")},
+          .parameters = {Parameter::path(
+                             "policy", "trained policy file (JSON); for several instances, one per instance in order"),
+                         Parameter::choice(
+                             "policy-check", "digest", {"digest", "shape"},
+                             "accept policies trained on this instance only, or any of its size and deadline")},
           .make = [](const Mdp& mdp, const ParameterReader& parameters) -> AllocatorFactory {
             if (!parameters.given("policy")) {
-              throw UsageError("ppo needs a trained policy: its parameter 'policy' names the file of a policy trained for this instance");
+              throw UsageError(
+                  "ppo needs a trained policy: its parameter 'policy' names the file of a policy trained for this "
+                  "instance");
             }
-            auto policy = std::make_shared<const PpoPolicy>(load_ppo_policy(parameters.text("policy")));
-            PpoAllocator probe(mdp, policy);  // fails here when the policy is for another instance
+            const std::string file = parameters.text("policy");
+            auto policy = std::make_shared<const PpoPolicy>(load_ppo_policy(file));
+            PpoAllocator probe(mdp, policy);  // fails here when the policy is for another shape of instance
+            if (parameters.text("policy-check") == "digest") check_trained_on(*policy, mdp.problem(), file);
             return [model = &mdp, policy] { return std::make_unique<PpoAllocator>(*model, policy); };
           }};
 }

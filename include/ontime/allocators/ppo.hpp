@@ -28,13 +28,13 @@ struct PpoHyperparameters {
   int hidden_units = 64;
   double clip = 0.2;
   double gamma = 0.99;
-  double lambda = 0.97;          // GAE
+  double lambda = 0.97;  // GAE
   double actor_learning_rate = 3e-4;
   double critic_learning_rate = 1e-3;
-  int train_iterations = 80;     // gradient steps per update, actor and critic each
+  int train_iterations = 80;  // gradient steps per update, actor and critic each
   int steps_per_epoch = 4'000;
   int max_episode_steps = 1'000;
-  double target_kl = 0.01;       // actor steps stop early past 1.5 x this KL
+  double target_kl = 0.01;  // actor steps stop early past 1.5 x this KL
 };
 
 // The actor and critic networks; defined inside the library (they are Eigen matrices, which
@@ -44,17 +44,26 @@ struct PpoNetworks;
 // A trained actor and critic, and what they were trained for. Made by `train_ppo` or
 // `load_ppo_policy`; copies share the (immutable) networks.
 struct PpoPolicy {
-  std::string instance;          // name of the instance it was trained on
+  std::string instance;         // name of the instance it was trained on
+  std::string instance_digest;  // instance_digest() of it; empty in files written before digests
   int skeleton_count = 0;
   Steps deadline = 0;
   std::uint64_t seed = 0;
-  std::uint64_t episodes = 0;    // training episodes
+  std::uint64_t episodes = 0;  // training episodes
   PpoHyperparameters hyperparameters;
   std::shared_ptr<const PpoNetworks> networks;
 };
 
+// What a policy records of the instance it was trained on: FNV-1a (64 bits) of the instance's
+// canonical JSON (problem_to_json) without its labels (name, description), written
+// "fnv1a64:" and 16 hexadecimal digits. The same content gives the same digest whatever the
+// file's layout, key order or name; any change of deadline, step length, distribution or
+// skeleton gives another.
+std::string instance_digest(const Problem& problem);
+
 // Policy files (JSON). Saving is atomic; loading validates every field and raises InputError
-// naming the file, the JSON path and the rule. Writing a policy without networks is a UsageError.
+// naming the file, the JSON path and the rule (an unknown key is refused by name). Writing a
+// policy without networks is a UsageError.
 void save_ppo_policy(const PpoPolicy& policy, const std::filesystem::path& path);
 std::string ppo_policy_to_json(const PpoPolicy& policy);
 PpoPolicy load_ppo_policy(const std::filesystem::path& path);
