@@ -51,7 +51,7 @@ class InstanceReader {
     const auto deadline = deadline_json.get<std::int64_t>();
     if (deadline < 1 || deadline > Problem::kMaxDeadline) {
       fail("deadline", "must be between 1 and " + std::to_string(Problem::kMaxDeadline) + " steps (got " +
-                           std::to_string(deadline) + ")");
+                           deadline_json.dump() + ")");
     }
 
     double step_seconds = 1.0;

@@ -4,6 +4,7 @@
 #include <fmt/core.h>
 
 #include "common.hpp"
+#include "number_options.hpp"
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/instance_io.hpp"
 
@@ -18,9 +19,8 @@ void add_solve_command(CLI::App& app) {
   auto options = std::make_shared<Options>();
   CLI::App* command = app.add_subcommand("solve", "Exact optimal success probability and first choice (expectimax)");
   command->add_option("INSTANCE", options->instance, "Instance file (JSON, SPEC §5)")->required();
-  command->add_option("--max-states", options->max_states, "Stop with an error past this many states")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
+  add_number_option(*command, "--max-states", options->max_states, "Stop with an error past this many states",
+                    std::size_t{1});
   command->add_flag("--json", options->json, "Print JSON");
   command->callback([options] {
     const Problem problem = load_problem(options->instance);

@@ -66,8 +66,8 @@ struct MonteCarloFlags {
 // Adds the required `--solver NAME` option, its help listing the allocators.
 CLI::Option* add_solver_option(CLI::App& command, std::string& solver);
 
-// Checks that every name is a known allocator (the CLI calls them solvers); throws UsageError
-// otherwise.
+// Checks that every name is a known allocator (the CLI calls them solvers), none empty and
+// none twice; throws UsageError otherwise.
 void check_solver_names(const std::vector<std::string>& names);
 
 // Prints JSON to stdout, two-space indented.
