@@ -623,5 +623,21 @@ TEST(Cli, AnInstanceDeadlineBeyondItsTypeIsQuotedAsWritten) {
       << result.err;
 }
 
+// A cap the memory cannot hold would end in "out of memory" instead of the cap's clean stop.
+TEST(Cli, CapsBeyondTheAvailableMemoryAreRefusedBeforeStarting) {
+  const auto states = ontime({"solve", paper("figure1"), "--max-states", "18446744073709551615"});
+  EXPECT_EQ(states.exit_code, 2);
+  EXPECT_NE(states.err.find("--max-states 18446744073709551615: would need up to"), std::string::npos) << states.err;
+  const auto tree = ontime({"evaluate", paper("figure1"), "--solver", "mcts", "--max-tree-mib", "16777216",
+                            "--episodes", "5", "--threads", "1"});
+  EXPECT_EQ(tree.exit_code, 2);
+  EXPECT_NE(tree.err.find("--max-tree-mib 16777216 with 1 thread: would need up to 1.64e+04 GiB"), std::string::npos)
+      << tree.err;
+  const auto table = ontime({"table", paper("figure1"), "--solvers", "mcts", "--max-tree-mib", "16777216", "--episodes",
+                             "5", "--threads", "1"});
+  EXPECT_EQ(table.exit_code, 2);
+  EXPECT_EQ(ontime({"solve", paper("figure1"), "--max-states", "1000"}).exit_code, 0);
+}
+
 }  // namespace
 }  // namespace ontime

@@ -248,6 +248,7 @@ void add_table_command(CLI::App& app) {
       mdps.push_back(std::make_unique<Mdp>(problems[i]));
       max_states.push_back(max_states_of(parameters));
       for (const std::string& solver : options->solvers) {
+        options->monte_carlo.check_tree_memory(solver, parameters);
         factories[i].push_back(make_allocator_factory(solver, *mdps[i], parameters));
       }
     }

@@ -1,11 +1,13 @@
 #include "common.hpp"
-#include "number_options.hpp"
 
 #include <algorithm>
 #include <cstdio>
 #include <fmt/format.h>
+#include <thread>
 #include <unistd.h>
 
+#include "memory_limits.hpp"
+#include "number_options.hpp"
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/error.hpp"
 
@@ -80,6 +82,18 @@ MonteCarloOptions MonteCarloFlags::options() const {
   options.seed = seed;
   options.threads = threads;
   return options;
+}
+
+void MonteCarloFlags::check_tree_memory(const std::string& solver, const ParameterValues& values) const {
+  const AllocatorKind& kind = allocator_registry().find(solver);
+  const bool has_tree_cap = std::any_of(kind.parameters.begin(), kind.parameters.end(),
+                                        [](const Parameter& parameter) { return parameter.name == "max-tree-mib"; });
+  if (!has_tree_cap) return;
+  const double mib = static_cast<double>(ParameterReader(kind, values).integer("max-tree-mib"));
+  const std::uint64_t workers =
+      std::min<std::uint64_t>(episodes, threads > 0 ? threads : std::max(1U, std::thread::hardware_concurrency()));
+  check_memory_for(fmt::format("--max-tree-mib {} with {} thread{}", mib, workers, workers == 1 ? "" : "s"),
+                   mib * 1024 * 1024 * static_cast<double>(workers));
 }
 
 CLI::Option* add_solver_option(CLI::App& command, std::string& solver) {

@@ -61,6 +61,9 @@ struct MonteCarloFlags {
   unsigned threads = 0;
   void add_to(CLI::App& command);
   MonteCarloOptions options() const;
+  // Refuses (UsageError, exit 2) a search-tree cap (`max-tree-mib`, if `solver` declares it) that
+  // the threads of the run together could not hold in the memory available.
+  void check_tree_memory(const std::string& solver, const ParameterValues& values) const;
 };
 
 // Adds the required `--solver NAME` option, its help listing the allocators.
