@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -18,35 +19,17 @@ namespace {
 class RecordingTimer final : public DecisionTimer {
  public:
   void record(std::int64_t nanoseconds) override {
-    samples.push_back(nanoseconds);
+    decisions.add(nanoseconds);
     episode_total += nanoseconds;
   }
   void end_episode() {
-    episode_totals.push_back(episode_total);
+    episodes.add(episode_total);
     episode_total = 0;
   }
-  std::vector<std::int64_t> samples;
-  std::vector<std::int64_t> episode_totals;
+  LatencyHistogram decisions;
+  LatencyHistogram episodes;  // the total decision time of each episode
   std::int64_t episode_total = 0;
 };
-
-LatencySummary summarise(std::vector<std::int64_t>& samples) {
-  LatencySummary summary;
-  summary.decisions = samples.size();
-  if (samples.empty()) return summary;
-  std::sort(samples.begin(), samples.end());
-  const auto at = [&](double quantile) {
-    const auto index = static_cast<std::size_t>(quantile * static_cast<double>(samples.size() - 1) + 0.5);
-    return static_cast<double>(samples[index]) / 1000.0;
-  };
-  double total = 0;
-  for (const std::int64_t sample : samples) total += static_cast<double>(sample);
-  summary.mean_us = total / static_cast<double>(samples.size()) / 1000.0;
-  summary.median_us = at(0.5);
-  summary.p99_us = at(0.99);
-  summary.max_us = static_cast<double>(samples.back()) / 1000.0;
-  return summary;
-}
 
 // What one thread of run_episodes keeps until the threads' results are merged.
 struct ThreadRun {
@@ -92,6 +75,57 @@ EpisodeResult run_episode(const Mdp& mdp, Allocator& allocator, World& world, st
   return result;
 }
 
+std::size_t LatencyHistogram::bucket_of(std::uint64_t nanoseconds) noexcept {
+  constexpr std::uint64_t kExact = std::uint64_t{1} << kSubBits;  // below it, one bucket per value
+  if (nanoseconds < kExact) return static_cast<std::size_t>(nanoseconds);
+  const int exponent = static_cast<int>(std::bit_width(nanoseconds)) - 1;  // >= kSubBits
+  const std::uint64_t sub = (nanoseconds >> (exponent - kSubBits)) - kExact;
+  return static_cast<std::size_t>((static_cast<std::uint64_t>(exponent - kSubBits + 1) << kSubBits) + sub);
+}
+
+double LatencyHistogram::middle_of(std::size_t bucket) noexcept {
+  constexpr std::size_t kExact = std::size_t{1} << kSubBits;
+  if (bucket < kExact) return static_cast<double>(bucket);
+  const int shift = static_cast<int>(bucket >> kSubBits) - 1;  // the bucket's width is 2^shift
+  const double low = std::ldexp(static_cast<double>(kExact + (bucket & (kExact - 1))), shift);
+  return low + (std::ldexp(1.0, shift) - 1) / 2;
+}
+
+void LatencyHistogram::add(std::int64_t nanoseconds) noexcept {
+  const std::int64_t value = std::max<std::int64_t>(nanoseconds, 0);
+  ++counts_[bucket_of(static_cast<std::uint64_t>(value))];
+  ++count_;
+  total_ += static_cast<double>(value);
+  max_ = std::max(max_, value);
+}
+
+void LatencyHistogram::merge(const LatencyHistogram& other) noexcept {
+  for (std::size_t i = 0; i < kBuckets; ++i) counts_[i] += other.counts_[i];
+  count_ += other.count_;
+  total_ += other.total_;
+  max_ = std::max(max_, other.max_);
+}
+
+LatencySummary LatencyHistogram::summary() const {
+  LatencySummary summary;
+  summary.decisions = count_;
+  if (count_ == 0) return summary;
+  const auto at = [&](double quantile) {
+    const auto rank = static_cast<std::uint64_t>(quantile * static_cast<double>(count_ - 1) + 0.5);
+    std::uint64_t below = 0;
+    for (std::size_t bucket = 0; bucket < kBuckets; ++bucket) {
+      below += counts_[bucket];
+      if (below > rank) return std::min(middle_of(bucket), static_cast<double>(max_)) / 1000.0;
+    }
+    return static_cast<double>(max_) / 1000.0;
+  };
+  summary.mean_us = total_ / static_cast<double>(count_) / 1000.0;
+  summary.median_us = at(0.5);
+  summary.p99_us = at(0.99);
+  summary.max_us = static_cast<double>(max_) / 1000.0;
+  return summary;
+}
+
 MonteCarloResult run_episodes(const Mdp& mdp, const WorldFactory& worlds, const AllocatorFactory& allocators,
                               const MonteCarloOptions& options) {
   const auto started = std::chrono::steady_clock::now();
@@ -123,20 +157,20 @@ MonteCarloResult run_episodes(const Mdp& mdp, const WorldFactory& worlds, const 
 
   MonteCarloResult result;
   result.episodes = options.episodes;
-  std::vector<std::int64_t> samples;
-  std::vector<std::int64_t> episode_totals;
+  LatencyHistogram decisions;
+  LatencyHistogram episode_totals;
   for (ThreadRun& run : runs) {
     result.successes += run.successes;
-    samples.insert(samples.end(), run.timer.samples.begin(), run.timer.samples.end());
-    episode_totals.insert(episode_totals.end(), run.timer.episode_totals.begin(), run.timer.episode_totals.end());
+    decisions.merge(run.timer.decisions);
+    episode_totals.merge(run.timer.episodes);
     run.allocator->collect_statistics(result.statistics);
     run.world->collect_statistics(result.world_statistics);
   }
   result.success_rate =
       options.episodes == 0 ? 0.0 : static_cast<double>(result.successes) / static_cast<double>(options.episodes);
   result.ci95 = ci95_half_width(result.success_rate, options.episodes);
-  result.decision_time = summarise(samples);
-  result.episode_decision_time = summarise(episode_totals);
+  result.decision_time = decisions.summary();
+  result.episode_decision_time = episode_totals.summary();
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }

@@ -14,7 +14,9 @@
 #include <sstream>
 #include <thread>
 
+#include "ontime/allocator_registry.hpp"
 #include "ontime/allocators/ppo.hpp"
+#include "ontime/evaluation.hpp"
 #include "support/bad_inputs.hpp"
 #include "support/bad_logs.hpp"
 #include "support/mini_world.hpp"
@@ -994,6 +996,161 @@ TEST(Cli, InterruptedTrainingLeavesTheOldSetOrTheNewSetNeverAMix) {
 
   ASSERT_EQ(testing::run_process(train("400", false)).exit_code, 0);
   EXPECT_EQ(entries(), (std::vector<std::string>{"policy.curve.csv", "policy.json"}));
+}
+
+// A one-line message on stderr that names `option`, quotes `written` and prints no run of more
+// than 25 digits (numbers are written compactly, never as 309 digits).
+void expect_one_line_naming(const testing::ProcessResult& result, const std::string& option,
+                            const std::string& written) {
+  EXPECT_EQ(result.exit_code, 2) << option << " " << written << ": " << result.err;
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+  EXPECT_NE(result.err.find(option), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("'" + written + "'"), std::string::npos) << result.err;
+  std::size_t digits = 0;
+  for (const char c : result.err) {
+    digits = std::isdigit(static_cast<unsigned char>(c)) != 0 ? digits + 1 : 0;
+    EXPECT_LE(digits, 25U) << result.err;
+  }
+}
+
+TEST(Cli, OutOfRangeNumbersAreRefusedWithTheValueAsWritten) {
+  const std::string figure1 = paper("figure1");
+  const std::vector<std::string> evaluate{"evaluate", figure1, "--solver", "mcts", "--episodes", "5"};
+  struct Case {
+    std::vector<std::string> arguments;  // appended to their command
+    std::string option;
+    std::string written;
+  };
+  const std::vector<std::pair<std::vector<std::string>, std::vector<Case>>> commands{
+      {evaluate,
+       {{{"--seed", "-1"}, "--seed", "-1"},
+        {{"--seed", "18446744073709551616"}, "--seed", "18446744073709551616"},
+        {{"--seed", "-18446744073709551615"}, "--seed", "-18446744073709551615"},
+        {{"--seed", "1.5"}, "--seed", "1.5"},
+        {{"--seed", "0x10"}, "--seed", "0x10"},
+        {{"--threads", "100000"}, "--threads", "100000"},
+        {{"--threads", "-1"}, "--threads", "-1"},
+        {{"--time-budget", "nan"}, "--time-budget", "nan"},
+        {{"--time-budget", "1e400"}, "--time-budget", "1e400"}}},
+      {{"evaluate", figure1, "--solver", "dp"},
+       {{{"--episodes", "0"}, "--episodes", "0"}, {{"--episodes", "1e400"}, "--episodes", "1e400"}}},
+      {{"solve", figure1},
+       {{{"--max-states", "18446744073709551616"}, "--max-states", "18446744073709551616"},
+        {{"--max-states", "1e400"}, "--max-states", "1e400"},
+        {{"--max-states", "0"}, "--max-states", "0"}}},
+      {{"table", figure1, "--solvers", "dp"}, {{{"--threads", "4294967296"}, "--threads", "4294967296"}}},
+      {{"sample-log", figure1, "-o", "unused.jsonl"},
+       {{{"--attempts", "-5"}, "--attempts", "-5"},
+        {{"--cutoff", "2147483648"}, "--cutoff", "2147483648"},
+        {{"--seed", "inf"}, "--seed", "inf"}}},
+      {{"fit", "unused.jsonl", "--skeletons", figure1, "-o", "unused.json"},
+       {{{"--step", "nan", "--deadline", "5"}, "--step", "nan"},
+        {{"--step", "0", "--deadline", "5"}, "--step", "0"},
+        {{"--step", "1", "--deadline", "1e400"}, "--deadline", "1e400"},
+        {{"--step", "1", "--deadline", "5", "--laplace", "-1"}, "--laplace", "-1"}}},
+      {{"study", "anytime", figure1},
+       {{{"--seed", "-1"}, "--seed", "-1"}, {{"--threads", "2000"}, "--threads", "2000"}}},
+      {{"train", figure1, "--out", "unused.json"}, {{{"--episodes", "-3"}, "--episodes", "-3"}}},
+      {{"collect", "--domain", "navigation"},
+       {{{"--trials", "0"}, "--trials", "0"},
+        {{"--step", "nan"}, "--step", "nan"},
+        {{"--deadline", "10001"}, "--deadline", "10001"},
+        {{"--checks-per-second", "-inf"}, "--checks-per-second", "-inf"}}},
+      {{"map", "--domain", "navigation"}, {{{"--seed", "18446744073709551616"}, "--seed", "18446744073709551616"}}},
+      {{"run", "--domain", "navigation", "--solver", "dp"},
+       {{{"--episodes", "-1"}, "--episodes", "-1"}, {{"--threads", "100000"}, "--threads", "100000"}}},
+  };
+  for (const auto& [command, cases] : commands) {
+    for (const Case& bad : cases) {
+      std::vector<std::string> arguments = command;
+      arguments.insert(arguments.end(), bad.arguments.begin(), bad.arguments.end());
+      SCOPED_TRACE(command.front() + " " + bad.option + " " + bad.written);
+      expect_one_line_naming(ontime(arguments), bad.option, bad.written);
+    }
+  }
+  // The extremes of the range are accepted and run as written.
+  std::vector<std::string> largest = evaluate;
+  largest.insert(largest.end(), {"--seed", "18446744073709551615", "--json"});
+  const auto accepted = ontime(largest);
+  ASSERT_EQ(accepted.exit_code, 0) << accepted.err;
+  EXPECT_EQ(json::parse(accepted.out)["seed"].get<std::uint64_t>(), 18446744073709551615ULL);
+  // A leading zero is decimal, not octal.
+  std::vector<std::string> padded = evaluate;
+  padded.insert(padded.end(), {"--seed", "010", "--json"});
+  EXPECT_EQ(json::parse(ontime(padded).out)["seed"].get<std::uint64_t>(), 10U);
+}
+
+TEST(Cli, TableRefusesEmptyAndRepeatedColumnsAndRepeatedInstances) {
+  const std::string figure1 = paper("figure1");
+  const auto empty = ontime({"table", figure1, "--episodes", "5", "--solvers", "dp,,greedy"});
+  EXPECT_EQ(empty.exit_code, 2);
+  EXPECT_NE(empty.err.find("--solvers: name 2 is empty"), std::string::npos) << empty.err;
+  EXPECT_EQ(ontime({"table", figure1, "--episodes", "5", "--solvers", "dp,"}).exit_code, 2);
+  EXPECT_EQ(ontime({"table", figure1, "--episodes", "5", "--solvers", ""}).exit_code, 2);
+  const auto repeated = ontime({"table", figure1, "--episodes", "5", "--solvers", "dp,greedy,dp"});
+  EXPECT_EQ(repeated.exit_code, 2);
+  EXPECT_NE(repeated.err.find("--solvers: 'dp' is given twice"), std::string::npos) << repeated.err;
+  // The same file under another name is the same instance.
+  const std::string other_name = (std::filesystem::path(figure1).parent_path() / "." / "figure1.json").string();
+  const auto twice = ontime({"table", figure1, other_name, "--episodes", "5", "--solvers", "dp"});
+  EXPECT_EQ(twice.exit_code, 2);
+  EXPECT_NE(twice.err.find("instance given twice (as argument 1 and 2)"), std::string::npos) << twice.err;
+  EXPECT_EQ(ontime({"table", figure1, paper("instance1"), "--episodes", "5", "--solvers", "dp,greedy"}).exit_code, 0);
+}
+
+TEST(Cli, UsageErrorsTakeOneLine) {
+  for (const std::vector<std::string>& arguments :
+       {std::vector<std::string>{}, {"frobnicate"}, {"solve"}, {"evaluate", paper("figure1"), "--no-such-option"}}) {
+    const auto result = ontime(arguments);
+    EXPECT_EQ(result.exit_code, 2);
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+    EXPECT_EQ(result.err.rfind("ontime: usage error: ", 0), 0U) << result.err;
+  }
+}
+
+// "Whichever ends first": a time budget so large that its deadline is out of the clock's range
+// leaves the iteration limit in charge (it must not end every search at once).
+TEST(Cli, AHugeTimeBudgetLeavesTheIterationLimitInCharge) {
+  const Problem problem = testing::paper_instance("instance3");
+  const Mdp mdp(problem);
+  for (const char* seconds : {"1e10", "1e308"}) {
+    const AllocatorFactory factory =
+        make_allocator_factory("mcts", mdp, {{"iterations", "1000"}, {"time-budget", seconds}});
+    MonteCarloOptions monte_carlo;
+    monte_carlo.episodes = 20;
+    monte_carlo.threads = 1;
+    const MonteCarloResult result = run_monte_carlo(mdp, factory, monte_carlo);
+    const double searches = result.statistics.find("searches").value_or(0.0);
+    EXPECT_GT(searches, 0.0) << seconds;
+    EXPECT_EQ(result.statistics.find("iterations").value_or(0.0), searches * 1000) << seconds;
+  }
+}
+
+TEST(Cli, AnInstanceDeadlineBeyondItsTypeIsQuotedAsWritten) {
+  const auto directory = scratch("huge_deadline");
+  const std::string path = (directory / "instance.json").string();
+  std::ofstream(path) << R"({"name": "x", "deadline": 18446744073709551615})";
+  const auto result = ontime({"solve", path});
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.err.find("deadline: must be between 1 and 10000 steps (got 18446744073709551615)"),
+            std::string::npos)
+      << result.err;
+}
+
+// A cap the memory cannot hold would end in "out of memory" instead of the cap's clean stop.
+TEST(Cli, CapsBeyondTheAvailableMemoryAreRefusedBeforeStarting) {
+  const auto states = ontime({"solve", paper("figure1"), "--max-states", "18446744073709551615"});
+  EXPECT_EQ(states.exit_code, 2);
+  EXPECT_NE(states.err.find("--max-states 18446744073709551615: would need up to"), std::string::npos) << states.err;
+  const auto tree = ontime({"evaluate", paper("figure1"), "--solver", "mcts", "--max-tree-mib", "16777216",
+                            "--episodes", "5", "--threads", "1"});
+  EXPECT_EQ(tree.exit_code, 2);
+  EXPECT_NE(tree.err.find("--max-tree-mib 16777216 with 1 thread: would need up to 1.64e+04 GiB"), std::string::npos)
+      << tree.err;
+  const auto table = ontime({"table", paper("figure1"), "--solvers", "mcts", "--max-tree-mib", "16777216", "--episodes",
+                             "5", "--threads", "1"});
+  EXPECT_EQ(table.exit_code, 2);
+  EXPECT_EQ(ontime({"solve", paper("figure1"), "--max-states", "1000"}).exit_code, 0);
 }
 
 }  // namespace

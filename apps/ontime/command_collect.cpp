@@ -10,6 +10,7 @@
 #include "common.hpp"
 #include "data_paths.hpp"
 #include "fit_report.hpp"
+#include "number_options.hpp"
 #include "ontime/domains/collection.hpp"
 #include "ontime/domains/collection_journal.hpp"
 #include "ontime/domains/registry.hpp"
@@ -18,7 +19,6 @@
 #include "ontime/input_file.hpp"
 #include "ontime/instance_io.hpp"
 #include "output_paths.hpp"
-#include "thread_limit.hpp"
 
 namespace ontime::cli {
 
@@ -47,26 +47,24 @@ void add_collect_command(CLI::App& app) {
   CLI::App* command = app.add_subcommand("collect", "Refine every action of a domain many times, log it, fit the instance");
   command->add_option("--domain", options->domain, "Domain: " + names)->required();
   command->add_option("--world", options->world, "World file (default: data/domains/DOMAIN.json)");
-  command->add_option("--trials", options->trials, "Attempts per action")->check(CLI::PositiveNumber)->capture_default_str();
-  command->add_option("--seed", options->seed, "Seed (trial t of action a uses stream t of stream a)")->capture_default_str();
-  command
-      ->add_option("--threads", options->threads,
-                   "Worker threads (0: one per hardware thread); the log does not depend on it")
-      ->check(CLI::Range(0U, kMaxThreads))
-      ->capture_default_str();
+  add_number_option(*command, "--trials", options->trials, "Attempts per action", std::uint64_t{1});
+  add_number_option(*command, "--seed", options->seed, "Seed (trial t of action a uses stream t of stream a)");
+  add_threads_option(*command, options->threads,
+                     "Worker threads (0: one per hardware thread); the log does not depend on it");
   command->add_option("--effort", options->effort, "Effort unit: checks (deterministic) or wall (wall-clock seconds)")
       ->check(CLI::IsMember({"checks", "wall"}))
       ->capture_default_str();
-  command->add_option("--step", options->step_seconds, "Seconds of effort per step (default: the world file's)")
-      ->check(CLI::PositiveNumber);
-  command->add_option("--deadline", options->deadline, "Deadline D in steps (default: the world file's)")
-      ->check(CLI::Range(1, static_cast<int>(Problem::kMaxDeadline)));
-  command->add_option("--budget", options->budget, "Steps of effort after which an attempt is cut off (default: D)")
-      ->check(CLI::PositiveNumber);
-  command->add_option("--checks-per-second", options->checks_per_second,
-                      "Nominal collision checks per second of the checks unit (default: the world file's)")
-      ->check(CLI::PositiveNumber);
-  command->add_option("--laplace", options->laplace, "Laplace smoothing of the fit")->check(CLI::NonNegativeNumber)->capture_default_str();
+  add_number_option(*command, "--step", options->step_seconds, "Seconds of effort per step (default: the world file's)",
+                    kPositive, std::numeric_limits<double>::max(), false);
+  add_number_option(*command, "--deadline", options->deadline, "Deadline D in steps (default: the world file's)",
+                    Steps{1}, Problem::kMaxDeadline, false);
+  add_number_option(*command, "--budget", options->budget,
+                    "Steps of effort after which an attempt is cut off (default: D)", Steps{1},
+                    std::numeric_limits<Steps>::max(), false);
+  add_number_option(*command, "--checks-per-second", options->checks_per_second,
+                    "Nominal collision checks per second of the checks unit (default: the world file's)", kPositive,
+                    std::numeric_limits<double>::max(), false);
+  add_number_option(*command, "--laplace", options->laplace, "Laplace smoothing of the fit", 0.0);
   command->add_option("--log", options->log,
                       "Planner log to write (default: data/logs/DOMAIN.jsonl in the current directory)");
   command->add_option(

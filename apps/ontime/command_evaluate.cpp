@@ -31,6 +31,7 @@ void add_evaluate_command(CLI::App& app) {
     const Problem problem = load_problem(options->instance);
     const Mdp mdp(problem);
     const ParameterValues parameters = options->allocator.values();
+    options->monte_carlo.check_tree_memory(options->solver, parameters);
     const AllocatorFactory factory = make_allocator_factory(options->solver, mdp, parameters);
 
     MonteCarloOptions monte_carlo = options->monte_carlo.options();

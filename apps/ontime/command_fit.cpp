@@ -7,6 +7,7 @@
 
 #include "common.hpp"
 #include "fit_report.hpp"
+#include "number_options.hpp"
 #include "ontime/fitting.hpp"
 #include "ontime/instance_io.hpp"
 #include "ontime/planner_log.hpp"
@@ -29,19 +30,19 @@ void add_fit_command(CLI::App& app) {
   auto options = std::make_shared<Options>();
   CLI::App* command = app.add_subcommand("fit", "Learn an instance's time distributions from a planner log");
   command->add_option("LOG", options->log, "Planner log (JSON Lines, docs/formats.md)")->required();
-  command->add_option("--step", options->step_seconds, "Length of one step in seconds (times are rounded up to steps)")
-      ->required()
-      ->check(CLI::PositiveNumber);
-  command->add_option("--deadline", options->deadline, "Deadline D in steps; planning or execution beyond it is \"never\"")
-      ->required()
-      ->check(CLI::Range(1, static_cast<int>(Problem::kMaxDeadline)));
+  add_number_option(*command, "--step", options->step_seconds,
+                    "Length of one step in seconds (times are rounded up to steps)", kPositive,
+                    std::numeric_limits<double>::max(), false)
+      ->required();
+  add_number_option(*command, "--deadline", options->deadline,
+                    "Deadline D in steps; planning or execution beyond it is \"never\"", Steps{1},
+                    Problem::kMaxDeadline, false)
+      ->required();
   command->add_option("--skeletons", options->skeletons,
                       "JSON file whose 'skeletons' member lists the plan skeletons (an instance or world file will do)")
       ->required();
   command->add_option("-o,--output", options->output, "Instance file to write (SPEC §5)")->required();
-  command->add_option("--laplace", options->laplace, "Laplace (add-alpha) smoothing of the estimates")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
+  add_number_option(*command, "--laplace", options->laplace, "Laplace (add-alpha) smoothing of the estimates", 0.0);
   command->add_option("--name", options->name, "Instance name (default: the output file's stem)");
   command->add_option("--description", options->description, "Instance description");
   command->add_flag("--json", options->json, "Print JSON");

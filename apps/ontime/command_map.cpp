@@ -7,6 +7,7 @@
 
 #include "common.hpp"
 #include "data_paths.hpp"
+#include "number_options.hpp"
 #include "ontime/atomic_file.hpp"
 #include "ontime/domains/collection.hpp"
 #include "ontime/domains/registry.hpp"
@@ -35,7 +36,7 @@ void add_map_command(CLI::App& app) {
   CLI::App* command = app.add_subcommand("map", "Draw a domain's world with one refined motion per skeleton (PNG)");
   command->add_option("--domain", options->domain, "Domain")->required();
   command->add_option("--world", options->world, "World file (default: data/domains/DOMAIN.json)");
-  command->add_option("--seed", options->seed, "Seed of the refinements drawn")->capture_default_str();
+  add_number_option(*command, "--seed", options->seed, "Seed of the refinements drawn");
   command->add_option("-o,--output", options->output,
                       "PNG to write (default: DOMAIN-map.png in the current directory); the drawing goes beside it as .json");
   command->callback([options] {

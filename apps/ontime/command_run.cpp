@@ -7,8 +7,9 @@
 #include <filesystem>
 
 #include "common.hpp"
-#include "ontime/allocators/optimal.hpp"
 #include "data_paths.hpp"
+#include "number_options.hpp"
+#include "ontime/allocators/optimal.hpp"
 #include "ontime/domains/planner_world.hpp"
 #include "ontime/domains/registry.hpp"
 #include "ontime/episode_runner.hpp"
@@ -40,19 +41,16 @@ void add_run_command(CLI::App& app) {
                       "The allocator's model (default: data/instances/DOMAIN.json in the current directory, as collect "
                       "writes it, else the one installed with ontime)");
   command->add_option("--world", options->world, "World file (default: data/domains/DOMAIN.json)");
-  command->add_option("--episodes", options->episodes, "Episodes")->check(CLI::PositiveNumber)->capture_default_str();
-  command->add_option("--seed", options->seed, "Seed (episode e uses stream e)")->capture_default_str();
-  command
-      ->add_option("--threads", options->threads,
-                   "Worker threads (0: one per hardware thread); results do not depend on it")
-      ->capture_default_str();
+  add_number_option(*command, "--episodes", options->episodes, "Episodes", std::uint64_t{1});
+  add_number_option(*command, "--seed", options->seed, "Seed (episode e uses stream e)");
+  add_threads_option(*command, options->threads,
+                     "Worker threads (0: one per hardware thread); results do not depend on it");
   command->add_option("--effort", options->effort, "Effort unit: checks (deterministic) or wall")
       ->check(CLI::IsMember({"checks", "wall"}))
       ->capture_default_str();
-  command
-      ->add_option("--checks-per-second", options->checks_per_second,
-                   "Nominal collision checks per second of the checks unit (default: the world file's)")
-      ->check(CLI::PositiveNumber);
+  add_number_option(*command, "--checks-per-second", options->checks_per_second,
+                    "Nominal collision checks per second of the checks unit (default: the world file's)", kPositive,
+                    std::numeric_limits<double>::max(), false);
   command->add_flag(
       "--independent-starts", options->independent_starts,
       "Start every action after the first from a fresh pose in its room, not where the previous refinement ended");

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include "common.hpp"
+#include "number_options.hpp"
 #include "ontime/instance_io.hpp"
 #include "ontime/log_sampling.hpp"
 #include "ontime/planner_log.hpp"
@@ -21,14 +22,13 @@ void add_sample_log_command(CLI::App& app) {
   CLI::App* command = app.add_subcommand("sample-log", "Draw a planner log from an instance's distributions");
   command->add_option("INSTANCE", options->instance, "Instance file (JSON, SPEC §5)")->required();
   command->add_option("-o,--output", options->output, "Planner log to write (JSON Lines)")->required();
-  command->add_option("--attempts", options->sampling.attempts_per_action, "Attempts per action")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  command->add_option("--seed", options->sampling.seed, "Seed (attempt i of action a uses stream i of stream a)")
-      ->capture_default_str();
-  command->add_option("--cutoff", options->sampling.cutoff_steps,
-                      "Steps of effort after which an attempt is cut off (default: the deadline)")
-      ->check(CLI::PositiveNumber);
+  add_number_option(*command, "--attempts", options->sampling.attempts_per_action, "Attempts per action",
+                    std::uint64_t{1});
+  add_number_option(*command, "--seed", options->sampling.seed,
+                    "Seed (attempt i of action a uses stream i of stream a)");
+  add_number_option(*command, "--cutoff", options->sampling.cutoff_steps,
+                    "Steps of effort after which an attempt is cut off (default: the deadline)", Steps{1},
+                    std::numeric_limits<Steps>::max(), false);
   command->callback([options] {
     const Problem problem = load_problem(options->instance);
     check_outputs({{"--output", options->output}}, {options->instance});

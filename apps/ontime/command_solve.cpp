@@ -4,10 +4,22 @@
 #include <fmt/core.h>
 
 #include "common.hpp"
+#include "memory_limits.hpp"
+#include "number_options.hpp"
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/instance_io.hpp"
 
 namespace ontime::cli {
+
+namespace {
+
+// The bytes of one state's slot in the solver's table (optimal.hpp).
+double state_slot_bytes(const Problem& problem) {
+  if (problem.skeleton_count() <= 4 && problem.deadline() <= 253) return 33;
+  return problem.skeleton_count() <= 10 ? 49 : 99;
+}
+
+}  // namespace
 
 void add_solve_command(CLI::App& app) {
   struct Options {
@@ -18,12 +30,15 @@ void add_solve_command(CLI::App& app) {
   auto options = std::make_shared<Options>();
   CLI::App* command = app.add_subcommand("solve", "Exact optimal success probability and first choice (expectimax)");
   command->add_option("INSTANCE", options->instance, "Instance file (JSON, SPEC §5)")->required();
-  command->add_option("--max-states", options->max_states, "Stop with an error past this many states")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
+  add_number_option(*command, "--max-states", options->max_states, "Stop with an error past this many states",
+                    std::size_t{1});
   command->add_flag("--json", options->json, "Print JSON");
   command->callback([options] {
     const Problem problem = load_problem(options->instance);
+    // The table's slot per state (optimal.hpp), doubled by its power-of-two growth and by 1.5
+    // while it grows: the most the solver can hold before its cap stops it.
+    check_memory_for(fmt::format("--max-states {}", options->max_states),
+                     3.0 * state_slot_bytes(problem) * static_cast<double>(options->max_states));
     const Mdp mdp(problem);
     const auto started = std::chrono::steady_clock::now();
     OptimalSolver solver(mdp, options->max_states);

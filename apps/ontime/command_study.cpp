@@ -8,13 +8,13 @@
 #include <limits>
 
 #include "common.hpp"
+#include "number_options.hpp"
 #include "ontime/atomic_file.hpp"
 #include "ontime/error.hpp"
 #include "ontime/experiments.hpp"
 #include "ontime/instance_io.hpp"
 #include "output_paths.hpp"
 #include "python_runner.hpp"
-#include "thread_limit.hpp"
 
 namespace ontime::cli {
 namespace {
@@ -168,13 +168,10 @@ void add_study_command(CLI::App& app) {
     CLI::App* command = study->add_subcommand(name, description);
     command->add_option("INSTANCE", options->instances, "Instance files (JSON, SPEC §5)")->required();
     command->add_option("--out", options->out, "Directory for the CSV and PNG")->capture_default_str();
-    command->add_option("--episodes", options->episodes, "Episodes per evaluated configuration")
-        ->check(CLI::PositiveNumber)
-        ->capture_default_str();
-    command->add_option("--seed", options->seed, "Seed of the hidden worlds")->capture_default_str();
-    command->add_option("--threads", options->threads, "Worker threads (0: one per hardware thread)")
-        ->check(CLI::Range(0U, kMaxThreads))
-        ->capture_default_str();
+    add_number_option(*command, "--episodes", options->episodes, "Episodes per evaluated configuration",
+                      std::uint64_t{1});
+    add_number_option(*command, "--seed", options->seed, "Seed of the hidden worlds");
+    add_threads_option(*command, options->threads, "Worker threads (0: one per hardware thread)");
     command->add_flag("--no-plot", options->no_plot, "Write the CSV only");
     command
         ->add_option("--searcher", options->searcher,

@@ -8,6 +8,8 @@
 #include <chrono>
 #include <filesystem>
 #include <functional>
+#include <ranges>
+#include <string_view>
 #include <fmt/format.h>
 
 #include "common.hpp"
@@ -193,6 +195,19 @@ void print_table(const TableOptions& options, const std::vector<Row>& rows) {
   }
 }
 
+// Refuses an instance given twice (the same file under any name): its row would repeat.
+void check_distinct_instances(const std::vector<std::string>& paths) {
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      std::error_code error;
+      if (paths[i] == paths[j] || std::filesystem::equivalent(paths[i], paths[j], error)) {
+        throw UsageError(fmt::format("{}: instance given twice (as argument {} and {}); one row per instance", paths[i],
+                                     j + 1, i + 1));
+      }
+    }
+  }
+}
+
 }  // namespace
 
 void add_table_command(CLI::App& app) {
@@ -202,15 +217,25 @@ void add_table_command(CLI::App& app) {
   options->solvers = allocator_registry().names({}, {Capability::needs_policy, Capability::optimal});
   CLI::App* command = app.add_subcommand("table", "Table I: success of several allocators on several instances");
   command->add_option("INSTANCE", options->instances, "Instance files (JSON, SPEC §5)")->required();
-  command->add_option("--solvers", options->solvers, "Comma-separated allocators, one column each")
-      ->delimiter(',')
-      ->capture_default_str();
+  // Split here rather than by CLI11, which drops empty names ("dp,,greedy") that must be refused.
+  command
+      ->add_option_function<std::string>(
+          "--solvers",
+          [options](const std::string& text) {
+            options->solvers.clear();
+            for (const auto part : std::views::split(std::string_view(text), ',')) {
+              options->solvers.emplace_back(part.begin(), part.end());
+            }
+          },
+          "Comma-separated allocators, one column each")
+      ->default_str(fmt::format("{}", fmt::join(options->solvers, ",")));
   command->add_flag("--exact", options->exact, "Add exact success probabilities and the exact optimum");
   command->add_flag("--json", options->json, "Print JSON");
   options->monte_carlo.add_to(*command);
   options->allocator.add_to(*command);
   command->callback([options] {
     check_solver_names(options->solvers);
+    check_distinct_instances(options->instances);
     // Load every instance and make every column's allocators first (policies loaded, parameters
     // checked): a bad file or value stops the command before any long computation.
     std::vector<Problem> problems;
@@ -223,6 +248,7 @@ void add_table_command(CLI::App& app) {
       mdps.push_back(std::make_unique<Mdp>(problems[i]));
       max_states.push_back(max_states_of(parameters));
       for (const std::string& solver : options->solvers) {
+        options->monte_carlo.check_tree_memory(solver, parameters);
         factories[i].push_back(make_allocator_factory(solver, *mdps[i], parameters));
       }
     }

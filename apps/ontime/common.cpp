@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <cstdio>
 #include <fmt/format.h>
+#include <thread>
 #include <unistd.h>
 
+#include "memory_limits.hpp"
+#include "number_options.hpp"
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/error.hpp"
 
@@ -68,12 +71,9 @@ nlohmann::ordered_json parameters_json(const AllocatorKind& kind, const Paramete
 }
 
 void MonteCarloFlags::add_to(CLI::App& command) {
-  command.add_option("--episodes", episodes, "Simulated episodes per evaluation")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  command.add_option("--seed", seed, "Seed of the hidden worlds (episode i uses stream i of it)")->capture_default_str();
-  command.add_option("--threads", threads, "Worker threads (0: one per hardware thread); results do not depend on it")
-      ->capture_default_str();
+  add_number_option(command, "--episodes", episodes, "Simulated episodes per evaluation", std::uint64_t{1});
+  add_number_option(command, "--seed", seed, "Seed of the hidden worlds (episode i uses stream i of it)");
+  add_threads_option(command, threads, "Worker threads (0: one per hardware thread); results do not depend on it");
 }
 
 MonteCarloOptions MonteCarloFlags::options() const {
@@ -82,6 +82,18 @@ MonteCarloOptions MonteCarloFlags::options() const {
   options.seed = seed;
   options.threads = threads;
   return options;
+}
+
+void MonteCarloFlags::check_tree_memory(const std::string& solver, const ParameterValues& values) const {
+  const AllocatorKind& kind = allocator_registry().find(solver);
+  const bool has_tree_cap = std::any_of(kind.parameters.begin(), kind.parameters.end(),
+                                        [](const Parameter& parameter) { return parameter.name == "max-tree-mib"; });
+  if (!has_tree_cap) return;
+  const double mib = static_cast<double>(ParameterReader(kind, values).integer("max-tree-mib"));
+  const std::uint64_t workers =
+      std::min<std::uint64_t>(episodes, threads > 0 ? threads : std::max(1U, std::thread::hardware_concurrency()));
+  check_memory_for(fmt::format("--max-tree-mib {} with {} thread{}", mib, workers, workers == 1 ? "" : "s"),
+                   mib * 1024 * 1024 * static_cast<double>(workers));
 }
 
 CLI::Option* add_solver_option(CLI::App& command, std::string& solver) {
@@ -94,8 +106,15 @@ CLI::Option* add_solver_option(CLI::App& command, std::string& solver) {
 
 void check_solver_names(const std::vector<std::string>& names) {
   const std::vector<std::string> known = allocator_registry().names();
-  for (const std::string& name : names) {
-    if (std::find(known.begin(), known.end(), name) == known.end()) throw unknown_name_error("solver", name, known);
+  if (names.empty()) throw UsageError("--solvers: give at least one allocator");
+  for (auto name = names.begin(); name != names.end(); ++name) {
+    if (name->empty()) {
+      throw UsageError(fmt::format("--solvers: name {} is empty (a stray comma?)", name - names.begin() + 1));
+    }
+    if (std::find(known.begin(), known.end(), *name) == known.end()) throw unknown_name_error("solver", *name, known);
+    if (std::find(names.begin(), name, *name) != name) {
+      throw UsageError(fmt::format("--solvers: '{}' is given twice (one column per allocator)", *name));
+    }
   }
 }
 

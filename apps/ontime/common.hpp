@@ -61,13 +61,16 @@ struct MonteCarloFlags {
   unsigned threads = 0;
   void add_to(CLI::App& command);
   MonteCarloOptions options() const;
+  // Refuses (UsageError, exit 2) a search-tree cap (`max-tree-mib`, if `solver` declares it) that
+  // the threads of the run together could not hold in the memory available.
+  void check_tree_memory(const std::string& solver, const ParameterValues& values) const;
 };
 
 // Adds the required `--solver NAME` option, its help listing the allocators.
 CLI::Option* add_solver_option(CLI::App& command, std::string& solver);
 
-// Checks that every name is a known allocator (the CLI calls them solvers); throws UsageError
-// otherwise.
+// Checks that every name is a known allocator (the CLI calls them solvers), none empty and
+// none twice; throws UsageError otherwise.
 void check_solver_names(const std::vector<std::string>& names);
 
 // Prints JSON to stdout, two-space indented.

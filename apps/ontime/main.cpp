@@ -32,7 +32,7 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
     if (error.get_exit_code() == 0) return app.exit(error);  // --help, --version
-    fmt::print(stderr, "ontime: usage error: {}\nRun 'ontime --help' or 'ontime COMMAND --help'.\n", error.what());
+    fmt::print(stderr, "ontime: usage error: {} (see 'ontime --help' or 'ontime COMMAND --help')\n", error.what());
     return kUsageExit;
   } catch (const ontime::InputError& error) {
     return report("error", error.what(), kUsageExit);

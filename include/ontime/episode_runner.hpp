@@ -11,6 +11,8 @@
 // thread, so the results do not depend on the thread count, and every episode's allocator has
 // its own random stream.
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 
@@ -57,6 +59,28 @@ struct MonteCarloOptions {
 struct LatencySummary {
   std::uint64_t decisions = 0;
   double mean_us = 0, median_us = 0, p99_us = 0, max_us = 0;
+};
+
+// Durations in nanoseconds summarised in fixed memory (about 29 KiB), however many are added:
+// a log-scale histogram with 64 buckets per power of two. The count, mean and maximum are exact;
+// a quantile is exact below 64 ns and otherwise the middle of the bucket holding it, within
+// 1/128 (0.8%) of the true sample value. Histograms of several threads merge exactly.
+class LatencyHistogram {
+ public:
+  void add(std::int64_t nanoseconds) noexcept;
+  void merge(const LatencyHistogram& other) noexcept;
+  // The quantile of rank round(q (n - 1)) of the n durations added, as LatencySummary's.
+  LatencySummary summary() const;
+
+ private:
+  static constexpr int kSubBits = 6;  // 2^6 buckets per power of two
+  static constexpr std::size_t kBuckets = (64 - kSubBits) << kSubBits;
+  static std::size_t bucket_of(std::uint64_t nanoseconds) noexcept;
+  static double middle_of(std::size_t bucket) noexcept;
+  std::array<std::uint64_t, kBuckets> counts_{};
+  std::uint64_t count_ = 0;
+  double total_ = 0;
+  std::int64_t max_ = 0;
 };
 
 struct MonteCarloResult {

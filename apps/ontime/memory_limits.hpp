@@ -1,0 +1,20 @@
+#pragma once
+// Memory caps checked against the memory this process can have, before long work starts: a
+// cap the machine cannot honour would end in "out of memory" (exit 1) instead of the cap's own
+// clean stop, so it is refused as a usage error (exit 2) naming the option and the bytes.
+
+#include <cstdint>
+#include <optional>
+#include <string_view>
+
+namespace ontime::cli {
+
+// The smaller of /proc/meminfo's MemAvailable and the room left under this process's cgroup
+// memory limit (v2 memory.max, or v1 memory.limit_in_bytes); nothing when neither is readable.
+std::optional<std::uint64_t> available_memory_bytes();
+
+// Throws UsageError "OPTION: would need up to N GiB of memory, M GiB available" when `bytes`
+// exceeds the available memory.
+void check_memory_for(std::string_view option, double bytes);
+
+}  // namespace ontime::cli
