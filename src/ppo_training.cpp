@@ -112,141 +112,192 @@ template double clipped_surrogate_loss<double>(const Eigen::MatrixXd&, const std
                                                const std::vector<int>&, const std::vector<double>&,
                                                const std::vector<double>&, double, Eigen::MatrixXd&, double&);
 
+namespace {
+
+// One training run: the networks, their optimisers, the sampling stream and the scratch buffers
+// that every episode and update reuse. train_ppo alternates play_episode (until an epoch's steps
+// are collected) and update.
+class PpoTrainer {
+ public:
+  PpoTrainer(const Mdp& mdp, std::uint64_t seed, const PpoHyperparameters& h)
+      : mdp_(mdp),
+        h_(h),
+        count_(mdp.skeleton_count()),
+        inputs_(feature_count(count_)),
+        networks_(initial_networks(stream_seed(seed, 0))),
+        actor_optimiser_(networks_.actor, h.actor_learning_rate),
+        critic_optimiser_(networks_.critic, h.critic_learning_rate),
+        sampling_(stream_seed(seed, 1)),
+        features_(inputs_),
+        log_probabilities_(static_cast<std::size_t>(count_)) {}
+
+  Batch& batch() noexcept { return batch_; }
+  PpoNetworks take_networks() { return std::move(networks_); }
+
+  // Plays one episode in the hidden world of `world_seed` with the current actor (choices
+  // sampled), appends its steps to the batch with their advantages (GAE) and returns, and
+  // returns how it ended.
+  Status play_episode(std::uint64_t world_seed) {
+    const HiddenWorld world(mdp_.problem(), world_seed);
+    State state = mdp_.start();
+    const std::size_t first = batch_.steps();
+    Status status = Status::running;
+    for (int step = 0; step < h_.max_episode_steps && status == Status::running; ++step) {
+      const ChoiceList choices = mdp_.useful_choices(state);
+      // No skeleton can succeed any more (the start state of an instance where success is
+      // impossible: `apply` reports this as failure only after a step): the episode is lost
+      // whatever the learner does, and a step without a choice teaches it nothing.
+      if (choices.empty()) {
+        status = Status::failure;
+        break;
+      }
+      state_features(mdp_, state, features_);
+      std::uint8_t valid[Problem::kMaxSkeletons] = {};
+      for (const int choice : choices) valid[choice] = 1;
+      const Vector& logits = networks_.actor.evaluate(features_);
+      masked_log_softmax(logits, valid, count_, log_probabilities_.data());
+      const double value = networks_.critic.evaluate(features_)(0);
+      const auto probability = [&](std::size_t i) {
+        return std::exp(log_probabilities_[static_cast<std::size_t>(choices[i])]);
+      };
+      const int action = choices[sample_index(choices.size(), probability, sampling_)];
+      const int refining = mdp_.next_action(state, action);
+      const Observation observation = world.observe(refining, state.spent[static_cast<std::size_t>(action)]);
+      status = mdp_.apply(state, action, observation);
+
+      batch_.features.insert(batch_.features.end(), features_.data(), features_.data() + inputs_);
+      batch_.valid.insert(batch_.valid.end(), valid, valid + count_);
+      batch_.actions.push_back(action);
+      batch_.log_probabilities.push_back(log_probabilities_[static_cast<std::size_t>(action)]);
+      batch_.values.push_back(value);
+      batch_.rewards.push_back(status == Status::success ? 1.0 : 0.0);
+    }
+    // Advantages (GAE) and discounted returns of the episode; a cut-off episode (step
+    // limit) is completed by the critic's value of its last state.
+    double next_value = 0;
+    if (status == Status::running) {
+      state_features(mdp_, state, features_);
+      next_value = networks_.critic.evaluate(features_)(0);
+    }
+    const std::size_t last = batch_.steps();
+    batch_.advantages.resize(last);
+    batch_.returns.resize(last);
+    double advantage = 0, discounted = next_value;
+    for (std::size_t t = last; t-- > first;) {
+      const double delta = batch_.rewards[t] + h_.gamma * next_value - batch_.values[t];
+      advantage = delta + h_.gamma * h_.lambda * advantage;
+      discounted = batch_.rewards[t] + h_.gamma * discounted;
+      batch_.advantages[t] = advantage;
+      batch_.returns[t] = discounted;
+      next_value = batch_.values[t];
+    }
+    return status;
+  }
+
+  // One PPO update from the batch: normalised advantages, clipped-surrogate actor steps (until
+  // the KL limit) and critic steps. Returns the actor steps taken; an empty batch (episodes that
+  // all ended before their first choice) holds nothing to learn from.
+  int update() {
+    const std::size_t steps = batch_.steps();
+    if (steps == 0) return 0;
+    double mean = 0, square = 0;
+    for (const double a : batch_.advantages) mean += a;
+    mean /= static_cast<double>(steps);
+    for (const double a : batch_.advantages) square += (a - mean) * (a - mean);
+    const double deviation = std::sqrt(square / static_cast<double>(steps));
+    for (double& a : batch_.advantages) a = (a - mean) / (deviation + 1e-8);
+
+    int actor_steps = 0;
+    inputs_matrix_ = Eigen::Map<const Matrix>(batch_.features.data(), inputs_, static_cast<Eigen::Index>(steps));
+    for (int iteration = 0; iteration < h_.train_iterations; ++iteration) {
+      const Matrix& logits = networks_.actor.forward(inputs_matrix_);
+      double kl = 0;
+      clipped_surrogate_loss<float>(logits, batch_.valid, batch_.actions, batch_.log_probabilities, batch_.advantages,
+                                    h_.clip, logits_gradient_, kl);
+      if (kl > 1.5 * h_.target_kl) break;
+      networks_.actor.backward(logits_gradient_);
+      actor_optimiser_.step(networks_.actor);
+      ++actor_steps;
+    }
+    for (int iteration = 0; iteration < h_.train_iterations; ++iteration) {
+      const Matrix& values = networks_.critic.forward(inputs_matrix_);
+      value_gradient_.resize(1, static_cast<Eigen::Index>(steps));
+      for (std::size_t n = 0; n < steps; ++n) {
+        value_gradient_(0, static_cast<Eigen::Index>(n)) = static_cast<float>(
+            2.0 * (values(0, static_cast<Eigen::Index>(n)) - batch_.returns[n]) / static_cast<double>(steps));
+      }
+      networks_.critic.backward(value_gradient_);
+      critic_optimiser_.step(networks_.critic);
+    }
+    return actor_steps;
+  }
+
+ private:
+  PpoNetworks initial_networks(std::uint64_t seed) const {
+    std::vector<int> actor_sizes{inputs_};
+    std::vector<int> critic_sizes{inputs_};
+    for (int layer = 0; layer < h_.hidden_layers; ++layer) {
+      actor_sizes.push_back(h_.hidden_units);
+      critic_sizes.push_back(h_.hidden_units);
+    }
+    actor_sizes.push_back(count_);
+    critic_sizes.push_back(1);
+    SplitMix64 initialisation(seed);
+    // Sequenced: the actor draws its weights first, then the critic, from one stream.
+    PolicyNetwork actor(actor_sizes, initialisation);
+    PolicyNetwork critic(critic_sizes, initialisation);
+    return PpoNetworks{std::move(actor), std::move(critic)};
+  }
+
+  const Mdp& mdp_;
+  const PpoHyperparameters& h_;
+  int count_;
+  int inputs_;
+  PpoNetworks networks_;
+  Adam<float> actor_optimiser_;
+  Adam<float> critic_optimiser_;
+  SplitMix64 sampling_;
+  Batch batch_;
+  Vector features_;
+  std::vector<double> log_probabilities_;
+  Matrix inputs_matrix_, logits_gradient_, value_gradient_;
+};
+
+}  // namespace
+
 PpoTraining train_ppo(const Mdp& mdp, std::uint64_t episodes, std::uint64_t seed, const PpoHyperparameters& h,
                       const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
   check(h);
   if (episodes == 0) throw UsageError("training needs at least one episode");
   const auto started = std::chrono::steady_clock::now();
-  const int count = mdp.skeleton_count();
-  const int inputs = feature_count(count);
 
   PpoTraining training;
   PpoPolicy& policy = training.policy;
   policy.instance = mdp.problem().name();
   policy.instance_digest = instance_digest(mdp.problem());
-  policy.skeleton_count = count;
+  policy.skeleton_count = mdp.skeleton_count();
   policy.deadline = mdp.deadline();
   policy.seed = seed;
   policy.episodes = episodes;
   policy.hyperparameters = h;
-  std::vector<int> actor_sizes{inputs};
-  std::vector<int> critic_sizes{inputs};
-  for (int layer = 0; layer < h.hidden_layers; ++layer) {
-    actor_sizes.push_back(h.hidden_units);
-    critic_sizes.push_back(h.hidden_units);
-  }
-  actor_sizes.push_back(count);
-  critic_sizes.push_back(1);
-  SplitMix64 initialisation(stream_seed(seed, 0));
-  PpoNetworks networks{PolicyNetwork(actor_sizes, initialisation), PolicyNetwork(critic_sizes, initialisation)};
-  Adam<float> actor_optimiser(networks.actor, h.actor_learning_rate);
-  Adam<float> critic_optimiser(networks.critic, h.critic_learning_rate);
-  SplitMix64 sampling(stream_seed(seed, 1));
+  PpoTrainer trainer(mdp, seed, h);
   const std::uint64_t world_seed = stream_seed(seed, 2);
 
-  Batch batch;
-  Vector features(inputs);
-  std::vector<double> log_probabilities(static_cast<std::size_t>(count));
   std::uint64_t episodes_done = 0;
   std::uint64_t steps_done = 0;
-  Matrix inputs_matrix, logits_gradient, value_gradient;
-
   for (int epoch = 1; episodes_done < episodes; ++epoch) {
-    batch.clear();
+    trainer.batch().clear();
     std::uint64_t epoch_episodes = 0, epoch_successes = 0;
-    while (batch.steps() < static_cast<std::size_t>(h.steps_per_epoch) && episodes_done < episodes) {
-      const HiddenWorld world(mdp.problem(), stream_seed(world_seed, episodes_done));
-      State state = mdp.start();
-      const std::size_t first = batch.steps();
-      Status status = Status::running;
-      for (int step = 0; step < h.max_episode_steps && status == Status::running; ++step) {
-        const ChoiceList choices = mdp.useful_choices(state);
-        // No skeleton can succeed any more (the start state of an instance where success is
-        // impossible: `apply` reports this as failure only after a step): the episode is lost
-        // whatever the learner does, and a step without a choice teaches it nothing.
-        if (choices.empty()) {
-          status = Status::failure;
-          break;
-        }
-        state_features(mdp, state, features);
-        std::uint8_t valid[Problem::kMaxSkeletons] = {};
-        for (const int choice : choices) valid[choice] = 1;
-        const Vector& logits = networks.actor.evaluate(features);
-        masked_log_softmax(logits, valid, count, log_probabilities.data());
-        const double value = networks.critic.evaluate(features)(0);
-        const auto probability = [&](std::size_t i) {
-          return std::exp(log_probabilities[static_cast<std::size_t>(choices[i])]);
-        };
-        const int action = choices[sample_index(choices.size(), probability, sampling)];
-        const int refining = mdp.next_action(state, action);
-        const Observation observation = world.observe(refining, state.spent[static_cast<std::size_t>(action)]);
-        status = mdp.apply(state, action, observation);
-
-        batch.features.insert(batch.features.end(), features.data(), features.data() + inputs);
-        batch.valid.insert(batch.valid.end(), valid, valid + count);
-        batch.actions.push_back(action);
-        batch.log_probabilities.push_back(log_probabilities[static_cast<std::size_t>(action)]);
-        batch.values.push_back(value);
-        batch.rewards.push_back(status == Status::success ? 1.0 : 0.0);
-      }
-      // Advantages (GAE) and discounted returns of the episode; a cut-off episode (step
-      // limit) is completed by the critic's value of its last state.
-      double next_value = 0;
-      if (status == Status::running) {
-        state_features(mdp, state, features);
-        next_value = networks.critic.evaluate(features)(0);
-      }
-      const std::size_t last = batch.steps();
-      batch.advantages.resize(last);
-      batch.returns.resize(last);
-      double advantage = 0, discounted = next_value;
-      for (std::size_t t = last; t-- > first;) {
-        const double delta = batch.rewards[t] + h.gamma * next_value - batch.values[t];
-        advantage = delta + h.gamma * h.lambda * advantage;
-        discounted = batch.rewards[t] + h.gamma * discounted;
-        batch.advantages[t] = advantage;
-        batch.returns[t] = discounted;
-        next_value = batch.values[t];
-      }
+    while (trainer.batch().steps() < static_cast<std::size_t>(h.steps_per_epoch) && episodes_done < episodes) {
+      const std::size_t before = trainer.batch().steps();
+      const Status status = trainer.play_episode(stream_seed(world_seed, episodes_done));
       ++episodes_done;
       ++epoch_episodes;
       epoch_successes += status == Status::success ? 1U : 0U;
-      steps_done += last - first;
+      steps_done += trainer.batch().steps() - before;
     }
-
-    const std::size_t steps = batch.steps();
-    int actor_steps = 0;
-    // An epoch of episodes that all ended before their first choice holds nothing to learn from.
-    if (steps > 0) {
-      double mean = 0, square = 0;
-      for (const double a : batch.advantages) mean += a;
-      mean /= static_cast<double>(steps);
-      for (const double a : batch.advantages) square += (a - mean) * (a - mean);
-      const double deviation = std::sqrt(square / static_cast<double>(steps));
-      for (double& a : batch.advantages) a = (a - mean) / (deviation + 1e-8);
-
-      inputs_matrix = Eigen::Map<const Matrix>(batch.features.data(), inputs, static_cast<Eigen::Index>(steps));
-      for (int iteration = 0; iteration < h.train_iterations; ++iteration) {
-        const Matrix& logits = networks.actor.forward(inputs_matrix);
-        double kl = 0;
-        clipped_surrogate_loss<float>(logits, batch.valid, batch.actions, batch.log_probabilities, batch.advantages,
-                                      h.clip, logits_gradient, kl);
-        if (kl > 1.5 * h.target_kl) break;
-        networks.actor.backward(logits_gradient);
-        actor_optimiser.step(networks.actor);
-        ++actor_steps;
-      }
-      for (int iteration = 0; iteration < h.train_iterations; ++iteration) {
-        const Matrix& values = networks.critic.forward(inputs_matrix);
-        value_gradient.resize(1, static_cast<Eigen::Index>(steps));
-        for (std::size_t n = 0; n < steps; ++n) {
-          value_gradient(0, static_cast<Eigen::Index>(n)) = static_cast<float>(
-              2.0 * (values(0, static_cast<Eigen::Index>(n)) - batch.returns[n]) / static_cast<double>(steps));
-        }
-        networks.critic.backward(value_gradient);
-        critic_optimiser.step(networks.critic);
-      }
-    }
+    const std::size_t steps = trainer.batch().steps();
+    const int actor_steps = trainer.update();
 
     LearningCurvePoint point;
     point.epoch = epoch;
@@ -259,7 +310,7 @@ PpoTraining train_ppo(const Mdp& mdp, std::uint64_t episodes, std::uint64_t seed
     training.curve.push_back(point);
     if (progress) progress(episodes_done, episodes);
   }
-  policy.networks = std::make_shared<const PpoNetworks>(std::move(networks));
+  policy.networks = std::make_shared<const PpoNetworks>(trainer.take_networks());
   return training;
 }
 
