@@ -87,6 +87,20 @@ TEST(CliRegistry, EveryCommandAndStudyHasHelp) {
   }
 }
 
+TEST(CliRegistry, AParameterGivenOncePerInstanceReachesEachInstanceWithExactParts) {
+  const std::string one = testing::source_path("data/instances/paper/instance1.json").string();
+  const std::string four = testing::source_path("data/instances/paper/instance4.json").string();
+  const auto result = testing::run_process({ONTIME_CLI, "table", one, four, "--solvers", "dp,mcts", "--episodes", "20",
+                                            "--iterations", "30", "--iterations", "40", "--exact", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const auto wrong = testing::run_process({ONTIME_CLI, "table", one, four, "--solvers", "dp", "--episodes", "20",
+                                           "--iterations", "30", "--iterations", "40", "--iterations", "50"});
+  EXPECT_EQ(wrong.exit_code, 2);
+  EXPECT_NE(wrong.err.find("--iterations: give one value, or one per instance (3 given for 2 instances)"),
+            std::string::npos)
+      << wrong.err;
+}
+
 TEST(CliRegistry, TheRegistryRefusesContradictoryDeclarations) {
   double seen = 0;
   const TestKind added(knob_kind(&seen));

@@ -1,10 +1,11 @@
 #include "common.hpp"
 
+#include <fmt/format.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdio>
-#include <fmt/format.h>
 #include <thread>
-#include <unistd.h>
 
 #include "memory_limits.hpp"
 #include "number_options.hpp"
@@ -17,11 +18,16 @@ namespace {
 
 std::string type_name(const Parameter& parameter) {
   switch (parameter.type) {
-    case ParameterType::integer: return "INT";
-    case ParameterType::real: return "REAL";
-    case ParameterType::text: return "TEXT";
-    case ParameterType::choice: return fmt::format("{{{}}}", fmt::join(parameter.choices, ","));
-    case ParameterType::path: return "FILE";
+    case ParameterType::integer:
+      return "INT";
+    case ParameterType::real:
+      return "REAL";
+    case ParameterType::text:
+      return "TEXT";
+    case ParameterType::choice:
+      return fmt::format("{{{}}}", fmt::join(parameter.choices, ","));
+    case ParameterType::path:
+      return "FILE";
   }
   return "VALUE";
 }
@@ -31,13 +37,14 @@ std::string type_name(const Parameter& parameter) {
 void AllocatorFlags::add_to(CLI::App& command) {
   const AllocatorRegistry& registry = allocator_registry();
   for (const Parameter& parameter : registry.parameters()) {
-    std::string help = fmt::format("{}: {}", fmt::join(registry.kinds_with_parameter(parameter.name), ", "),
-                                   parameter.help);
+    std::string help =
+        fmt::format("{}: {}", fmt::join(registry.kinds_with_parameter(parameter.name), ", "), parameter.help);
     if (!parameter.default_value.empty()) help += fmt::format(" (default {})", parameter.default_value);
     CLI::Option* option = command.add_option("--" + parameter.name, given[parameter.name], help);
     option->type_name(type_name(parameter));
     // Files may follow one flag (--policy a.json b.json); other values one per flag, repeatable.
-    if (parameter.type != ParameterType::path) option->expected(1)->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+    if (parameter.type != ParameterType::path)
+      option->expected(1)->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   }
 }
 
@@ -61,7 +68,13 @@ ParameterValues AllocatorFlags::values(std::size_t index, std::size_t instance_c
   return values;
 }
 
-std::size_t AllocatorFlags::max_states() const { return max_states_of(values()); }
+std::size_t AllocatorFlags::max_states() const {
+  // Only max-states: the other parameters may be given once per instance.
+  ParameterValues values;
+  const auto found = given.find("max-states");
+  if (found != given.end() && !found->second.empty()) values.set("max-states", found->second.front());
+  return max_states_of(values);
+}
 
 nlohmann::ordered_json parameters_json(const AllocatorKind& kind, const ParameterValues& values) {
   nlohmann::ordered_json out = nlohmann::ordered_json::object();
