@@ -34,7 +34,8 @@ void BM_NavigationCollisionCheck(benchmark::State& bench) {
   std::vector<ontime::domains::Pose> poses;
   for (int i = 0; i < 4096; ++i) {
     poses.push_back({bounds[0] + (bounds[2] - bounds[0]) * ontime::uniform01(random),
-                     bounds[1] + (bounds[3] - bounds[1]) * ontime::uniform01(random), 6.28 * ontime::uniform01(random)});
+                     bounds[1] + (bounds[3] - bounds[1]) * ontime::uniform01(random),
+                     6.28 * ontime::uniform01(random)});
   }
   std::size_t next = 0;
   for (auto _ : bench) {
@@ -52,7 +53,8 @@ void refinement_benchmark(benchmark::State& bench, const ontime::domains::Domain
   const auto tree = ontime::domains::skeleton_tree(domain.skeletons());
   const auto& node = tree.at(static_cast<std::size_t>(bench.range(0)));
   const auto& defaults = world.collection;
-  const ontime::domains::EffortSettings effort{ontime::domains::EffortUnit::collision_checks, defaults.checks_per_second};
+  const ontime::domains::EffortSettings effort{ontime::domains::EffortUnit::collision_checks,
+                                               defaults.checks_per_second};
   std::uint64_t seed = 0, checks = 0, found = 0;
   for (auto _ : bench) {
     ++seed;

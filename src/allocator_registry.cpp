@@ -1,9 +1,10 @@
 #include "ontime/allocator_registry.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <fmt/format.h>
 #include <system_error>
 #include <utility>
 
@@ -43,22 +44,32 @@ std::vector<std::string> Capabilities::names() const {
 
 std::string_view to_string(Capability capability) noexcept {
   switch (capability) {
-    case Capability::stationary: return "stationary";
-    case Capability::randomised: return "randomised";
-    case Capability::anytime: return "anytime";
-    case Capability::needs_policy: return "needs-policy";
-    case Capability::optimal: return "optimal";
+    case Capability::stationary:
+      return "stationary";
+    case Capability::randomised:
+      return "randomised";
+    case Capability::anytime:
+      return "anytime";
+    case Capability::needs_policy:
+      return "needs-policy";
+    case Capability::optimal:
+      return "optimal";
   }
   return "?";
 }
 
 std::string_view to_string(ParameterType type) noexcept {
   switch (type) {
-    case ParameterType::integer: return "integer";
-    case ParameterType::real: return "real";
-    case ParameterType::text: return "text";
-    case ParameterType::choice: return "choice";
-    case ParameterType::path: return "path";
+    case ParameterType::integer:
+      return "integer";
+    case ParameterType::real:
+      return "real";
+    case ParameterType::text:
+      return "text";
+    case ParameterType::choice:
+      return "choice";
+    case ParameterType::path:
+      return "path";
   }
   return "?";
 }
@@ -76,8 +87,8 @@ Parameter Parameter::real(std::string name, double default_value, double minimum
 
 Parameter Parameter::choice(std::string name, std::string default_value, std::vector<std::string> choices,
                             std::string help) {
-  return Parameter{std::move(name), ParameterType::choice, std::move(default_value), -kNoLimit, kNoLimit,
-                   std::move(choices), std::move(help)};
+  return Parameter{std::move(name), ParameterType::choice, std::move(default_value), -kNoLimit,
+                   kNoLimit,        std::move(choices),    std::move(help)};
 }
 
 Parameter Parameter::text(std::string name, std::string default_value, std::string help) {
@@ -108,7 +119,8 @@ std::optional<std::string> Parameter::violation(std::string_view value) const {
       const std::optional<double> number = parse_number(*this, value);
       const std::string what = type == ParameterType::integer ? "a whole number" : "a finite number";
       const std::string range = allowed();
-      if (!number || *number < minimum || *number > maximum) return rule("must be " + what + (range.empty() ? "" : " " + range));
+      if (!number || *number < minimum || *number > maximum)
+        return rule("must be " + what + (range.empty() ? "" : " " + range));
       return std::nullopt;
     }
     case ParameterType::choice:
@@ -119,7 +131,8 @@ std::optional<std::string> Parameter::violation(std::string_view value) const {
     case ParameterType::path:
       if (value.empty()) return rule("must name a file");
       return std::nullopt;
-    case ParameterType::text: return std::nullopt;
+    case ParameterType::text:
+      return std::nullopt;
   }
   return std::nullopt;
 }
@@ -204,7 +217,8 @@ std::vector<Parameter> AllocatorRegistry::parameters() const {
   std::vector<Parameter> out;
   for (const AllocatorKind& kind : kinds_) {
     for (const Parameter& parameter : kind.parameters) {
-      const bool seen = std::any_of(out.begin(), out.end(), [&](const Parameter& p) { return p.name == parameter.name; });
+      const bool seen =
+          std::any_of(out.begin(), out.end(), [&](const Parameter& p) { return p.name == parameter.name; });
       if (!seen) out.push_back(parameter);
     }
   }

@@ -8,9 +8,12 @@ namespace ontime {
 
 std::string_view to_string(Aggregation aggregation) noexcept {
   switch (aggregation) {
-    case Aggregation::sum: return "sum";
-    case Aggregation::max: return "max";
-    case Aggregation::self: return "self";
+    case Aggregation::sum:
+      return "sum";
+    case Aggregation::max:
+      return "max";
+    case Aggregation::self:
+      return "self";
   }
   return "sum";
 }
@@ -26,7 +29,7 @@ ContiguousSuccessTable::ContiguousSuccessTable(const Mdp& mdp, Aggregation aggre
     : mdp_(&mdp), aggregation_(aggregation), deadline_(mdp.deadline()) {
   const Problem& problem = mdp.problem();
   const auto deadline = static_cast<std::size_t>(deadline_);
-  const std::size_t row = deadline + 2;         // G(v), v = 0 .. D + 1
+  const std::size_t row = deadline + 2;  // G(v), v = 0 .. D + 1
   const std::size_t planning_row = 2 * deadline + 1;
 
   planning_.assign(static_cast<std::size_t>(problem.action_count()) * planning_row, 0.0);
@@ -109,8 +112,9 @@ double ContiguousSuccessTable::success_probability(int k, int l, Steps spent, St
   const double remaining = survival_[static_cast<std::size_t>(action) * deadline + static_cast<std::size_t>(spent)];
   if (remaining <= 0) return 0.0;
   const double* p = &planning_[static_cast<std::size_t>(action) * (2 * deadline + 1) + static_cast<std::size_t>(spent)];
-  const double* g = &continuation_[(offsets_[static_cast<std::size_t>(k)] + static_cast<std::size_t>(l)) * (deadline + 2) +
-                                   static_cast<std::size_t>(used)];
+  const double* g =
+      &continuation_[(offsets_[static_cast<std::size_t>(k)] + static_cast<std::size_t>(l)) * (deadline + 2) +
+                     static_cast<std::size_t>(used)];
   const std::size_t terms = deadline - static_cast<std::size_t>(used);
   double value = 0;
   for (std::size_t t = 1; t <= terms; ++t) value += p[t] * g[t];

@@ -104,7 +104,10 @@ class Expectimax {
   using Memo = absl::flat_hash_map<Key, ExpectimaxEntry, Hash>;
 
   Expectimax(const Mdp& mdp, Policy policy, std::size_t max_states, double tie_tolerance, std::string what)
-      : mdp_(&mdp), policy_(std::move(policy)), max_states_(max_states), tie_tolerance_(tie_tolerance),
+      : mdp_(&mdp),
+        policy_(std::move(policy)),
+        max_states_(max_states),
+        tie_tolerance_(tie_tolerance),
         what_(std::move(what)) {}
 
   ExpectimaxEntry solve(const State& start) {
@@ -155,7 +158,8 @@ class Expectimax {
     policy_.choices(state, choices_);
     for (const int choice : choices_) {
       mdp_->for_each_outcome(state, choice, [&](double probability, Status status, const State& next) {
-        items_.push_back(Item{choice, status, probability, next, status == Status::running ? policy_.key(next) : Key{}});
+        items_.push_back(
+            Item{choice, status, probability, next, status == Status::running ? policy_.key(next) : Key{}});
       });
     }
     frame.end = items_.size();

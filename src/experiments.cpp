@@ -1,8 +1,9 @@
 #include "ontime/experiments.hpp"
 
+#include <fmt/format.h>
+
 #include <chrono>
 #include <cmath>
-#include <fmt/format.h>
 
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/error.hpp"

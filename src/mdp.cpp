@@ -72,8 +72,7 @@ Mdp::Mdp(const Problem& problem)
     rest_[base + static_cast<std::size_t>(length)] = 0;
     for (int l = length; l-- > 0;) {
       const Action& action = problem.action(problem.action_at(k, l));
-      const std::int64_t least =
-          least_steps(action.planning.min_step()) + least_steps(action.execution.min_step());
+      const std::int64_t least = least_steps(action.planning.min_step()) + least_steps(action.execution.min_step());
       rest_[base + static_cast<std::size_t>(l)] =
           std::min(kUnreachable, rest_[base + static_cast<std::size_t>(l) + 1] + least);
     }
@@ -86,7 +85,8 @@ bool Mdp::can_succeed(const State& state, int k) const noexcept {
   const auto slot = static_cast<std::size_t>(k);
   const Steps spent = state.spent[slot];
   if (spent > deadline_) return false;
-  const Steps finish = next_finish_[static_cast<std::size_t>(action) * static_cast<std::size_t>(deadline_ + 1) + static_cast<std::size_t>(spent)];
+  const Steps finish = next_finish_[static_cast<std::size_t>(action) * static_cast<std::size_t>(deadline_ + 1) +
+                                    static_cast<std::size_t>(spent)];
   const Steps execution = min_execution_[static_cast<std::size_t>(action)];
   if (finish == kNever || execution == kNever) return false;
   const std::int64_t need = std::int64_t{state.time} + state.execution[slot] + finish + execution +
@@ -146,9 +146,10 @@ Status Mdp::apply(State& state, int choice, const Observation& observation) cons
       if (spent <= deadline_) ++spent;
     }
   } else if (action >= 0) {
-    const std::int64_t total = observation.execution == kNever
-                                   ? std::int64_t{deadline_} + 1
-                                   : std::int64_t{state.execution[static_cast<std::size_t>(choice)]} + observation.execution;
+    const std::int64_t total =
+        observation.execution == kNever
+            ? std::int64_t{deadline_} + 1
+            : std::int64_t{state.execution[static_cast<std::size_t>(choice)]} + observation.execution;
     const std::uint16_t execution = saturate_execution(total);
     for (const int member : problem_->members(action)) {
       const auto slot = static_cast<std::size_t>(member);

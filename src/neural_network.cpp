@@ -22,7 +22,8 @@ Mlp<Scalar>::Mlp(const std::vector<int>& sizes, SplitMix64& generator) : sizes_(
         weight(i, j) = static_cast<Scalar>((2.0 * uniform01(generator) - 1.0) * bound);
       }
     }
-    for (Eigen::Index i = 0; i < bias.size(); ++i) bias(i) = static_cast<Scalar>((2.0 * uniform01(generator) - 1.0) * bound);
+    for (Eigen::Index i = 0; i < bias.size(); ++i)
+      bias(i) = static_cast<Scalar>((2.0 * uniform01(generator) - 1.0) * bound);
     weights_.push_back(std::move(weight));
     biases_.push_back(std::move(bias));
   }

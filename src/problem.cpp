@@ -58,7 +58,8 @@ Problem::Problem(std::string name, Steps deadline, double step_seconds, std::vec
         reject("skeleton " + std::to_string(k) + " names an unknown action");
       }
       if (!seen.insert(action).second) {
-        reject("skeleton " + std::to_string(k) + " repeats action '" + actions_[static_cast<std::size_t>(action)].id + "'");
+        reject("skeleton " + std::to_string(k) + " repeats action '" + actions_[static_cast<std::size_t>(action)].id +
+               "'");
       }
       const auto slot = static_cast<std::size_t>(action);
       const int parent = l == 0 ? -1 : path[l - 1];

@@ -15,8 +15,8 @@ SkeletonList parse_skeleton_file(std::string_view text, std::string_view source)
   const std::string name(source);
   const Json root = detail::parse_json_strict<Json>(text, name);
   if (!root.is_object()) {
-    throw InputError(name, "top level", "must be a JSON object with a 'skeletons' member (got " +
-                                            detail::describe_json_type(root) + ")");
+    throw InputError(name, "top level",
+                     "must be a JSON object with a 'skeletons' member (got " + detail::describe_json_type(root) + ")");
   }
   if (!root.contains("skeletons")) throw InputError(name, "top level", "missing required key 'skeletons'");
   std::vector<std::string> ids;

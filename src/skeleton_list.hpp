@@ -4,11 +4,10 @@
 // source, the JSON path (`skeletons[1][2]`) and the rule.
 
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 namespace ontime::detail {
 

@@ -866,9 +866,9 @@ TEST(Cli, ALaplaceAlphaThatSwampsTheLogIsAUsageError) {
   const auto directory = scratch("laplace");
   const auto sampled = ontime({"sample-log", paper("figure1"), "-o", (directory / "log.jsonl").string()});
   ASSERT_EQ(sampled.exit_code, 0) << sampled.err;
-  const auto fitted = ontime({"fit", (directory / "log.jsonl").string(), "--step", "1", "--deadline", "5",
-                              "--skeletons", paper("figure1"), "--laplace", "1e308", "-o",
-                              (directory / "fit.json").string()});
+  const auto fitted =
+      ontime({"fit", (directory / "log.jsonl").string(), "--step", "1", "--deadline", "5", "--skeletons",
+              paper("figure1"), "--laplace", "1e308", "-o", (directory / "fit.json").string()});
   EXPECT_EQ(fitted.exit_code, 2) << fitted.err;
   EXPECT_NE(fitted.err.find("laplace: the Laplace smoothing alpha must be between 0 and 1e+06"), std::string::npos)
       << fitted.err;

@@ -1,3 +1,5 @@
+#include "ontime/domains/collection.hpp"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -5,11 +7,10 @@
 #include <map>
 #include <stdexcept>
 
-#include "ontime/domains/collection.hpp"
 #include "ontime/domains/collection_journal.hpp"
 #include "ontime/domains/manipulation.hpp"
-#include "ontime/error.hpp"
 #include "ontime/domains/navigation.hpp"
+#include "ontime/error.hpp"
 #include "ontime/fitting.hpp"
 #include "ontime/planner_log.hpp"
 #include "support/mini_world.hpp"
@@ -113,7 +114,8 @@ TEST(Collection, RefinesAWholeSkeletonForPictures) {
 }
 
 const ManipulationDomain& kitchen() {
-  static const ManipulationDomain domain(load_manipulation_world(testing::source_path("data/domains/manipulation.json")));
+  static const ManipulationDomain domain(
+      load_manipulation_world(testing::source_path("data/domains/manipulation.json")));
   return domain;
 }
 

@@ -1,7 +1,8 @@
+#include "ontime/contiguous_success.hpp"
+
 #include <gtest/gtest.h>
 
 #include "ontime/allocators/dp.hpp"
-#include "ontime/contiguous_success.hpp"
 #include "ontime/error.hpp"
 #include "ontime/evaluation.hpp"
 #include "support/paper.hpp"

@@ -1,10 +1,11 @@
+#include "ontime/knapsack.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/error.hpp"
-#include "ontime/knapsack.hpp"
 #include "ontime/random.hpp"
 #include "support/paper.hpp"
 
@@ -25,7 +26,9 @@ Knapsack random_knapsack(std::uint64_t seed) {
   return knapsack;
 }
 
-double relative_difference(double a, double b) { return std::abs(a - b) / std::max({std::abs(a), std::abs(b), 1e-300}); }
+double relative_difference(double a, double b) {
+  return std::abs(a - b) / std::max({std::abs(a), std::abs(b), 1e-300});
+}
 
 // The exact optimum of the reduced instance is the best success over maximum-value knapsack
 // sets, and the bounds of the proof hold for every set.
@@ -105,7 +108,8 @@ TEST(Knapsack, RejectsInvalidFiles) {
     return std::string("accepted");
   };
   EXPECT_EQ(place_of(R"({"capacity": 5, "items": [{"weight": 2, "value": 3}]})"), "accepted");
-  EXPECT_EQ(place_of(R"({"capacity": 5.0, "items": [{"weight": 2.0, "value": 3e0}]})"), "accepted");  // as Python writes
+  EXPECT_EQ(place_of(R"({"capacity": 5.0, "items": [{"weight": 2.0, "value": 3e0}]})"),
+            "accepted");  // as Python writes
   EXPECT_EQ(place_of(R"({"items": [{"weight": 2, "value": 3}]})"), "top level: missing required key 'capacity'");
   EXPECT_EQ(place_of(R"({"capacity": 0, "items": [{"weight": 2, "value": 3}]})").substr(0, 10), "capacity: ");
   EXPECT_EQ(place_of(R"({"capacity": 10001, "items": [{"weight": 2, "value": 3}]})").substr(0, 10), "capacity: ");
@@ -113,7 +117,8 @@ TEST(Knapsack, RejectsInvalidFiles) {
   EXPECT_EQ(place_of(R"({"capacity": 5, "items": [{"weight": -2, "value": 3}]})").substr(0, 18), "items[0].weight: m");
   EXPECT_EQ(place_of(R"({"capacity": 5, "items": [{"weight": 2, "value": 1.5}]})").substr(0, 17), "items[0].value: m");
   EXPECT_EQ(place_of(R"({"capacity": 5, "items": [{"weight": 2}]})"), "items[0]: missing required key 'value'");
-  EXPECT_EQ(place_of(R"({"capacity": 5, "items": [{"weight": 2, "value": 3, "size": 1}]})").substr(0, 14), "items[0].size:");
+  EXPECT_EQ(place_of(R"({"capacity": 5, "items": [{"weight": 2, "value": 3, "size": 1}]})").substr(0, 14),
+            "items[0].size:");
   std::string many = R"({"capacity": 5, "items": [)";
   for (int i = 0; i < 17; ++i) many += std::string(i > 0 ? "," : "") + R"({"weight": 1, "value": 1})";
   EXPECT_EQ(place_of(many + "]}").substr(0, 17), "items: at most 16");

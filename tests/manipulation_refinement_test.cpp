@@ -11,7 +11,8 @@ namespace ontime::domains {
 namespace {
 
 const ManipulationDomain& kitchen() {
-  static const ManipulationDomain domain(load_manipulation_world(testing::source_path("data/domains/manipulation.json")));
+  static const ManipulationDomain domain(
+      load_manipulation_world(testing::source_path("data/domains/manipulation.json")));
   return domain;
 }
 
@@ -22,7 +23,8 @@ const Pr2Arm& kitchen_arm() {
 
 // Refines `action` from `start` with up to `steps` steps of 2,000 checks; fails the test when
 // nothing is found.
-std::unique_ptr<Refinement> refined(const std::string& action, const Configuration& start, std::uint64_t seed, int steps = 40) {
+std::unique_ptr<Refinement> refined(const std::string& action, const Configuration& start, std::uint64_t seed,
+                                    int steps = 40) {
   const EffortSettings effort{EffortUnit::collision_checks, 1000};
   auto refinement = kitchen().refine(action, start, seed, effort);
   for (int step = 1; step <= steps; ++step) {
@@ -61,7 +63,8 @@ void expect_collision_free(const std::vector<Configuration>& motion) {
     ASSERT_EQ(a.held, b.held);
     const double base_length = std::hypot(b.base.x - a.base.x, b.base.y - a.base.y) +
                                0.5 * std::abs(std::remainder(b.base.theta - a.base.theta, 2 * std::numbers::pi));
-    const int pieces = std::max(1, static_cast<int>(std::ceil(std::max(joint_distance(a.arm, b.arm) / arm_step, base_length / base_step))));
+    const int pieces = std::max(
+        1, static_cast<int>(std::ceil(std::max(joint_distance(a.arm, b.arm) / arm_step, base_length / base_step))));
     for (int k = 0; k <= pieces; ++k) {
       const double t = static_cast<double>(k) / pieces;
       const Pose base{a.base.x + t * (b.base.x - a.base.x), a.base.y + t * (b.base.y - a.base.y),
@@ -172,7 +175,8 @@ TEST(ManipulationDomain, AFallbackStartRebuildsTheWorldOfTheSkeletonPrefix) {
   EXPECT_EQ(b2, world.objects[static_cast<std::size_t>(world.object_index("B2"))].pose);
   // A refinement accepts it as its start (it checks the robot and the held object).
   const EffortSettings effort{EffortUnit::collision_checks, 1000};
-  EXPECT_NO_THROW(domain.refine("move+place(B1,R1)[B3,B4]", domain.fallback_start("move+place(B1,R1)[B3,B4]", 9), 1, effort));
+  EXPECT_NO_THROW(
+      domain.refine("move+place(B1,R1)[B3,B4]", domain.fallback_start("move+place(B1,R1)[B3,B4]", 9), 1, effort));
 }
 
 TEST(ManipulationDomain, ExecutionTimesFollowTheSlowestJointAndTheBase) {
@@ -185,8 +189,8 @@ TEST(ManipulationDomain, ExecutionTimesFollowTheSlowestJointAndTheBase) {
   EXPECT_NEAR(domain.arm_seconds({a, b}), 1.0 / (speed * 2.088), 1e-12);
   EXPECT_NEAR(domain.arm_seconds({a, b, a}), 2.0 / (speed * 2.088), 1e-12);
   const auto& robot = domain.world().robot;
-  EXPECT_NEAR(domain.drive_seconds({Pose{0, 0, 0}, Pose{3, 4, 0}, Pose{3, 4, 1}}), 5.0 / robot.linear_speed + 1.0 / robot.angular_speed,
-              1e-12);
+  EXPECT_NEAR(domain.drive_seconds({Pose{0, 0, 0}, Pose{3, 4, 0}, Pose{3, 4, 1}}),
+              5.0 / robot.linear_speed + 1.0 / robot.angular_speed, 1e-12);
 }
 
 }  // namespace

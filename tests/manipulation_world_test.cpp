@@ -1,3 +1,5 @@
+#include "ontime/domains/manipulation_world.hpp"
+
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -6,7 +8,6 @@
 #include <set>
 
 #include "ontime/domains/collection.hpp"
-#include "ontime/domains/manipulation_world.hpp"
 #include "ontime/error.hpp"
 #include "support/paper.hpp"
 
@@ -52,7 +53,9 @@ TEST(ManipulationWorld, TheSkeletonsAreThoseOfAppendixA) {
   // of B3 and B4 and then B1, sigma3 and sigma4 four actions, sigma7 and sigma8 eight.
   const auto shared = [&](std::size_t a, std::size_t b) {
     std::size_t n = 0;
-    while (n < world.skeletons[a].size() && n < world.skeletons[b].size() && world.skeletons[a][n] == world.skeletons[b][n]) ++n;
+    while (n < world.skeletons[a].size() && n < world.skeletons[b].size() &&
+           world.skeletons[a][n] == world.skeletons[b][n])
+      ++n;
     return n;
   };
   EXPECT_EQ(shared(0, 1), 2u);
@@ -96,36 +99,93 @@ TEST(ManipulationWorld, EveryBrokenRuleIsReportedWithItsPlace) {
   const std::vector<BadWorld> cases{
       {"unknown key", [](ordered_json& w) { w["colour"] = "red"; }, "colour", "unknown key"},
       {"no objects", [](ordered_json& w) { w.erase("objects"); }, "top level", "missing required key 'objects'"},
-      {"floor", [](ordered_json& w) { w["floor"]["max"] = {0, 3}; }, "floor", "'max' must exceed 'min'"},
-      {"box outside", [](ordered_json& w) { w["fixed"]["worktop"][0]["max"][0] = 7.0; }, "fixed.worktop[0]", "within the floor"},
-      {"box inverted", [](ordered_json& w) { w["fixed"]["table"][0]["max"][2] = 0.6; }, "fixed.table[0]", "'max' must exceed"},
-      {"region surface", [](ordered_json& w) { w["regions"]["R1"]["on"] = "oven"; }, "regions.R1.on", "unknown furniture 'oven'"},
+      {"floor",
+       [](ordered_json& w) {
+         w["floor"]["max"] = {0, 3};
+       },
+       "floor", "'max' must exceed 'min'"},
+      {"box outside", [](ordered_json& w) { w["fixed"]["worktop"][0]["max"][0] = 7.0; }, "fixed.worktop[0]",
+       "within the floor"},
+      {"box inverted", [](ordered_json& w) { w["fixed"]["table"][0]["max"][2] = 0.6; }, "fixed.table[0]",
+       "'max' must exceed"},
+      {"region surface", [](ordered_json& w) { w["regions"]["R1"]["on"] = "oven"; }, "regions.R1.on",
+       "unknown furniture 'oven'"},
       {"region height", [](ordered_json& w) { w["regions"]["R1"]["height"] = 0.8; }, "regions.R1", "top at height 0.8"},
-      {"region off the top", [](ordered_json& w) { w["regions"]["R2"]["max"][0] = 3.9; }, "regions.R2", "under the whole rectangle"},
-      {"region yaw", [](ordered_json& w) { w["regions"]["C1"]["yaw"] = {1, 0}; }, "regions.C1.yaw", "must not be below"},
+      {"region off the top", [](ordered_json& w) { w["regions"]["R2"]["max"][0] = 3.9; }, "regions.R2",
+       "under the whole rectangle"},
+      {"region yaw",
+       [](ordered_json& w) {
+         w["regions"]["C1"]["yaw"] = {1, 0};
+       },
+       "regions.C1.yaw", "must not be below"},
       {"region id", [](ordered_json& w) { w["regions"]["R 3"] = w["regions"]["R1"]; }, "regions.\"R 3\"", "region ids"},
-      {"object region", [](ordered_json& w) { w["objects"]["B1"]["on"] = "R9"; }, "objects.B1.on", "unknown region 'R9'"},
-      {"object floating", [](ordered_json& w) { w["objects"]["B1"]["pose"] = {2.0, 1.0, 0}; }, "objects.B1.pose", "does not stand on"},
-      {"object too wide", [](ordered_json& w) { w["objects"]["B2"]["size"] = {0.08, 0.06, 0.2}; }, "objects.B2.size", "gripper could not close"},
-      {"object flat", [](ordered_json& w) { w["objects"]["B2"]["size"] = {0.06, 0.06, 0.05}; }, "objects.B2.size", "z must exceed"},
-      {"objects overlap", [](ordered_json& w) { w["objects"]["B3"]["pose"] = {0.86, 3.40, 0}; }, "objects.B1", "overlaps"},
+      {"object region", [](ordered_json& w) { w["objects"]["B1"]["on"] = "R9"; }, "objects.B1.on",
+       "unknown region 'R9'"},
+      {"object floating",
+       [](ordered_json& w) {
+         w["objects"]["B1"]["pose"] = {2.0, 1.0, 0};
+       },
+       "objects.B1.pose", "does not stand on"},
+      {"object too wide",
+       [](ordered_json& w) {
+         w["objects"]["B2"]["size"] = {0.08, 0.06, 0.2};
+       },
+       "objects.B2.size", "gripper could not close"},
+      {"object flat",
+       [](ordered_json& w) {
+         w["objects"]["B2"]["size"] = {0.06, 0.06, 0.05};
+       },
+       "objects.B2.size", "z must exceed"},
+      {"objects overlap",
+       [](ordered_json& w) {
+         w["objects"]["B3"]["pose"] = {0.86, 3.40, 0};
+       },
+       "objects.B1", "overlaps"},
       {"goal object", [](ordered_json& w) { w["goal"]["B9"] = "R1"; }, "goal.B9", "unknown object 'B9'"},
-      {"carry limit", [](ordered_json& w) { w["robot"]["carry"][3] = 0.5; }, "robot.carry[3]", "l_elbow_flex_joint must lie within"},
+      {"carry limit", [](ordered_json& w) { w["robot"]["carry"][3] = 0.5; }, "robot.carry[3]",
+       "l_elbow_flex_joint must lie within"},
       {"torso", [](ordered_json& w) { w["robot"]["torso_lift"] = 0.5; }, "robot.torso_lift", "0 to 0.33 m"},
       {"arm speed", [](ordered_json& w) { w["robot"]["arm_speed"] = 1.5; }, "robot.arm_speed", "at most 1"},
-      {"start outside", [](ordered_json& w) { w["start"]["base"] = {-1.0, 1.0, 0}; }, "start.base", "not on the floor"},
-      {"start blocked", [](ordered_json& w) { w["start"]["base"] = {3.0, 3.2, 0}; }, "start.base", "collides"},
-      {"base distance", [](ordered_json& w) { w["planner"]["base_distance"] = {0.9, 0.5}; }, "planner.base_distance", "nearest < farthest"},
+      {"start outside",
+       [](ordered_json& w) {
+         w["start"]["base"] = {-1.0, 1.0, 0};
+       },
+       "start.base", "not on the floor"},
+      {"start blocked",
+       [](ordered_json& w) {
+         w["start"]["base"] = {3.0, 3.2, 0};
+       },
+       "start.base", "collides"},
+      {"base distance",
+       [](ordered_json& w) {
+         w["planner"]["base_distance"] = {0.9, 0.5};
+       },
+       "planner.base_distance", "nearest < farthest"},
       {"ik checks", [](ordered_json& w) { w["planner"]["ik_checks"] = 2.5; }, "planner.ik_checks", "whole number"},
-      {"base resolution", [](ordered_json& w) { w["planner"]["base_resolution"] = 0.2; }, "planner.base_resolution", "below the wall thickness"},
-      {"not an action", [](ordered_json& w) { w["skeletons"][0][1] = "fly(B1)"; }, "skeletons[0][1]", "neither move+pick"},
-      {"wrong context", [](ordered_json& w) { w["skeletons"][0][2] = "move+pick(B2)"; }, "skeletons[0][2]", "must list the objects moved before it: [B1]"},
-      {"full hand", [](ordered_json& w) { w["skeletons"][0] = {"move+pick(B1)", "move+pick(B2)"}; }, "skeletons[0][1]", "already holds B1"},
-      {"empty hand", [](ordered_json& w) { w["skeletons"][0] = {"move+place(B5,C2)"}; }, "skeletons[0][0]", "the hand is empty"},
-      {"unknown region", [](ordered_json& w) { w["skeletons"][0][1] = "move+place(B1,R7)"; }, "skeletons[0][1]", "unknown region 'R7'"},
-      {"goal missed", [](ordered_json& w) { w["skeletons"][0] = {"move+pick(B1)", "move+place(B1,R1)"}; }, "skeletons[0]", "does not bring B2 to R2"},
-      {"holding at the end", [](ordered_json& w) { w["skeletons"][0].erase(3); }, "skeletons[0]", "ends with B2 in the hand"},
-      {"skeleton rule", [](ordered_json& w) { w["skeletons"][1] = w["skeletons"][0]; }, "skeletons[1]", "the same skeleton as skeletons[0]"},
+      {"base resolution", [](ordered_json& w) { w["planner"]["base_resolution"] = 0.2; }, "planner.base_resolution",
+       "below the wall thickness"},
+      {"not an action", [](ordered_json& w) { w["skeletons"][0][1] = "fly(B1)"; }, "skeletons[0][1]",
+       "neither move+pick"},
+      {"wrong context", [](ordered_json& w) { w["skeletons"][0][2] = "move+pick(B2)"; }, "skeletons[0][2]",
+       "must list the objects moved before it: [B1]"},
+      {"full hand",
+       [](ordered_json& w) {
+         w["skeletons"][0] = {"move+pick(B1)", "move+pick(B2)"};
+       },
+       "skeletons[0][1]", "already holds B1"},
+      {"empty hand", [](ordered_json& w) { w["skeletons"][0] = {"move+place(B5,C2)"}; }, "skeletons[0][0]",
+       "the hand is empty"},
+      {"unknown region", [](ordered_json& w) { w["skeletons"][0][1] = "move+place(B1,R7)"; }, "skeletons[0][1]",
+       "unknown region 'R7'"},
+      {"goal missed",
+       [](ordered_json& w) {
+         w["skeletons"][0] = {"move+pick(B1)", "move+place(B1,R1)"};
+       },
+       "skeletons[0]", "does not bring B2 to R2"},
+      {"holding at the end", [](ordered_json& w) { w["skeletons"][0].erase(3); }, "skeletons[0]",
+       "ends with B2 in the hand"},
+      {"skeleton rule", [](ordered_json& w) { w["skeletons"][1] = w["skeletons"][0]; }, "skeletons[1]",
+       "the same skeleton as skeletons[0]"},
   };
   for (const BadWorld& bad : cases) {
     ordered_json world = ordered_json::parse(kitchen_text());

@@ -1,9 +1,10 @@
+#include "ontime/allocators/mcts.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "ontime/allocator_registry.hpp"
-#include "ontime/allocators/mcts.hpp"
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/error.hpp"
 #include "ontime/evaluation.hpp"
@@ -59,7 +60,8 @@ class CheatingAllocator final : public Allocator {
   const HiddenWorld*& world_;
 };
 
-double sampled_rate(const Mdp& mdp, Allocator& allocator, std::uint64_t episodes, const HiddenWorld** expose = nullptr) {
+double sampled_rate(const Mdp& mdp, Allocator& allocator, std::uint64_t episodes,
+                    const HiddenWorld** expose = nullptr) {
   std::uint64_t successes = 0;
   for (std::uint64_t episode = 0; episode < episodes; ++episode) {
     const std::uint64_t seed = stream_seed(2024, episode);
@@ -68,9 +70,10 @@ double sampled_rate(const Mdp& mdp, Allocator& allocator, std::uint64_t episodes
     Session session(mdp, allocator, stream_seed(seed, 1));
     while (session.status() == Status::running) {
       const Decision decision = session.choose();
-      session.report(decision.action < 0
-                         ? Observation::not_yet()
-                         : world.observe(decision.action, session.state().spent[static_cast<std::size_t>(decision.skeleton)]));
+      session.report(
+          decision.action < 0
+              ? Observation::not_yet()
+              : world.observe(decision.action, session.state().spent[static_cast<std::size_t>(decision.skeleton)]));
     }
     successes += session.status() == Status::success;
   }

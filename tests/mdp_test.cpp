@@ -123,10 +123,11 @@ TEST_F(FigureOne, RejectsImpossibleObservations) {
 
 TEST(Mdp, IdleStepOnAFullyRefinedSkeleton) {
   // sigma0 = (a) refined too slowly; choosing it again only spends time.
-  const Problem problem("idle", 6, 1.0,
-                        {Action{"a", Distribution::from_pmf({0.0, 1.0}), Distribution::from_pmf({0, 0, 0, 0, 0, 0, 1.0})},
-                         Action{"b", Distribution::from_pmf({0.0, 0.0, 1.0}), Distribution::from_pmf({1.0})}},
-                        {{0}, {1}});
+  const Problem problem(
+      "idle", 6, 1.0,
+      {Action{"a", Distribution::from_pmf({0.0, 1.0}), Distribution::from_pmf({0, 0, 0, 0, 0, 0, 1.0})},
+       Action{"b", Distribution::from_pmf({0.0, 0.0, 1.0}), Distribution::from_pmf({1.0})}},
+      {{0}, {1}});
   const Mdp mdp(problem);
   State state = mdp.start();
   ASSERT_EQ(mdp.apply(state, 0, Observation::found(6)), Status::running);  // 1 + 6 > 6

@@ -25,7 +25,9 @@ bool run(Refinement& refinement, double step, int steps) {
   return false;
 }
 
-Pose pose(const Configuration& configuration) { return Pose{configuration.at(0), configuration.at(1), configuration.at(2)}; }
+Pose pose(const Configuration& configuration) {
+  return Pose{configuration.at(0), configuration.at(1), configuration.at(2)};
+}
 
 TEST(NavigationRefinement, FindsACollisionFreeMotionThatConnectsItsEndpoints) {
   const NavigationDomain& domain = office();
@@ -50,7 +52,8 @@ TEST(NavigationRefinement, FindsACollisionFreeMotionThatConnectsItsEndpoints) {
       if (i == 0) continue;
       const Pose a = pose(motion[i - 1]), b = pose(motion[i]);
       const double turn = std::remainder(b.theta - a.theta, 2 * std::numbers::pi);
-      const int pieces = 1 + static_cast<int>(std::max(std::hypot(b.x - a.x, b.y - a.y) / 0.005, std::abs(turn) / 0.005));
+      const int pieces =
+          1 + static_cast<int>(std::max(std::hypot(b.x - a.x, b.y - a.y) / 0.005, std::abs(turn) / 0.005));
       for (int k = 0; k <= pieces; ++k) {
         const double f = static_cast<double>(k) / pieces;
         const Pose between{a.x + f * (b.x - a.x), a.y + f * (b.y - a.y), a.theta + f * turn};

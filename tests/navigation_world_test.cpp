@@ -1,3 +1,5 @@
+#include "ontime/domains/navigation_world.hpp"
+
 #include <gtest/gtest.h>
 
 #include <functional>
@@ -5,7 +7,6 @@
 #include <set>
 
 #include "ontime/domains/navigation_collision.hpp"
-#include "ontime/domains/navigation_world.hpp"
 #include "ontime/error.hpp"
 #include "support/mini_world.hpp"
 #include "support/paper.hpp"
@@ -45,7 +46,8 @@ TEST(NavigationWorld, TheFourSkeletonsAreExactlyTheRoomPathsFromStartToGoal) {
   // The skeletons are the paper's (Section VII-A), sigma2 and sigma3 sharing move(R1,R5).
   EXPECT_EQ(world.skeletons[1][0], "move(R1,R5)");
   EXPECT_EQ(world.skeletons[2][0], "move(R1,R5)");
-  EXPECT_EQ(world.skeletons[3], (std::vector<std::string>{"move(R1,R10)", "move(R10,R11)", "move(R11,R12)", "move(R12,R13)"}));
+  EXPECT_EQ(world.skeletons[3],
+            (std::vector<std::string>{"move(R1,R10)", "move(R10,R11)", "move(R11,R12)", "move(R12,R13)"}));
 }
 
 TEST(NavigationWorld, WallsCloseEveryRoomExceptAtDoors) {
@@ -56,8 +58,8 @@ TEST(NavigationWorld, WallsCloseEveryRoomExceptAtDoors) {
   NavigationWorld thin = world;
   thin.robot.length = thin.robot.width = 0.05;
   const NavigationCollision probe(thin, 0.0);
-  EXPECT_TRUE(probe.collides(Pose{4.5, 9.0, 0.0}));   // the wall between R2 and R5
-  EXPECT_TRUE(probe.collides(Pose{7.5, 6.0, 0.0}));   // the wall between R6 and R8
+  EXPECT_TRUE(probe.collides(Pose{4.5, 9.0, 0.0}));  // the wall between R2 and R5
+  EXPECT_TRUE(probe.collides(Pose{7.5, 6.0, 0.0}));  // the wall between R6 and R8
   for (const Door& door : world.doors) {
     EXPECT_FALSE(probe.collides(Pose{door.x, door.y, 0.0})) << door.rooms[0] << "-" << door.rooms[1];
     const double beside = door.width / 2 + 0.05;  // just past the opening, inside the wall
@@ -86,36 +88,104 @@ TEST(NavigationWorld, EveryBrokenRuleIsReportedWithItsPlace) {
       {"negative wall", [](ordered_json& w) { w["wall_thickness"] = -1; }, "wall_thickness", "positive number"},
       {"unknown key", [](ordered_json& w) { w["colour"] = "red"; }, "colour", "unknown key"},
       {"no rooms", [](ordered_json& w) { w.erase("rooms"); }, "top level", "missing required key 'rooms'"},
-      {"overlap", [](ordered_json& w) { w["rooms"]["B"]["min"] = {2.5, 0}; }, "rooms.B", "overlaps room A"},
-      {"inverted", [](ordered_json& w) { w["rooms"]["D"]["max"] = {6, 2}; }, "rooms.D", "'max' must exceed 'min'"},
-      {"tiny room", [](ordered_json& w) { w["rooms"]["D"]["max"] = {6, 3.7}; }, "rooms.D", "too small for the robot"},
+      {"overlap",
+       [](ordered_json& w) {
+         w["rooms"]["B"]["min"] = {2.5, 0};
+       },
+       "rooms.B", "overlaps room A"},
+      {"inverted",
+       [](ordered_json& w) {
+         w["rooms"]["D"]["max"] = {6, 2};
+       },
+       "rooms.D", "'max' must exceed 'min'"},
+      {"tiny room",
+       [](ordered_json& w) {
+         w["rooms"]["D"]["max"] = {6, 3.7};
+       },
+       "rooms.D", "too small for the robot"},
       {"room not a box", [](ordered_json& w) { w["rooms"]["A"]["min"] = {0}; }, "rooms.A.min", "array of 2 numbers"},
-      {"door far", [](ordered_json& w) { w["doors"][0]["rooms"] = {"A", "C"}; }, "doors[0].rooms", "share no edge"},
-      {"door corner to corner", [](ordered_json& w) { w["doors"][0]["rooms"] = {"A", "D"}; }, "doors[0].rooms", "share no edge"},
-      {"door off edge", [](ordered_json& w) { w["doors"][0]["center"] = {3.2, 1.5}; }, "doors[0].center", "not on the edge x = 3"},
-      {"door narrow", [](ordered_json& w) { w["doors"][1]["width"] = 0.7; }, "doors[1].width", "narrower than the robot"},
-      {"door corner", [](ordered_json& w) { w["doors"][0]["center"] = {3, 0.3}; }, "doors[0]", "does not fit"},
+      {"door far",
+       [](ordered_json& w) {
+         w["doors"][0]["rooms"] = {"A", "C"};
+       },
+       "doors[0].rooms", "share no edge"},
+      {"door corner to corner",
+       [](ordered_json& w) {
+         w["doors"][0]["rooms"] = {"A", "D"};
+       },
+       "doors[0].rooms", "share no edge"},
+      {"door off edge",
+       [](ordered_json& w) {
+         w["doors"][0]["center"] = {3.2, 1.5};
+       },
+       "doors[0].center", "not on the edge x = 3"},
+      {"door narrow", [](ordered_json& w) { w["doors"][1]["width"] = 0.7; }, "doors[1].width",
+       "narrower than the robot"},
+      {"door corner",
+       [](ordered_json& w) {
+         w["doors"][0]["center"] = {3, 0.3};
+       },
+       "doors[0]", "does not fit"},
       {"door room", [](ordered_json& w) { w["doors"][2]["rooms"][1] = "Z"; }, "doors[2].rooms[1]", "unknown room 'Z'"},
-      {"door same room", [](ordered_json& w) { w["doors"][2]["rooms"] = {"B", "B"}; }, "doors[2].rooms", "two different rooms"},
-      {"obstacle outside", [](ordered_json& w) { w["obstacles"][0]["center"] = {7.5, 4.5}; }, "obstacles[0].center", "not inside any room"},
-      {"obstacle size", [](ordered_json& w) { w["obstacles"][0]["size"] = {1.0, 0}; }, "obstacles[0].size", "must be positive"},
-      {"obstacle angle", [](ordered_json& w) { w["obstacles"][0]["angle"] = "flat"; }, "obstacles[0].angle", "must be a number"},
-      {"start blocked", [](ordered_json& w) { w["obstacles"][0]["center"] = {1.5, 1.5}; }, "start.pose", "collides"},
-      {"start elsewhere", [](ordered_json& w) { w["start"]["pose"] = {4.5, 1.5, 0}; }, "start.pose", "not inside the start room A"},
+      {"door same room",
+       [](ordered_json& w) {
+         w["doors"][2]["rooms"] = {"B", "B"};
+       },
+       "doors[2].rooms", "two different rooms"},
+      {"obstacle outside",
+       [](ordered_json& w) {
+         w["obstacles"][0]["center"] = {7.5, 4.5};
+       },
+       "obstacles[0].center", "not inside any room"},
+      {"obstacle size",
+       [](ordered_json& w) {
+         w["obstacles"][0]["size"] = {1.0, 0};
+       },
+       "obstacles[0].size", "must be positive"},
+      {"obstacle angle", [](ordered_json& w) { w["obstacles"][0]["angle"] = "flat"; }, "obstacles[0].angle",
+       "must be a number"},
+      {"start blocked",
+       [](ordered_json& w) {
+         w["obstacles"][0]["center"] = {1.5, 1.5};
+       },
+       "start.pose", "collides"},
+      {"start elsewhere",
+       [](ordered_json& w) {
+         w["start"]["pose"] = {4.5, 1.5, 0};
+       },
+       "start.pose", "not inside the start room A"},
       {"start room", [](ordered_json& w) { w["start"]["room"] = "Q"; }, "start.room", "unknown room 'Q'"},
       {"goal is start", [](ordered_json& w) { w["goal_room"] = "A"; }, "goal_room", "must differ"},
-      {"resolution", [](ordered_json& w) { w["planner"]["resolution"] = 0.1; }, "planner.resolution", "below the wall thickness"},
+      {"resolution", [](ordered_json& w) { w["planner"]["resolution"] = 0.1; }, "planner.resolution",
+       "below the wall thickness"},
       {"range", [](ordered_json& w) { w["planner"]["range"] = 0; }, "planner.range", "positive number"},
-      {"deadline", [](ordered_json& w) { w["collection"]["deadline"] = 0; }, "collection.deadline", "whole number of steps"},
-      {"rate", [](ordered_json& w) { w["collection"]["checks_per_second"] = -5; }, "collection.checks_per_second", "positive"},
+      {"deadline", [](ordered_json& w) { w["collection"]["deadline"] = 0; }, "collection.deadline",
+       "whole number of steps"},
+      {"rate", [](ordered_json& w) { w["collection"]["checks_per_second"] = -5; }, "collection.checks_per_second",
+       "positive"},
       {"speed", [](ordered_json& w) { w["robot"]["linear_speed"] = 0; }, "robot.linear_speed", "positive number"},
-      {"footprint", [](ordered_json& w) { w["robot"]["footprint"] = {0.6, -1}; }, "robot.footprint", "must be positive"},
-      {"not a move", [](ordered_json& w) { w["skeletons"][0][1] = "fly(B,C)"; }, "skeletons[0][1]", "is not move(FROM,TO)"},
-      {"no door", [](ordered_json& w) { w["skeletons"][0] = {"move(A,B)", "move(B,C)", "move(C,D)", "move(D,B)"}; w["goal_room"] = "B"; },
+      {"footprint",
+       [](ordered_json& w) {
+         w["robot"]["footprint"] = {0.6, -1};
+       },
+       "robot.footprint", "must be positive"},
+      {"not a move", [](ordered_json& w) { w["skeletons"][0][1] = "fly(B,C)"; }, "skeletons[0][1]",
+       "is not move(FROM,TO)"},
+      {"no door",
+       [](ordered_json& w) {
+         w["skeletons"][0] = {"move(A,B)", "move(B,C)", "move(C,D)", "move(D,B)"};
+         w["goal_room"] = "B";
+       },
        "skeletons[0][2]", "no door joins C and D"},
-      {"wrong start", [](ordered_json& w) { w["skeletons"][0][0] = "move(B,A)"; }, "skeletons[0][0]", "starts in B but the robot is in A"},
-      {"wrong end", [](ordered_json& w) { w["skeletons"][0] = {"move(A,B)", "move(B,D)"}; }, "skeletons[0]", "not in the goal room C"},
-      {"skeleton rule", [](ordered_json& w) { w["skeletons"] = ordered_json::array(); }, "skeletons", "at least one skeleton"},
+      {"wrong start", [](ordered_json& w) { w["skeletons"][0][0] = "move(B,A)"; }, "skeletons[0][0]",
+       "starts in B but the robot is in A"},
+      {"wrong end",
+       [](ordered_json& w) {
+         w["skeletons"][0] = {"move(A,B)", "move(B,D)"};
+       },
+       "skeletons[0]", "not in the goal room C"},
+      {"skeleton rule", [](ordered_json& w) { w["skeletons"] = ordered_json::array(); }, "skeletons",
+       "at least one skeleton"},
   };
   for (const BadWorld& bad : cases) {
     ordered_json world = ordered_json::parse(testing::kMiniWorld);

@@ -1,7 +1,8 @@
+#include "ontime/allocators/optimal.hpp"
+
 #include <gtest/gtest.h>
 
 #include "ontime/allocator_registry.hpp"
-#include "ontime/allocators/optimal.hpp"
 #include "ontime/error.hpp"
 #include "ontime/evaluation.hpp"
 #include "support/paper.hpp"
@@ -66,10 +67,11 @@ TEST(Optimal, EveryStateEncodingGivesTheReferenceValue) {
     return Distribution::from_pmf(pmf);
   };
   for (const auto& [deadline, expected] : {std::pair{254, 0.875}, std::pair{249, 0.75}}) {
-    const Problem problem("long", deadline, 1.0,
-                          {Action{"a", at(100), Distribution::from_pmf({1.0})}, Action{"b", at(100), Distribution::from_pmf({1.0})},
-                           Action{"c", at(50), Distribution::from_pmf({1.0})}},
-                          {{0}, {1}, {2}});
+    const Problem problem(
+        "long", deadline, 1.0,
+        {Action{"a", at(100), Distribution::from_pmf({1.0})}, Action{"b", at(100), Distribution::from_pmf({1.0})},
+         Action{"c", at(50), Distribution::from_pmf({1.0})}},
+        {{0}, {1}, {2}});
     const Mdp mdp(problem);
     OptimalSolver solver(mdp);
     EXPECT_NEAR(solver.solve(mdp.start()), expected, 1e-12) << deadline;

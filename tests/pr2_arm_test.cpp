@@ -1,3 +1,5 @@
+#include "ontime/domains/pr2_arm.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -5,7 +7,6 @@
 
 #include "ontime/domains/manipulation.hpp"
 #include "ontime/domains/manipulation_collision.hpp"
-#include "ontime/domains/pr2_arm.hpp"
 #include "ontime/random.hpp"
 #include "support/paper.hpp"
 
@@ -75,7 +76,7 @@ TEST(ManipulationCollision, TheRobotCollidesWithFurnitureItselfAndTheFloorButNot
   for (const MovableObject& object : world.objects) poses.push_back(object.pose);
   const ManipulationCollision collision(world, arm, poses, -1, Transform::Identity(), world.robot.clearance);
   EXPECT_FALSE(collision.collides(world.start, world.robot.carry));
-  EXPECT_TRUE(collision.collides(Pose{1.1, 3.3, 0}, world.robot.carry));  // inside the shelf
+  EXPECT_TRUE(collision.collides(Pose{1.1, 3.3, 0}, world.robot.carry));   // inside the shelf
   EXPECT_TRUE(collision.collides(Pose{-0.2, 1.5, 0}, world.robot.carry));  // in the wall
   // The arm hanging straight down in front of the shoulder goes through the base.
   EXPECT_TRUE(collision.collides(world.start, ArmJoints{0, std::numbers::pi / 2 - 0.2, 0, 0, 0, 0, 0}));

@@ -46,7 +46,7 @@ TEST(Problem, RejectsBrokenRules) {
     return Problem("p", deadline, 1.0, {simple("a"), simple("b"), simple("c")}, std::move(skeletons));
   };
   EXPECT_NO_THROW(make({{0, 1}, {0, 2}}));
-  EXPECT_NO_THROW(make({{0}, {0, 1}}));  // a skeleton may be a prefix of another
+  EXPECT_NO_THROW(make({{0}, {0, 1}}));              // a skeleton may be a prefix of another
   EXPECT_THROW(make({{0, 1}, {0, 1}}), UsageError);  // listed twice
   EXPECT_THROW(make({{0, 1, 0}}), UsageError);       // repeats an action
   EXPECT_THROW(make({{0, 1}, {2, 1}}), UsageError);  // shared after different prefixes

@@ -1,10 +1,11 @@
+#include "ontime/session.hpp"
+
 #include <gtest/gtest.h>
 
 #include <stdexcept>
 
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/error.hpp"
-#include "ontime/session.hpp"
 #include "support/paper.hpp"
 
 namespace ontime {
@@ -78,19 +79,20 @@ TEST(Session, RejectsMisuse) {
   Session session(mdp, allocator);
   EXPECT_THROW(session.report_not_yet(), std::logic_error);  // no decision yet
   session.choose();
-  EXPECT_THROW(session.choose(), std::logic_error);          // decision not reported
+  EXPECT_THROW(session.choose(), std::logic_error);  // decision not reported
   EXPECT_THROW(session.report_refined(-3), UsageError);
   EXPECT_EQ(session.report_refined(1), Status::running);
   session.choose();
   EXPECT_EQ(session.report_refined(10), Status::running);
-  EXPECT_THROW(session.choose(), UsageError);                // allocator answered skeleton 7
+  EXPECT_THROW(session.choose(), UsageError);  // allocator answered skeleton 7
 }
 
 TEST(Session, IdleStepsCannotReportARefinement) {
-  const Problem problem("idle", 6, 1.0,
-                        {Action{"a", Distribution::from_pmf({0.0, 1.0}), Distribution::from_pmf({0, 0, 0, 0, 0, 0, 1.0})},
-                         Action{"b", Distribution::from_pmf({0.0, 0.0, 1.0}), Distribution::from_pmf({1.0})}},
-                        {{0}, {1}});
+  const Problem problem(
+      "idle", 6, 1.0,
+      {Action{"a", Distribution::from_pmf({0.0, 1.0}), Distribution::from_pmf({0, 0, 0, 0, 0, 0, 1.0})},
+       Action{"b", Distribution::from_pmf({0.0, 0.0, 1.0}), Distribution::from_pmf({1.0})}},
+      {{0}, {1}});
   const Mdp mdp(problem);
   ScriptedAllocator allocator({0, 0});
   Session session(mdp, allocator);

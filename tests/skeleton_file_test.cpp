@@ -1,7 +1,8 @@
+#include "ontime/skeleton_file.hpp"
+
 #include <gtest/gtest.h>
 
 #include "ontime/error.hpp"
-#include "ontime/skeleton_file.hpp"
 #include "support/paper.hpp"
 
 namespace ontime {

@@ -2,8 +2,9 @@
 // parameters, as tables (Markdown) or JSON. docs/cli.md holds the Markdown output (a test
 // checks that it is current).
 
-#include <cmath>
 #include <fmt/format.h>
+
+#include <cmath>
 
 #include "common.hpp"
 #include "markdown_table.hpp"
@@ -41,11 +42,13 @@ std::string allocators_markdown() {
   const AllocatorRegistry& registry = allocator_registry();
   std::vector<std::vector<std::string>> kinds;
   for (const AllocatorKind& kind : registry.kinds()) {
-    kinds.push_back({"`" + kind.name + "`", fmt::format("{}", fmt::join(kind.capabilities.names(), ", ")), kind.summary});
+    kinds.push_back(
+        {"`" + kind.name + "`", fmt::format("{}", fmt::join(kind.capabilities.names(), ", ")), kind.summary});
   }
   std::vector<std::vector<std::string>> parameters;
   for (const Parameter& parameter : registry.parameters()) {
-    parameters.push_back({"`--" + parameter.name + "`", fmt::format("{}", fmt::join(registry.kinds_with_parameter(parameter.name), ", ")),
+    parameters.push_back({"`--" + parameter.name + "`",
+                          fmt::format("{}", fmt::join(registry.kinds_with_parameter(parameter.name), ", ")),
                           std::string(to_string(parameter.type)),
                           parameter.default_value.empty() ? "none" : parameter.default_value, parameter.allowed(),
                           parameter.help});

@@ -44,7 +44,8 @@ void add_collect_command(CLI::App& app) {
   auto options = std::make_shared<Options>();
   std::string names;
   for (const std::string& name : domains::domain_names()) names += (names.empty() ? "" : ", ") + name;
-  CLI::App* command = app.add_subcommand("collect", "Refine every action of a domain many times, log it, fit the instance");
+  CLI::App* command =
+      app.add_subcommand("collect", "Refine every action of a domain many times, log it, fit the instance");
   command->add_option("--domain", options->domain, "Domain: " + names)->required();
   command->add_option("--world", options->world, "World file (default: data/domains/DOMAIN.json)");
   add_number_option(*command, "--trials", options->trials, "Attempts per action", std::uint64_t{1});
@@ -76,7 +77,8 @@ void add_collect_command(CLI::App& app) {
                     "Continue the collection recorded in the checkpoint, if there is one (same settings, same result)");
   command->add_flag("--json", options->json, "Print JSON");
   command->callback([options] {
-    const std::filesystem::path world = options->world.empty() ? default_world_file(options->domain) : std::filesystem::path(options->world);
+    const std::filesystem::path world =
+        options->world.empty() ? default_world_file(options->domain) : std::filesystem::path(options->world);
     const domains::LoadedDomain loaded = domains::load_domain(options->domain, world);
     const domains::CollectionDefaults& defaults = loaded.defaults.collection;
     const std::filesystem::path log_path =
@@ -89,12 +91,14 @@ void add_collect_command(CLI::App& app) {
     collection.seed = options->seed;
     collection.threads = options->threads;
     collection.effort.unit = domains::parse_effort_unit(options->effort);
-    collection.effort.checks_per_second = options->checks_per_second > 0 ? options->checks_per_second : defaults.checks_per_second;
+    collection.effort.checks_per_second =
+        options->checks_per_second > 0 ? options->checks_per_second : defaults.checks_per_second;
     collection.step_seconds = options->step_seconds > 0 ? options->step_seconds : defaults.step_seconds;
     const Steps deadline = options->deadline > 0 ? options->deadline : defaults.deadline;
     collection.budget_steps = options->budget > 0 ? options->budget : deadline;
-    const std::filesystem::path checkpoint_path =
-        options->checkpoint.empty() ? std::filesystem::path(log_path.string() + ".checkpoint") : std::filesystem::path(options->checkpoint);
+    const std::filesystem::path checkpoint_path = options->checkpoint.empty()
+                                                      ? std::filesystem::path(log_path.string() + ".checkpoint")
+                                                      : std::filesystem::path(options->checkpoint);
     // The checkpoint is read back on --resume, but it is the collection's own file, not an input.
     check_outputs({{"--log", log_path}, {"--instance", instance_path}, {"--checkpoint", checkpoint_path}}, {world},
                   MissingFolder::create);
@@ -103,7 +107,8 @@ void add_collect_command(CLI::App& app) {
       throw UsageError(checkpoint_path.string() +
                        ": the checkpoint of an unfinished collection is there; resume it (--resume) or delete it");
     }
-    domains::CollectionJournal journal(checkpoint_path, *loaded.domain, collection, read_input_file(world, "world"), options->resume);
+    domains::CollectionJournal journal(checkpoint_path, *loaded.domain, collection, read_input_file(world, "world"),
+                                       options->resume);
     collection.journal = &journal;
     const std::size_t resumed = journal.finished().size();
     ProgressBar bar("collect " + options->domain);
@@ -117,7 +122,8 @@ void add_collect_command(CLI::App& app) {
     fit_options.laplace = options->laplace;
     fit_options.name = options->domain;
     fit_options.description = fmt::format(
-        "Fitted from {} attempts per action of the {} domain ({}): seed {}, effort unit {}{}, step {} s, cut-off {} steps",
+        "Fitted from {} attempts per action of the {} domain ({}): seed {}, effort unit {}{}, step {} s, cut-off {} "
+        "steps",
         options->trials, options->domain, world.filename().string(), options->seed, options->effort,
         collection.effort.unit == domains::EffortUnit::collision_checks
             ? fmt::format(" at {} checks per second", collection.effort.checks_per_second)

@@ -38,8 +38,9 @@ void add_fit_command(CLI::App& app) {
                     "Deadline D in steps; planning or execution beyond it is \"never\"", Steps{1},
                     Problem::kMaxDeadline, false)
       ->required();
-  command->add_option("--skeletons", options->skeletons,
-                      "JSON file whose 'skeletons' member lists the plan skeletons (an instance or world file will do)")
+  command
+      ->add_option("--skeletons", options->skeletons,
+                   "JSON file whose 'skeletons' member lists the plan skeletons (an instance or world file will do)")
       ->required();
   command->add_option("-o,--output", options->output, "Instance file to write (SPEC §5)")->required();
   add_number_option(*command, "--laplace", options->laplace, "Laplace (add-alpha) smoothing of the estimates", 0.0);

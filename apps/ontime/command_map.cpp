@@ -37,8 +37,9 @@ void add_map_command(CLI::App& app) {
   command->add_option("--domain", options->domain, "Domain")->required();
   command->add_option("--world", options->world, "World file (default: data/domains/DOMAIN.json)");
   add_number_option(*command, "--seed", options->seed, "Seed of the refinements drawn");
-  command->add_option("-o,--output", options->output,
-                      "PNG to write (default: DOMAIN-map.png in the current directory); the drawing goes beside it as .json");
+  command->add_option(
+      "-o,--output", options->output,
+      "PNG to write (default: DOMAIN-map.png in the current directory); the drawing goes beside it as .json");
   command->callback([options] {
     const std::filesystem::path world =
         options->world.empty() ? default_world_file(options->domain) : std::filesystem::path(options->world);
@@ -59,8 +60,10 @@ void add_map_command(CLI::App& app) {
     drawing["title"] = fmt::format("{}: one refined motion per skeleton (seed {})", scene.title, options->seed);
     drawing["polygons"] = Json::array();
     for (const domains::ScenePolygon& polygon : scene.polygons) {
-      drawing["polygons"].push_back(
-          {{"kind", polygon.kind}, {"label", polygon.label}, {"view", polygon.view}, {"points", points_json(polygon.points)}});
+      drawing["polygons"].push_back({{"kind", polygon.kind},
+                                     {"label", polygon.label},
+                                     {"view", polygon.view},
+                                     {"points", points_json(polygon.points)}});
     }
     drawing["paths"] = Json::array();
     const auto& skeletons = domain.skeletons();

@@ -22,8 +22,8 @@ std::string histogram_csv(const Problem& problem) {
     std::string quoted = "\"";
     for (const char c : action.id) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
     quoted += "\"";
-    for (const auto& [kind, distribution] :
-         {std::pair<const char*, const Distribution*>{"planning", &action.planning}, {"execution", &action.execution}}) {
+    for (const auto& [kind, distribution] : {std::pair<const char*, const Distribution*>{"planning", &action.planning},
+                                             {"execution", &action.execution}}) {
       const auto masses = distribution->masses();
       for (std::size_t t = 0; t < masses.size(); ++t) {
         if (masses[t] > 0) csv += fmt::format("{},{},{},{:.17g}\n", quoted, kind, t, masses[t]);
@@ -49,10 +49,10 @@ void add_plot_command(CLI::App& app) {
                       "the plotted data goes beside it as .csv");
   command->callback([options] {
     const Problem problem = load_problem(options->instance);
-    std::filesystem::path png = options->output.empty()
-                                    ? std::filesystem::path(std::filesystem::path(options->instance).stem().string() +
-                                                            "-histograms.png")
-                                    : std::filesystem::path(options->output);
+    std::filesystem::path png =
+        options->output.empty()
+            ? std::filesystem::path(std::filesystem::path(options->instance).stem().string() + "-histograms.png")
+            : std::filesystem::path(options->output);
     std::filesystem::path csv = png;
     csv.replace_extension(".csv");
     check_outputs({{"--output", png}, {"--output (plotted data)", csv}}, {options->instance});

@@ -18,8 +18,9 @@ void add_reduce_knapsack_command(CLI::App& app) {
   auto options = std::make_shared<Options>();
   CLI::App* command =
       app.add_subcommand("reduce-knapsack", "Write the effort-allocation instance of Theorem 1 for a knapsack problem");
-  command->add_option("KNAPSACK", options->knapsack,
-                      "Knapsack file: {\"capacity\": W, \"items\": [{\"weight\": w, \"value\": v}, ...]}")
+  command
+      ->add_option("KNAPSACK", options->knapsack,
+                   "Knapsack file: {\"capacity\": W, \"items\": [{\"weight\": w, \"value\": v}, ...]}")
       ->required();
   command->add_option("--out", options->out, "Instance file to write (default: standard output)");
   command->callback([options] {

@@ -1,7 +1,8 @@
 // `ontime solve INSTANCE`: the exact optimum by expectimax.
 
-#include <chrono>
 #include <fmt/core.h>
+
+#include <chrono>
 
 #include "common.hpp"
 #include "memory_limits.hpp"

@@ -109,8 +109,8 @@ void run_compute_time(const StudyOptions& options) {
   for (std::size_t i = 0; i < problems.size(); ++i) {
     const Mdp mdp(problems[i]);
     const ComputeTimeStudy study = compute_time_study(mdp, settings_of(options, bar, i, problems.size()));
-    for (const auto& [solver, result] : {std::pair{options.searcher, &study.searcher},
-                                         std::pair{options.reference, &study.reference}}) {
+    for (const auto& [solver, result] :
+         {std::pair{options.searcher, &study.searcher}, std::pair{options.reference, &study.reference}}) {
       csv += fmt::format("{},{},{},{},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.6g}\n", label_of(options.instances[i]), solver,
                          result->episodes, result->success_rate, result->ci95,
                          result->episode_decision_time.mean_us * 1e-6, result->episode_decision_time.median_us * 1e-6,
@@ -148,10 +148,10 @@ void run_anytime(const StudyOptions& options) {
     const Mdp mdp(problems[i]);
     const AnytimeStudy study = anytime_study(mdp, multipliers, settings_of(options, bar, i, problems.size()));
     for (const AnytimePoint& point : study.points) {
-      csv += fmt::format("{},{},{},{:.9g},{},{},{:.6g},{:.9g},{},{}\n", label_of(options.instances[i]), options.episodes,
-                         point.log10_multiplier, point.seconds_per_decision, point.searcher.success_rate,
-                         point.searcher.ci95, iterations_per_search(point.searcher), study.reference_decision_seconds,
-                         study.reference.success_rate, study.optimum);
+      csv += fmt::format("{},{},{},{:.9g},{},{},{:.6g},{:.9g},{},{}\n", label_of(options.instances[i]),
+                         options.episodes, point.log10_multiplier, point.seconds_per_decision,
+                         point.searcher.success_rate, point.searcher.ci95, iterations_per_search(point.searcher),
+                         study.reference_decision_seconds, study.reference.success_rate, study.optimum);
     }
   }
   finish(options, "anytime", csv);
@@ -162,8 +162,7 @@ void run_anytime(const StudyOptions& options) {
 void add_study_command(CLI::App& app) {
   CLI::App* study = app.add_subcommand("study", "Computation-time studies of mcts against dp-rerun (Figs. 4-6)");
   study->require_subcommand(1);
-  const auto add = [study](const std::string& name, const std::string& description,
-                           void (*run)(const StudyOptions&)) {
+  const auto add = [study](const std::string& name, const std::string& description, void (*run)(const StudyOptions&)) {
     auto options = std::make_shared<StudyOptions>();
     CLI::App* command = study->add_subcommand(name, description);
     command->add_option("INSTANCE", options->instances, "Instance files (JSON, SPEC §5)")->required();
@@ -183,14 +182,16 @@ void add_study_command(CLI::App& app) {
                      "The stationary allocator it is measured against (its time per decision sets the searcher's)")
         ->capture_default_str();
     if (name == "anytime") {
-      command->add_option("--log10-multipliers", options->multipliers,
-                          "Comma-separated exponents m: mcts gets 10^m times dp-rerun's time per decision")
+      command
+          ->add_option("--log10-multipliers", options->multipliers,
+                       "Comma-separated exponents m: mcts gets 10^m times dp-rerun's time per decision")
           ->capture_default_str();
     }
     options->allocator.add_to(*command);
     command->callback([options, run] { run(*options); });
   };
-  add("compute-time", "Fig. 4: total decision time per episode, mcts (--iterations) against dp-rerun", run_compute_time);
+  add("compute-time", "Fig. 4: total decision time per episode, mcts (--iterations) against dp-rerun",
+      run_compute_time);
   add("equal-time", "Fig. 5: mcts given exactly dp-rerun's measured time per decision", run_equal_time);
   add("anytime", "Fig. 6: mcts success against log10 of a multiplier of dp-rerun's time", run_anytime);
 }

@@ -5,12 +5,13 @@
 // large instance does not cost the whole table; the states and seconds of every exact part are
 // listed below the table.
 
+#include <fmt/format.h>
+
 #include <chrono>
 #include <filesystem>
 #include <functional>
 #include <ranges>
 #include <string_view>
-#include <fmt/format.h>
 
 #include "common.hpp"
 #include "markdown_table.hpp"
@@ -60,7 +61,9 @@ ExactPart exact_part(std::size_t max_states, const Compute& compute) {
   return part;
 }
 
-std::string exact_text(const ExactPart& part) { return part.value ? fmt::format("{:.4f}", *part.value) : "cap reached"; }
+std::string exact_text(const ExactPart& part) {
+  return part.value ? fmt::format("{:.4f}", *part.value) : "cap reached";
+}
 
 Json exact_json(const ExactPart& part) {
   Json out;
@@ -258,8 +261,9 @@ void add_table_command(CLI::App& app) {
     const std::uint64_t total = per_row * problems.size();
     std::vector<Row> rows;
     for (std::size_t i = 0; i < problems.size(); ++i) {
-      rows.push_back(measure_row(*options, i, *mdps[i], factories[i], max_states[i],
-                                 [&bar, i, per_row, total](std::uint64_t done) { bar.update(i * per_row + done, total); }));
+      rows.push_back(
+          measure_row(*options, i, *mdps[i], factories[i], max_states[i],
+                      [&bar, i, per_row, total](std::uint64_t done) { bar.update(i * per_row + done, total); }));
     }
     if (options->json) {
       print_json(table_json(*options, rows));

@@ -31,10 +31,13 @@ void add_train_command(CLI::App& app) {
   auto options = std::make_shared<Options>();
   CLI::App* command = app.add_subcommand("train", "Learn a model-free policy (ppo) from simulated episodes");
   command->add_option("INSTANCE", options->instance, "Instance file (JSON, SPEC §5)")->required();
-  command->add_option("--solver", options->solver, "Learner (only ppo)")->check(CLI::IsMember({"ppo"}))->capture_default_str();
+  command->add_option("--solver", options->solver, "Learner (only ppo)")
+      ->check(CLI::IsMember({"ppo"}))
+      ->capture_default_str();
   add_number_option(*command, "--episodes", options->episodes, "Training episodes", std::uint64_t{1});
   add_number_option(*command, "--seed", options->seed, "Seed of initialisation, sampling and hidden worlds");
-  command->add_option("--out", options->out, "Policy file to write (JSON); the learning curve goes beside it")->required();
+  command->add_option("--out", options->out, "Policy file to write (JSON); the learning curve goes beside it")
+      ->required();
   command->add_flag("--no-plot", options->no_plot, "Write the learning curve CSV only");
   command->add_flag("--json", options->json, "Print JSON");
   command->callback([options] {

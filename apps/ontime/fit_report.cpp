@@ -8,10 +8,10 @@ namespace ontime::cli {
 namespace {
 
 struct ActionSummary {
-  double found_in_time;     // P(planning time <= D)
-  double mean_planning;     // E[T | T <= D], steps
-  double mean_execution;    // E[X | X <= D], steps
-  double execution_never;   // P(X > D)
+  double found_in_time;    // P(planning time <= D)
+  double mean_planning;    // E[T | T <= D], steps
+  double mean_execution;   // E[X | X <= D], steps
+  double execution_never;  // P(X > D)
 };
 
 ActionSummary summarise(const Action& action) {
@@ -24,8 +24,8 @@ std::string format_mean(double mean) { return std::isfinite(mean) ? fmt::format(
 }  // namespace
 
 std::string fit_report_markdown(const FitResult& fit) {
-  const std::vector<std::string> header{"action",         "attempts", "found",           "cut off", "P(T ≤ D)",
-                                        "E[T | T ≤ D]", "E[X | X ≤ D]", "P(X > D)"};
+  const std::vector<std::string> header{"action",   "attempts",     "found",        "cut off",
+                                        "P(T ≤ D)", "E[T | T ≤ D]", "E[X | X ≤ D]", "P(X > D)"};
   std::vector<std::vector<std::string>> body;
   for (std::size_t a = 0; a < fit.actions.size(); ++a) {
     const ActionFit& counts = fit.actions[a];
@@ -50,7 +50,8 @@ Json fit_report_json(const FitResult& fit) {
     entry["cut_off"] = counts.censored;
     entry["planning_within_deadline"] = summary.found_in_time;
     entry["mean_planning_steps"] = std::isfinite(summary.mean_planning) ? Json(summary.mean_planning) : Json(nullptr);
-    entry["mean_execution_steps"] = std::isfinite(summary.mean_execution) ? Json(summary.mean_execution) : Json(nullptr);
+    entry["mean_execution_steps"] =
+        std::isfinite(summary.mean_execution) ? Json(summary.mean_execution) : Json(nullptr);
     entry["execution_never"] = summary.execution_never;
     actions.push_back(entry);
   }

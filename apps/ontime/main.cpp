@@ -2,10 +2,11 @@
 // Exit codes: 0 success, 2 bad input or usage (message names the file, the place, the rule),
 // 1 internal error.
 
+#include <fmt/core.h>
+
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
-#include <fmt/core.h>
 #include <memory>
 #include <new>
 

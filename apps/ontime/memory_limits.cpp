@@ -1,8 +1,9 @@
 #include "memory_limits.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <charconv>
-#include <fmt/format.h>
 #include <fstream>
 #include <sstream>
 #include <string>

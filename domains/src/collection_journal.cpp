@@ -53,7 +53,8 @@ void write_all(int descriptor, const std::string& text, const std::filesystem::p
   while (written < text.size()) {
     const ssize_t n = ::write(descriptor, text.data() + written, text.size() - written);
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) throw std::runtime_error(path.string() + ": cannot write the checkpoint (" + std::strerror(errno) + ")");
+    if (n <= 0)
+      throw std::runtime_error(path.string() + ": cannot write the checkpoint (" + std::strerror(errno) + ")");
     written += static_cast<std::size_t>(n);
   }
 }
@@ -91,10 +92,11 @@ CollectionJournal::CollectionJournal(std::filesystem::path path, const Domain& d
       if (number == 1) {
         for (const auto& [key, wanted] : expected.items()) {
           if (!value.is_object() || !value.contains(key) || value[key] != wanted) {
-            throw InputError(source, place,
-                             "the checkpoint of another collection ('" + key + "' is " +
-                                 (value.is_object() && value.contains(key) ? value[key].dump() : std::string("missing")) +
-                                 " there, " + wanted.dump() + " here); delete it to start over");
+            throw InputError(
+                source, place,
+                "the checkpoint of another collection ('" + key + "' is " +
+                    (value.is_object() && value.contains(key) ? value[key].dump() : std::string("missing")) +
+                    " there, " + wanted.dump() + " here); delete it to start over");
           }
         }
       } else {
@@ -105,7 +107,8 @@ CollectionJournal::CollectionJournal(std::filesystem::path path, const Domain& d
         }
         JournalTrial trial;
         trial.action = value["action"].get<std::size_t>();
-        const std::vector<RefinementAttempt> records = parse_planner_log(value["record"].dump() + "\n", source + " " + place);
+        const std::vector<RefinementAttempt> records =
+            parse_planner_log(value["record"].dump() + "\n", source + " " + place);
         trial.attempt = records.front();
         if (trial.attempt.action != expected["actions"][trial.action].get<std::string>() || !trial.attempt.trial ||
             *trial.attempt.trial >= options.trials || !seen.emplace(trial.action, *trial.attempt.trial).second) {

@@ -77,14 +77,15 @@ std::vector<Transform> box_grasps(const std::array<double, 3>& size) {
   };
   const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
   std::vector<Transform> grasps;
-  for (const Eigen::Vector3d& normal : {Eigen::Vector3d(-1, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, -1, 0),
-                                        Eigen::Vector3d(0, 1, 0)}) {
+  for (const Eigen::Vector3d& normal :
+       {Eigen::Vector3d(-1, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, -1, 0), Eigen::Vector3d(0, 1, 0)}) {
     const Eigen::Vector3d approach = -normal;
-    for (const double side : {1.0, -1.0}) grasps.push_back(frame(approach, (side * up).cross(approach), Eigen::Vector3d::Zero()));
+    for (const double side : {1.0, -1.0})
+      grasps.push_back(frame(approach, (side * up).cross(approach), Eigen::Vector3d::Zero()));
   }
   const Eigen::Vector3d top(0, 0, size[2] / 2 - kTopGraspDepth);
-  for (const Eigen::Vector3d& across : {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(-1, 0, 0), Eigen::Vector3d(0, 1, 0),
-                                        Eigen::Vector3d(0, -1, 0)}) {
+  for (const Eigen::Vector3d& across :
+       {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(-1, 0, 0), Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, -1, 0)}) {
     grasps.push_back(frame(-up, across, top));
   }
   return grasps;
@@ -152,10 +153,12 @@ ManipulationCollision::ManipulationCollision(const ManipulationWorld& world, con
   impl.base = box(base_size[0] + pad, base_size[1] + pad, base_size[2] + pad);
   impl.base_offset = translation(0, 0, base_size[2] / 2);
   const double torso_top = arm.torso().translation().z() + kTorsoMax[2];
-  impl.torso = box(kTorsoMax[0] - kTorsoMin[0] + pad, kTorsoMax[1] - kTorsoMin[1] + pad, torso_top - base_size[2] + pad);
-  impl.torso_offset = translation((kTorsoMin[0] + kTorsoMax[0]) / 2, (kTorsoMin[1] + kTorsoMax[1]) / 2,
-                                  (base_size[2] + torso_top) / 2);
-  impl.shoulder = std::make_unique<Object>(std::make_shared<fcl::Sphered>(kShoulderRadius + clearance), Transform::Identity());
+  impl.torso =
+      box(kTorsoMax[0] - kTorsoMin[0] + pad, kTorsoMax[1] - kTorsoMin[1] + pad, torso_top - base_size[2] + pad);
+  impl.torso_offset =
+      translation((kTorsoMin[0] + kTorsoMax[0]) / 2, (kTorsoMin[1] + kTorsoMax[1]) / 2, (base_size[2] + torso_top) / 2);
+  impl.shoulder =
+      std::make_unique<Object>(std::make_shared<fcl::Sphered>(kShoulderRadius + clearance), Transform::Identity());
   impl.upper_arm = std::make_unique<Object>(
       std::make_shared<fcl::Capsuled>(kUpperArmRadius + clearance, kUpperArmTo - kUpperArmFrom), Transform::Identity());
   impl.upper_arm_offset = along_x(kUpperArmFrom, kUpperArmTo);
@@ -189,7 +192,8 @@ bool ManipulationCollision::collides(const Pose& base, const ArmJoints& arm) con
   impl.place(*impl.right_finger, wrist * impl.right_offset);
   impl.place(*impl.forearm, torso * frames[4] * impl.forearm_offset);
   if (impl.held) impl.place(*impl.held, torso * frames[kArmJointCount] * impl.grasp);
-  for (Object* part : {impl.left_finger.get(), impl.right_finger.get(), impl.palm.get(), impl.held.get(), impl.forearm.get()}) {
+  for (Object* part :
+       {impl.left_finger.get(), impl.right_finger.get(), impl.palm.get(), impl.held.get(), impl.forearm.get()}) {
     if (part != nullptr && impl.hits_world(part)) return true;
   }
   impl.place(*impl.upper_arm, torso * frames[2] * impl.upper_arm_offset);
@@ -200,7 +204,8 @@ bool ManipulationCollision::collides(const Pose& base, const ArmJoints& arm) con
     if (impl.hits_world(part)) return true;
   }
   // Self-collisions.
-  for (Object* moving : {impl.left_finger.get(), impl.right_finger.get(), impl.palm.get(), impl.held.get(), impl.forearm.get()}) {
+  for (Object* moving :
+       {impl.left_finger.get(), impl.right_finger.get(), impl.palm.get(), impl.held.get(), impl.forearm.get()}) {
     if (moving == nullptr) continue;
     if (overlap(*moving, *impl.base) || overlap(*moving, *impl.torso)) return true;
     if (moving != impl.forearm.get() && overlap(*moving, *impl.upper_arm)) return true;

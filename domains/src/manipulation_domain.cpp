@@ -1,5 +1,3 @@
-#include "ontime/domains/manipulation.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -7,6 +5,7 @@
 
 #include "manipulation_refinement.hpp"
 #include "ompl_support.hpp"
+#include "ontime/domains/manipulation.hpp"
 #include "ontime/domains/manipulation_collision.hpp"
 #include "ontime/domains/world_types.hpp"
 #include "ontime/random.hpp"
@@ -41,8 +40,10 @@ std::vector<std::array<double, 2>> bar(const Eigen::Vector3d& a, const Eigen::Ve
   Eigen::Vector2d along(b.x() - a.x(), b.z() - a.z());
   if (along.norm() < 1e-9) along = Eigen::Vector2d(1, 0);
   const Eigen::Vector2d side = Eigen::Vector2d(-along.y(), along.x()).normalized() * (width / 2);
-  return {{a.x() + side.x(), a.z() + side.y()}, {b.x() + side.x(), b.z() + side.y()},
-          {b.x() - side.x(), b.z() - side.y()}, {a.x() - side.x(), a.z() - side.y()}};
+  return {{a.x() + side.x(), a.z() + side.y()},
+          {b.x() + side.x(), b.z() + side.y()},
+          {b.x() - side.x(), b.z() - side.y()},
+          {a.x() - side.x(), a.z() - side.y()}};
 }
 
 }  // namespace
@@ -110,7 +111,8 @@ Configuration ManipulationDomain::fallback_start(const std::string& action, std:
     if (before.kind != ManipulationKind::place) continue;
     const auto object = static_cast<std::size_t>(world_.object_index(before.object));
     const PlacementRegion& region = world_.regions[static_cast<std::size_t>(world_.region_index(before.region))];
-    const ManipulationCollision collision(world_, arm, state.objects, static_cast<int>(object), Transform::Identity(), 0.0);
+    const ManipulationCollision collision(world_, arm, state.objects, static_cast<int>(object), Transform::Identity(),
+                                          0.0);
     for (int attempt = 0;; ++attempt) {
       if (attempt == 100'000) throw std::runtime_error("no free placement found in region " + region.id);
       const ObjectPose pose{uniform(region.min_x, region.max_x), uniform(region.min_y, region.max_y),
@@ -125,7 +127,8 @@ Configuration ManipulationDomain::fallback_start(const std::string& action, std:
   const auto tool = [&](const Pose& base) { return base_transform(base) * arm.torso() * arm.tool(state.arm); };
   const auto upright = [](const Transform& object) {
     const Eigen::Vector3d x = object.linear().col(0);
-    return ObjectPose{object.translation().x(), object.translation().y(), object.translation().z(), std::atan2(x.y(), x.x())};
+    return ObjectPose{object.translation().x(), object.translation().y(), object.translation().z(),
+                      std::atan2(x.y(), x.x())};
   };
   if (parsed.kind == ManipulationKind::place) {
     // The grasp that holds the object most nearly upright with the arm carried; the object is
@@ -147,7 +150,8 @@ Configuration ManipulationDomain::fallback_start(const std::string& action, std:
   for (int attempt = 0;; ++attempt) {
     if (attempt == 100'000) throw std::runtime_error("no free base pose found on the floor");
     if (!collision.collides(state.base, state.arm)) break;
-    state.base = Pose{uniform(floor[0], floor[2]), uniform(floor[1], floor[3]), uniform(-std::numbers::pi, std::numbers::pi)};
+    state.base =
+        Pose{uniform(floor[0], floor[2]), uniform(floor[1], floor[3]), uniform(-std::numbers::pi, std::numbers::pi)};
   }
   if (state.held >= 0) state.objects[static_cast<std::size_t>(state.held)] = upright(tool(state.base) * grasp);
   return configuration(state);
@@ -176,7 +180,8 @@ Scene ManipulationDomain::scene() const {
   const auto& f = world_.floor;
   scene.polygons.push_back(ScenePolygon{"room", "", rectangle(f[0], f[1], f[2], f[3]), "top"});
   for (const Box3& wall : world_.walls) {
-    scene.polygons.push_back(ScenePolygon{"wall", "", rectangle(wall.min[0], wall.min[1], wall.max[0], wall.max[1]), "top"});
+    scene.polygons.push_back(
+        ScenePolygon{"wall", "", rectangle(wall.min[0], wall.min[1], wall.max[0], wall.max[1]), "top"});
   }
   // Seen from the front: the floor up to the walls' height, and the back wall's extent.
   scene.polygons.push_back(ScenePolygon{"room", "", rectangle(f[0], 0, f[2], world_.wall_height), "front"});
@@ -187,34 +192,39 @@ Scene ManipulationDomain::scene() const {
         extent.min[axis] = std::min(extent.min[axis], box.min[axis]);
         extent.max[axis] = std::max(extent.max[axis], box.max[axis]);
       }
-      scene.polygons.push_back(ScenePolygon{"obstacle", "", rectangle(box.min[0], box.min[1], box.max[0], box.max[1]), "top"});
-      scene.polygons.push_back(ScenePolygon{"obstacle", "", rectangle(box.min[0], box.min[2], box.max[0], box.max[2]), "front"});
+      scene.polygons.push_back(
+          ScenePolygon{"obstacle", "", rectangle(box.min[0], box.min[1], box.max[0], box.max[1]), "top"});
+      scene.polygons.push_back(
+          ScenePolygon{"obstacle", "", rectangle(box.min[0], box.min[2], box.max[0], box.max[2]), "front"});
     }
     // The name, once per piece of furniture, just beneath it in the front view.
-    scene.polygons.push_back(ScenePolygon{
-        "caption", fixed.name, rectangle(extent.min[0], extent.min[2] - 0.12, extent.max[0], extent.min[2] - 0.02), "front"});
+    scene.polygons.push_back(
+        ScenePolygon{"caption", fixed.name,
+                     rectangle(extent.min[0], extent.min[2] - 0.12, extent.max[0], extent.min[2] - 0.02), "front"});
   }
   for (const PlacementRegion& region : world_.regions) {
     scene.polygons.push_back(
         ScenePolygon{"region", region.id, rectangle(region.min_x, region.min_y, region.max_x, region.max_y), "top"});
-    scene.polygons.push_back(
-        ScenePolygon{"region", region.id, rectangle(region.min_x, region.height, region.max_x, region.height + 0.012), "front"});
+    scene.polygons.push_back(ScenePolygon{
+        "region", region.id, rectangle(region.min_x, region.height, region.max_x, region.height + 0.012), "front"});
   }
   for (const MovableObject& object : world_.objects) {
     const ObjectPose& pose = object.pose;
-    scene.polygons.push_back(
-        ScenePolygon{"object", object.id, turned_rectangle(pose.x, pose.y, object.size[0], object.size[1], pose.yaw), "top"});
-    const double half = (std::abs(std::cos(pose.yaw)) * object.size[0] + std::abs(std::sin(pose.yaw)) * object.size[1]) / 2;
     scene.polygons.push_back(ScenePolygon{
-        "object", object.id, rectangle(pose.x - half, pose.z - object.size[2] / 2, pose.x + half, pose.z + object.size[2] / 2),
-        "front"});
+        "object", object.id, turned_rectangle(pose.x, pose.y, object.size[0], object.size[1], pose.yaw), "top"});
+    const double half =
+        (std::abs(std::cos(pose.yaw)) * object.size[0] + std::abs(std::sin(pose.yaw)) * object.size[1]) / 2;
+    scene.polygons.push_back(ScenePolygon{
+        "object", object.id,
+        rectangle(pose.x - half, pose.z - object.size[2] / 2, pose.x + half, pose.z + object.size[2] / 2), "front"});
   }
   const KitchenState start = state(initial_configuration());
   scene.polygons.push_back(ScenePolygon{"robot", "", outline(initial_configuration()), "top"});
   const Pr2Arm arm(world_.robot.torso_lift);
   const Transform torso = base_transform(start.base) * arm.torso();
   const auto& size = world_.robot.base_size;
-  const double reach = (std::abs(std::cos(start.base.theta)) * size[0] + std::abs(std::sin(start.base.theta)) * size[1]) / 2;
+  const double reach =
+      (std::abs(std::cos(start.base.theta)) * size[0] + std::abs(std::sin(start.base.theta)) * size[1]) / 2;
   scene.polygons.push_back(
       ScenePolygon{"robot", "", rectangle(start.base.x - reach, 0, start.base.x + reach, size[2]), "front"});
   const ArmFrames frames = arm.frames(start.arm);
@@ -229,7 +239,8 @@ Scene ManipulationDomain::scene() const {
 std::vector<std::array<double, 2>> ManipulationDomain::trace(const std::vector<Configuration>& motion) const {
   std::vector<std::array<double, 2>> points;
   for (const Configuration& configuration : motion) {
-    if (configuration.size() < 2) throw std::invalid_argument("a manipulation configuration starts with the base's x, y");
+    if (configuration.size() < 2)
+      throw std::invalid_argument("a manipulation configuration starts with the base's x, y");
     if (!points.empty() && points.back()[0] == configuration[0] && points.back()[1] == configuration[1]) continue;
     points.push_back({configuration[0], configuration[1]});
   }

@@ -10,9 +10,9 @@
 #include <stdexcept>
 
 #include "ompl_support.hpp"
-#include "phased_refinement.hpp"
 #include "ontime/domains/manipulation_collision.hpp"
 #include "ontime/random.hpp"
+#include "phased_refinement.hpp"
 
 namespace ontime::domains {
 namespace {
@@ -49,7 +49,9 @@ class ArmJointSpace final : public ob::RealVectorStateSpace {
     setBounds(limits);
   }
 
-  double distance(const ob::State* a, const ob::State* b) const override { return joint_distance(joints_of(a), joints_of(b)); }
+  double distance(const ob::State* a, const ob::State* b) const override {
+    return joint_distance(joints_of(a), joints_of(b));
+  }
 
   void interpolate(const ob::State* from, const ob::State* to, double t, ob::State* state) const override {
     set_joints(state, interpolate_joints(joints_of(from), joints_of(to), t));
@@ -91,22 +93,25 @@ class ManipulationRefinement final : public detail::PhasedRefinement {
       throw std::invalid_argument("cannot pick " + action.object + " while holding " + world_.objects[start.held].id);
     }
     if (action.kind == ManipulationKind::place) {
-      if (start.held != static_cast<int>(object_)) throw std::invalid_argument("cannot place " + action.object + " without holding it");
+      if (start.held != static_cast<int>(object_))
+        throw std::invalid_argument("cannot place " + action.object + " without holding it");
       const int region = world_.region_index(action.region);
       if (region < 0) throw std::invalid_argument("unknown region " + action.region);
       region_ = &world_.regions[static_cast<std::size_t>(region)];
     }
     if (start.held >= 0) {
       // The grasp (tool frame -> object) follows from the arm and the object's pose at pick-up.
-      grasp_ = tool_in_world(start.base, start.arm).inverse() * object_transform(start.objects[static_cast<std::size_t>(start.held)]);
+      grasp_ = tool_in_world(start.base, start.arm).inverse() *
+               object_transform(start.objects[static_cast<std::size_t>(start.held)]);
     }
     const double clearance = world_.robot.clearance;
     collision_ = std::make_unique<ManipulationCollision>(world_, arm_, start.objects, start.held, grasp_, clearance);
     // The world once the action is done, for the configuration the next action starts from.
-    after_ = std::make_unique<ManipulationCollision>(world_, arm_, start.objects,
-                                                     action.kind == ManipulationKind::pick ? static_cast<int>(object_) : -1,
-                                                     Transform::Identity(), clearance);
-    if (collision_->collides(start.base, start.arm)) throw std::invalid_argument("the start configuration is in collision");
+    after_ = std::make_unique<ManipulationCollision>(
+        world_, arm_, start.objects, action.kind == ManipulationKind::pick ? static_cast<int>(object_) : -1,
+        Transform::Identity(), clearance);
+    if (collision_->collides(start.base, start.arm))
+      throw std::invalid_argument("the start configuration is in collision");
     grasps_ = box_grasps(world_.objects[object_].size);
     if (start.arm != world_.robot.carry) phase_ = Phase::retreat;
   }
@@ -258,8 +263,9 @@ class ManipulationRefinement final : public detail::PhasedRefinement {
   }
 
   template <class Waypoint>
-  std::unique_ptr<detail::ResumableRrtConnect> make_planner(const ob::SpaceInformationPtr& information, const Waypoint& from,
-                                                            const Waypoint& to, double range) const {
+  std::unique_ptr<detail::ResumableRrtConnect> make_planner(const ob::SpaceInformationPtr& information,
+                                                            const Waypoint& from, const Waypoint& to,
+                                                            double range) const {
     ob::ScopedState<> a(information), b(information);
     set(a.get(), from);
     set(b.get(), to);
@@ -280,7 +286,8 @@ class ManipulationRefinement final : public detail::PhasedRefinement {
   void draw_target() {
     Transform tool;
     if (action_.kind == ManipulationKind::pick) {
-      const Transform& grasp = grasps_[static_cast<std::size_t>(uniform01(random_) * static_cast<double>(grasps_.size()))];
+      const Transform& grasp =
+          grasps_[static_cast<std::size_t>(uniform01(random_) * static_cast<double>(grasps_.size()))];
       tool = object_transform(start_.objects[object_]) * grasp;
       after_->set_grasp(grasp.inverse());
     } else {
@@ -299,7 +306,8 @@ class ManipulationRefinement final : public detail::PhasedRefinement {
                            uniform(-world_.planner.base_heading_spread, world_.planner.base_heading_spread);
     const Pose base{x, y, std::remainder(heading, 2 * kPi)};
     ArmJoints guess{};
-    for (std::size_t j = 0; j < kArmJointCount; ++j) guess[j] = uniform(pr2_left_arm_joints()[j].lower, pr2_left_arm_joints()[j].upper);
+    for (std::size_t j = 0; j < kArmJointCount; ++j)
+      guess[j] = uniform(pr2_left_arm_joints()[j].lower, pr2_left_arm_joints()[j].upper);
     meter_.count_check();
     const auto& floor = world_.floor;
     if (!(x > floor[0] && x < floor[2] && y > floor[1] && y < floor[3])) return;
@@ -324,7 +332,8 @@ class ManipulationRefinement final : public detail::PhasedRefinement {
     ob::ScopedState<> near(approach_.information), at(approach_.information);
     set(near.get(), *before);
     set(at.get(), *joints);
-    if (!approach_.information->isValid(near.get()) || !approach_.information->checkMotion(near.get(), at.get())) return;
+    if (!approach_.information->isValid(near.get()) || !approach_.information->checkMotion(near.get(), at.get()))
+      return;
     target_base_ = base;
     target_arm_ = *joints;
     target_started_ = meter_.checks();
@@ -426,9 +435,9 @@ class ManipulationRefinement final : public detail::PhasedRefinement {
 
 }  // namespace
 
-std::unique_ptr<Refinement> make_manipulation_refinement(const ManipulationDomain& domain, const ManipulationAction& action,
-                                                         const KitchenState& start, std::uint64_t seed,
-                                                         const EffortSettings& effort) {
+std::unique_ptr<Refinement> make_manipulation_refinement(const ManipulationDomain& domain,
+                                                         const ManipulationAction& action, const KitchenState& start,
+                                                         std::uint64_t seed, const EffortSettings& effort) {
   return std::make_unique<ManipulationRefinement>(domain, action, start, seed, effort);
 }
 

@@ -17,9 +17,7 @@ using detail::Json;
 using detail::number_text;
 constexpr double kTolerance = 1e-9;
 
-bool plain_id(std::string_view id) {
-  return !id.empty() && id.find_first_of("()[], +") == std::string_view::npos;
-}
+bool plain_id(std::string_view id) { return !id.empty() && id.find_first_of("()[], +") == std::string_view::npos; }
 
 class KitchenReader : detail::WorldFields {
  public:
@@ -27,12 +25,15 @@ class KitchenReader : detail::WorldFields {
 
   ManipulationWorld read(std::string_view text) {
     const Json root = detail::parse_json_strict<Json>(text, source());
-    if (!root.is_object()) fail("top level", "a world must be a JSON object (got " + detail::describe_json_type(root) + ")");
-    check_keys(root, "", {"name", "description", "floor", "walls", "fixed", "regions", "objects", "goal", "robot", "start",
-                          "planner", "collection", "skeletons"});
+    if (!root.is_object())
+      fail("top level", "a world must be a JSON object (got " + detail::describe_json_type(root) + ")");
+    check_keys(root, "",
+               {"name", "description", "floor", "walls", "fixed", "regions", "objects", "goal", "robot", "start",
+                "planner", "collection", "skeletons"});
     ManipulationWorld world;
     world.source = source();
-    world.name = root.contains("name") ? string_at(root["name"], "name") : std::filesystem::path(source()).stem().string();
+    world.name =
+        root.contains("name") ? string_at(root["name"], "name") : std::filesystem::path(source()).stem().string();
     if (root.contains("description")) world.description = string_at(root["description"], "description");
     read_floor(member(root, "", "floor"), member(root, "", "walls"), world);
     read_robot(member(root, "", "robot"), world);
@@ -79,8 +80,9 @@ class KitchenReader : detail::WorldFields {
     // Four walls just outside the floor, overlapping at the corners.
     const double t = world.wall_thickness, h = world.wall_height;
     const auto& f = world.floor;
-    world.walls = {Box3{{f[0] - t, f[1] - t, 0}, {f[0], f[3] + t, h}}, Box3{{f[2], f[1] - t, 0}, {f[2] + t, f[3] + t, h}},
-                   Box3{{f[0] - t, f[1] - t, 0}, {f[2] + t, f[1], h}}, Box3{{f[0] - t, f[3], 0}, {f[2] + t, f[3] + t, h}}};
+    world.walls = {
+        Box3{{f[0] - t, f[1] - t, 0}, {f[0], f[3] + t, h}}, Box3{{f[2], f[1] - t, 0}, {f[2] + t, f[3] + t, h}},
+        Box3{{f[0] - t, f[1] - t, 0}, {f[2] + t, f[1], h}}, Box3{{f[0] - t, f[3], 0}, {f[2] + t, f[3] + t, h}}};
   }
 
   void read_robot(const Json& value, ManipulationWorld& world) const {
@@ -89,33 +91,37 @@ class KitchenReader : detail::WorldFields {
     ManipulationRobot& robot = world.robot;
     const Json& base = object_at(member(value, "robot", "base"), "robot.base");
     check_keys(base, "robot.base", {"size", "linear_speed", "angular_speed"});
-    const std::vector<double> size = numbers(member(base, "robot.base", "size"), "robot.base.size", 3, "length, width, height");
+    const std::vector<double> size =
+        numbers(member(base, "robot.base", "size"), "robot.base.size", 3, "length, width, height");
     if (!(size[0] > 0 && size[1] > 0 && size[2] > 0)) fail("robot.base.size", "every size must be positive");
     robot.base_size = {size[0], size[1], size[2]};
     robot.linear_speed = positive(member(base, "robot.base", "linear_speed"), "robot.base.linear_speed");
     robot.angular_speed = positive(member(base, "robot.base", "angular_speed"), "robot.base.angular_speed");
     robot.torso_lift = finite(member(value, "robot", "torso_lift"), "robot.torso_lift");
-    if (robot.torso_lift < 0 || robot.torso_lift > 0.33) fail("robot.torso_lift", "the PR2's torso lifts by 0 to 0.33 m");
+    if (robot.torso_lift < 0 || robot.torso_lift > 0.33)
+      fail("robot.torso_lift", "the PR2's torso lifts by 0 to 0.33 m");
     robot.arm_speed = positive(member(value, "robot", "arm_speed"), "robot.arm_speed");
     if (robot.arm_speed > 1) fail("robot.arm_speed", "a fraction of the joint velocity limits, at most 1");
     robot.gripper_seconds = non_negative(member(value, "robot", "gripper_seconds"), "robot.gripper_seconds");
     robot.clearance = non_negative(member(value, "robot", "clearance"), "robot.clearance");
-    const std::vector<double> carry = numbers(member(value, "robot", "carry"), "robot.carry", kArmJointCount, "arm joints");
+    const std::vector<double> carry =
+        numbers(member(value, "robot", "carry"), "robot.carry", kArmJointCount, "arm joints");
     std::copy(carry.begin(), carry.end(), robot.carry.begin());
     for (std::size_t j = 0; j < kArmJointCount; ++j) {
       const ArmJointSpec& joint = pr2_left_arm_joints()[j];
       if (carry[j] < joint.lower || carry[j] > joint.upper) {
-        fail(detail::json_index("robot.carry", j), std::string(joint.name) + " must lie within [" + number_text(joint.lower) +
-                                                      ", " + number_text(joint.upper) + "]");
+        fail(detail::json_index("robot.carry", j), std::string(joint.name) + " must lie within [" +
+                                                       number_text(joint.lower) + ", " + number_text(joint.upper) +
+                                                       "]");
       }
     }
   }
 
   void read_planner(const Json& value, ManipulationWorld& world) const {
     object_at(value, "planner");
-    check_keys(value, "planner", {"arm_range", "arm_resolution", "base_range", "base_resolution", "base_distance",
-                                  "base_heading_spread", "approach_distance", "ik_checks", "target_checks",
-                                  "placement_gap"});
+    check_keys(value, "planner",
+               {"arm_range", "arm_resolution", "base_range", "base_resolution", "base_distance", "base_heading_spread",
+                "approach_distance", "ik_checks", "target_checks", "placement_gap"});
     ManipulationPlanner& planner = world.planner;
     planner.arm_range = positive(member(value, "planner", "arm_range"), "planner.arm_range");
     planner.arm_resolution = positive(member(value, "planner", "arm_resolution"), "planner.arm_resolution");
@@ -125,12 +131,15 @@ class KitchenReader : detail::WorldFields {
       fail("planner.base_resolution", "must be below the wall thickness (" + number_text(world.wall_thickness) +
                                           " m), or a motion could jump through a wall between two checks");
     }
-    planner.base_distance = pair(member(value, "planner", "base_distance"), "planner.base_distance", "nearest, farthest");
+    planner.base_distance =
+        pair(member(value, "planner", "base_distance"), "planner.base_distance", "nearest, farthest");
     if (!(planner.base_distance[0] > 0 && planner.base_distance[1] > planner.base_distance[0])) {
       fail("planner.base_distance", "must be two distances with 0 < nearest < farthest");
     }
-    planner.base_heading_spread = non_negative(member(value, "planner", "base_heading_spread"), "planner.base_heading_spread");
-    planner.approach_distance = non_negative(member(value, "planner", "approach_distance"), "planner.approach_distance");
+    planner.base_heading_spread =
+        non_negative(member(value, "planner", "base_heading_spread"), "planner.base_heading_spread");
+    planner.approach_distance =
+        non_negative(member(value, "planner", "approach_distance"), "planner.approach_distance");
     planner.ik_checks = whole(member(value, "planner", "ik_checks"), "planner.ik_checks", 0, 1'000'000);
     planner.target_checks = whole(member(value, "planner", "target_checks"), "planner.target_checks", 1, 1'000'000'000);
     planner.placement_gap = positive(member(value, "planner", "placement_gap"), "planner.placement_gap");
@@ -140,7 +149,8 @@ class KitchenReader : detail::WorldFields {
     object_at(value, path);
     check_keys(value, path, {"min", "max"});
     const std::vector<double> low = numbers(member(value, path, "min"), detail::json_member(path, "min"), 3, "x, y, z");
-    const std::vector<double> high = numbers(member(value, path, "max"), detail::json_member(path, "max"), 3, "x, y, z");
+    const std::vector<double> high =
+        numbers(member(value, path, "max"), detail::json_member(path, "max"), 3, "x, y, z");
     Box3 box{{low[0], low[1], low[2]}, {high[0], high[1], high[2]}};
     for (std::size_t axis = 0; axis < 3; ++axis) {
       if (!(box.max[axis] > box.min[axis])) fail(path, "'max' must exceed 'min' in x, y and z");
@@ -154,13 +164,15 @@ class KitchenReader : detail::WorldFields {
   }
 
   void read_fixed(const Json& value, ManipulationWorld& world) const {
-    if (!value.is_object() || value.empty()) fail("fixed", "must be an object mapping furniture names to arrays of boxes");
+    if (!value.is_object() || value.empty())
+      fail("fixed", "must be an object mapping furniture names to arrays of boxes");
     for (const auto& [name, boxes] : value.items()) {
       const std::string path = detail::json_member("fixed", name);
       if (name.empty()) fail(path, "furniture names must be non-empty");
       if (!boxes.is_array() || boxes.empty()) fail(path, "must be a non-empty array of boxes");
       FixedObject fixed{name, {}};
-      for (std::size_t i = 0; i < boxes.size(); ++i) fixed.boxes.push_back(read_box(boxes[i], detail::json_index(path, i), world));
+      for (std::size_t i = 0; i < boxes.size(); ++i)
+        fixed.boxes.push_back(read_box(boxes[i], detail::json_index(path, i), world));
       world.fixed.push_back(std::move(fixed));
     }
   }
@@ -177,7 +189,8 @@ class KitchenReader : detail::WorldFields {
       region.surface = string_at(member(region_json, path, "on"), detail::json_member(path, "on"));
       const auto fixed = std::find_if(world.fixed.begin(), world.fixed.end(),
                                       [&](const FixedObject& candidate) { return candidate.name == region.surface; });
-      if (fixed == world.fixed.end()) fail(detail::json_member(path, "on"), "unknown furniture '" + region.surface + "'");
+      if (fixed == world.fixed.end())
+        fail(detail::json_member(path, "on"), "unknown furniture '" + region.surface + "'");
       region.height = finite(member(region_json, path, "height"), detail::json_member(path, "height"));
       const auto low = pair(member(region_json, path, "min"), detail::json_member(path, "min"), "x, y");
       const auto high = pair(member(region_json, path, "max"), detail::json_member(path, "max"), "x, y");
@@ -219,18 +232,23 @@ class KitchenReader : detail::WorldFields {
       check_keys(object_json, path, {"size", "on", "pose"});
       MovableObject object;
       object.id = id;
-      const std::vector<double> size = numbers(member(object_json, path, "size"), detail::json_member(path, "size"), 3, "x, y, z");
-      if (!(size[0] > 0 && size[1] > 0 && size[2] > 0)) fail(detail::json_member(path, "size"), "every size must be positive");
+      const std::vector<double> size =
+          numbers(member(object_json, path, "size"), detail::json_member(path, "size"), 3, "x, y, z");
+      if (!(size[0] > 0 && size[1] > 0 && size[2] > 0))
+        fail(detail::json_member(path, "size"), "every size must be positive");
       if (size[0] >= widest || size[1] >= widest) {
-        fail(detail::json_member(path, "size"), "x and y must be below " + number_text(widest) +
-                                                    " m, or the gripper could not close around the object with its clearance");
+        fail(detail::json_member(path, "size"),
+             "x and y must be below " + number_text(widest) +
+                 " m, or the gripper could not close around the object with its clearance");
       }
-      if (size[2] <= 2 * kTopGraspDepth) fail(detail::json_member(path, "size"), "z must exceed " + number_text(2 * kTopGraspDepth) + " m");
+      if (size[2] <= 2 * kTopGraspDepth)
+        fail(detail::json_member(path, "size"), "z must exceed " + number_text(2 * kTopGraspDepth) + " m");
       object.size = {size[0], size[1], size[2]};
       object.region = string_at(member(object_json, path, "on"), detail::json_member(path, "on"));
       const int region = world.region_index(object.region);
       if (region < 0) fail(detail::json_member(path, "on"), "unknown region '" + object.region + "'");
-      const std::vector<double> pose = numbers(member(object_json, path, "pose"), detail::json_member(path, "pose"), 3, "x, y, yaw");
+      const std::vector<double> pose =
+          numbers(member(object_json, path, "pose"), detail::json_member(path, "pose"), 3, "x, y, yaw");
       const PlacementRegion& on = world.regions[static_cast<std::size_t>(region)];
       // Objects start on the region's surface (the rectangle is where placements are drawn).
       const FixedObject& surface = *std::find_if(world.fixed.begin(), world.fixed.end(),
@@ -271,7 +289,8 @@ class KitchenReader : detail::WorldFields {
     for (std::size_t i = 0; i < world.objects.size(); ++i) {
       const ManipulationCollision alone(world, arm, poses, static_cast<int>(i), Transform::Identity(), 0.0);
       if (alone.held_object_collides(poses[i])) {
-        fail(detail::json_member("objects", world.objects[i].id), "overlaps a wall, a piece of furniture or another object");
+        fail(detail::json_member("objects", world.objects[i].id),
+             "overlaps a wall, a piece of furniture or another object");
       }
     }
     const ManipulationCollision collision(world, arm, poses, -1, Transform::Identity(), world.robot.clearance);
@@ -291,18 +310,21 @@ class KitchenReader : detail::WorldFields {
       for (std::size_t l = 0; l < skeleton.size(); ++l) {
         const std::string place = detail::json_index(detail::json_index("skeletons", k), l);
         const std::optional<ManipulationAction> action = parse_manipulation_action(skeleton[l]);
-        if (!action) fail(place, "'" + skeleton[l] + "' is neither move+pick(OBJECT)[...] nor move+place(OBJECT,REGION)[...]");
+        if (!action)
+          fail(place, "'" + skeleton[l] + "' is neither move+pick(OBJECT)[...] nor move+place(OBJECT,REGION)[...]");
         const int object = world.object_index(action->object);
         if (object < 0) fail(place, "unknown object '" + action->object + "'");
         if (action->context != moved) {
-          fail(place, "its context must list the objects moved before it: [" + join(moved) + "], not [" + join(action->context) + "]");
+          fail(place, "its context must list the objects moved before it: [" + join(moved) + "], not [" +
+                          join(action->context) + "]");
         }
         if (action->kind == ManipulationKind::pick) {
           if (!held.empty()) fail(place, "the hand already holds " + held);
           held = action->object;
         } else {
           if (world.region_index(action->region) < 0) fail(place, "unknown region '" + action->region + "'");
-          if (held != action->object) fail(place, held.empty() ? "the hand is empty" : "the hand holds " + held + ", not " + action->object);
+          if (held != action->object)
+            fail(place, held.empty() ? "the hand is empty" : "the hand holds " + held + ", not " + action->object);
           held.clear();
           where[static_cast<std::size_t>(object)] = action->region;
           moved.push_back(action->object);

@@ -28,17 +28,20 @@ struct NavigationCollision::Impl {
   std::unique_ptr<fcl::CollisionObjectd> robot;
 };
 
-NavigationCollision::NavigationCollision(const NavigationWorld& world, double clearance) : impl_(std::make_unique<Impl>()) {
+NavigationCollision::NavigationCollision(const NavigationWorld& world, double clearance)
+    : impl_(std::make_unique<Impl>()) {
   const auto add = [this](const Rectangle& shape) {
     auto box = std::make_shared<fcl::Boxd>(shape.length, shape.width, kHeight);
-    impl_->obstacles.push_back(std::make_unique<fcl::CollisionObjectd>(box, planar_transform(shape.x, shape.y, shape.angle)));
+    impl_->obstacles.push_back(
+        std::make_unique<fcl::CollisionObjectd>(box, planar_transform(shape.x, shape.y, shape.angle)));
     impl_->obstacles.back()->computeAABB();
     impl_->manager.registerObject(impl_->obstacles.back().get());
   };
   for (const Rectangle& wall : world.walls) add(wall);
   for (const Obstacle& obstacle : world.obstacles) add(obstacle.shape);
   impl_->manager.setup();
-  auto footprint = std::make_shared<fcl::Boxd>(world.robot.length + 2 * clearance, world.robot.width + 2 * clearance, kHeight);
+  auto footprint =
+      std::make_shared<fcl::Boxd>(world.robot.length + 2 * clearance, world.robot.width + 2 * clearance, kHeight);
   impl_->robot = std::make_unique<fcl::CollisionObjectd>(footprint, fcl::Transform3d::Identity());
 }
 

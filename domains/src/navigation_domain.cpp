@@ -1,11 +1,10 @@
-#include "ontime/domains/navigation.hpp"
-
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
 
 #include "navigation_refinement.hpp"
 #include "ompl_support.hpp"
+#include "ontime/domains/navigation.hpp"
 #include "ontime/domains/navigation_collision.hpp"
 #include "ontime/random.hpp"
 
@@ -21,7 +20,9 @@ Pose pose_of(const Configuration& configuration) {
 
 NavigationDomain::NavigationDomain(NavigationWorld world) : world_(std::move(world)) { detail::quiet_ompl(); }
 
-Configuration NavigationDomain::initial_configuration() const { return {world_.start.x, world_.start.y, world_.start.theta}; }
+Configuration NavigationDomain::initial_configuration() const {
+  return {world_.start.x, world_.start.y, world_.start.theta};
+}
 
 std::unique_ptr<Refinement> NavigationDomain::refine(const std::string& action, const Configuration& start,
                                                      std::uint64_t seed, const EffortSettings& effort) const {
@@ -58,9 +59,10 @@ Scene NavigationDomain::scene() const {
   Scene scene;
   scene.title = world_.name;
   for (const Room& room : world_.rooms) {
-    scene.polygons.push_back(ScenePolygon{"room", room.id,
-                                          {{room.min_x, room.min_y}, {room.max_x, room.min_y}, {room.max_x, room.max_y},
-                                           {room.min_x, room.max_y}}});
+    scene.polygons.push_back(ScenePolygon{
+        "room",
+        room.id,
+        {{room.min_x, room.min_y}, {room.max_x, room.min_y}, {room.max_x, room.max_y}, {room.min_x, room.max_y}}});
   }
   for (const Rectangle& wall : world_.walls) {
     const auto corners = wall.corners();

@@ -9,9 +9,9 @@
 #include <stdexcept>
 
 #include "ompl_support.hpp"
-#include "phased_refinement.hpp"
 #include "ontime/domains/navigation_collision.hpp"
 #include "ontime/random.hpp"
+#include "phased_refinement.hpp"
 
 namespace ontime::domains {
 namespace {
@@ -35,8 +35,9 @@ class NavigationRefinement final : public detail::PhasedRefinement {
     if (!source.contains(start_.x, start_.y)) throw std::invalid_argument("the start pose is not in room " + source.id);
     if (collision_.collides(start_)) throw std::invalid_argument("the start pose is in collision");
     const double half = world.wall_thickness / 2;
-    const std::array<double, 4> bounds{std::min(source.min_x, target.min_x) - half, std::min(source.min_y, target.min_y) - half,
-                                       std::max(source.max_x, target.max_x) + half, std::max(source.max_y, target.max_y) + half};
+    const std::array<double, 4> bounds{
+        std::min(source.min_x, target.min_x) - half, std::min(source.min_y, target.min_y) - half,
+        std::max(source.max_x, target.max_x) + half, std::max(source.max_y, target.max_y) + half};
     auto space = std::make_shared<ob::SE2StateSpace>();
     ob::RealVectorBounds limits(2);
     limits.setLow(0, bounds[0]);
@@ -96,7 +97,8 @@ class NavigationRefinement final : public detail::PhasedRefinement {
 
   void sample_goal() {
     const double half = domain_.world().wall_thickness / 2;
-    const Pose candidate{uniform(target_.min_x + half, target_.max_x - half), uniform(target_.min_y + half, target_.max_y - half),
+    const Pose candidate{uniform(target_.min_x + half, target_.max_x - half),
+                         uniform(target_.min_y + half, target_.max_y - half),
                          uniform(-std::numbers::pi, std::numbers::pi)};
     meter_.count_check();
     if (collision_.collides(candidate)) return;
@@ -148,8 +150,9 @@ class NavigationRefinement final : public detail::PhasedRefinement {
 
 }  // namespace
 
-std::unique_ptr<Refinement> make_navigation_refinement(const NavigationDomain& domain, const Room& source, const Room& target,
-                                                       const Pose& start, std::uint64_t seed, const EffortSettings& effort) {
+std::unique_ptr<Refinement> make_navigation_refinement(const NavigationDomain& domain, const Room& source,
+                                                       const Room& target, const Pose& start, std::uint64_t seed,
+                                                       const EffortSettings& effort) {
   return std::make_unique<NavigationRefinement>(domain, source, target, start, seed, effort);
 }
 

@@ -19,7 +19,8 @@
 namespace ontime::domains {
 
 // `start` must lie in `source`.
-std::unique_ptr<Refinement> make_navigation_refinement(const NavigationDomain& domain, const Room& source, const Room& target,
-                                                       const Pose& start, std::uint64_t seed, const EffortSettings& effort);
+std::unique_ptr<Refinement> make_navigation_refinement(const NavigationDomain& domain, const Room& source,
+                                                       const Room& target, const Pose& start, std::uint64_t seed,
+                                                       const EffortSettings& effort);
 
 }  // namespace ontime::domains

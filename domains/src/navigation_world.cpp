@@ -9,11 +9,11 @@
 #include <set>
 #include <stdexcept>
 
-#include "world_fields.hpp"
 #include "ontime/domains/navigation_collision.hpp"
 #include "ontime/error.hpp"
 #include "ontime/problem.hpp"
 #include "ontime/skeleton_file.hpp"
+#include "world_fields.hpp"
 
 namespace ontime::domains {
 namespace {
@@ -54,12 +54,15 @@ class WorldReader : detail::WorldFields {
 
   NavigationWorld read(std::string_view text) {
     const Json root = detail::parse_json_strict<Json>(text, source());
-    if (!root.is_object()) fail("top level", "a world must be a JSON object (got " + detail::describe_json_type(root) + ")");
-    check_keys(root, "", {"name", "description", "wall_thickness", "rooms", "doors", "obstacles", "robot", "start",
-                          "goal_room", "planner", "collection", "skeletons"});
+    if (!root.is_object())
+      fail("top level", "a world must be a JSON object (got " + detail::describe_json_type(root) + ")");
+    check_keys(root, "",
+               {"name", "description", "wall_thickness", "rooms", "doors", "obstacles", "robot", "start", "goal_room",
+                "planner", "collection", "skeletons"});
     NavigationWorld world;
     world.source = source();
-    world.name = root.contains("name") ? string_at(root["name"], "name") : std::filesystem::path(source()).stem().string();
+    world.name =
+        root.contains("name") ? string_at(root["name"], "name") : std::filesystem::path(source()).stem().string();
     if (root.contains("description")) world.description = string_at(root["description"], "description");
     world.wall_thickness = positive(member(root, "", "wall_thickness"), "wall_thickness");
     world.robot = read_robot(member(root, "", "robot"));
@@ -81,7 +84,8 @@ class WorldReader : detail::WorldFields {
     object_at(value, "robot");
     check_keys(value, "robot", {"footprint", "clearance", "linear_speed", "angular_speed"});
     RobotModel robot;
-    const std::vector<double> footprint = numbers(member(value, "robot", "footprint"), "robot.footprint", 2, "length, width");
+    const std::vector<double> footprint =
+        numbers(member(value, "robot", "footprint"), "robot.footprint", 2, "length, width");
     if (!(footprint[0] > 0 && footprint[1] > 0)) fail("robot.footprint", "length and width must be positive");
     robot.length = footprint[0];
     robot.width = footprint[1];
@@ -116,8 +120,10 @@ class WorldReader : detail::WorldFields {
       }
       object_at(room_json, path);
       check_keys(room_json, path, {"min", "max"});
-      const std::vector<double> low = numbers(member(room_json, path, "min"), detail::json_member(path, "min"), 2, "x, y");
-      const std::vector<double> high = numbers(member(room_json, path, "max"), detail::json_member(path, "max"), 2, "x, y");
+      const std::vector<double> low =
+          numbers(member(room_json, path, "min"), detail::json_member(path, "min"), 2, "x, y");
+      const std::vector<double> high =
+          numbers(member(room_json, path, "max"), detail::json_member(path, "max"), 2, "x, y");
       Room room{id, low[0], low[1], high[0], high[1]};
       if (!(room.max_x > room.min_x && room.max_y > room.min_y)) fail(path, "'max' must exceed 'min' in x and in y");
       if (std::min(room.max_x - room.min_x, room.max_y - room.min_y) - world.wall_thickness <= smallest) {
@@ -154,13 +160,14 @@ class WorldReader : detail::WorldFields {
       door.rooms = {room_id(rooms[0], detail::json_index(rooms_path, 0), world),
                     room_id(rooms[1], detail::json_index(rooms_path, 1), world)};
       if (door.rooms[0] == door.rooms[1]) fail(rooms_path, "a door joins two different rooms");
-      const std::vector<double> center = numbers(member(door_json, path, "center"), detail::json_member(path, "center"), 2, "x, y");
+      const std::vector<double> center =
+          numbers(member(door_json, path, "center"), detail::json_member(path, "center"), 2, "x, y");
       door.x = center[0];
       door.y = center[1];
       door.width = positive(member(door_json, path, "width"), detail::json_member(path, "width"));
       if (door.width <= passable) {
-        fail(detail::json_member(path, "width"), "narrower than the robot (" + number_text(passable) +
-                                                     " m with clearance); it could never pass");
+        fail(detail::json_member(path, "width"),
+             "narrower than the robot (" + number_text(passable) + " m with clearance); it could never pass");
       }
       const Room& a = world.room(door.rooms[0]);
       const Room& b = world.room(door.rooms[1]);
@@ -170,9 +177,9 @@ class WorldReader : detail::WorldFields {
       const double across = edge->vertical ? door.x : door.y;
       const double along = edge->vertical ? door.y : door.x;
       if (std::abs(across - edge->across) > kTolerance) {
-        fail(detail::json_member(path, "center"), std::string("not on the edge ") + (edge->vertical ? "x" : "y") + " = " +
-                                                      number_text(edge->across) + " that rooms " + a.id + " and " + b.id +
-                                                      " share");
+        fail(detail::json_member(path, "center"), std::string("not on the edge ") + (edge->vertical ? "x" : "y") +
+                                                      " = " + number_text(edge->across) + " that rooms " + a.id +
+                                                      " and " + b.id + " share");
       }
       const double along_low = edge->low, along_high = edge->high;
       if (along - door.width / 2 < along_low + world.wall_thickness / 2 - kTolerance ||
@@ -191,10 +198,13 @@ class WorldReader : detail::WorldFields {
       check_keys(obstacle_json, path, {"name", "center", "size", "angle"});
       Obstacle obstacle;
       obstacle.name = string_at(member(obstacle_json, path, "name"), detail::json_member(path, "name"));
-      const std::vector<double> center = numbers(member(obstacle_json, path, "center"), detail::json_member(path, "center"), 2, "x, y");
-      const std::vector<double> size = numbers(member(obstacle_json, path, "size"), detail::json_member(path, "size"), 2, "length, width");
+      const std::vector<double> center =
+          numbers(member(obstacle_json, path, "center"), detail::json_member(path, "center"), 2, "x, y");
+      const std::vector<double> size =
+          numbers(member(obstacle_json, path, "size"), detail::json_member(path, "size"), 2, "length, width");
       if (!(size[0] > 0 && size[1] > 0)) fail(detail::json_member(path, "size"), "length and width must be positive");
-      const double angle = obstacle_json.contains("angle") ? finite(obstacle_json["angle"], detail::json_member(path, "angle")) : 0.0;
+      const double angle =
+          obstacle_json.contains("angle") ? finite(obstacle_json["angle"], detail::json_member(path, "angle")) : 0.0;
       obstacle.shape = Rectangle{center[0], center[1], size[0], size[1], angle};
       if (std::none_of(world.rooms.begin(), world.rooms.end(),
                        [&](const Room& room) { return room.contains(center[0], center[1]); })) {

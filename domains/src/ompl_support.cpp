@@ -5,7 +5,6 @@
 #include <ompl/util/Console.h>
 
 #include <mutex>
-
 #include <stdexcept>
 
 namespace ontime::domains::detail {

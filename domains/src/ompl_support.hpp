@@ -109,8 +109,7 @@ class SeededVectorSampler final : public ompl::base::StateSampler {
     auto* values = state->as<ompl::base::RealVectorStateSpace::StateType>();
     const auto* centre = near->as<ompl::base::RealVectorStateSpace::StateType>();
     for (std::size_t i = 0; i < bounds_.low.size(); ++i) {
-      values->values[i] =
-          std::clamp(centre->values[i] + uniform(-distance, distance), bounds_.low[i], bounds_.high[i]);
+      values->values[i] = std::clamp(centre->values[i] + uniform(-distance, distance), bounds_.low[i], bounds_.high[i]);
     }
   }
 

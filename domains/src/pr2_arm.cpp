@@ -1,13 +1,12 @@
 #include "ontime/domains/pr2_arm.hpp"
 
+#include <cmath>
 #include <kdl/chain.hpp>
 #include <kdl/chainfksolverpos_recursive.hpp>
 #include <kdl/chainiksolverpos_nr_jl.hpp>
 #include <kdl/chainiksolvervel_wdls.hpp>
 #include <kdl/frames.hpp>
 #include <kdl/jntarray.hpp>
-
-#include <cmath>
 #include <numbers>
 #include <stdexcept>
 
@@ -105,7 +104,8 @@ Pr2Arm::Pr2Arm(double torso_lift) : impl_(std::make_unique<Impl>()) {
   torso_.translation() = Eigen::Vector3d(kTorsoBack, 0, kTorsoHeight + torso_lift);
   impl_->chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::None), KDL::Frame(KDL::Vector(0, kShoulderLeft, 0))));
   for (std::size_t j = 0; j < kArmJointCount; ++j) {
-    impl_->chain.addSegment(KDL::Segment(KDL::Joint(joint_type(kJoints[j].axis)), KDL::Frame(KDL::Vector(kOffsets[j], 0, 0))));
+    impl_->chain.addSegment(
+        KDL::Segment(KDL::Joint(joint_type(kJoints[j].axis)), KDL::Frame(KDL::Vector(kOffsets[j], 0, 0))));
   }
   // Continuous joints get wide limits in the solver (it clamps at its limits) and are wrapped after.
   KDL::JntArray lower(kArmJointCount), upper(kArmJointCount);

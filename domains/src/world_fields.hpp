@@ -18,11 +18,11 @@
 namespace ontime::domains::detail {
 
 using Json = nlohmann::ordered_json;
+using ontime::read_input_file;
 using ontime::detail::describe_json_type;
 using ontime::detail::json_index;
 using ontime::detail::json_member;
 using ontime::detail::parse_json_strict;
-using ontime::read_input_file;
 
 // "%g" of a number, for messages.
 std::string number_text(double value);
@@ -33,14 +33,17 @@ class WorldFields {
 
   const std::string& source() const noexcept { return source_; }
 
-  [[noreturn]] void fail(const std::string& place, const std::string& rule) const { throw InputError(source_, place, rule); }
+  [[noreturn]] void fail(const std::string& place, const std::string& rule) const {
+    throw InputError(source_, place, rule);
+  }
 
   void check_keys(const Json& object, const std::string& path, std::initializer_list<std::string_view> allowed) const {
     ontime::detail::check_known_keys(object, path, allowed, source_);
   }
 
   const Json& member(const Json& object, const std::string& path, const char* key) const {
-    if (!object.contains(key)) fail(path.empty() ? "top level" : path, std::string("missing required key '") + key + "'");
+    if (!object.contains(key))
+      fail(path.empty() ? "top level" : path, std::string("missing required key '") + key + "'");
     return object[key];
   }
 
@@ -84,11 +87,13 @@ class WorldFields {
     const Json& deadline = member(value, "collection", "deadline");
     const std::optional<std::int64_t> steps = ontime::detail::json_whole_number(deadline, 1, Problem::kMaxDeadline);
     if (!steps) {
-      fail("collection.deadline", "must be a whole number of steps between 1 and " + std::to_string(Problem::kMaxDeadline));
+      fail("collection.deadline",
+           "must be a whole number of steps between 1 and " + std::to_string(Problem::kMaxDeadline));
     }
     collection.deadline = static_cast<Steps>(*steps);
     collection.step_seconds = positive(member(value, "collection", "step_seconds"), "collection.step_seconds");
-    collection.checks_per_second = positive(member(value, "collection", "checks_per_second"), "collection.checks_per_second");
+    collection.checks_per_second =
+        positive(member(value, "collection", "checks_per_second"), "collection.checks_per_second");
     return collection;
   }
 

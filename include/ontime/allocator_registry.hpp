@@ -69,7 +69,7 @@ struct Parameter {
   // A file; no default (the kind says what its absence means).
   static Parameter path(std::string name, std::string help);
 
-  std::string name;           // lower case with hyphens: "max-states"
+  std::string name;  // lower case with hyphens: "max-states"
   ParameterType type = ParameterType::real;
   std::string default_value;  // text form; empty: no default (the kind says what that means)
   double minimum = -std::numeric_limits<double>::infinity();  // integer and real

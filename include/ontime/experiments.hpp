@@ -62,11 +62,10 @@ struct AnytimePoint {
 };
 struct AnytimeStudy {
   double reference_decision_seconds = 0;
-  double optimum = 0;               // exact (the optimal solver, within the max-states parameter)
+  double optimum = 0;  // exact (the optimal solver, within the max-states parameter)
   MonteCarloResult reference;
   std::vector<AnytimePoint> points;
 };
-AnytimeStudy anytime_study(const Mdp& mdp, const std::vector<double>& log10_multipliers,
-                           const StudySettings& settings);
+AnytimeStudy anytime_study(const Mdp& mdp, const std::vector<double>& log10_multipliers, const StudySettings& settings);
 
 }  // namespace ontime

@@ -59,9 +59,9 @@ struct FitOptions {
 // What the log said about one action.
 struct ActionFit {
   std::string id;
-  std::size_t attempts = 0;   // records of the action
-  std::size_t found = 0;      // of which found a motion
-  std::size_t censored = 0;   // of which were cut off
+  std::size_t attempts = 0;  // records of the action
+  std::size_t found = 0;     // of which found a motion
+  std::size_t censored = 0;  // of which were cut off
 };
 
 struct FitResult {

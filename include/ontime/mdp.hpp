@@ -40,13 +40,11 @@ class ChoiceList {
 
 // What one step of refinement effort revealed.
 struct Observation {
-  bool refined = false;   // a motion was found in this step
-  Steps execution = 0;    // its execution time (may be kNever); only when refined
+  bool refined = false;  // a motion was found in this step
+  Steps execution = 0;   // its execution time (may be kNever); only when refined
 
   static constexpr Observation not_yet() noexcept { return {}; }
-  static constexpr Observation found(Steps execution_steps) noexcept {
-    return {true, execution_steps};
-  }
+  static constexpr Observation found(Steps execution_steps) noexcept { return {true, execution_steps}; }
 };
 
 class Mdp {
@@ -62,7 +60,9 @@ class Mdp {
   // The action skeleton k refines next, or -1 when it is fully refined (choosing it idles).
   int next_action(const State& state, int k) const noexcept {
     const int refined = state.refined[static_cast<std::size_t>(k)];
-    return refined < lengths_[static_cast<std::size_t>(k)] ? paths_[offsets_[static_cast<std::size_t>(k)] + static_cast<std::size_t>(refined)] : -1;
+    return refined < lengths_[static_cast<std::size_t>(k)]
+               ? paths_[offsets_[static_cast<std::size_t>(k)] + static_cast<std::size_t>(refined)]
+               : -1;
   }
 
   // Applies one step of effort on skeleton `choice` with its observed result, in place.
@@ -109,12 +109,14 @@ class Mdp {
 
   // P(the next step of effort on `action` finds a motion | `spent` steps did not).
   double hazard(int action, Steps spent) const noexcept {
-    return spent < deadline_ ? hazards_[static_cast<std::size_t>(action) * static_cast<std::size_t>(deadline_) + static_cast<std::size_t>(spent)] : 0.0;
+    return spent < deadline_ ? hazards_[static_cast<std::size_t>(action) * static_cast<std::size_t>(deadline_) +
+                                        static_cast<std::size_t>(spent)]
+                             : 0.0;
   }
 
  private:
   struct ExecutionOutcome {
-    Steps steps;          // deadline + 1 stands for "too slow or never"
+    Steps steps;  // deadline + 1 stands for "too slow or never"
     double probability;
   };
 
@@ -125,14 +127,14 @@ class Mdp {
   const Problem* problem_;
   int skeleton_count_;
   Steps deadline_;
-  std::vector<int> lengths_;             // A_k
-  std::vector<std::size_t> offsets_;     // start of skeleton k in paths_
-  std::vector<int> paths_;               // actions of all skeletons, concatenated
-  std::vector<std::int64_t> rest_;       // least planning+execution of positions l.. of k (offsets_ + l)
-  std::vector<double> hazards_;          // [action][spent], spent < deadline
-  std::vector<Steps> next_finish_;       // [action][spent]: least t >= 1 with p(spent + t) > 0, or kNever
+  std::vector<int> lengths_;          // A_k
+  std::vector<std::size_t> offsets_;  // start of skeleton k in paths_
+  std::vector<int> paths_;            // actions of all skeletons, concatenated
+  std::vector<std::int64_t> rest_;    // least planning+execution of positions l.. of k (offsets_ + l)
+  std::vector<double> hazards_;       // [action][spent], spent < deadline
+  std::vector<Steps> next_finish_;    // [action][spent]: least t >= 1 with p(spent + t) > 0, or kNever
   std::vector<std::vector<ExecutionOutcome>> execution_outcomes_;  // per action
-  std::vector<Steps> min_execution_;     // per action, kNever if none
+  std::vector<Steps> min_execution_;                               // per action, kNever if none
 };
 
 template <class Visitor>
@@ -167,8 +169,8 @@ Observation Mdp::sample_observation(const State& state, int choice, Generator& g
   const double found = hazard(action, state.spent[static_cast<std::size_t>(choice)]);
   if (!(uniform01(generator) < found)) return Observation::not_yet();
   const auto& outcomes = execution_outcomes_[static_cast<std::size_t>(action)];
-  const std::size_t drawn =
-      sample_index(outcomes.size(), [&outcomes](std::size_t i) { return outcomes[i].probability; }, generator);
+  const std::size_t drawn = sample_index(
+      outcomes.size(), [&outcomes](std::size_t i) { return outcomes[i].probability; }, generator);
   return Observation::found(outcomes[drawn].steps);
 }
 

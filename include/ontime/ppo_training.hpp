@@ -21,12 +21,12 @@ namespace ontime {
 
 struct LearningCurvePoint {
   int epoch = 0;
-  std::uint64_t episodes = 0;        // training episodes so far
-  std::uint64_t steps = 0;           // environment steps so far
-  double success_rate = 0;           // of this epoch's episodes (sampled actions)
-  double mean_episode_length = 0;    // steps
-  int actor_steps = 0;               // gradient steps before the KL stop
-  double seconds = 0;                // wall-clock since training started
+  std::uint64_t episodes = 0;      // training episodes so far
+  std::uint64_t steps = 0;         // environment steps so far
+  double success_rate = 0;         // of this epoch's episodes (sampled actions)
+  double mean_episode_length = 0;  // steps
+  int actor_steps = 0;             // gradient steps before the KL stop
+  double seconds = 0;              // wall-clock since training started
 };
 
 struct PpoTraining {

@@ -16,9 +16,9 @@
 namespace ontime {
 
 struct Action {
-  std::string id;            // e.g. "move(R1,R5)"
-  Distribution planning;     // steps of effort until refined, t >= 1
-  Distribution execution;    // steps to execute the refined motion, x >= 0
+  std::string id;          // e.g. "move(R1,R5)"
+  Distribution planning;   // steps of effort until refined, t >= 1
+  Distribution execution;  // steps to execute the refined motion, x >= 0
 };
 
 class Problem {
@@ -52,17 +52,13 @@ class Problem {
 
   // Prefix tree. Every action used by some skeleton is one node.
   // Skeletons whose path passes through the action, ascending (N(k, l) of Eq. (1)).
-  std::span<const int> members(int action) const {
-    return members_.at(static_cast<std::size_t>(action));
-  }
+  std::span<const int> members(int action) const { return members_.at(static_cast<std::size_t>(action)); }
   // Position of the action in the skeletons that use it; -1 when no skeleton uses it.
   int position(int action) const { return position_.at(static_cast<std::size_t>(action)); }
   // The preceding action on the path from the root, or -1 for a first action.
   int parent(int action) const { return parent_.at(static_cast<std::size_t>(action)); }
   // True when some skeleton ends with this action (refining it may complete a plan).
-  bool completes_a_skeleton(int action) const {
-    return completes_.at(static_cast<std::size_t>(action)) != 0;
-  }
+  bool completes_a_skeleton(int action) const { return completes_.at(static_cast<std::size_t>(action)) != 0; }
 
  private:
   std::string name_;

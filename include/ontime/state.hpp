@@ -13,9 +13,9 @@
 namespace ontime {
 
 struct State {
-  std::uint16_t time = 0;                                  // CT: steps used
-  std::array<std::uint8_t, Problem::kMaxSkeletons> refined{};     // l_k: actions refined
-  std::array<std::uint16_t, Problem::kMaxSkeletons> spent{};      // PT_k: steps on action l_k
+  std::uint16_t time = 0;                                      // CT: steps used
+  std::array<std::uint8_t, Problem::kMaxSkeletons> refined{};  // l_k: actions refined
+  std::array<std::uint16_t, Problem::kMaxSkeletons> spent{};   // PT_k: steps on action l_k
   // ET_k: execution steps of the refined actions, saturated at deadline + 1 (any larger
   // value is equally too slow, and saturation keeps equivalent states equal).
   std::array<std::uint16_t, Problem::kMaxSkeletons> execution{};

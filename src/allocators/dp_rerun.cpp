@@ -25,15 +25,17 @@ int DpRerunAllocator::choose(const State& state) {
 }
 
 AllocatorKind dp_rerun_kind() {
-  return {.name = "dp-rerun",
-          .summary = "the paper's DP_Rerun: Eq. (1) re-evaluated before every step, the most promising skeleton refined",
-          .capabilities = {Capability::stationary},
-          .parameters = {Parameter::choice("aggregation", "sum", {"sum", "max", "self"},
-                                           "how Eq. (1) combines the skeletons sharing an action")},
-          .make = [](const Mdp& mdp, const ParameterReader& parameters) -> AllocatorFactory {
-            auto table = std::make_shared<const ContiguousSuccessTable>(mdp, parse_aggregation(parameters.text("aggregation")));
-            return [model = &mdp, table] { return std::make_unique<DpRerunAllocator>(*model, table); };
-          }};
+  return {
+      .name = "dp-rerun",
+      .summary = "the paper's DP_Rerun: Eq. (1) re-evaluated before every step, the most promising skeleton refined",
+      .capabilities = {Capability::stationary},
+      .parameters = {Parameter::choice("aggregation", "sum", {"sum", "max", "self"},
+                                       "how Eq. (1) combines the skeletons sharing an action")},
+      .make = [](const Mdp& mdp, const ParameterReader& parameters) -> AllocatorFactory {
+        auto table =
+            std::make_shared<const ContiguousSuccessTable>(mdp, parse_aggregation(parameters.text("aggregation")));
+        return [model = &mdp, table] { return std::make_unique<DpRerunAllocator>(*model, table); };
+      }};
 }
 
 }  // namespace ontime

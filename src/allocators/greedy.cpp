@@ -1,8 +1,8 @@
 #include "ontime/allocators/greedy.hpp"
 
-#include "ontime/allocator_registry.hpp"
-
 #include <limits>
+
+#include "ontime/allocator_registry.hpp"
 
 namespace ontime {
 namespace {

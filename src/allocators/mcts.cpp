@@ -43,10 +43,9 @@ std::size_t MctsAllocator::tree_bytes() const noexcept {
 }
 
 bool MctsAllocator::would_exceed_memory(std::size_t nodes, std::size_t edges, std::size_t outcomes) const {
-  const std::size_t projected =
-      grown_capacity(nodes_.capacity(), nodes_.size() + nodes) * sizeof(DecisionNode) +
-      grown_capacity(edges_.capacity(), edges_.size() + edges) * sizeof(Edge) +
-      grown_capacity(outcomes_.capacity(), outcomes_.size() + outcomes) * sizeof(Outcome);
+  const std::size_t projected = grown_capacity(nodes_.capacity(), nodes_.size() + nodes) * sizeof(DecisionNode) +
+                                grown_capacity(edges_.capacity(), edges_.size() + edges) * sizeof(Edge) +
+                                grown_capacity(outcomes_.capacity(), outcomes_.size() + outcomes) * sizeof(Outcome);
   return projected > options_.max_tree_bytes;
 }
 

@@ -57,12 +57,15 @@ struct OptimalSolver::Impl {
   static Search make(const Mdp& mdp, std::size_t max_states) {
     const auto build = [&]<std::size_t Words>() -> Search {
       return detail::Expectimax<OptimalPolicy<Words>>(mdp, OptimalPolicy<Words>(mdp), max_states,
-                                                       OptimalSolver::kTieTolerance, "optimal");
+                                                      OptimalSolver::kTieTolerance, "optimal");
     };
     switch (detail::packed_words(mdp)) {
-      case 2: return build.template operator()<2>();
-      case 4: return build.template operator()<4>();
-      default: return build.template operator()<0>();
+      case 2:
+        return build.template operator()<2>();
+      case 4:
+        return build.template operator()<4>();
+      default:
+        return build.template operator()<0>();
     }
   }
 

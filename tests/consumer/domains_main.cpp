@@ -1,6 +1,5 @@
 // Loads a domain's world file with the installed domains component and prints its skeletons.
 #include <iostream>
-
 #include <ontime/domains/registry.hpp>
 
 int main(int argc, char** argv) {

@@ -2,7 +2,6 @@
 // the public PPO handle (no Eigen in sight), then prints the optimum.
 #include <iostream>
 #include <memory>
-
 #include <ontime/ontime.hpp>
 
 int main(int argc, char** argv) {

@@ -1,13 +1,14 @@
 #include "support/process.hpp"
 
-#include <array>
-#include <chrono>
-#include <csignal>
-#include <cerrno>
 #include <poll.h>
-#include <stdexcept>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include <array>
+#include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <stdexcept>
 
 namespace ontime::testing {
 

@@ -31,16 +31,16 @@
 #include <vector>
 
 #include "ontime/allocator.hpp"
+#include "ontime/decision_budget.hpp"
 #include "ontime/mdp.hpp"
 #include "ontime/random.hpp"
-#include "ontime/decision_budget.hpp"
 
 namespace ontime {
 
 struct MctsOptions {
-  double exploration = 0.5;                              // C of UCT
+  double exploration = 0.5;                                    // C of UCT
   DecisionBudget budget = DecisionBudget::iterations(10'000);  // default per decision
-  std::size_t max_tree_bytes = std::size_t{1} << 30;      // 1 GiB
+  std::size_t max_tree_bytes = std::size_t{1} << 30;           // 1 GiB
   bool reuse_tree = true;
   // Rollout policy: nullptr for uniformly random useful choices, else a factory of a
   // stationary allocator (its choices must depend on the state alone).
@@ -80,7 +80,7 @@ class MctsAllocator final : public Allocator {
     std::uint32_t visits = 0;
     std::uint16_t edge_count = 0;
   };
-  struct Edge {  // a chance node: one choice in a decision node
+  struct Edge {                           // a chance node: one choice in a decision node
     std::uint32_t first_outcome = kNone;  // kNone until first taken
     std::uint32_t visits = 0;
     std::uint32_t successes = 0;

@@ -76,7 +76,6 @@ class OptimalAllocator final : public Allocator {
   std::string_view name() const noexcept override { return "optimal"; }
   int choose(const State& state) override;
 
-
  private:
   const Mdp* mdp_;
   std::shared_ptr<const OptimalSolver> solved_;

@@ -45,9 +45,9 @@ class ThompsonAllocator final : public Allocator {
 
   const Mdp* mdp_;
   SplitMix64 generator_{0};
-  std::uint64_t decision_ = 0;             // numbers the draws: an action is drawn once per decision
-  std::vector<std::uint64_t> drawn_at_;    // per action: the decision of its last draw
-  std::vector<std::int64_t> drawn_time_;   // per action: its draw in that decision
+  std::uint64_t decision_ = 0;            // numbers the draws: an action is drawn once per decision
+  std::vector<std::uint64_t> drawn_at_;   // per action: the decision of its last draw
+  std::vector<std::int64_t> drawn_time_;  // per action: its draw in that decision
 };
 
 }  // namespace ontime

@@ -39,10 +39,10 @@ std::vector<TreeAction> skeleton_tree(const std::vector<std::vector<std::string>
 struct CollectionOptions {
   std::uint64_t trials = 1000;  // attempts per action
   std::uint64_t seed = 1;
-  unsigned threads = 0;         // 0: one per hardware thread
+  unsigned threads = 0;  // 0: one per hardware thread
   EffortSettings effort;
-  double step_seconds = 1.0;    // one step of effort
-  Steps budget_steps = 1;       // cut-off
+  double step_seconds = 1.0;  // one step of effort
+  Steps budget_steps = 1;     // cut-off
   // Called with the number of attempts done and the total (from one thread at a time).
   std::function<void(std::uint64_t done, std::uint64_t total)> progress;
   // When set: trials it holds are taken from it instead of being run again, and every trial

@@ -70,8 +70,8 @@ class Domain {
 
   // Starts refining `action` from `start`; every random choice comes from `seed`.
   // Throws std::invalid_argument for an unknown action or an invalid start.
-  virtual std::unique_ptr<Refinement> refine(const std::string& action, const Configuration& start,
-                                             std::uint64_t seed, const EffortSettings& effort) const = 0;
+  virtual std::unique_ptr<Refinement> refine(const std::string& action, const Configuration& start, std::uint64_t seed,
+                                             const EffortSettings& effort) const = 0;
 
   // A start for `action` drawn from `seed` when no refinement of the action before it
   // succeeded (so there is no end configuration to start from).

@@ -72,16 +72,16 @@ struct ManipulationRobot {
 };
 
 struct ManipulationPlanner {
-  double arm_range = 0;        // RRT-Connect's longest extension in joint space (rad)
-  double arm_resolution = 0;   // joint-space distance between collision checks (rad)
-  double base_range = 0;       // as navigation's: SE(2) state-space distance
-  double base_resolution = 0;  // metres of SE(2) state-space distance between checks
+  double arm_range = 0;                   // RRT-Connect's longest extension in joint space (rad)
+  double arm_resolution = 0;              // joint-space distance between collision checks (rad)
+  double base_range = 0;                  // as navigation's: SE(2) state-space distance
+  double base_resolution = 0;             // metres of SE(2) state-space distance between checks
   std::array<double, 2> base_distance{};  // base positions are drawn this far from the target (m)
   double base_heading_spread = 0;         // base heading: facing the target, +- this (rad)
-  double approach_distance = 0;  // the gripper's last stretch to a grasp or placement, along its axis (m)
-  int ik_checks = 0;           // effort of one IK solve, in collision checks
-  int target_checks = 0;       // effort spent on one target before drawing another
-  double placement_gap = 0;    // objects rest this far above their surface (m)
+  double approach_distance = 0;           // the gripper's last stretch to a grasp or placement, along its axis (m)
+  int ik_checks = 0;                      // effort of one IK solve, in collision checks
+  int target_checks = 0;                  // effort spent on one target before drawing another
+  double placement_gap = 0;               // objects rest this far above their surface (m)
 };
 
 struct ManipulationWorld {

@@ -27,8 +27,8 @@ struct Room {
 
 struct Door {
   std::array<std::string, 2> rooms;
-  double x = 0, y = 0;  // centre, on the shared edge
-  double width = 0;     // clear opening
+  double x = 0, y = 0;            // centre, on the shared edge
+  double width = 0;               // clear opening
   bool on_vertical_edge = false;  // the shared edge runs along y (rooms side by side in x)
 };
 
