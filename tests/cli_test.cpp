@@ -975,12 +975,19 @@ TEST(Cli, InterruptedTrainingLeavesTheOldSetOrTheNewSetNeverAMix) {
     }
     return false;
   });
-  EXPECT_EQ(staging.exit_code, 128 + SIGINT) << staging.err;
   EXPECT_EQ(entries(), expected_names);
-  // (Compared as booleans: a failure would print whole files.)
-  EXPECT_TRUE(read_file(policy) == old_set[0]);
-  EXPECT_TRUE(read_file(csv) == old_set[1]);
-  EXPECT_TRUE(read_file(png) == old_set[2]);
+  // The signal lands while the set is staged (the old set stays), or, rarely, while it is being
+  // renamed with signals held (the whole new set is in place): never a mix. (Compared as
+  // booleans: a failure would print whole files.)
+  if (read_file(policy) == old_set[0]) {
+    EXPECT_EQ(staging.exit_code, 128 + SIGINT) << staging.err;
+    EXPECT_TRUE(read_file(csv) == old_set[1]);
+    EXPECT_TRUE(read_file(png) == old_set[2]);
+  } else {
+    EXPECT_TRUE(staging.exit_code == 128 + SIGINT || staging.exit_code == 0) << staging.err;
+    EXPECT_TRUE(read_file(csv) != old_set[1]) << "a new policy beside the old curve CSV";
+    EXPECT_TRUE(read_file(png) != old_set[2]) << "a new policy beside the old curve PNG";
+  }
 
   // Cut off as soon as a new policy shows: the curve beside it is new too.
   const std::vector<std::string> before{read_file(policy), read_file(csv), read_file(png)};
