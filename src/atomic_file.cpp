@@ -55,70 +55,77 @@ int write_all(int descriptor, std::string_view content) {
   return 0;
 }
 
-// Devices and FIFOs cannot be replaced without destroying them; they get the content directly.
-void write_directly(const std::filesystem::path& path, std::string_view content) {
-  const int descriptor = ::open(path.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC);
-  if (descriptor < 0) fail(path, "cannot open", errno);
-  const int error = write_all(descriptor, content);
-  ::close(descriptor);
-  if (error != 0) fail(path, "cannot write", error);
-}
-
-void replace_atomically(const std::filesystem::path& path, std::string_view content) {
-  const std::filesystem::path directory = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
-  // Built with += : GCC 12 warns falsely (-Wrestrict) on "." + std::string.
-  std::string temporary_name(".");
-  temporary_name += path.filename().string();
-  temporary_name += ".tmp-XXXXXX";
-  std::string pattern = (directory / temporary_name).string();
-  const int descriptor = ::mkstemp(pattern.data());
-  if (descriptor < 0) fail(path, "cannot create a temporary file beside it", errno);
-  const auto abandon = [&](const char* what, int error) {
-    ::close(descriptor);
-    ::unlink(pattern.c_str());
-    fail(path, what, error);
-  };
-  if (const int error = write_all(descriptor, content); error != 0) abandon("cannot write", error);
-  if (::fchmod(descriptor, 0644) != 0) abandon("cannot set permissions", errno);
-  if (::fsync(descriptor) != 0) abandon("cannot flush", errno);
-  if (::close(descriptor) != 0) {
-    const int error = errno;
-    ::unlink(pattern.c_str());
-    fail(path, "cannot close", error);
-  }
-  if (std::rename(pattern.c_str(), path.c_str()) != 0) {
-    const int error = errno;
-    ::unlink(pattern.c_str());
-    fail(path, "cannot replace", error);
-  }
-}
-
 }  // namespace
 
-void write_file_atomically(const std::filesystem::path& path, std::string_view content) {
+AtomicFileWriter::AtomicFileWriter(const std::filesystem::path& path) : target_(path) {
   struct stat link {};
+  bool direct = false;
   if (::lstat(path.c_str(), &link) != 0) {
     if (errno != ENOENT) fail(path, "cannot inspect", errno);
-    replace_atomically(path, content);
+  } else {
+    struct stat target {};
+    if (::stat(path.c_str(), &target) != 0) fail(path, "is a symbolic link that cannot be followed", errno);
+    if (S_ISDIR(target.st_mode)) fail(path, "cannot replace", EISDIR);
+    // Devices and FIFOs cannot be replaced without destroying them; they get the content directly.
+    direct = S_ISCHR(target.st_mode) || S_ISFIFO(target.st_mode);
+    if (!direct && !S_ISREG(target.st_mode)) {
+      throw UsageError(path.string() + ": is neither a regular file, a character device nor a FIFO");
+    }
+    if (!direct && S_ISLNK(link.st_mode)) {
+      std::error_code error;
+      target_ = std::filesystem::canonical(path, error);
+      if (error) fail(path, "cannot follow the symbolic link", error.value());
+    }
+  }
+  if (direct) {
+    descriptor_ = ::open(path.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC);
+    if (descriptor_ < 0) fail(path, "cannot open", errno);
     return;
   }
-  struct stat target {};
-  if (::stat(path.c_str(), &target) != 0) fail(path, "is a symbolic link that cannot be followed", errno);
-  if (S_ISCHR(target.st_mode) || S_ISFIFO(target.st_mode)) {
-    write_directly(path, content);
+  const std::filesystem::path directory =
+      target_.has_parent_path() ? target_.parent_path() : std::filesystem::path(".");
+  // Built with += : GCC 12 warns falsely (-Wrestrict) on "." + std::string.
+  std::string temporary_name(".");
+  temporary_name += target_.filename().string();
+  temporary_name += ".tmp-XXXXXX";
+  temporary_ = (directory / temporary_name).string();
+  descriptor_ = ::mkstemp(temporary_.data());
+  if (descriptor_ < 0) {
+    temporary_.clear();
+    fail(target_, "cannot create a temporary file beside it", errno);
+  }
+}
+
+AtomicFileWriter::~AtomicFileWriter() {
+  if (descriptor_ >= 0) ::close(descriptor_);
+  if (!committed_ && !temporary_.empty()) ::unlink(temporary_.c_str());
+}
+
+void AtomicFileWriter::write(std::string_view piece) {
+  if (const int error = write_all(descriptor_, piece); error != 0) fail(target_, "cannot write", error);
+}
+
+void AtomicFileWriter::commit() {
+  if (temporary_.empty()) {  // a device or FIFO: written already
+    const int error = ::close(descriptor_) != 0 ? errno : 0;
+    descriptor_ = -1;
+    committed_ = true;
+    if (error != 0) fail(target_, "cannot write", error);
     return;
   }
-  if (S_ISDIR(target.st_mode)) fail(path, "cannot replace", EISDIR);
-  if (!S_ISREG(target.st_mode))
-    throw UsageError(path.string() + ": is neither a regular file, a character device nor a FIFO");
-  if (!S_ISLNK(link.st_mode)) {
-    replace_atomically(path, content);
-    return;
-  }
-  std::error_code error;
-  const std::filesystem::path resolved = std::filesystem::canonical(path, error);
-  if (error) fail(path, "cannot follow the symbolic link", error.value());
-  replace_atomically(resolved, content);
+  if (::fchmod(descriptor_, 0644) != 0) fail(target_, "cannot set permissions", errno);
+  if (::fsync(descriptor_) != 0) fail(target_, "cannot flush", errno);
+  const int closed = ::close(descriptor_);
+  descriptor_ = -1;
+  if (closed != 0) fail(target_, "cannot close", errno);
+  if (std::rename(temporary_.c_str(), target_.c_str()) != 0) fail(target_, "cannot replace", errno);
+  committed_ = true;
+}
+
+void write_file_atomically(const std::filesystem::path& path, std::string_view content) {
+  AtomicFileWriter writer(path);
+  writer.write(content);
+  writer.commit();
 }
 
 }  // namespace ontime

@@ -22,6 +22,13 @@ double seconds_within_step(Steps steps, double step_seconds, Generator& generato
 }  // namespace
 
 std::vector<RefinementAttempt> sample_planner_log(const Problem& problem, const LogSamplingOptions& options) {
+  std::vector<RefinementAttempt> log;
+  sample_planner_log(problem, options, [&log](RefinementAttempt attempt) { log.push_back(std::move(attempt)); });
+  return log;
+}
+
+void sample_planner_log(const Problem& problem, const LogSamplingOptions& options,
+                        const std::function<void(RefinementAttempt)>& emit) {
   if (options.cutoff_steps < 0) throw UsageError("the cut-off must be >= 0 steps");
   const Steps cutoff = options.cutoff_steps > 0 ? options.cutoff_steps : problem.deadline();
   const double step = problem.step_seconds();
@@ -37,7 +44,6 @@ std::vector<RefinementAttempt> sample_planner_log(const Problem& problem, const 
                     "use a smaller step_seconds or cut-off",
                     longest, step));
   }
-  std::vector<RefinementAttempt> log;
   for (int a = 0; a < problem.action_count(); ++a) {
     if (problem.position(a) < 0) continue;  // no skeleton uses it
     const Action& action = problem.action(a);
@@ -57,10 +63,9 @@ std::vector<RefinementAttempt> sample_planner_log(const Problem& problem, const 
       } else {
         attempt.planning_seconds = static_cast<double>(cutoff) * step;
       }
-      log.push_back(std::move(attempt));
+      emit(std::move(attempt));
     }
   }
-  return log;
 }
 
 }  // namespace ontime

@@ -62,6 +62,27 @@ TEST(AtomicFile, ReplacesARegularFileWhole) {
   EXPECT_EQ(entry_count(directory), 1U);  // no temporary file left
 }
 
+TEST(AtomicFile, AWriterPutsItsPiecesInPlaceOnlyOnCommit) {
+  const fs::path directory = scratch("pieces");
+  const fs::path file = directory / "out.txt";
+  std::ofstream(file) << "old";
+  {
+    AtomicFileWriter abandoned(file);
+    abandoned.write("never ");
+    abandoned.write("committed");
+    EXPECT_EQ(entry_count(directory), 2U);  // the target and the temporary file
+  }
+  EXPECT_EQ(text_of(file), "old");
+  EXPECT_EQ(entry_count(directory), 1U);
+  AtomicFileWriter writer(file);
+  writer.write("new ");
+  writer.write("content");
+  EXPECT_EQ(text_of(file), "old");
+  writer.commit();
+  EXPECT_EQ(text_of(file), "new content");
+  EXPECT_EQ(entry_count(directory), 1U);
+}
+
 TEST(AtomicFile, AFolderThatCannotTakeTheFileIsTheCallersError) {
   const fs::path directory = scratch("folder");
   const fs::path missing = directory / "missing" / "out.txt";

@@ -1162,3 +1162,28 @@ TEST(Cli, CapsBeyondTheAvailableMemoryAreRefusedBeforeStarting) {
 
 }  // namespace
 }  // namespace ontime
+
+namespace ontime {
+namespace {
+
+// The exact parts of evaluate, table and study, and the search trees of a study, are checked
+// against the memory available before any work, as solve's cap is.
+TEST(Cli, ExactPartsAndStudyTreesBeyondTheAvailableMemoryAreRefusedBeforeStarting) {
+  const std::string huge = "1000000000000";  // 10^12 states: terabytes
+  for (const std::vector<std::string>& arguments :
+       {std::vector<std::string>{"evaluate", paper("instance1"), "--solver", "dp", "--exact", "--max-states", huge},
+        std::vector<std::string>{"table", paper("instance1"), "--solvers", "dp", "--exact", "--max-states", huge},
+        std::vector<std::string>{"study", "anytime", paper("instance1"), "--no-plot", "--out",
+                                 scratch("memory_study").string(), "--max-states", huge}}) {
+    const auto result = ontime(arguments);
+    EXPECT_EQ(result.exit_code, 2) << arguments[0] << ": " << result.err;
+    EXPECT_NE(result.err.find("--max-states " + huge + ": would need up to"), std::string::npos) << result.err;
+  }
+  const auto trees = ontime({"study", "compute-time", paper("instance1"), "--no-plot", "--out",
+                             scratch("memory_trees").string(), "--threads", "2", "--max-tree-mib", "16777216"});
+  EXPECT_EQ(trees.exit_code, 2) << trees.err;
+  EXPECT_NE(trees.err.find("--max-tree-mib 16777216 with 2 threads: would need up to"), std::string::npos) << trees.err;
+}
+
+}  // namespace
+}  // namespace ontime

@@ -354,5 +354,18 @@ TEST(Fitting, ALaplaceAlphaThatSwampsTheLogIsRefused) {
   }
 }
 
+TEST(Fitting, AStreamedLogHasTheSameAttemptsInTheSameOrder) {
+  const Problem paper = testing::paper_instance("instance3");
+  LogSamplingOptions options;
+  options.attempts_per_action = 50;
+  options.seed = 9;
+  const std::vector<RefinementAttempt> whole = sample_planner_log(paper, options);
+  std::vector<std::string> streamed;
+  sample_planner_log(paper, options,
+                     [&](const RefinementAttempt& attempt) { streamed.push_back(planner_log_line(attempt)); });
+  ASSERT_EQ(streamed.size(), whole.size());
+  for (std::size_t i = 0; i < whole.size(); ++i) EXPECT_EQ(streamed[i], planner_log_line(whole[i])) << i;
+}
+
 }  // namespace
 }  // namespace ontime

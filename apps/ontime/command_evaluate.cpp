@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include "common.hpp"
+#include "memory_limits.hpp"
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/instance_io.hpp"
 
@@ -32,6 +33,9 @@ void add_evaluate_command(CLI::App& app) {
     const Mdp mdp(problem);
     const ParameterValues parameters = options->allocator.values();
     options->monte_carlo.check_tree_memory(options->solver, parameters);
+    if (options->exact || allocator_registry().find(options->solver).capabilities.has(Capability::optimal)) {
+      check_state_cap_memory(problem, max_states_of(parameters));
+    }
     const AllocatorFactory factory = make_allocator_factory(options->solver, mdp, parameters);
 
     MonteCarloOptions monte_carlo = options->monte_carlo.options();

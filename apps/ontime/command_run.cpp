@@ -8,6 +8,7 @@
 
 #include "common.hpp"
 #include "data_paths.hpp"
+#include "memory_limits.hpp"
 #include "number_options.hpp"
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/domains/planner_world.hpp"
@@ -67,6 +68,10 @@ void add_run_command(CLI::App& app) {
     const Problem problem = load_problem(instance);
     const Mdp mdp(problem);
     const ParameterValues parameters = options->allocator.values();
+    check_tree_memory(options->solver, parameters, options->episodes, options->threads);
+    if (options->exact || allocator_registry().find(options->solver).capabilities.has(Capability::optimal)) {
+      check_state_cap_memory(problem, max_states_of(parameters));
+    }
     const AllocatorFactory factory = make_allocator_factory(options->solver, mdp, parameters);
     domains::PlannerWorldOptions planner;
     planner.effort.unit = domains::parse_effort_unit(options->effort);

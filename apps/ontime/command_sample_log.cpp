@@ -5,6 +5,7 @@
 
 #include "common.hpp"
 #include "number_options.hpp"
+#include "ontime/atomic_file.hpp"
 #include "ontime/instance_io.hpp"
 #include "ontime/log_sampling.hpp"
 #include "ontime/planner_log.hpp"
@@ -32,9 +33,21 @@ void add_sample_log_command(CLI::App& app) {
   command->callback([options] {
     const Problem problem = load_problem(options->instance);
     check_outputs({{"--output", options->output}}, {options->instance});
-    const std::vector<RefinementAttempt> log = sample_planner_log(problem, options->sampling);
-    save_planner_log(log, options->output);
-    fmt::print("Wrote {} records ({} attempts per action, seed {}) to {}.\n", log.size(),
+    // Streamed: a log of any length is written in constant memory, in pieces of about 1 MiB.
+    AtomicFileWriter writer(options->output);
+    std::string piece;
+    std::uint64_t records = 0;
+    sample_planner_log(problem, options->sampling, [&](const RefinementAttempt& attempt) {
+      piece += planner_log_line(attempt);
+      ++records;
+      if (piece.size() >= (std::size_t{1} << 20)) {
+        writer.write(piece);
+        piece.clear();
+      }
+    });
+    writer.write(piece);
+    writer.commit();
+    fmt::print("Wrote {} records ({} attempts per action, seed {}) to {}.\n", records,
                options->sampling.attempts_per_action, options->sampling.seed, options->output);
   });
 }

@@ -12,16 +12,6 @@
 
 namespace ontime::cli {
 
-namespace {
-
-// The bytes of one state's slot in the solver's table (optimal.hpp).
-double state_slot_bytes(const Problem& problem) {
-  if (problem.skeleton_count() <= 4 && problem.deadline() <= 253) return 33;
-  return problem.skeleton_count() <= 10 ? 49 : 99;
-}
-
-}  // namespace
-
 void add_solve_command(CLI::App& app) {
   struct Options {
     std::string instance;
@@ -36,10 +26,7 @@ void add_solve_command(CLI::App& app) {
   command->add_flag("--json", options->json, "Print JSON");
   command->callback([options] {
     const Problem problem = load_problem(options->instance);
-    // The table's slot per state (optimal.hpp), doubled by its power-of-two growth and by 1.5
-    // while it grows: the most the solver can hold before its cap stops it.
-    check_memory_for(fmt::format("--max-states {}", options->max_states),
-                     3.0 * state_slot_bytes(problem) * static_cast<double>(options->max_states));
+    check_state_cap_memory(problem, options->max_states);
     const Mdp mdp(problem);
     const auto started = std::chrono::steady_clock::now();
     OptimalSolver solver(mdp, options->max_states);

@@ -8,7 +8,9 @@
 #include <limits>
 
 #include "common.hpp"
+#include "memory_limits.hpp"
 #include "number_options.hpp"
+#include "ontime/allocators/optimal.hpp"
 #include "ontime/atomic_file.hpp"
 #include "ontime/error.hpp"
 #include "ontime/experiments.hpp"
@@ -71,6 +73,12 @@ std::vector<Problem> prepare(const StudyOptions& options, const std::string& kin
   std::vector<OutputFile> outputs{{"--out", output_of(options, kind, ".csv")}};
   if (!options.no_plot) outputs.push_back({"--out", output_of(options, kind, ".png")});
   check_outputs(outputs, {options.instances.begin(), options.instances.end()}, MissingFolder::create);
+  // Memory the study would need (the searcher's trees; the anytime study's exact optimum).
+  const ParameterValues parameters = options.allocator.values();
+  check_tree_memory(options.searcher, parameters, options.episodes, options.threads);
+  if (kind == "anytime") {
+    for (const Problem& problem : problems) check_state_cap_memory(problem, max_states_of(parameters));
+  }
   return problems;
 }
 

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <functional>
@@ -15,6 +16,7 @@
 
 #include "common.hpp"
 #include "markdown_table.hpp"
+#include "memory_limits.hpp"
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/error.hpp"
 #include "ontime/instance_io.hpp"
@@ -250,6 +252,12 @@ void add_table_command(CLI::App& app) {
       const ParameterValues parameters = options->allocator.values(i, problems.size());
       mdps.push_back(std::make_unique<Mdp>(problems[i]));
       max_states.push_back(max_states_of(parameters));
+      const bool exact_work =
+          options->exact ||
+          std::any_of(options->solvers.begin(), options->solvers.end(), [](const std::string& solver) {
+            return allocator_registry().find(solver).capabilities.has(Capability::optimal);
+          });
+      if (exact_work) check_state_cap_memory(problems[i], max_states.back());
       for (const std::string& solver : options->solvers) {
         options->monte_carlo.check_tree_memory(solver, parameters);
         factories[i].push_back(make_allocator_factory(solver, *mdps[i], parameters));

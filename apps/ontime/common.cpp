@@ -98,6 +98,11 @@ MonteCarloOptions MonteCarloFlags::options() const {
 }
 
 void MonteCarloFlags::check_tree_memory(const std::string& solver, const ParameterValues& values) const {
+  cli::check_tree_memory(solver, values, episodes, threads);
+}
+
+void check_tree_memory(const std::string& solver, const ParameterValues& values, std::uint64_t episodes,
+                       unsigned threads) {
   const AllocatorKind& kind = allocator_registry().find(solver);
   const bool has_tree_cap = std::any_of(kind.parameters.begin(), kind.parameters.end(),
                                         [](const Parameter& parameter) { return parameter.name == "max-tree-mib"; });

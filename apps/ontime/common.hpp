@@ -55,6 +55,11 @@ struct AllocatorFlags {
 nlohmann::ordered_json parameters_json(const AllocatorKind& kind, const ParameterValues& values);
 
 // Options shared by commands that run Monte Carlo episodes.
+// Refuses (UsageError, exit 2) a search-tree cap (the max-tree-mib parameter of `solver`, if it
+// has one) times the threads that would run it when that exceeds the memory available.
+void check_tree_memory(const std::string& solver, const ParameterValues& values, std::uint64_t episodes,
+                       unsigned threads);
+
 struct MonteCarloFlags {
   std::uint64_t episodes = 10'000;
   std::uint64_t seed = 1;

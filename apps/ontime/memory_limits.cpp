@@ -61,4 +61,10 @@ void check_memory_for(std::string_view option, double bytes) {
   }
 }
 
+void check_state_cap_memory(const Problem& problem, std::size_t max_states) {
+  const double slot_bytes =
+      problem.skeleton_count() <= 4 && problem.deadline() <= 253 ? 33 : (problem.skeleton_count() <= 10 ? 49 : 99);
+  check_memory_for(fmt::format("--max-states {}", max_states), 3.0 * slot_bytes * static_cast<double>(max_states));
+}
+
 }  // namespace ontime::cli

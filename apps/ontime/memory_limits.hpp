@@ -7,6 +7,8 @@
 #include <optional>
 #include <string_view>
 
+#include "ontime/problem.hpp"
+
 namespace ontime::cli {
 
 // The smaller of /proc/meminfo's MemAvailable and the room left under this process's cgroup
@@ -16,5 +18,10 @@ std::optional<std::uint64_t> available_memory_bytes();
 // Throws UsageError "OPTION: would need up to N GiB of memory, M GiB available" when `bytes`
 // exceeds the available memory.
 void check_memory_for(std::string_view option, double bytes);
+
+// The same for the exact solver's and the exact evaluation's state cap on `problem`: the table's
+// slot per state (optimal.hpp), doubled by its power-of-two growth and by 1.5 while it grows,
+// is the most they can hold before the cap stops them.
+void check_state_cap_memory(const Problem& problem, std::size_t max_states);
 
 }  // namespace ontime::cli

@@ -16,4 +16,25 @@ namespace ontime {
 // failure of the system; the target is then left as it was.
 void write_file_atomically(const std::filesystem::path& path, std::string_view content);
 
+// The same, for content written piece by piece (a log too large to hold): the pieces go to the
+// temporary file (or straight to a device or FIFO) as they come, and commit() puts the file in
+// place. Destroyed without commit(), the temporary file is removed and the target is untouched.
+// Errors as for write_file_atomically, from the constructor, write() or commit().
+class AtomicFileWriter {
+ public:
+  explicit AtomicFileWriter(const std::filesystem::path& path);
+  ~AtomicFileWriter();
+  AtomicFileWriter(const AtomicFileWriter&) = delete;
+  AtomicFileWriter& operator=(const AtomicFileWriter&) = delete;
+
+  void write(std::string_view piece);
+  void commit();
+
+ private:
+  std::filesystem::path target_;  // the file replaced (a followed link's target)
+  std::string temporary_;         // empty when writing directly to a device or FIFO
+  int descriptor_ = -1;
+  bool committed_ = false;
+};
+
 }  // namespace ontime

@@ -3,6 +3,7 @@
 // fitting (fitting.hpp) recovers what produced the data.
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "ontime/planner_log.hpp"
@@ -25,5 +26,10 @@ struct LogSamplingOptions {
 // steps when x is "never"). Any other attempt is logged as cut off after cutoff steps.
 // Attempt i of action a draws from stream_seed(stream_seed(seed, a), i): same seed, same log.
 std::vector<RefinementAttempt> sample_planner_log(const Problem& problem, const LogSamplingOptions& options);
+
+// The same attempts, in the same order, handed to `emit` one at a time as they are drawn, so
+// that a log of any length can be written without holding it (constant memory).
+void sample_planner_log(const Problem& problem, const LogSamplingOptions& options,
+                        const std::function<void(RefinementAttempt)>& emit);
 
 }  // namespace ontime
