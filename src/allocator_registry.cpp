@@ -239,7 +239,10 @@ AllocatorFactory AllocatorRegistry::make_factory(std::string_view name, const Md
                                                  const ParameterValues& values) const {
   const AllocatorKind& kind = find(name);
   const std::vector<Parameter> declared = parameters();
-  for (const auto& [given, value] : values.all()) {
+  for (const auto& entry : values.all()) {
+    // A named reference, not a structured binding: clang 14 cannot capture bindings in a lambda.
+    const std::string& given = entry.first;
+    const std::string& value = entry.second;
     const auto parameter =
         std::find_if(declared.begin(), declared.end(), [&](const Parameter& p) { return p.name == given; });
     if (parameter == declared.end()) {
