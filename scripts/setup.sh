@@ -11,6 +11,7 @@ packages=(
   libompl-dev libfcl-dev liborocos-kdl-dev
   libboost-serialization-dev libboost-filesystem-dev libboost-system-dev
   python3 python3-matplotlib python3-numpy
+  python3-dev pybind11-dev python3-pybind11 python3-pytest
   clang libclang-rt-14-dev clang-format
 )
 

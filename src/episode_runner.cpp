@@ -9,6 +9,7 @@
 #include <mutex>
 #include <vector>
 
+#include "ontime/error.hpp"
 #include "ontime/parallel.hpp"
 #include "ontime/random.hpp"
 #include "ontime/session.hpp"
@@ -141,6 +142,7 @@ MonteCarloResult run_episodes(const Mdp& mdp, const WorldFactory& worlds, const 
     run.world = worlds();
     return [&](std::uint64_t begin, std::uint64_t end) {
       for (std::uint64_t episode = begin; episode < end; ++episode) {
+        if (options.stop && options.stop()) throw Cancelled("episodes stopped at the caller's request");
         const EpisodeResult result =
             run_episode(mdp, *run.allocator, *run.world, stream_seed(options.seed, episode), options.decision_budget,
                         options.time_decisions ? &run.timer : nullptr);

@@ -44,7 +44,8 @@ MonteCarloResult run_monte_carlo(const Mdp& mdp, const AllocatorFactory& factory
   return run_episodes(mdp, hidden_worlds(mdp.problem()), factory, options);
 }
 
-ExactEvaluation evaluate_exactly(const Mdp& mdp, Allocator& allocator, std::size_t max_states) {
+ExactEvaluation evaluate_exactly(const Mdp& mdp, Allocator& allocator, std::size_t max_states,
+                                 const std::function<bool()>& stop) {
   if (!allocator.is_stationary()) {
     throw UsageError("exact evaluation needs an allocator whose choice depends only on the state; '" +
                      std::string(allocator.name()) + "' does not (use Monte Carlo)");
@@ -53,6 +54,7 @@ ExactEvaluation evaluate_exactly(const Mdp& mdp, Allocator& allocator, std::size
   const auto run = [&](auto policy) {
     detail::Expectimax<decltype(policy)> search(mdp, policy, max_states, 0.0,
                                                 "exact evaluation of " + std::string(allocator.name()));
+    search.set_stop(stop);
     ExactEvaluation result;
     result.success_probability = search.solve(mdp.start()).value;
     result.states = search.memo().size();

@@ -19,6 +19,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -110,6 +111,10 @@ class Expectimax {
         tie_tolerance_(tie_tolerance),
         what_(std::move(what)) {}
 
+  // A condition checked every few thousand states: once it returns true, solve throws Cancelled
+  // (the states solved so far are kept).
+  void set_stop(std::function<bool()> stop) { stop_ = std::move(stop); }
+
   ExpectimaxEntry solve(const State& start) {
     const Key start_key = policy_.key(start);
     if (const auto found = memo_.find(start_key); found != memo_.end()) return found->second;
@@ -186,6 +191,9 @@ class Expectimax {
         best = {value, choice};
       }
     }
+    if (stop_ && (memo_.size() & (kStopCheckInterval - 1)) == 0 && stop_()) {
+      throw Cancelled(what_ + ": stopped at the caller's request after " + std::to_string(memo_.size()) + " states");
+    }
     if (memo_.size() >= max_states_) {
       throw ResourceLimitError(what_ + ": reached the cap of " + std::to_string(max_states_) +
                                " states (the max-states parameter) before finishing (about " +
@@ -198,8 +206,13 @@ class Expectimax {
     frames_.pop_back();
   }
 
+  // States between two checks of the stop condition: rare enough to cost nothing, frequent
+  // enough (well under a millisecond of work) to stop promptly.
+  static constexpr std::size_t kStopCheckInterval = 4096;
+
   const Mdp* mdp_;
   Policy policy_;
+  std::function<bool()> stop_;
   std::size_t max_states_;
   double tie_tolerance_;
   std::string what_;

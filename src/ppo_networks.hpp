@@ -23,10 +23,8 @@ struct PpoNetworks {
   PolicyNetwork critic;
 };
 
-// Features of a state (the MDP state of SPEC §2 normalised): CT / D, and per skeleton
-// l_k / A_k, PT_k / D and ET_k / D. Fills `features` (size feature_count).
+// The features of a state (normalised_state, ontime/allocators/ppo.hpp) in a network's input.
 void state_features(const Mdp& mdp, const State& state, PolicyNetwork::Vector& features);
-int feature_count(int skeleton_count) noexcept;
 
 // The clipped surrogate loss of PPO, -mean(min(r A, clip(r, 1 - e, 1 + e) A)) with
 // r = exp(log pi(a | s) - old log pi), over a batch of logits (one column per sample) with

@@ -54,6 +54,9 @@ struct MonteCarloOptions {
   DecisionBudget decision_budget;
   // Called now and then with the number of episodes done (from one thread at a time).
   std::function<void(std::uint64_t done, std::uint64_t total)> progress;
+  // Checked before each episode, from every thread (so it must be thread-safe): once it returns
+  // true, no episode starts and the run ends by throwing Cancelled.
+  std::function<bool()> stop;
 };
 
 struct LatencySummary {
@@ -96,7 +99,7 @@ struct MonteCarloResult {
 };
 
 // Runs `options.episodes` episodes, seeded as above. Each thread gets its own allocator from
-// `allocators` and its own world from `worlds`.
+// `allocators` and its own world from `worlds`. Throws Cancelled when `options.stop` trips.
 MonteCarloResult run_episodes(const Mdp& mdp, const WorldFactory& worlds, const AllocatorFactory& allocators,
                               const MonteCarloOptions& options);
 

@@ -46,4 +46,11 @@ class ResourceLimitError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// A computation ended early because its caller asked it to stop (a stop condition it was given
+// returned true): an interrupted evaluation or solve. Nothing it would have written was written.
+class Cancelled : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 }  // namespace ontime

@@ -3,6 +3,7 @@
 // hidden sampled worlds), and exact success probability.
 
 #include <cstddef>
+#include <functional>
 
 #include "ontime/allocator.hpp"
 #include "ontime/episode_runner.hpp"
@@ -22,7 +23,9 @@ struct ExactEvaluation {
 
 // The success probability of a stationary allocator (SPEC §4): a finite sum over the states
 // reachable under its choices, with no sampling. Throws UsageError when the allocator is not
-// stationary, ResourceLimitError past `max_states`.
-ExactEvaluation evaluate_exactly(const Mdp& mdp, Allocator& allocator, std::size_t max_states = 10'000'000);
+// stationary, ResourceLimitError past `max_states`, Cancelled once `stop` (checked every few
+// thousand states) returns true.
+ExactEvaluation evaluate_exactly(const Mdp& mdp, Allocator& allocator, std::size_t max_states = 10'000'000,
+                                 const std::function<bool()>& stop = {});
 
 }  // namespace ontime

@@ -75,6 +75,9 @@ struct OptimalSolver::Impl {
 OptimalSolver::OptimalSolver(const Mdp& mdp, std::size_t max_states)
     : mdp_(&mdp), max_states_(max_states), impl_(std::make_unique<Impl>(mdp, max_states)) {}
 OptimalSolver::~OptimalSolver() = default;
+void OptimalSolver::set_stop(std::function<bool()> stop) {
+  std::visit([&](auto& search) { search.set_stop(std::move(stop)); }, impl_->search);
+}
 OptimalSolver::OptimalSolver(OptimalSolver&&) noexcept = default;
 OptimalSolver& OptimalSolver::operator=(OptimalSolver&&) noexcept = default;
 

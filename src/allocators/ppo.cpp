@@ -10,18 +10,23 @@ namespace ontime {
 
 int feature_count(int skeleton_count) noexcept { return 1 + 3 * skeleton_count; }
 
-void state_features(const Mdp& mdp, const State& state, PolicyNetwork::Vector& features) {
+void normalised_state(const Mdp& mdp, const State& state, std::span<float> out) noexcept {
   const Problem& problem = mdp.problem();
   const int count = mdp.skeleton_count();
   const auto deadline = static_cast<float>(mdp.deadline());
-  features.resize(feature_count(count));
-  features(0) = static_cast<float>(state.time) / deadline;
+  out[0] = static_cast<float>(state.time) / deadline;
   for (int k = 0; k < count; ++k) {
     const auto slot = static_cast<std::size_t>(k);
-    features(1 + 3 * k) = static_cast<float>(state.refined[slot]) / static_cast<float>(problem.skeleton_length(k));
-    features(2 + 3 * k) = static_cast<float>(state.spent[slot]) / deadline;
-    features(3 + 3 * k) = static_cast<float>(state.execution[slot]) / deadline;
+    const auto base = static_cast<std::size_t>(3 * k);
+    out[base + 1] = static_cast<float>(state.refined[slot]) / static_cast<float>(problem.skeleton_length(k));
+    out[base + 2] = static_cast<float>(state.spent[slot]) / deadline;
+    out[base + 3] = static_cast<float>(state.execution[slot]) / deadline;
   }
+}
+
+void state_features(const Mdp& mdp, const State& state, PolicyNetwork::Vector& features) {
+  features.resize(feature_count(mdp.skeleton_count()));
+  normalised_state(mdp, state, std::span<float>(features.data(), static_cast<std::size_t>(features.size())));
 }
 
 struct PpoAllocator::Evaluation {

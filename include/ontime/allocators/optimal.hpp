@@ -21,6 +21,7 @@
 // when it would hold more than `max_states` states, never by running out of memory.
 
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <optional>
 
@@ -46,6 +47,9 @@ class OptimalSolver {
   // The optimal choice in a state already solved, or nullopt if it was not reached.
   std::optional<int> best_choice(const State& state) const;
 
+  // A condition checked every few thousand states while solving: once it returns true, solve
+  // throws Cancelled (the states solved so far are kept).
+  void set_stop(std::function<bool()> stop);
   // States memoised so far.
   std::size_t states() const noexcept;
   std::size_t max_states() const noexcept { return max_states_; }

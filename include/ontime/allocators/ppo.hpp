@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -36,6 +37,13 @@ struct PpoHyperparameters {
   int max_episode_steps = 1'000;
   double target_kl = 0.01;  // actor steps stop early past 1.5 x this KL
 };
+
+// The number of features of a state with K skeletons: 1 + 3 K.
+int feature_count(int skeleton_count) noexcept;
+// The features of a state, written to `out` (size feature_count): CT / D, then per skeleton
+// l_k / A_k, PT_k / D and ET_k / D (ET_k saturates at D + 1, so its feature at (D + 1) / D).
+// The input of the policy networks, and the observation of the Python environment.
+void normalised_state(const Mdp& mdp, const State& state, std::span<float> out) noexcept;
 
 // The actor and critic networks; defined inside the library (they are Eigen matrices, which
 // stay private to it), so that a policy is an opaque handle here.

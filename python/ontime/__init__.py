@@ -1,0 +1,176 @@
+"""OnTime: deadline-aware effort allocation for task and motion planning.
+
+A robot has candidate plan skeletons (sequences of abstract actions); each action must be refined
+by a motion planner whose planning and execution times are uncertain. OnTime decides, step by
+step, which skeleton gets the planner's next slice of effort, so that some skeleton is refined and
+executed before a deadline.
+
+    import ontime
+    problem = ontime.load_problem("data/instances/paper/instance1.json")
+    print(ontime.solve(problem)["optimal_success_probability"])
+    print(ontime.evaluate(problem, "dp-rerun", episodes=10_000, seed=1, exact=True))
+    session = ontime.Session(ontime.make_allocator(problem, "dp-rerun"))
+
+The C++ core does the work (`ontime._ontime`); this layer adds the conversions between Python data
+and the library's formats. docs/python.md describes the whole API.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Any, Iterable, Mapping, Optional, Sequence, Union
+
+from ._ontime import (  # noqa: F401  (re-exported)
+    NEVER,
+    Action,
+    Allocator,
+    Decision,
+    Distribution,
+    Error,
+    InputError,
+    Mdp,
+    Problem,
+    ResourceLimitError,
+    Session,
+    State,
+    Status,
+    UsageError,
+    allocators,
+    evaluate,
+    load_problem,
+    make_allocator,
+    read_planner_log,
+    run_episodes,
+    solve,
+    train_ppo,
+)
+from . import _ontime
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "NEVER", "Action", "Allocator", "Decision", "Distribution", "Error", "InputError", "Mdp", "Problem",
+    "ResourceLimitError", "Session", "State", "Status", "UsageError", "World", "allocators", "evaluate",
+    "fit", "load_problem", "make_allocator", "read_planner_log", "run_episodes", "solve", "train_ppo",
+    "write_planner_log",
+]
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+class World:
+    """The world an episode happens in, implemented in Python: what a step of effort reveals.
+
+    Subclass it around your own planner and pass it (or its class, to get one per thread) to
+    ontime.run_episodes, which runs any allocator against it with the library's episode runner.
+
+    begin_episode(seed) starts an episode whose randomness comes from `seed` alone.
+    step(action, spent) spends one step of effort on the action with index `action` (into
+    Problem.actions; its parent action is already refined in this episode) which has had `spent`
+    steps so far, and returns None (no motion yet) or the refined motion's execution time in steps
+    (an int >= 0; ontime.NEVER or math.inf when it cannot be executed).
+    statistics() may return counters (name -> number) summed over the run.
+    """
+
+    def begin_episode(self, seed: int) -> None:
+        raise NotImplementedError
+
+    def step(self, action: int, spent: int) -> Optional[int]:
+        raise NotImplementedError
+
+    def statistics(self) -> Mapping[str, float]:
+        return {}
+
+
+def _distribution_entry(value: Any) -> Any:
+    """A PMF or CDF given as a sequence or numpy array becomes the instance format's {step: p}."""
+    if isinstance(value, Mapping):
+        return {str(step): float(p) for step, p in value.items()}
+    if hasattr(value, "tolist"):
+        value = value.tolist()
+    if isinstance(value, (list, tuple)):
+        return {str(step): float(p) for step, p in enumerate(value) if p != 0}
+    return value
+
+
+def _instance_data(data: Mapping[str, Any]) -> Any:
+    """The instance format with distributions given as arrays converted, everything else as is."""
+    out = dict(data)
+    actions = out.get("actions")
+    if isinstance(actions, Mapping):
+        converted = {}
+        for action_id, action in actions.items():
+            if isinstance(action, Mapping):
+                action = dict(action)
+                for which in ("planning", "execution"):
+                    law = action.get(which)
+                    if isinstance(law, Mapping):
+                        action[which] = {key: (_distribution_entry(value) if key in ("pmf", "cdf") else value)
+                                         for key, value in law.items()}
+            converted[action_id] = action
+        out["actions"] = converted
+    return out
+
+
+def _problem_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Problem:
+    """An instance from a dict in the instance format (SPEC §5); PMFs and CDFs may be sequences or
+    numpy arrays indexed by step. Raises InputError naming the place and the rule, as for a file."""
+    if not isinstance(data, Mapping):
+        raise InputError(f"{source}: the instance must be a JSON object (a dict), got {type(data).__name__}")
+    try:
+        text = json.dumps(_instance_data(data), allow_nan=True)
+    except (TypeError, ValueError) as error:
+        raise InputError(f"{source}: the instance cannot be written as JSON: {error}") from None
+    return Problem.from_json(text, source)
+
+
+def _problem_to_dict(self: Problem) -> dict:
+    """The instance as a dict in the instance format (PMF form): Problem.from_dict reads it back."""
+    return json.loads(self.to_json())
+
+
+Problem.from_dict = staticmethod(_problem_from_dict)
+Problem.to_dict = _problem_to_dict
+
+
+def _records_text(records: Iterable[Mapping[str, Any]]) -> str:
+    lines = []
+    for record in records:
+        if not isinstance(record, Mapping):
+            lines.append(json.dumps(record) if isinstance(record, (list, str, int, float)) else "null")
+        else:
+            lines.append(json.dumps(dict(record), allow_nan=True))
+    return "".join(line + "\n" for line in lines)
+
+
+def write_planner_log(records: Iterable[Mapping[str, Any]], path: PathLike) -> None:
+    """Writes planner-log records (dicts with action, planning_seconds, found, execution_seconds when
+    found) as a log file (JSON Lines, docs/formats.md), atomically. Every record is checked by the
+    rules of a log file; InputError names the record as `<records>, line N`."""
+    _ontime._save_planner_log(_records_text(records), "<records>", os.fspath(path))
+
+
+def fit(records_or_path: Union[PathLike, Iterable[Mapping[str, Any]]], *, step: float, deadline: int,
+        skeletons: Union[PathLike, Sequence[Sequence[str]]], laplace: float = 0.0, name: str = "fitted",
+        description: str = "") -> Problem:
+    """Learns an instance from a planner log, as `ontime fit` does: each action's planning- and
+    execution-time distributions by maximum likelihood (Kaplan-Meier for attempts cut off), in steps
+    of `step` seconds, with deadline `deadline` steps.
+
+    records_or_path: a log file or its records (dicts); skeletons: a JSON file with a `skeletons`
+    member (an instance or world file will do) or the skeletons as lists of action ids.
+    """
+    # Files are read by the library's own readers (limits, encodings, places in messages), records
+    # and skeleton lists given in Python are read as the text of such files.
+    log_is_path = isinstance(records_or_path, (str, os.PathLike))
+    log = os.fspath(records_or_path) if log_is_path else _records_text(records_or_path)
+    skeletons_is_path = isinstance(skeletons, (str, os.PathLike))
+    skeleton_data = (os.fspath(skeletons) if skeletons_is_path
+                     else json.dumps({"skeletons": [list(s) for s in skeletons]}))
+    return _ontime._fit(log, log_is_path, skeleton_data, skeletons_is_path, float(step), int(deadline),
+                        float(laplace), name, description)
+
+
+from . import env  # noqa: E402,F401  (ontime.env.EffortAllocationEnv)
+from . import domains  # noqa: E402,F401  (ontime.domains, when built)

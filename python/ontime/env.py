@@ -1,0 +1,159 @@
+"""A Gymnasium-style environment of the effort-allocation MDP.
+
+    env = ontime.env.EffortAllocationEnv(ontime.load_problem("data/instances/paper/instance1.json"), seed=1)
+    observation, info = env.reset(seed=1)
+    while True:
+        action = policy(observation, info["action_mask"])
+        observation, reward, terminated, truncated, info = env.step(action)
+        if terminated or truncated:
+            break
+
+It follows Gymnasium's Env API (reset/step signatures, spaces, seeding) without requiring gymnasium:
+when gymnasium is importable, `observation_space` and `action_space` are gymnasium.spaces objects,
+otherwise small equivalents with the same attributes and methods (shape, dtype, n, sample, contains,
+seed). Debian 12 packages no gymnasium.
+
+Episode: one simulated episode of the problem (a hidden sampled world). Action: a skeleton index in
+[0, K). Observation: the normalised MDP state the ppo allocator sees (float32, 1 + 3 K values: CT/D,
+then per skeleton l_k/A_k, PT_k/D, ET_k/D). Reward: 1 on success, 0 otherwise (as in the paper).
+The episode terminates on success or failure (deadline passed, or no skeleton can still meet it); it
+is never truncated. info["action_mask"] (also env.action_masks()) marks the useful choices: one per
+group of skeletons sharing their next action, among those that can still succeed.
+
+Seeding: reset(seed=s) restarts the episode count; episode e after it lives in the hidden world of
+stream e of s, the world episode e of `ontime.evaluate(..., seed=s)` lives in. reset() without a
+seed goes on to the next episode.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Optional, Tuple
+
+import numpy as np
+
+from ._ontime import Problem, _EnvironmentCore
+
+try:  # Gymnasium's spaces when it is installed; it is never required.
+    from gymnasium import spaces as _gym_spaces  # type: ignore
+except ImportError:  # pragma: no cover - depends on the machine
+    _gym_spaces = None
+
+
+class Box:
+    """A box of real vectors, as gymnasium.spaces.Box (low, high, shape, dtype, sample, contains, seed)."""
+
+    def __init__(self, low: float, high: float, shape: Tuple[int, ...], dtype=np.float32, seed: Optional[int] = None):
+        self.shape = tuple(shape)
+        self.dtype = np.dtype(dtype)
+        self.low = np.full(self.shape, low, dtype=self.dtype)
+        self.high = np.full(self.shape, high, dtype=self.dtype)
+        self._rng = np.random.default_rng(seed)
+
+    def seed(self, seed: Optional[int] = None) -> list:
+        self._rng = np.random.default_rng(seed)
+        return [seed]
+
+    def sample(self) -> np.ndarray:
+        return self._rng.uniform(self.low, self.high).astype(self.dtype)
+
+    def contains(self, x: Any) -> bool:
+        x = np.asarray(x)
+        return (x.shape == self.shape and np.can_cast(x.dtype, self.dtype)
+                and bool(np.all(x >= self.low)) and bool(np.all(x <= self.high)))
+
+    def __contains__(self, x: Any) -> bool:
+        return self.contains(x)
+
+    def __repr__(self) -> str:
+        return f"Box({self.low.min()}, {self.high.max()}, {self.shape}, {self.dtype})"
+
+
+class Discrete:
+    """The integers 0..n-1, as gymnasium.spaces.Discrete (n, shape, dtype, sample, contains, seed)."""
+
+    def __init__(self, n: int, seed: Optional[int] = None):
+        self.n = int(n)
+        self.shape: Tuple[int, ...] = ()
+        self.dtype = np.dtype(np.int64)
+        self.start = 0
+        self._rng = np.random.default_rng(seed)
+
+    def seed(self, seed: Optional[int] = None) -> list:
+        self._rng = np.random.default_rng(seed)
+        return [seed]
+
+    def sample(self, mask: Optional[np.ndarray] = None) -> int:
+        if mask is not None:
+            allowed = np.flatnonzero(np.asarray(mask))
+            return int(self._rng.choice(allowed)) if allowed.size else 0
+        return int(self._rng.integers(self.n))
+
+    def contains(self, x: Any) -> bool:
+        if isinstance(x, (int, np.integer)) and not isinstance(x, bool):
+            return 0 <= int(x) < self.n
+        if isinstance(x, np.ndarray) and x.shape == () and np.issubdtype(x.dtype, np.integer):
+            return 0 <= int(x) < self.n
+        return False
+
+    def __contains__(self, x: Any) -> bool:
+        return self.contains(x)
+
+    def __repr__(self) -> str:
+        return f"Discrete({self.n})"
+
+
+class EffortAllocationEnv:
+    """The effort-allocation MDP of `problem` as a Gymnasium-style environment (see the module)."""
+
+    metadata = {"render_modes": []}
+    render_mode = None
+    spec = None
+
+    def __init__(self, problem: Problem, seed: int = 0):
+        self.problem = problem
+        self._core = _EnvironmentCore(problem, int(seed))
+        skeletons = self._core.skeleton_count
+        deadline = problem.deadline
+        high = 1.0 + 1.0 / deadline  # ET_k saturates at D + 1
+        if _gym_spaces is not None:
+            self.observation_space = _gym_spaces.Box(0.0, high, shape=(self._core.feature_size,), dtype=np.float32,
+                                                     seed=int(seed))
+            self.action_space = _gym_spaces.Discrete(skeletons, seed=int(seed))
+        else:
+            self.observation_space = Box(0.0, high, (self._core.feature_size,), np.float32, seed=int(seed))
+            self.action_space = Discrete(skeletons, seed=int(seed))
+        self._mask = None
+
+    def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None):
+        """Starts an episode; returns (observation, info)."""
+        if seed is not None:
+            self.action_space.seed(int(seed))
+        observation = self._core.reset(None if seed is None else int(seed))
+        self._mask = self._core.action_mask()
+        return observation, {"action_mask": self._mask}
+
+    def step(self, action):
+        """One step of effort on skeleton `action`; returns (observation, reward, terminated,
+        truncated, info)."""
+        observation, reward, terminated, truncated = self._core.step(int(action))
+        self._mask = self._core.action_mask()
+        return observation, reward, terminated, truncated, {"action_mask": self._mask}
+
+    def action_masks(self) -> np.ndarray:
+        """The useful choices of the current state as booleans (MaskablePPO's convention)."""
+        return self._core.action_mask().astype(bool)
+
+    @property
+    def state(self):
+        """The MDP state (ontime.State) of the current step."""
+        return self._core.state
+
+    @property
+    def unwrapped(self) -> "EffortAllocationEnv":
+        return self
+
+    def render(self) -> None:
+        return None
+
+    def close(self) -> None:
+        pass

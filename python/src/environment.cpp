@@ -1,0 +1,106 @@
+// The stepping core of ontime.env.EffortAllocationEnv: one simulated episode at a time in a hidden
+// sampled world (the simulator's HiddenWorld, seeded as the episode runner seeds it), observed as
+// the normalised MDP state the ppo allocator sees. Written in C++ so that a step costs a few
+// microseconds from Python; the Gymnasium-style API around it is pure Python (env.py).
+
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include "bindings.hpp"
+#include "ontime/allocators/ppo.hpp"
+#include "ontime/error.hpp"
+#include "ontime/random.hpp"
+#include "ontime/simulator.hpp"
+
+namespace ontime::python {
+
+namespace {
+
+class EnvironmentCore {
+ public:
+  EnvironmentCore(std::shared_ptr<MdpHandle> mdp, std::uint64_t seed)
+      : mdp_(std::move(mdp)),
+        world_(*mdp_->problem, 0),
+        seed_(seed),
+        features_(static_cast<std::size_t>(feature_count(mdp_->mdp.skeleton_count()))) {}
+
+  int skeleton_count() const { return mdp_->mdp.skeleton_count(); }
+  int feature_size() const { return static_cast<int>(features_); }
+
+  // Episode e after the seed was last set draws its hidden world from stream_seed(seed, e), as
+  // episode e of the episode runner does.
+  py::array_t<float> reset(std::optional<std::uint64_t> seed) {
+    if (seed) {
+      seed_ = *seed;
+      episode_ = 0;
+    }
+    world_.begin_episode(stream_seed(seed_, episode_++));
+    state_ = mdp_->mdp.start();
+    status_ = Status::running;
+    return observation();
+  }
+
+  py::tuple step(long long action) {
+    if (status_ != Status::running) throw UsageError("the episode is over: call reset() before step()");
+    if (action < 0 || action >= skeleton_count()) {
+      throw UsageError("action " + std::to_string(action) + " is not a skeleton index in [0, " +
+                       std::to_string(skeleton_count()) + ")");
+    }
+    const int choice = static_cast<int>(action);
+    const int next = mdp_->mdp.next_action(state_, choice);
+    const Observation seen =
+        next < 0 ? Observation::not_yet() : world_.step(next, state_.spent[static_cast<std::size_t>(choice)]);
+    status_ = mdp_->mdp.apply(state_, choice, seen);
+    const double reward = status_ == Status::success ? 1.0 : 0.0;
+    return py::make_tuple(observation(), reward, status_ != Status::running, false);
+  }
+
+  py::array_t<std::int8_t> action_mask() const {
+    py::array_t<std::int8_t> mask(skeleton_count());
+    auto view = mask.mutable_unchecked<1>();
+    for (int k = 0; k < skeleton_count(); ++k) view(k) = 0;
+    if (status_ == Status::running) {
+      for (const int choice : mdp_->mdp.useful_choices(state_)) view(choice) = 1;
+    }
+    return mask;
+  }
+
+  StateView state() const { return {state_, skeleton_count()}; }
+  Status status() const { return status_; }
+  std::shared_ptr<MdpHandle> mdp() const { return mdp_; }
+
+ private:
+  py::array_t<float> observation() const {
+    py::array_t<float> out(static_cast<py::ssize_t>(features_));
+    normalised_state(mdp_->mdp, state_, std::span<float>(out.mutable_data(), features_));
+    return out;
+  }
+
+  std::shared_ptr<MdpHandle> mdp_;
+  HiddenWorld world_;
+  std::uint64_t seed_;
+  std::uint64_t episode_ = 0;
+  std::size_t features_;
+  State state_{};
+  Status status_ = Status::failure;  // no episode yet: step() needs a reset() first
+};
+
+}  // namespace
+
+void bind_environment(py::module_& m) {
+  py::class_<EnvironmentCore>(m, "_EnvironmentCore")
+      .def(py::init([](const py::object& problem, std::uint64_t seed) {
+             return std::make_unique<EnvironmentCore>(to_mdp(problem), seed);
+           }),
+           py::arg("problem"), py::arg("seed"))
+      .def_property_readonly("skeleton_count", &EnvironmentCore::skeleton_count)
+      .def_property_readonly("feature_size", &EnvironmentCore::feature_size)
+      .def("reset", &EnvironmentCore::reset, py::arg("seed") = py::none())
+      .def("step", &EnvironmentCore::step, py::arg("action"))
+      .def("action_mask", &EnvironmentCore::action_mask)
+      .def_property_readonly("state", &EnvironmentCore::state)
+      .def_property_readonly("status", &EnvironmentCore::status)
+      .def_property_readonly("mdp", &EnvironmentCore::mdp);
+}
+
+}  // namespace ontime::python

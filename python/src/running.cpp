@@ -1,0 +1,486 @@
+// Bindings of allocators, sessions, worlds written in Python, and the long computations (solve,
+// evaluate, episodes, training), all on the library's one episode runner.
+
+#include <pybind11/stl.h>
+
+#include <chrono>
+#include <optional>
+#include <stdexcept>
+
+#include "bindings.hpp"
+#include "ontime/allocators/optimal.hpp"
+#include "ontime/allocators/ppo.hpp"
+#include "ontime/episode_runner.hpp"
+#include "ontime/error.hpp"
+#include "ontime/evaluation.hpp"
+#include "ontime/ppo_training.hpp"
+#include "ontime/session.hpp"
+#include "ontime/simulator.hpp"
+
+namespace ontime::python {
+
+namespace {
+
+DecisionBudget budget_of(std::optional<std::uint64_t> iterations, std::optional<double> seconds) {
+  if (iterations && seconds) return DecisionBudget::either(*iterations, *seconds);
+  if (iterations) return DecisionBudget::iterations(*iterations);
+  if (seconds) return DecisionBudget::seconds(*seconds);
+  return {};
+}
+
+struct DecisionView {
+  int skeleton = -1;
+  int action = -1;
+  std::shared_ptr<const Problem> problem;
+};
+
+struct SessionHandle {
+  SessionHandle(std::shared_ptr<AllocatorHandle> handle, std::uint64_t seed_value, DecisionBudget default_budget)
+      : allocator(std::move(handle)),
+        session(allocator->mdp->mdp, *allocator->allocator, seed_value),
+        budget(std::move(default_budget)) {}
+  std::shared_ptr<AllocatorHandle> allocator;
+  Session session;
+  DecisionBudget budget;
+};
+
+// Session calls out of turn raise std::logic_error in C++: a usage error for a Python caller.
+template <class Call>
+auto session_call(Call&& call) {
+  try {
+    return call();
+  } catch (const UsageError&) {
+    throw;
+  } catch (const std::logic_error& error) {
+    throw UsageError(error.what());
+  }
+}
+
+const char* status_name(Status status) {
+  switch (status) {
+    case Status::running:
+      return "running";
+    case Status::success:
+      return "success";
+    case Status::failure:
+      return "failure";
+  }
+  return "?";
+}
+
+// A World implemented in Python (a subclass of ontime.World), called with the GIL held.
+class PythonWorld final : public World {
+ public:
+  explicit PythonWorld(py::object world) : world_(std::move(world)) {}
+  ~PythonWorld() override {
+    const py::gil_scoped_acquire acquire;
+    world_ = py::object();
+  }
+  PythonWorld(const PythonWorld&) = delete;
+  PythonWorld& operator=(const PythonWorld&) = delete;
+
+  void begin_episode(std::uint64_t seed) override {
+    const py::gil_scoped_acquire acquire;
+    world_.attr("begin_episode")(seed);
+  }
+
+  Observation step(int action, Steps spent) override {
+    const py::gil_scoped_acquire acquire;
+    const py::object result = world_.attr("step")(action, spent);
+    if (result.is_none()) return Observation::not_yet();
+    if (py::isinstance<py::bool_>(result)) {
+      throw UsageError("World.step must return None (not yet) or the execution time in steps, not a bool");
+    }
+    if (py::isinstance<py::float_>(result) && std::isinf(result.cast<double>()) && result.cast<double>() > 0) {
+      return Observation::found(kNever);
+    }
+    if (!py::hasattr(result, "__index__")) {
+      throw UsageError(
+          "World.step must return None (not yet) or the execution time in steps (an int, "
+          "ontime.NEVER or math.inf), got " +
+          std::string(py::str(py::type::of(result).attr("__name__"))));
+    }
+    const auto steps = py::int_(result).cast<long long>();
+    if (steps < 0) throw UsageError("World.step returned a negative execution time (" + std::to_string(steps) + ")");
+    return Observation::found(steps >= kNever ? kNever : static_cast<Steps>(steps));
+  }
+
+  void collect_statistics(Statistics& statistics) const override {
+    const py::gil_scoped_acquire acquire;
+    if (!py::hasattr(world_, "statistics")) return;
+    const py::dict counters = world_.attr("statistics")();
+    for (const auto& [name, value] : counters) statistics.add(std::string(py::str(name)), value.cast<double>());
+  }
+
+ private:
+  py::object world_;
+};
+
+py::dict latency_dict(const LatencySummary& latency) {
+  py::dict out;
+  out["median"] = latency.median_us;
+  out["p99"] = latency.p99_us;
+  out["mean"] = latency.mean_us;
+  out["max"] = latency.max_us;
+  out["decisions"] = latency.decisions;
+  return out;
+}
+
+py::dict statistics_dict(const Statistics& statistics) {
+  py::dict out;
+  for (const Statistics::Counter& counter : statistics.counters()) out[py::str(counter.name)] = counter.value;
+  return out;
+}
+
+MonteCarloResult run_with_hooks(const Mdp& mdp, const WorldFactory& worlds, const AllocatorFactory& factory,
+                                MonteCarloOptions options, const std::function<bool()>& stop, Progress& progress) {
+  progress.total = options.episodes;
+  options.stop = stop;
+  options.progress = [&progress](std::uint64_t done, std::uint64_t) { progress.done = done; };
+  return run_episodes(mdp, worlds, factory, options);
+}
+
+void check_episodes(std::uint64_t episodes) {
+  if (episodes == 0) throw UsageError("episodes must be at least 1");
+}
+
+}  // namespace
+
+py::dict monte_carlo_dict(const std::string& solver, const ParameterValues& values, const std::string& instance,
+                          const MonteCarloResult& result, std::uint64_t seed) {
+  py::dict out;
+  out["solver"] = solver;
+  out["parameters"] = parameters_dict(solver, values);
+  out["instance"] = instance;
+  out["episodes"] = result.episodes;
+  out["seed"] = seed;
+  out["successes"] = result.successes;
+  out["success_rate"] = result.success_rate;
+  out["ci95"] = result.ci95;
+  out["decision_time_us"] = latency_dict(result.decision_time);
+  out["seconds"] = result.seconds;
+  out["statistics"] = statistics_dict(result.statistics);
+  return out;
+}
+
+void bind_running(py::module_& m) {
+  py::enum_<Status>(m, "Status", "Where an episode or session stands.")
+      .value("running", Status::running)
+      .value("success", Status::success)
+      .value("failure", Status::failure);
+
+  py::class_<AllocatorHandle, std::shared_ptr<AllocatorHandle>>(
+      m, "Allocator",
+      "An effort allocator of the registry, made by ontime.make_allocator. One allocator serves one session "
+      "at a time; episode runs make their own per thread from the same kind and parameters.")
+      .def_property_readonly(
+          "name", [](const AllocatorHandle& h) { return h.name; }, "The registry name of its kind.")
+      .def_property_readonly(
+          "parameters", [](const AllocatorHandle& h) { return parameters_dict(h.name, h.values); },
+          "Its parameters, defaults filled in (registry names, text values).")
+      .def_property_readonly(
+          "capabilities",
+          [](const AllocatorHandle& h) { return allocator_registry().find(h.name).capabilities.names(); })
+      .def_property_readonly("mdp", [](const AllocatorHandle& h) { return h.mdp; })
+      .def_property_readonly(
+          "is_stationary", [](const AllocatorHandle& h) { return h.allocator->is_stationary(); },
+          "True when its choice is a function of the state alone (exact evaluation applies).")
+      .def(
+          "begin_episode", [](AllocatorHandle& h, std::uint64_t seed) { h.allocator->begin_episode(seed); },
+          py::arg("seed"), "Starts a new episode; `seed` seeds its randomness.")
+      .def(
+          "choose",
+          [](AllocatorHandle& h, const StateView& state, std::optional<std::uint64_t> iterations,
+             std::optional<double> seconds) {
+            const DecisionBudget budget = budget_of(iterations, seconds);
+            const py::gil_scoped_release release;
+            return h.allocator->choose(state.state, budget);
+          },
+          py::arg("state"), py::kw_only(), py::arg("iterations") = py::none(), py::arg("seconds") = py::none(),
+          "The skeleton to spend the next step on in `state`, within the budget given (anytime allocators; "
+          "unset: the allocator's own).")
+      .def(
+          "statistics",
+          [](const AllocatorHandle& h) {
+            Statistics statistics;
+            h.allocator->collect_statistics(statistics);
+            return statistics_dict(statistics);
+          },
+          "Its counters (e.g. mcts iterations) since it was made.")
+      .def("__repr__", [](const AllocatorHandle& h) { return "ontime.Allocator('" + h.name + "')"; });
+
+  m.def(
+      "make_allocator",
+      [](const py::object& mdp, const std::string& name, const py::kwargs& kwargs) {
+        return make_allocator_handle(to_mdp(mdp), name, parameter_values(kwargs));
+      },
+      py::arg("mdp"), py::arg("name"),
+      "Makes the allocator `name` of the registry for an Mdp (or a Problem, or an instance path), with its "
+      "parameters as keyword arguments, '_' for '-': make_allocator(mdp, 'mcts', iterations=2000). "
+      "ontime.allocators() lists the kinds and their parameters. Raises UsageError for an unknown name or a "
+      "bad value.");
+
+  py::class_<DecisionView>(m, "Decision", "An allocator's decision: which skeleton, which action to refine now.")
+      .def_readonly("skeleton", &DecisionView::skeleton, "The skeleton chosen (0-based).")
+      .def_readonly("action", &DecisionView::action,
+                    "The index of the action to refine now (into Problem.actions), or -1: the step is spent idle.")
+      .def_property_readonly(
+          "action_id",
+          [](const DecisionView& d) -> py::object {
+            if (d.action < 0) return py::none();
+            return py::str(d.problem->action(d.action).id);
+          },
+          "The id of the action to refine now, or None.")
+      .def("__repr__", [](const DecisionView& d) {
+        return "ontime.Decision(skeleton=" + std::to_string(d.skeleton) + ", action=" + std::to_string(d.action) +
+               (d.action >= 0 ? " '" + d.problem->action(d.action).id + "'" : std::string()) + ")";
+      });
+
+  py::class_<SessionHandle>(
+      m, "Session",
+      "An online session: the caller's own planner does the work, the allocator decides.\n\n"
+      "    session = ontime.Session(ontime.make_allocator(problem, 'dp-rerun'))\n"
+      "    while session.status == ontime.Status.running:\n"
+      "        decision = session.choose()\n"
+      "        # one step of planning effort on decision.action_id ...\n"
+      "        if found: session.report_refined(execution_steps)\n"
+      "        else: session.report_not_yet()\n"
+      "    if session.status == ontime.Status.success: execute(session.solution)\n\n"
+      "`iterations` / `seconds` set the per-decision budget of an anytime allocator (mcts) for every decision; "
+      "choose() may override it for one. The allocator must not serve another session at the same time.")
+      .def(py::init([](std::shared_ptr<AllocatorHandle> allocator, std::uint64_t seed,
+                       std::optional<std::uint64_t> iterations, std::optional<double> seconds) {
+             return std::make_unique<SessionHandle>(std::move(allocator), seed, budget_of(iterations, seconds));
+           }),
+           py::arg("allocator"), py::arg("seed") = 0, py::kw_only(), py::arg("iterations") = py::none(),
+           py::arg("seconds") = py::none())
+      .def(
+          "choose",
+          [](SessionHandle& h) {
+            const int skeleton = session_call([&] { return h.session.choose(h.budget).skeleton; });
+            return DecisionView{skeleton, h.session.mdp().next_action(h.session.state(), skeleton),
+                                h.allocator->mdp->problem};
+          },
+          "Asks the allocator for the next step (within the session's budget).")
+      .def(
+          "choose",
+          [](SessionHandle& h, std::optional<std::uint64_t> iterations, std::optional<double> seconds) {
+            const DecisionBudget budget = budget_of(iterations, seconds);
+            const int skeleton = session_call([&] { return h.session.choose(budget).skeleton; });
+            return DecisionView{skeleton, h.session.mdp().next_action(h.session.state(), skeleton),
+                                h.allocator->mdp->problem};
+          },
+          py::kw_only(), py::arg("iterations") = py::none(), py::arg("seconds") = py::none(),
+          "The same within this budget (iterations and/or seconds of search) for this decision only.")
+      .def(
+          "report_not_yet", [](SessionHandle& h) { return session_call([&] { return h.session.report_not_yet(); }); },
+          "The step just decided found no motion. Returns the status.")
+      .def(
+          "report_refined",
+          [](SessionHandle& h, long long execution_steps) {
+            if (execution_steps < 0) throw UsageError("execution time must be >= 0 steps");
+            const Steps steps = execution_steps >= kNever ? kNever : static_cast<Steps>(execution_steps);
+            return session_call([&] { return h.session.report_refined(steps); });
+          },
+          py::arg("execution_steps"),
+          "The step just decided found a motion that takes `execution_steps` to execute (ontime.NEVER: it "
+          "cannot be executed). Returns the status.")
+      .def_property_readonly("status", [](const SessionHandle& h) { return h.session.status(); })
+      .def_property_readonly("state",
+                             [](const SessionHandle& h) {
+                               return StateView{h.session.state(), h.session.mdp().skeleton_count()};
+                             })
+      .def_property_readonly(
+          "solution",
+          [](const SessionHandle& h) -> py::object {
+            if (h.session.solution() < 0) return py::none();
+            return py::int_(h.session.solution());
+          },
+          "The skeleton to execute after success, else None.")
+      .def_property_readonly(
+          "steps_used", [](const SessionHandle& h) { return h.session.steps_used(); }, "Steps of effort spent (CT).")
+      .def("__repr__", [](const SessionHandle& h) {
+        return std::string("ontime.Session(") + h.allocator->name + ", " + status_name(h.session.status()) +
+               ", steps used " + std::to_string(h.session.steps_used()) + ")";
+      });
+
+  m.def(
+      "run_episodes",
+      [](const py::object& problem, const py::object& world, const py::object& allocator, std::uint64_t episodes,
+         std::uint64_t seed, unsigned threads, std::optional<std::uint64_t> iterations, std::optional<double> seconds,
+         const py::object& progress, const py::kwargs& kwargs) {
+        check_episodes(episodes);
+        const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
+        std::string solver;
+        ParameterValues values;
+        if (py::isinstance<AllocatorHandle>(allocator)) {
+          const auto& handle = allocator.cast<const AllocatorHandle&>();
+          if (handle.mdp->problem != mdp->problem && handle.mdp->problem->name() != mdp->problem->name()) {
+            throw UsageError("the allocator was made for another problem ('" + handle.mdp->problem->name() + "')");
+          }
+          if (kwargs.size() > 0) throw UsageError("give parameters to make_allocator, not with an Allocator");
+          solver = handle.name;
+          values = handle.values;
+        } else {
+          solver = allocator.cast<std::string>();
+          values = parameter_values(kwargs);
+        }
+        const bool instance = py::hasattr(world, "step");
+        if (instance && threads != 1) {
+          throw UsageError(
+              "one World object runs on one thread: give a factory (e.g. the World's class) for threads != 1");
+        }
+        if (!instance && !PyCallable_Check(world.ptr())) {
+          throw py::type_error("world must be an ontime.World or a callable that makes one");
+        }
+        const AllocatorFactory factory = [&] {
+          const py::gil_scoped_release release;
+          return make_allocator_factory(solver, mdp->mdp, values);
+        }();
+        const WorldFactory worlds = [world, instance]() -> std::unique_ptr<World> {
+          const py::gil_scoped_acquire acquire;
+          py::object made = instance ? world : world();
+          if (!py::hasattr(made, "step") || !py::hasattr(made, "begin_episode")) {
+            throw UsageError("the world factory must return an ontime.World (begin_episode and step)");
+          }
+          return std::make_unique<PythonWorld>(std::move(made));
+        };
+        MonteCarloOptions options;
+        options.episodes = episodes;
+        options.seed = seed;
+        options.threads = threads;
+        options.decision_budget = budget_of(iterations, seconds);
+        MonteCarloResult result;
+        run_interruptibly(
+            [&](const std::function<bool()>& stop, Progress& counters) {
+              result = run_with_hooks(mdp->mdp, worlds, factory, options, stop, counters);
+            },
+            progress);
+        py::dict out = monte_carlo_dict(solver, values, instance_label(problem, *mdp->problem), result, seed);
+        out["world_statistics"] = statistics_dict(result.world_statistics);
+        return out;
+      },
+      py::arg("problem"), py::arg("world"), py::arg("allocator"), py::kw_only(), py::arg("episodes") = 1000,
+      py::arg("seed") = 1, py::arg("threads") = 1, py::arg("iterations") = py::none(), py::arg("seconds") = py::none(),
+      py::arg("progress") = py::none(),
+      "Episodes in which an allocator (an Allocator, or a registry name with its parameters as keyword "
+      "arguments) decides and `world` answers: an ontime.World, or a callable making one per thread. The "
+      "library's episode runner, seeded as the command line seeds it: episode e begins the world with "
+      "stream_seed(seed, e). Returns the command line's result fields plus the allocators' `statistics` and "
+      "the worlds' `world_statistics`. `progress(done, total)` is called now and then; Ctrl-C stops the run "
+      "(KeyboardInterrupt).");
+
+  m.def(
+      "evaluate",
+      [](const py::object& problem, const std::string& solver, std::uint64_t episodes, std::uint64_t seed,
+         unsigned threads, bool exact, const py::object& progress, const py::kwargs& kwargs) {
+        check_episodes(episodes);
+        const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
+        const ParameterValues values = parameter_values(kwargs);
+        std::optional<AllocatorFactory> factory;
+        {
+          const py::gil_scoped_release release;
+          factory = make_allocator_factory(solver, mdp->mdp, values);
+        }
+        MonteCarloOptions options;
+        options.episodes = episodes;
+        options.seed = seed;
+        options.threads = threads;
+        MonteCarloResult result;
+        std::optional<ExactEvaluation> exact_result;
+        run_interruptibly(
+            [&](const std::function<bool()>& stop, Progress& counters) {
+              result = run_with_hooks(mdp->mdp, hidden_worlds(*mdp->problem), *factory, options, stop, counters);
+              if (exact) {
+                const auto allocator = (*factory)();
+                exact_result = evaluate_exactly(mdp->mdp, *allocator, max_states_of(values), stop);
+              }
+            },
+            progress);
+        py::dict out = monte_carlo_dict(solver, values, instance_label(problem, *mdp->problem), result, seed);
+        if (exact_result) {
+          out["exact_success_probability"] = exact_result->success_probability;
+          out["exact_states"] = exact_result->states;
+        }
+        return out;
+      },
+      py::arg("problem"), py::arg("solver"), py::kw_only(), py::arg("episodes") = 10'000, py::arg("seed") = 1,
+      py::arg("threads") = 0, py::arg("exact") = false, py::arg("progress") = py::none(),
+      "Success rate of an allocator over simulated episodes (hidden sampled worlds), as `ontime evaluate "
+      "--json` reports it: the same fields and, for the same seed, the same counts whatever `threads`. "
+      "exact=True adds the exact success probability (stationary allocators). Parameters of the allocator "
+      "as keyword arguments. The GIL is released; Ctrl-C stops it (KeyboardInterrupt).");
+
+  m.def(
+      "solve",
+      [](const py::object& problem, std::size_t max_states) {
+        const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
+        if (max_states == 0) throw UsageError("max_states must be at least 1");
+        double value = 0;
+        double seconds = 0;
+        int first = -1;
+        std::size_t states = 0;
+        run_interruptibly([&](const std::function<bool()>& stop, Progress&) {
+          const auto started = std::chrono::steady_clock::now();
+          OptimalSolver solver(mdp->mdp, max_states);
+          solver.set_stop(stop);
+          value = solver.solve(mdp->mdp.start());
+          seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+          first = solver.best_choice(mdp->mdp.start()).value_or(-1);
+          states = solver.states();
+        });
+        const Problem& p = *mdp->problem;
+        py::dict out;
+        out["instance"] = instance_label(problem, p);
+        out["name"] = p.name();
+        out["optimal_success_probability"] = value;
+        out["states"] = states;
+        out["seconds"] = seconds;
+        out["first_choice"] = first;
+        out["first_action"] = first >= 0 ? p.action(mdp->mdp.next_action(mdp->mdp.start(), first)).id : "";
+        return out;
+      },
+      py::arg("problem"), py::arg("max_states") = OptimalSolver::kDefaultMaxStates,
+      "The exact optimal success probability and first choice (expectimax), as `ontime solve --json` "
+      "reports them. Raises ResourceLimitError past max_states; the GIL is released and Ctrl-C stops it.");
+
+  m.def(
+      "train_ppo",
+      [](const py::object& problem, const py::object& out, std::uint64_t episodes, std::uint64_t seed,
+         const py::object& progress) {
+        check_episodes(episodes);
+        const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
+        const std::string path = py::str(py::module_::import("os").attr("fspath")(out));
+        std::optional<PpoTraining> training;
+        run_interruptibly(
+            [&](const std::function<bool()>& stop, Progress& counters) {
+              counters.total = episodes;
+              training = train_ppo(mdp->mdp, episodes, seed, {}, [&](std::uint64_t done, std::uint64_t) {
+                if (stop()) throw Cancelled("training stopped at the caller's request");
+                counters.done = done;
+              });
+              save_ppo_policy(training->policy, path);
+            },
+            progress);
+        py::list curve;
+        for (const LearningCurvePoint& point : training->curve) {
+          py::dict row;
+          row["epoch"] = point.epoch;
+          row["episodes"] = point.episodes;
+          row["steps"] = point.steps;
+          row["success_rate"] = point.success_rate;
+          row["mean_episode_length"] = point.mean_episode_length;
+          row["actor_steps"] = point.actor_steps;
+          row["seconds"] = point.seconds;
+          curve.append(row);
+        }
+        return curve;
+      },
+      py::arg("problem"), py::arg("out"), py::kw_only(), py::arg("episodes") = 10'000, py::arg("seed") = 1,
+      py::arg("progress") = py::none(),
+      "Trains the ppo policy on simulated episodes (as `ontime train`), writes it to `out` (atomically, only "
+      "when training finished) and returns the learning curve as a list of dicts. Use it with "
+      "make_allocator(problem, 'ppo', policy=out).");
+}
+
+}  // namespace ontime::python

@@ -1,0 +1,83 @@
+"""The module gives the command line's numbers: exact values to 1e-12, identical Monte Carlo counts
+for the same seed, the same fields, the same registry."""
+
+import pytest
+
+import ontime
+from conftest import PAPER_INSTANCES
+
+EXACT_SOLVERS = ["dp", "dp-rerun", "greedy", "round-robin"]
+
+
+@pytest.mark.parametrize("path", PAPER_INSTANCES, ids=lambda p: p.stem)
+def test_solve_matches_the_cli(path, cli):
+    expected = cli("solve", path, "--json")
+    got = ontime.solve(str(path))
+    assert set(got) == set(expected)
+    assert got["optimal_success_probability"] == pytest.approx(expected["optimal_success_probability"], abs=1e-12)
+    for key in ("instance", "name", "states", "first_choice", "first_action"):
+        assert got[key] == expected[key]
+
+
+@pytest.mark.parametrize("path", PAPER_INSTANCES, ids=lambda p: p.stem)
+@pytest.mark.parametrize("solver", EXACT_SOLVERS)
+def test_exact_evaluation_matches_the_cli(path, solver, cli):
+    expected = cli("evaluate", path, "--solver", solver, "--episodes", 2000, "--seed", 7, "--exact", "--json")
+    got = ontime.evaluate(str(path), solver, episodes=2000, seed=7, exact=True)
+    assert got["exact_success_probability"] == pytest.approx(expected["exact_success_probability"], abs=1e-12)
+    assert got["exact_states"] == expected["exact_states"]
+    assert got["successes"] == expected["successes"]
+
+
+@pytest.mark.parametrize("solver,params,flags", [
+    ("mcts", {"iterations": 300}, ["--iterations", 300]),
+    ("thompson", {}, []),
+    ("dp-rerun", {"aggregation": "max"}, ["--aggregation", "max"]),
+])
+def test_monte_carlo_counts_match_the_cli_for_the_same_seed(solver, params, flags, cli):
+    path = PAPER_INSTANCES[1]
+    expected = cli("evaluate", path, "--solver", solver, "--episodes", 3000, "--seed", 11, "--threads", 2, *flags,
+                   "--json")
+    got = ontime.evaluate(str(path), solver, episodes=3000, seed=11, threads=1, **params)
+    # Every field of the CLI's JSON is there; the counts are identical (other thread count too).
+    assert set(expected) <= set(got)
+    for key in ("solver", "parameters", "instance", "episodes", "seed", "successes", "success_rate", "ci95"):
+        assert got[key] == expected[key], key
+    assert set(got["decision_time_us"]) == set(expected["decision_time_us"])
+    assert got["decision_time_us"]["decisions"] == expected["decision_time_us"]["decisions"]
+
+
+def test_the_registry_is_listed_as_the_cli_lists_it(cli):
+    assert ontime.allocators() == cli("allocators", "--json")
+
+
+def test_table_one_optimum_values():
+    # The paper's Table I instances: the exact optimum OnTime reports (docs/experiments.md).
+    values = [ontime.solve(str(p))["optimal_success_probability"] for p in PAPER_INSTANCES]
+    assert [round(v, 4) for v in values] == [0.9420, 0.7200, 0.6763, 0.9000, 0.6992]
+
+
+def test_parameters_as_keywords_reach_the_allocator():
+    problem = ontime.load_problem(PAPER_INSTANCES[0])
+    mcts = ontime.make_allocator(problem, "mcts", iterations=123, exploration=0.25)
+    assert mcts.parameters["iterations"] == "123"
+    assert mcts.parameters["exploration"] == "0.25"
+    mcts.begin_episode(3)
+    mcts.choose(ontime.Mdp(problem).start())
+    assert mcts.statistics()["iterations"] == 123
+    with pytest.raises(ontime.UsageError, match="unknown allocator 'nope'"):
+        ontime.make_allocator(problem, "nope")
+    with pytest.raises(ontime.UsageError, match="exploration"):
+        ontime.make_allocator(problem, "mcts", exploration=-1.0)
+    with pytest.raises(ontime.UsageError, match="allocator parameter 'colour'"):
+        ontime.make_allocator(problem, "mcts", colour="red")
+
+
+def test_a_non_stationary_allocator_has_no_exact_value():
+    with pytest.raises(ontime.UsageError, match="does not"):
+        ontime.evaluate(str(PAPER_INSTANCES[0]), "mcts", episodes=10, exact=True, iterations=10)
+
+
+def test_a_state_cap_is_a_resource_limit():
+    with pytest.raises(ontime.ResourceLimitError, match="cap of 10 states"):
+        ontime.solve(str(PAPER_INSTANCES[0]), max_states=10)
