@@ -6,6 +6,7 @@
 
 #include "bindings.hpp"
 #include "ontime/episode_runner.hpp"
+#include "ontime/evaluation.hpp"
 #include "ontime/planner_log.hpp"
 
 #ifdef ONTIME_PYTHON_DOMAINS
@@ -20,6 +21,9 @@
 namespace ontime::python {
 
 py::list attempts_list(const std::vector<RefinementAttempt>& attempts);
+std::pair<MonteCarloResult, std::optional<ExactEvaluation>> run_and_evaluate(
+    const MdpHandle& mdp, const WorldFactory& worlds, const AllocatorFactory& factory, const MonteCarloOptions& options,
+    bool exact, const ParameterValues& values, const py::object& progress);
 py::dict monte_carlo_dict(const std::string& solver, const ParameterValues& values, const std::string& instance,
                           const MonteCarloResult& result, std::uint64_t seed);
 
@@ -126,26 +130,17 @@ void bind_domains(py::module_& m) {
         domains::PlannerWorldOptions planner;
         planner.effort = effort_of(*domain, effort, checks_per_second);
         planner.independent_starts = independent_starts;
+        const AllocatorFactory factory = [&] {
+          const py::gil_scoped_release release;
+          return make_allocator_factory(solver, mdp->mdp, values);
+        }();
         MonteCarloOptions options;
         options.episodes = episodes;
         options.seed = seed;
         options.threads = threads;
-        MonteCarloResult result;
-        std::optional<ExactEvaluation> exact_result;
-        run_interruptibly(
-            [&](const std::function<bool()>& stop, Progress& counters) {
-              const AllocatorFactory factory = make_allocator_factory(solver, mdp->mdp, values);
-              counters.total = episodes;
-              options.stop = stop;
-              options.progress = [&counters](std::uint64_t done, std::uint64_t) { counters.done = done; };
-              result = run_episodes(mdp->mdp, domains::planner_worlds(*domain->loaded.domain, *mdp->problem, planner),
-                                    factory, options);
-              if (exact) {
-                const auto allocator = factory();
-                exact_result = evaluate_exactly(mdp->mdp, *allocator, max_states_of(values), stop);
-              }
-            },
-            progress);
+        const auto [result, exact_result] =
+            run_and_evaluate(*mdp, domains::planner_worlds(*domain->loaded.domain, *mdp->problem, planner), factory,
+                             options, exact, values, progress);
         py::dict out = monte_carlo_dict(solver, values, instance_label(problem, *mdp->problem), result, seed);
         out["domain"] = domain->name;
         out["independent_starts"] = independent_starts;

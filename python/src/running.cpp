@@ -146,6 +146,23 @@ void check_episodes(std::uint64_t episodes) {
 
 }  // namespace
 
+std::pair<MonteCarloResult, std::optional<ExactEvaluation>> run_and_evaluate(
+    const MdpHandle& mdp, const WorldFactory& worlds, const AllocatorFactory& factory, const MonteCarloOptions& options,
+    bool exact, const ParameterValues& values, const py::object& progress) {
+  MonteCarloResult result;
+  std::optional<ExactEvaluation> exact_result;
+  run_interruptibly(
+      [&](const std::function<bool()>& stop, Progress& counters) {
+        result = run_with_hooks(mdp.mdp, worlds, factory, options, stop, counters);
+        if (exact) {
+          const auto allocator = factory();
+          exact_result = evaluate_exactly(mdp.mdp, *allocator, max_states_of(values), stop);
+        }
+      },
+      progress);
+  return {result, exact_result};
+}
+
 py::dict monte_carlo_dict(const std::string& solver, const ParameterValues& values, const std::string& instance,
                           const MonteCarloResult& result, std::uint64_t seed) {
   py::dict out;
@@ -386,17 +403,8 @@ void bind_running(py::module_& m) {
         options.episodes = episodes;
         options.seed = seed;
         options.threads = threads;
-        MonteCarloResult result;
-        std::optional<ExactEvaluation> exact_result;
-        run_interruptibly(
-            [&](const std::function<bool()>& stop, Progress& counters) {
-              result = run_with_hooks(mdp->mdp, hidden_worlds(*mdp->problem), *factory, options, stop, counters);
-              if (exact) {
-                const auto allocator = (*factory)();
-                exact_result = evaluate_exactly(mdp->mdp, *allocator, max_states_of(values), stop);
-              }
-            },
-            progress);
+        const auto [result, exact_result] =
+            run_and_evaluate(*mdp, hidden_worlds(*mdp->problem), *factory, options, exact, values, progress);
         py::dict out = monte_carlo_dict(solver, values, instance_label(problem, *mdp->problem), result, seed);
         if (exact_result) {
           out["exact_success_probability"] = exact_result->success_probability;
