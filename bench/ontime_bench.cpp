@@ -42,19 +42,95 @@ std::vector<ontime::State> decision_states(const ontime::Mdp& mdp, ontime::Alloc
   return states;
 }
 
-void BM_DpRerunDecision(benchmark::State& bench) {
-  const ontime::Problem problem = paper(static_cast<int>(bench.range(0)));
+// dp-rerun's decisions in the states its own `episodes` episodes visit, cycled through.
+void time_dp_rerun_decisions(benchmark::State& bench, const ontime::Problem& problem, int episodes) {
   const ontime::Mdp mdp(problem);
   ontime::DpRerunAllocator allocator(mdp);
-  const std::vector<ontime::State> states = decision_states(mdp, allocator, 2000);
+  const std::vector<ontime::State> states = decision_states(mdp, allocator, episodes);
   std::size_t next = 0;
   for (auto _ : bench) {
     benchmark::DoNotOptimize(allocator.choose(states[next]));
     next = next + 1 == states.size() ? 0 : next + 1;
   }
+  bench.counters["states"] = static_cast<double>(states.size());
   bench.SetLabel(problem.name());
 }
+
+void BM_DpRerunDecision(benchmark::State& bench) {
+  time_dp_rerun_decisions(bench, paper(static_cast<int>(bench.range(0))), 2000);
+}
 BENCHMARK(BM_DpRerunDecision)->DenseRange(1, 5);
+
+// A task planner's many skeletons: `families` groups of skeletons sharing their first two
+// actions, each skeleton with three more of its own, D = 200. Planning takes 1-30 steps (with
+// some chance of never), execution 0-10.
+ontime::Problem wide_problem(int skeletons, int per_family) {
+  ontime::SplitMix64 generator(17);
+  const auto distribution = [&](int first, int last, double never) {
+    std::vector<double> masses(static_cast<std::size_t>(last) + 1, 0.0);
+    double total = 0;
+    for (int i = 0; i < 3; ++i) {
+      const double weight = 0.1 + ontime::uniform01(generator);
+      masses[static_cast<std::size_t>(
+          first + static_cast<int>(generator() % static_cast<std::uint64_t>(last - first + 1)))] += weight;
+      total += weight;
+    }
+    for (double& mass : masses) mass *= (1.0 - never) / total;
+    return ontime::Distribution::from_pmf(std::move(masses));
+  };
+  std::vector<ontime::Action> actions;
+  const auto add_action = [&] {
+    std::string id = std::to_string(actions.size());
+    id.insert(0, 1, 'a');  // not "a" + ...: GCC 12 warns falsely (-Wrestrict) about that at -O3
+    actions.push_back(ontime::Action{std::move(id), distribution(1, 30, 0.1), distribution(0, 10, 0.0)});
+    return static_cast<int>(actions.size()) - 1;
+  };
+  std::vector<std::vector<int>> paths;
+  std::vector<int> family;
+  for (int k = 0; k < skeletons; ++k) {
+    if (k % per_family == 0) family = {add_action(), add_action()};
+    std::vector<int> path = family;
+    for (int i = 0; i < 3; ++i) path.push_back(add_action());
+    paths.push_back(std::move(path));
+  }
+  return ontime::Problem("wide", 200, 1.0, std::move(actions), std::move(paths));
+}
+
+// dp-rerun on 16 and 1,000 skeletons of 5 actions, D = 200, in the states its own episodes
+// visit (target: <= 20 us median with 1,000).
+void BM_DpRerunDecisionWide(benchmark::State& bench) {
+  time_dp_rerun_decisions(bench, wide_problem(static_cast<int>(bench.range(0)), 8), 50);
+}
+BENCHMARK(BM_DpRerunDecisionWide)->Arg(16)->Arg(1000)->Unit(benchmark::kMicrosecond);
+
+// One step of a session (choose, then report "not yet") with round-robin, plain (Arg 0) or live
+// on the steady clock (Arg 1): the difference is the live accounting (target <= 1 us).
+void BM_SessionStep(benchmark::State& bench) {
+  const bool live = bench.range(0) != 0;
+  // Found at the 1,000th step, D = 2,000: 500 steps never end the session.
+  std::vector<double> late(1001, 0.0);
+  late[1000] = 1.0;
+  const ontime::Problem problem(
+      "late", 2000, 1.0,
+      {ontime::Action{"a", ontime::Distribution::from_pmf(late), ontime::Distribution::from_pmf({1.0})}}, {{0}});
+  const ontime::Mdp mdp(problem);
+  ontime::RoundRobinAllocator allocator(1);
+  const ontime::SteadyClock clock;
+  std::uint64_t steps = 0;
+  while (bench.KeepRunning()) {
+    bench.PauseTiming();
+    ontime::Session session = live ? ontime::Session(mdp, allocator, 0, clock) : ontime::Session(mdp, allocator, 0);
+    bench.ResumeTiming();
+    for (int i = 0; i < 500; ++i) {
+      session.choose();
+      session.report_not_yet();
+    }
+    steps += 500;
+  }
+  bench.SetItemsProcessed(static_cast<std::int64_t>(steps));
+  bench.SetLabel(live ? "live" : "plain");
+}
+BENCHMARK(BM_SessionStep)->Arg(0)->Arg(1);
 
 void BM_DpRerunTables(benchmark::State& bench) {
   const ontime::Problem problem = paper(static_cast<int>(bench.range(0)));

@@ -56,6 +56,8 @@ ContiguousSuccessTable::ContiguousSuccessTable(const Mdp& mdp, Aggregation aggre
   continuation_.assign(slots * row, 0.0);
   // PS(k, l, 0, U) with an unconditioned planning time, U = 0 .. D (zero at U >= D).
   std::vector<double> unconditioned(slots * (deadline + 1), 0.0);
+  fresh_.assign(slots * (deadline + 1), 0.0);
+  bound_.assign(slots * (deadline + 1), 0.0);
 
   // Later positions first: G(k, l) needs PS(k', l + 1) of the skeletons sharing position l.
   for (int l = longest; l-- > 0;) {
@@ -96,10 +98,17 @@ ContiguousSuccessTable::ContiguousSuccessTable(const Mdp& mdp, Aggregation aggre
         }
       }
       const double* p = &planning_[static_cast<std::size_t>(action) * planning_row];
-      for (std::size_t used = 0; used < deadline; ++used) {
+      const double start = survival_[static_cast<std::size_t>(action) * deadline];
+      double later = 0;  // max of G(v) over v > used
+      for (std::size_t used = deadline; used-- > 0;) {
         double value = 0;
         for (std::size_t t = 1; used + t <= deadline; ++t) value += p[t] * g[used + t];
         unconditioned[slot * (deadline + 1) + used] = value;
+        // The query's own arithmetic (the same sum, divided by S(0)), so that a fresh value
+        // read here equals the one computed on demand to the last bit.
+        fresh_[slot * (deadline + 1) + used] = start > 0 ? value / start : 0.0;
+        later = std::max(later, g[used + 1]);
+        bound_[slot * (deadline + 1) + used] = later * kBoundMargin;
       }
     }
   }
@@ -121,11 +130,18 @@ double ContiguousSuccessTable::success_probability(int k, int l, Steps spent, St
   return value / remaining;
 }
 
+double ContiguousSuccessTable::upper_bound(const State& state, int k) const noexcept {
+  const auto index = static_cast<std::size_t>(k);
+  if (mdp_->next_action(state, k) < 0) return 0.0;
+  return upper_bound(k, state.refined[index], std::int64_t{state.time} + state.execution[index]);
+}
+
 double ContiguousSuccessTable::success_probability(const State& state, int k) const noexcept {
   const auto slot = static_cast<std::size_t>(k);
   if (mdp_->next_action(state, k) < 0) return 0.0;
-  return success_probability(k, state.refined[slot], state.spent[slot],
-                             static_cast<Steps>(state.time) + state.execution[slot]);
+  const std::int64_t used = std::int64_t{state.time} + state.execution[slot];
+  if (state.spent[slot] == 0) return fresh_success_probability(k, state.refined[slot], used);
+  return success_probability(k, state.refined[slot], state.spent[slot], static_cast<Steps>(used));
 }
 
 }  // namespace ontime

@@ -38,7 +38,17 @@ struct ThreadRun {
   std::unique_ptr<World> world;
   RecordingTimer timer;
   std::uint64_t successes = 0;
+  // Live runs: charges summed over this thread's episodes in whole nanoseconds, so that the
+  // sums do not depend on how episodes fell to threads.
+  std::array<std::int64_t, 5> live_nanoseconds{};
+  std::uint64_t model_successes = 0;
+  std::uint64_t model_undecided = 0;
 };
+
+void add_totals(std::array<std::int64_t, 5>& sum, const LiveTotals& episode) noexcept {
+  const double parts[] = {episode.decision, episode.planning, episode.overrun, episode.outside, episode.elapsed};
+  for (std::size_t i = 0; i < sum.size(); ++i) sum[i] += std::llround(parts[i] * 1e9);
+}
 
 }  // namespace
 
@@ -48,9 +58,12 @@ double ci95_half_width(double rate, std::uint64_t episodes) noexcept {
 }
 
 EpisodeResult run_episode(const Mdp& mdp, Allocator& allocator, World& world, std::uint64_t seed,
-                          const DecisionBudget& budget, DecisionTimer* timer) {
+                          const DecisionBudget& budget, DecisionTimer* timer, const std::optional<LiveRun>& live) {
+  static const SteadyClock steady_clock;
   world.begin_episode(seed);
-  Session session(mdp, allocator, stream_seed(seed, 1));
+  const Clock& clock = world.clock() != nullptr ? *world.clock() : steady_clock;
+  Session session = live ? Session(mdp, allocator, stream_seed(seed, 1), clock, live->options)
+                         : Session(mdp, allocator, stream_seed(seed, 1));
   EpisodeResult result;
   while (session.status() == Status::running) {
     Decision decision;
@@ -62,6 +75,7 @@ EpisodeResult run_episode(const Mdp& mdp, Allocator& allocator, World& world, st
     } else {
       decision = session.choose(budget);
     }
+    if (decision.skeleton < 0) break;  // a live session ran out of time before deciding
     ++result.decisions;
     if (decision.action < 0) {
       session.report_not_yet();
@@ -73,6 +87,11 @@ EpisodeResult run_episode(const Mdp& mdp, Allocator& allocator, World& world, st
   result.status = session.status();
   result.solution = session.solution();
   result.steps_used = session.steps_used();
+  if (live) {
+    result.live = session.totals();
+    result.model_status = session.model_status();
+    if (live->keep_timeline) result.timeline = session.timeline();
+  }
   return result;
 }
 
@@ -131,12 +150,13 @@ MonteCarloResult run_episodes(const Mdp& mdp, const WorldFactory& worlds, const 
                               const MonteCarloOptions& options) {
   const auto started = std::chrono::steady_clock::now();
   // Episodes are handed out in blocks: the hand-out and the progress report cost little even
-  // when an episode takes a fraction of a microsecond.
-  constexpr std::uint64_t kBlock = 256;
+  // when an episode takes a fraction of a microsecond. Short runs (often of long episodes,
+  // against a real planner) get smaller blocks, so that every thread has some.
   std::vector<ThreadRun> runs(worker_count(options.episodes, options.threads));
+  const std::uint64_t block = std::clamp<std::uint64_t>(options.episodes / (8 * runs.size()), 1, 256);
   std::atomic<std::uint64_t> done{0};
   std::mutex progress_mutex;
-  for_each_block(options.episodes, options.threads, kBlock, [&](unsigned thread) {
+  for_each_block(options.episodes, options.threads, block, [&](unsigned thread) {
     ThreadRun& run = runs[thread];
     run.allocator = allocators();
     run.world = worlds();
@@ -145,8 +165,14 @@ MonteCarloResult run_episodes(const Mdp& mdp, const WorldFactory& worlds, const 
         if (options.stop && options.stop()) throw Cancelled("episodes stopped at the caller's request");
         const EpisodeResult result =
             run_episode(mdp, *run.allocator, *run.world, stream_seed(options.seed, episode), options.decision_budget,
-                        options.time_decisions ? &run.timer : nullptr);
+                        options.time_decisions ? &run.timer : nullptr, options.live);
         if (result.status == Status::success) ++run.successes;
+        if (options.live) {
+          add_totals(run.live_nanoseconds, result.live);
+          if (result.model_status == Status::success) ++run.model_successes;
+          if (result.model_status == Status::running) ++run.model_undecided;
+        }
+        if (options.on_episode) options.on_episode(episode, result);
         if (options.time_decisions) run.timer.end_episode();
       }
       const std::uint64_t finished = done.fetch_add(end - begin) + (end - begin);
@@ -161,12 +187,23 @@ MonteCarloResult run_episodes(const Mdp& mdp, const WorldFactory& worlds, const 
   result.episodes = options.episodes;
   LatencyHistogram decisions;
   LatencyHistogram episode_totals;
+  std::array<std::int64_t, 5> live_nanoseconds{};
   for (ThreadRun& run : runs) {
     result.successes += run.successes;
     decisions.merge(run.timer.decisions);
     episode_totals.merge(run.timer.episodes);
     run.allocator->collect_statistics(result.statistics);
     run.world->collect_statistics(result.world_statistics);
+    for (std::size_t i = 0; i < live_nanoseconds.size(); ++i) live_nanoseconds[i] += run.live_nanoseconds[i];
+    result.model_successes += run.model_successes;
+    result.model_undecided += run.model_undecided;
+  }
+  if (options.episodes > 0) {
+    const double scale = 1e-9 / static_cast<double>(options.episodes);
+    result.live_mean = {
+        static_cast<double>(live_nanoseconds[0]) * scale, static_cast<double>(live_nanoseconds[1]) * scale,
+        static_cast<double>(live_nanoseconds[2]) * scale, static_cast<double>(live_nanoseconds[3]) * scale,
+        static_cast<double>(live_nanoseconds[4]) * scale};
   }
   result.success_rate =
       options.episodes == 0 ? 0.0 : static_cast<double>(result.successes) / static_cast<double>(options.episodes);

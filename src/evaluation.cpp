@@ -10,22 +10,23 @@
 namespace ontime {
 namespace {
 
-// The allocator's own choice is the only choice; states are their own keys (packed into
-// Words 64-bit words when Words > 0).
+// The allocator's own choice is the only choice; states are keyed by their fixed-size copy
+// (packed into Words 64-bit words when Words > 0).
 template <std::size_t Words>
 class StationaryPolicy {
  public:
   StationaryPolicy(Allocator& allocator, int skeleton_count)
       : allocator_(&allocator), skeleton_count_(skeleton_count) {}
-  void choices(const State& state, std::vector<int>& out) const {
-    const int choice = allocator_->choose(state);
+  void choices(const detail::CompactState& state, std::vector<int>& out) const {
+    detail::expanded(state, scratch_);
+    const int choice = allocator_->choose(scratch_);
     if (choice < 0 || choice >= skeleton_count_) {
       throw UsageError("allocator '" + std::string(allocator_->name()) + "' chose skeleton " + std::to_string(choice) +
                        ", outside [0, " + std::to_string(skeleton_count_) + ")");
     }
     out.push_back(choice);
   }
-  auto key(const State& state) const {
+  auto key(const detail::CompactState& state) const {
     if constexpr (Words > 0) {
       return detail::pack<Words>(state, skeleton_count_);
     } else {
@@ -36,6 +37,7 @@ class StationaryPolicy {
  private:
   Allocator* allocator_;
   int skeleton_count_;
+  mutable State scratch_;  // the state the allocator is asked about
 };
 
 }  // namespace

@@ -71,8 +71,33 @@ inline std::size_t packed_words(const Mdp& mdp) noexcept {
   return bytes <= 16 ? 2 : bytes <= 32 ? 4 : 0;
 }
 
+// A whole state in a fixed 82 bytes (at most kMaxExactSkeletons skeletons; unused slots zero):
+// the state the search works on, and its key where the deadline or the skeleton count is too
+// large for a PackedState.
+struct CompactState {
+  std::uint16_t time = 0;
+  std::array<std::uint8_t, kMaxExactSkeletons> refined{};
+  std::array<std::uint16_t, kMaxExactSkeletons> spent{};
+  std::array<std::uint16_t, kMaxExactSkeletons> execution{};
+
+  friend bool operator==(const CompactState&, const CompactState&) = default;
+};
+static_assert(sizeof(CompactState) == 2 + 16 + 32 + 32, "CompactState must have no padding: it is hashed as bytes");
+
+inline CompactState compact(const State& state, int skeleton_count) noexcept {
+  CompactState out;
+  out.time = state.time;
+  for (int k = 0; k < skeleton_count; ++k) {
+    const auto slot = static_cast<std::size_t>(k);
+    out.refined[slot] = state.refined[slot];
+    out.spent[slot] = state.spent[slot];
+    out.execution[slot] = state.execution[slot];
+  }
+  return out;
+}
+
 template <std::size_t Words>
-PackedState<Words> pack(const State& state, int skeleton_count) noexcept {
+PackedState<Words> pack(const CompactState& state, int skeleton_count) noexcept {
   std::array<std::uint8_t, 8 * Words> bytes{};
   bytes[0] = static_cast<std::uint8_t>(state.time & 0xFF);
   bytes[1] = static_cast<std::uint8_t>(state.time >> 8);
@@ -87,21 +112,43 @@ PackedState<Words> pack(const State& state, int skeleton_count) noexcept {
   return packed;
 }
 
-// Hash of a full (unpacked) state: its bytes (unused slots are zero).
-struct FullStateHash {
-  std::size_t operator()(const State& state) const noexcept {
-    return absl::Hash<std::string_view>{}(std::string_view(reinterpret_cast<const char*>(&state), sizeof(State)));
+// The state a CompactState holds, written into `out` (sized for `compact`'s skeletons).
+inline void expanded(const CompactState& compact, State& out) noexcept {
+  out.time = compact.time;
+  for (std::size_t k = 0; k < compact.refined.size(); ++k) {
+    out.refined[k] = compact.refined[k];
+    out.spent[k] = compact.spent[k];
+    out.execution[k] = compact.execution[k];
+  }
+}
+
+struct CompactStateHash {
+  std::size_t operator()(const CompactState& state) const noexcept {
+    return absl::Hash<std::string_view>{}(
+        std::string_view(reinterpret_cast<const char*>(&state), sizeof(CompactState)));
   }
 };
 
+// Throws UsageError when the problem has more skeletons than the exact solvers' keys hold.
+inline void require_exact_size(const Mdp& mdp, const std::string& what) {
+  if (mdp.skeleton_count() > kMaxExactSkeletons) {
+    throw UsageError(what + ": the instance has " + std::to_string(mdp.skeleton_count()) +
+                     " skeletons; exact solving and exact evaluation take at most " +
+                     std::to_string(kMaxExactSkeletons) + " (use a sampled evaluation or an approximate allocator)");
+  }
+}
+
+// The search runs on CompactStates (the Mdp's functions are templates on the state type): a
+// copy is a plain 82-byte copy, with no indirection.
+//
 // Policy provides:
-//   void choices(const State&, std::vector<int>& out) const;  // in increasing preference on ties
-//   Key key(const State&) const;   // states with one key share a value; Key is State or PackedState
+//   void choices(const CompactState&, std::vector<int>& out) const;  // in increasing preference on ties
+//   Key key(const CompactState&) const;   // states with one key share a value; CompactState or PackedState
 template <class Policy>
 class Expectimax {
  public:
-  using Key = std::remove_cvref_t<decltype(std::declval<const Policy&>().key(std::declval<const State&>()))>;
-  using Hash = std::conditional_t<std::is_same_v<Key, State>, FullStateHash, PackedStateHash>;
+  using Key = std::remove_cvref_t<decltype(std::declval<const Policy&>().key(std::declval<const CompactState&>()))>;
+  using Hash = std::conditional_t<std::is_same_v<Key, CompactState>, CompactStateHash, PackedStateHash>;
   using Memo = absl::flat_hash_map<Key, ExpectimaxEntry, Hash>;
 
   Expectimax(const Mdp& mdp, Policy policy, std::size_t max_states, double tie_tolerance, std::string what)
@@ -109,13 +156,16 @@ class Expectimax {
         policy_(std::move(policy)),
         max_states_(max_states),
         tie_tolerance_(tie_tolerance),
-        what_(std::move(what)) {}
+        what_(std::move(what)) {
+    require_exact_size(mdp, what_);
+  }
 
   // A condition checked every few thousand states: once it returns true, solve throws Cancelled
   // (the states solved so far are kept).
   void set_stop(std::function<bool()> stop) { stop_ = std::move(stop); }
 
-  ExpectimaxEntry solve(const State& start) {
+  ExpectimaxEntry solve(const State& start_state) {
+    const CompactState start = compact(start_state, mdp_->skeleton_count());
     const Key start_key = policy_.key(start);
     if (const auto found = memo_.find(start_key); found != memo_.end()) return found->second;
     push(start, start_key);
@@ -125,7 +175,7 @@ class Expectimax {
       while (frames_[top].cursor < frames_[top].end) {
         const Item& item = items_[frames_[top].cursor++];
         if (item.status == Status::running && !memo_.contains(item.key)) {
-          const State next = item.next;
+          const CompactState next = item.next;  // push may move the items
           const Key next_key = item.key;
           push(next, next_key);
           descended = true;
@@ -139,6 +189,7 @@ class Expectimax {
   }
 
   const Memo& memo() const noexcept { return memo_; }
+  Key key_of(const State& state) const { return policy_.key(compact(state, mdp_->skeleton_count())); }
   const Policy& policy() const noexcept { return policy_; }
 
   // Memory held by the memo (table slots and their control bytes).
@@ -149,7 +200,7 @@ class Expectimax {
     int choice;
     Status status;
     double probability;
-    State next;
+    CompactState next;
     Key key;  // of `next`, when running
   };
   struct Frame {
@@ -157,12 +208,12 @@ class Expectimax {
     std::size_t begin, end, cursor;
   };
 
-  void push(const State& state, const Key& key) {
+  void push(const CompactState& state, const Key& key) {
     Frame frame{key, items_.size(), 0, items_.size()};
     choices_.clear();
     policy_.choices(state, choices_);
     for (const int choice : choices_) {
-      mdp_->for_each_outcome(state, choice, [&](double probability, Status status, const State& next) {
+      mdp_->for_each_outcome(state, choice, [&](double probability, Status status, const CompactState& next) {
         items_.push_back(
             Item{choice, status, probability, next, status == Status::running ? policy_.key(next) : Key{}});
       });

@@ -9,6 +9,7 @@
 
 #include "ontime/error.hpp"
 #include "ontime/json_input.hpp"
+#include "ontime/state.hpp"
 
 namespace ontime {
 namespace {
@@ -47,9 +48,10 @@ Knapsack parse_knapsack(std::string_view text, std::string_view source_view) {
   knapsack.capacity = positive_integer(root["capacity"], source, "capacity", Problem::kMaxDeadline);
   const Json& items = root["items"];
   if (!items.is_array() || items.empty()) throw InputError(source, "items", "must be a non-empty array of items");
-  if (items.size() > static_cast<std::size_t>(Problem::kMaxSkeletons)) {
+  // The reduction exists to be solved exactly, so its items are bounded by the exact solver.
+  if (items.size() > static_cast<std::size_t>(kMaxExactSkeletons)) {
     throw InputError(source, "items",
-                     "at most " + std::to_string(Problem::kMaxSkeletons) + " items (one skeleton each; got " +
+                     "at most " + std::to_string(kMaxExactSkeletons) + " items (one skeleton each; got " +
                          std::to_string(items.size()) + ")");
   }
   for (std::size_t i = 0; i < items.size(); ++i) {

@@ -79,101 +79,17 @@ Mdp::Mdp(const Problem& problem)
   }
 }
 
-bool Mdp::can_succeed(const State& state, int k) const noexcept {
-  const int action = next_action(state, k);
-  if (action < 0) return false;
-  const auto slot = static_cast<std::size_t>(k);
-  const Steps spent = state.spent[slot];
-  if (spent > deadline_) return false;
-  const Steps finish = next_finish_[static_cast<std::size_t>(action) * static_cast<std::size_t>(deadline_ + 1) +
-                                    static_cast<std::size_t>(spent)];
-  const Steps execution = min_execution_[static_cast<std::size_t>(action)];
-  if (finish == kNever || execution == kNever) return false;
-  const std::int64_t need = std::int64_t{state.time} + state.execution[slot] + finish + execution +
-                            rest_[offsets_[slot] + slot + state.refined[slot] + 1];
-  return need <= deadline_;
+void Mdp::reject_choice(int choice) const {
+  throw UsageError("skeleton index " + std::to_string(choice) + " out of range [0, " + std::to_string(skeleton_count_) +
+                   ")");
 }
 
-bool Mdp::any_can_succeed(const State& state) const noexcept {
-  for (int k = 0; k < skeleton_count_; ++k) {
-    if (can_succeed(state, k)) return true;
-  }
-  return false;
+void Mdp::reject_idle_refinement(int choice) const {
+  throw UsageError("skeleton " + std::to_string(choice) + " has nothing left to refine; its step was idle");
 }
 
-int Mdp::first_with_work_left(const State& state) const noexcept {
-  for (int k = 0; k < skeleton_count_; ++k) {
-    if (next_action(state, k) >= 0) return k;
-  }
-  return 0;
-}
-
-bool Mdp::group_can_succeed(const State& state, int action) const noexcept {
-  for (const int member : problem_->members(action)) {
-    if (can_succeed(state, member)) return true;
-  }
-  return false;
-}
-
-ChoiceList Mdp::useful_choices(const State& state) const noexcept {
-  ChoiceList choices;
-  for (int k = 0; k < skeleton_count_; ++k) {
-    const int action = next_action(state, k);
-    if (action < 0 || problem_->members(action).front() != k) continue;
-    if (group_can_succeed(state, action)) choices.push_back(k);
-  }
-  return choices;
-}
-
-Status Mdp::apply(State& state, int choice, const Observation& observation) const {
-  if (choice < 0 || choice >= skeleton_count_) {
-    throw UsageError("skeleton index " + std::to_string(choice) + " out of range [0, " +
-                     std::to_string(skeleton_count_) + ")");
-  }
-  const int action = next_action(state, choice);
-  // Checked before the state changes, so that a rejected observation leaves it as it was.
-  if (observation.refined && action < 0) {
-    throw UsageError("skeleton " + std::to_string(choice) + " has nothing left to refine; its step was idle");
-  }
-  if (observation.refined && observation.execution < 0) {
-    throw UsageError("execution time must be >= 0 steps (got " + std::to_string(observation.execution) + ")");
-  }
-  ++state.time;
-  // An idle step (action < 0) only spends time.
-  if (action >= 0 && !observation.refined) {
-    for (const int member : problem_->members(action)) {
-      std::uint16_t& spent = state.spent[static_cast<std::size_t>(member)];
-      if (spent <= deadline_) ++spent;
-    }
-  } else if (action >= 0) {
-    const std::int64_t total =
-        observation.execution == kNever
-            ? std::int64_t{deadline_} + 1
-            : std::int64_t{state.execution[static_cast<std::size_t>(choice)]} + observation.execution;
-    const std::uint16_t execution = saturate_execution(total);
-    for (const int member : problem_->members(action)) {
-      const auto slot = static_cast<std::size_t>(member);
-      ++state.refined[slot];
-      state.spent[slot] = 0;
-      state.execution[slot] = execution;
-    }
-    if (problem_->completes_a_skeleton(action) && std::int64_t{state.time} + execution <= deadline_) {
-      return Status::success;
-    }
-  }
-  if (state.time >= deadline_ || !any_can_succeed(state)) return Status::failure;
-  return Status::running;
-}
-
-int Mdp::completed_skeleton(const State& state, int choice) const {
-  const auto slot = static_cast<std::size_t>(choice);
-  if (state.refined[slot] == 0) return -1;
-  const int action = paths_[offsets_[slot] + state.refined[slot] - 1U];
-  for (const int member : problem_->members(action)) {
-    const auto index = static_cast<std::size_t>(member);
-    if (state.refined[index] == lengths_[index]) return member;
-  }
-  return -1;
+void Mdp::reject_execution(Steps execution) {
+  throw UsageError("execution time must be >= 0 steps (got " + std::to_string(execution) + ")");
 }
 
 }  // namespace ontime

@@ -129,7 +129,8 @@ class PpoTrainer {
         critic_optimiser_(networks_.critic, h.critic_learning_rate),
         sampling_(stream_seed(seed, 1)),
         features_(inputs_),
-        log_probabilities_(static_cast<std::size_t>(count_)) {}
+        log_probabilities_(static_cast<std::size_t>(count_)),
+        valid_(static_cast<std::size_t>(count_)) {}
 
   Batch& batch() noexcept { return batch_; }
   PpoNetworks take_networks() { return std::move(networks_); }
@@ -152,8 +153,9 @@ class PpoTrainer {
         break;
       }
       state_features(mdp_, state, features_);
-      std::uint8_t valid[Problem::kMaxSkeletons] = {};
-      for (const int choice : choices) valid[choice] = 1;
+      std::fill(valid_.begin(), valid_.end(), std::uint8_t{0});
+      for (const int choice : choices) valid_[choice] = 1;
+      const std::uint8_t* valid = valid_.data();
       const Vector& logits = networks_.actor.evaluate(features_);
       masked_log_softmax(logits, valid, count_, log_probabilities_.data());
       const double value = networks_.critic.evaluate(features_)(0);
@@ -260,6 +262,7 @@ class PpoTrainer {
   Batch batch_;
   Vector features_;
   std::vector<double> log_probabilities_;
+  std::vector<std::uint8_t> valid_;  // 1 for the useful choices of the current state
   Matrix inputs_matrix_, logits_gradient_, value_gradient_;
 };
 

@@ -17,11 +17,13 @@
 #include "ontime/allocator_registry.hpp"
 #include "ontime/allocators/ppo.hpp"
 #include "ontime/evaluation.hpp"
+#include "ontime/instance_io.hpp"
 #include "support/bad_inputs.hpp"
 #include "support/bad_logs.hpp"
 #include "support/mini_world.hpp"
 #include "support/paper.hpp"
 #include "support/process.hpp"
+#include "support/random_instances.hpp"
 
 namespace ontime {
 namespace {
@@ -177,6 +179,35 @@ TEST(Cli, StudiesWriteTheirCsvAndPlot) {
   EXPECT_FALSE(std::filesystem::exists(directory / "compute_time.png"));
   const auto bad = ontime({"study", "anytime", paper("instance4"), "--log10-multipliers", "0,x"});
   EXPECT_EQ(bad.exit_code, 2);
+}
+
+// An instance of 300 skeletons: sampled evaluation by the approximate allocators, and a one-line
+// refusal naming the file and the limit from everything exact, before any work.
+TEST(Cli, ThreeHundredSkeletonsAreEvaluatedAndRefusedByTheExactSolver) {
+  const auto directory = scratch("wide");
+  const std::string path = (directory / "wide.json").string();
+  save_problem(testing::wide_instance(8, 300, 4, 80), path);
+  for (const char* solver : {"dp-rerun", "thompson", "greedy"}) {
+    const auto result =
+        ontime({"evaluate", path, "--solver", solver, "--episodes", "400", "--seed", "2", "--threads", "2", "--json"});
+    ASSERT_EQ(result.exit_code, 0) << solver << ": " << result.err;
+    const json out = json::parse(result.out);
+    EXPECT_EQ(out["episodes"], 400) << solver;
+    EXPECT_GT(out["success_rate"].get<double>(), 0.0) << solver;
+    EXPECT_FALSE(out.contains("exact_success_probability")) << solver;
+  }
+  for (const std::vector<std::string>& command :
+       {std::vector<std::string>{"solve", path},
+        std::vector<std::string>{"evaluate", path, "--solver", "dp", "--exact"},
+        std::vector<std::string>{"table", path, "--solvers", "dp-rerun,optimal", "--episodes", "10"}}) {
+    const auto result = ontime(command);
+    EXPECT_EQ(result.exit_code, 2) << command[0] << ": " << result.err;
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+    EXPECT_NE(result.err.find(path + ": skeletons: 300 skeletons; exact solving and exact evaluation take at most 16"),
+              std::string::npos)
+        << result.err;
+    EXPECT_TRUE(result.out.empty()) << result.out;
+  }
 }
 
 TEST(Cli, KnapsackReductionWritesASolvableInstance) {
@@ -469,6 +500,39 @@ TEST(Cli, CollectWritesWhereRunLooksForItsModel) {
   const auto after = in_dir(on_collected);
   ASSERT_EQ(after.exit_code, 0) << after.err;
   EXPECT_EQ(json::parse(after.out)["instance"], "data/instances/navigation.json");
+}
+
+// Live episodes against the real planner: every episode's charges and timeline in the JSON, one
+// episode's timeline as CSV; the live options need a live run.
+TEST(Cli, RunLiveReportsEveryEpisodesChargesAndTimeline) {
+  const std::filesystem::path dir = scratch("live");
+  const auto result =
+      ontime({"run", "--domain", "navigation", "--solver", "dp-rerun", "--live", "--episodes", "3", "--threads", "1",
+              "--json", "--timeline", (dir / "timeline.png").string(), "--timeline-episode", "2", "--no-plot"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const json out = json::parse(result.out);
+  EXPECT_TRUE(out["live"].get<bool>());
+  EXPECT_EQ(out["effort"], "checks");
+  ASSERT_EQ(out["episode_results"].size(), 3u);
+  std::uint64_t successes = 0;
+  for (const json& episode : out["episode_results"]) {
+    successes += episode["status"] == "success" ? 1 : 0;
+    ASSERT_FALSE(episode["timeline"].empty());
+    double planning = 0;
+    for (const json& step : episode["timeline"]) planning += step["planning_seconds"].get<double>();
+    EXPECT_NEAR(episode["planning_seconds"].get<double>(), planning, 1e-9);
+    // Planner calls count their nominal seconds: at least a little effort each.
+    EXPECT_GT(planning, 0.0);
+    EXPECT_LE(episode["elapsed_seconds"].get<double>(), 66.0 + 1e-6);
+  }
+  EXPECT_EQ(out["successes"].get<std::uint64_t>(), successes);
+  EXPECT_LE(out["step_clock_successes"].get<std::uint64_t>() + out["step_clock_undecided"].get<std::uint64_t>(), 3u);
+  EXPECT_EQ(line_count(dir / "timeline.csv"), out["episode_results"][2]["timeline"].size() + 1);
+  EXPECT_FALSE(std::filesystem::exists(dir / "timeline.png"));
+
+  const auto not_live = ontime({"run", "--domain", "navigation", "--solver", "dp", "--decision-share", "0.3"});
+  EXPECT_EQ(not_live.exit_code, 2);
+  EXPECT_NE(not_live.err.find("--decision-share needs live episodes"), std::string::npos) << not_live.err;
 }
 
 // Every file a command writes is checked before its work starts: a missing or unusable folder,

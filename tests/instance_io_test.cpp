@@ -139,6 +139,22 @@ TEST(InstanceIo, EveryBadFileNamesItsPlaceAndRule) {
   }
 }
 
+// Skeleton indices are 16-bit: one more skeleton than that is refused by the reader, before the
+// skeletons themselves are read. Hundreds load (wide_problem_test.cpp).
+TEST(InstanceIo, MoreSkeletonsThanIndicesCanNameAreRefused) {
+  std::string text = R"({"deadline": 4, "step_seconds": 1.0, "actions": {"x": {"planning": {"pmf": {"1": 1.0}},
+      "execution": {"pmf": {"1": 1.0}}}}, "skeletons": [)";
+  for (int k = 0; k <= Problem::kMaxSkeletons; ++k) text += k == 0 ? R"(["x"])" : R"(,["x"])";
+  text += "]}";
+  try {
+    parse_problem(text, "many.json");
+    ADD_FAILURE() << "65,536 skeletons were accepted";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.place(), "skeletons");
+    EXPECT_NE(error.rule().find("at most 65535 skeletons"), std::string::npos) << error.rule();
+  }
+}
+
 // Restores the process-wide input size limit when a test ends.
 struct InputLimitGuard {
   explicit InputLimitGuard(std::uint64_t bytes) { set_max_input_bytes(bytes); }

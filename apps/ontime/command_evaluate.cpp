@@ -34,7 +34,7 @@ void add_evaluate_command(CLI::App& app) {
     const ParameterValues parameters = options->allocator.values();
     options->monte_carlo.check_tree_memory(options->solver, parameters);
     if (options->exact || allocator_registry().find(options->solver).capabilities.has(Capability::optimal)) {
-      check_state_cap_memory(problem, max_states_of(parameters));
+      check_state_cap_memory(problem, max_states_of(parameters), options->instance);
     }
     const AllocatorFactory factory = make_allocator_factory(options->solver, mdp, parameters);
 

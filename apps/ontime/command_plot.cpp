@@ -19,9 +19,7 @@ namespace {
 std::string histogram_csv(const Problem& problem) {
   std::string csv = "action,distribution,step,probability\n";
   for (const Action& action : problem.actions()) {
-    std::string quoted = "\"";
-    for (const char c : action.id) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
-    quoted += "\"";
+    const std::string quoted = csv_field(action.id);
     for (const auto& [kind, distribution] : {std::pair<const char*, const Distribution*>{"planning", &action.planning},
                                              {"execution", &action.execution}}) {
       const auto masses = distribution->masses();

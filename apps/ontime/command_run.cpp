@@ -1,22 +1,89 @@
 // `ontime run --domain NAME --solver NAME`: episodes in which an allocator drives the domain's
 // real motion planner step by step (several refinements interleaved), against the success the
-// allocator expects from the fitted instance.
+// allocator expects from the fitted instance. With `--effort wall` (or `--live`) every episode
+// is a live session (session.hpp): the allocator's thinking and the planner's overruns are
+// charged against the deadline in seconds, the planner's time being real (wall) or the nominal
+// seconds of its collision checks (checks).
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <span>
+#include <vector>
 
 #include "common.hpp"
 #include "data_paths.hpp"
 #include "memory_limits.hpp"
 #include "number_options.hpp"
 #include "ontime/allocators/optimal.hpp"
+#include "ontime/atomic_file.hpp"
 #include "ontime/domains/planner_world.hpp"
 #include "ontime/domains/registry.hpp"
 #include "ontime/episode_runner.hpp"
+#include "ontime/error.hpp"
 #include "ontime/instance_io.hpp"
+#include "output_paths.hpp"
+#include "python_runner.hpp"
 
 namespace ontime::cli {
+namespace {
+
+const char* status_name(Status status) {
+  return status == Status::success ? "success" : status == Status::failure ? "failure" : "undecided";
+}
+
+// The charges of a live episode (prefix "") or their means over a run ("mean_").
+void add_charges(Json& out, const LiveTotals& totals, const std::string& prefix) {
+  out[prefix + "elapsed_seconds"] = totals.elapsed;
+  out[prefix + "decision_seconds"] = totals.decision;
+  out[prefix + "planning_seconds"] = totals.planning;
+  out[prefix + "overrun_seconds"] = totals.overrun;
+  out[prefix + "outside_seconds"] = totals.outside;
+}
+
+Json live_json(const EpisodeResult& result) {
+  Json episode;
+  episode["status"] = status_name(result.status);
+  episode["step_clock_status"] = status_name(result.model_status);
+  episode["solution"] = result.solution;
+  episode["decisions"] = result.decisions;
+  episode["steps"] = result.steps_used;
+  add_charges(episode, result.live, "");
+  Json timeline = Json::array();
+  for (const LiveStep& step : result.timeline) {
+    timeline.push_back({{"skeleton", step.skeleton},
+                        {"action", step.action},
+                        {"start", step.start},
+                        {"outside_seconds", step.outside_seconds},
+                        {"decision_seconds", step.decision_seconds},
+                        {"planning_seconds", step.planning_seconds},
+                        {"overrun_seconds", step.overrun_seconds},
+                        {"observe_seconds", step.observe_seconds},
+                        {"steps_charged", step.steps_charged},
+                        {"refined", step.refined},
+                        {"execution_seconds", step.refined ? Json(step.execution_seconds) : Json(nullptr)}});
+  }
+  episode["timeline"] = std::move(timeline);
+  return episode;
+}
+
+// One row per step of the episode: what the timeline picture draws.
+std::string timeline_csv(const Problem& problem, const EpisodeResult& result) {
+  std::string csv =
+      "skeleton,action,start,outside_seconds,decision_seconds,planning_seconds,overrun_seconds,observe_seconds,"
+      "refined,execution_seconds\n";
+  for (const LiveStep& step : result.timeline) {
+    const std::string action = step.action >= 0 ? problem.action(step.action).id : "";
+    csv += fmt::format("{},{},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{},{:.9f}\n", step.skeleton, csv_field(action),
+                       step.start, step.outside_seconds, step.decision_seconds, step.planning_seconds,
+                       step.overrun_seconds, step.observe_seconds, step.refined ? 1 : 0,
+                       step.refined ? step.execution_seconds : 0.0);
+  }
+  return csv;
+}
+
+}  // namespace
 
 void add_run_command(CLI::App& app) {
   struct Options {
@@ -32,6 +99,11 @@ void add_run_command(CLI::App& app) {
     bool exact = false;
     bool independent_starts = false;
     bool json = false;
+    bool live = false;
+    double decision_share = 0.5;
+    std::string timeline;
+    std::uint64_t timeline_episode = 0;
+    bool no_plot = false;
     AllocatorFlags allocator;
   };
   auto options = std::make_shared<Options>();
@@ -56,21 +128,50 @@ void add_run_command(CLI::App& app) {
       "--independent-starts", options->independent_starts,
       "Start every action after the first from a fresh pose in its room, not where the previous refinement ended");
   command->add_flag("--exact", options->exact, "Also the exact success the allocator expects from the instance");
-  command->add_flag("--json", options->json, "Print JSON");
+  command->add_flag("--live", options->live,
+                    "Live episodes on the clock (always with --effort wall): the allocator's thinking and the "
+                    "planner's overruns are charged; with --effort checks planner calls count their nominal seconds");
+  add_number_option(*command, "--decision-share", options->decision_share,
+                    "Live: the share of a step an anytime allocator (mcts) thinks per decision", kPositive, 1e6);
+  command->add_option("--timeline", options->timeline,
+                      "Live: draw one episode's timeline into this PNG (its data beside it as .csv)");
+  add_number_option(*command, "--timeline-episode", options->timeline_episode, "The episode --timeline draws");
+  command->add_flag("--no-plot", options->no_plot, "With --timeline: write the .csv only");
+  command->add_flag("--json", options->json, "Print JSON (live: every episode and its timeline)");
   options->allocator.add_to(*command);
-  command->callback([options] {
+  command->callback([options, command] {
     check_solver_names({options->solver});
+    const bool live = options->live || options->effort == "wall";
+    for (const char* name : {"--decision-share", "--timeline", "--timeline-episode", "--no-plot"}) {
+      if (!live && command->count(name) > 0) {
+        throw UsageError(fmt::format("{} needs live episodes (--live or --effort wall)", name));
+      }
+    }
+    if (options->timeline_episode >= options->episodes) {
+      throw UsageError(fmt::format("--timeline-episode {}: the run has episodes 0 to {}", options->timeline_episode,
+                                   options->episodes - 1));
+    }
     const std::filesystem::path world =
         options->world.empty() ? default_world_file(options->domain) : std::filesystem::path(options->world);
     const std::filesystem::path instance =
         options->instance.empty() ? default_model_file(options->domain) : std::filesystem::path(options->instance);
+    std::filesystem::path timeline_png;
+    std::filesystem::path timeline_data;
+    if (!options->timeline.empty()) {
+      timeline_png = options->timeline;
+      timeline_data = timeline_png;
+      timeline_data.replace_extension(".csv");
+      std::vector<OutputFile> outputs{{"--timeline (plotted data)", timeline_data}};
+      if (!options->no_plot) outputs.push_back({"--timeline", timeline_png});
+      check_outputs(outputs, {world, instance});
+    }
     const domains::LoadedDomain loaded = domains::load_domain(options->domain, world);
     const Problem problem = load_problem(instance);
     const Mdp mdp(problem);
     const ParameterValues parameters = options->allocator.values();
     check_tree_memory(options->solver, parameters, options->episodes, options->threads);
     if (options->exact || allocator_registry().find(options->solver).capabilities.has(Capability::optimal)) {
-      check_state_cap_memory(problem, max_states_of(parameters));
+      check_state_cap_memory(problem, max_states_of(parameters), instance.string());
     }
     const AllocatorFactory factory = make_allocator_factory(options->solver, mdp, parameters);
     domains::PlannerWorldOptions planner;
@@ -82,6 +183,15 @@ void add_run_command(CLI::App& app) {
     episodes.episodes = options->episodes;
     episodes.seed = options->seed;
     episodes.threads = options->threads;
+    std::vector<EpisodeResult> results;
+    if (live) {
+      episodes.live = LiveRun{LiveOptions{.decision_share = options->decision_share}, true};
+      results.resize(options->episodes);
+      // Each episode writes its own slot: no two threads touch one.
+      episodes.on_episode = [&results](std::uint64_t episode, const EpisodeResult& result) {
+        results[episode] = result;
+      };
+    }
     const MonteCarloResult summary =
         run_episodes(mdp, domains::planner_worlds(*loaded.domain, problem, planner), factory, episodes);
     const double refinements_started =
@@ -90,6 +200,36 @@ void add_run_command(CLI::App& app) {
     if (options->exact) {
       const auto allocator = factory();
       exact = evaluate_exactly(mdp, *allocator, max_states_of(parameters));
+    }
+    if (!timeline_data.empty()) {
+      const EpisodeResult& shown = results[options->timeline_episode];
+      write_file_atomically(timeline_data, timeline_csv(problem, shown));
+      if (!options->no_plot) {
+        const std::string title = fmt::format("{} on {}, episode {}: {} at {:.1f} s of {:.1f} s", options->solver,
+                                              options->domain, options->timeline_episode, status_name(shown.status),
+                                              shown.live.elapsed, problem.deadline() * problem.step_seconds());
+        // The plan executed: every action of the skeleton that succeeded.
+        double execution = 0;
+        if (shown.status == Status::success) {
+          const std::span<const int> plan = problem.skeleton(shown.solution);
+          for (const LiveStep& step : shown.timeline) {
+            if (step.refined && std::find(plan.begin(), plan.end(), step.action) != plan.end()) {
+              execution += step.execution_seconds;
+            }
+          }
+        }
+        run_python_script("plot_timeline.py", timeline_png, [&](const std::string& drawing) {
+          return std::vector<std::string>{
+              "--data",      timeline_data.string(),
+              "--output",    drawing,
+              "--title",     title,
+              "--deadline",  fmt::format("{}", problem.deadline() * problem.step_seconds()),
+              "--step",      fmt::format("{}", problem.step_seconds()),
+              "--skeletons", std::to_string(problem.skeleton_count()),
+              "--solution",  std::to_string(shown.status == Status::success ? shown.solution : -1),
+              "--execution", fmt::format("{}", execution)};
+        });
+      }
     }
     if (options->json) {
       Json out;
@@ -106,13 +246,39 @@ void add_run_command(CLI::App& app) {
       out["refinements_started"] = refinements_started;
       out["seconds"] = summary.seconds;
       if (exact) out["model_exact_success_probability"] = exact->success_probability;
+      out["effort"] = options->effort;
+      out["live"] = live;
+      if (live) {
+        out["decision_share"] = options->decision_share;
+        out["step_clock_successes"] = summary.model_successes;
+        out["step_clock_undecided"] = summary.model_undecided;
+        add_charges(out, summary.live_mean, "mean_");
+        Json detail = Json::array();
+        for (const EpisodeResult& result : results) detail.push_back(live_json(result));
+        out["episode_results"] = std::move(detail);
+      }
       print_json(out);
       return;
     }
     fmt::print("solver               {} on the {} domain (model {})\n", options->solver, options->domain,
                instance.string());
-    fmt::print("real planner         {:.4f} ± {:.4f}  ({} of {} episodes, seed {}, {:.1f} s)\n", summary.success_rate,
-               summary.ci95, summary.successes, summary.episodes, options->seed, summary.seconds);
+    fmt::print("real planner         {:.4f} ± {:.4f}  ({} of {} episodes, seed {}, {:.1f} s){}\n", summary.success_rate,
+               summary.ci95, summary.successes, summary.episodes, options->seed, summary.seconds, live ? ", live" : "");
+    if (live) {
+      fmt::print(
+          "same calls, steps    {:.4f}  ({} of {} by the model's step clock; {} undecided when the live episode "
+          "ended)\n",
+          static_cast<double>(summary.model_successes) / static_cast<double>(summary.episodes), summary.model_successes,
+          summary.episodes, summary.model_undecided);
+      fmt::print(
+          "charged per episode  thinking {:.3f} s, planning {:.3f} s (overruns {:.3f} s): {:.3f} s of {:.1f} s\n",
+          summary.live_mean.decision, summary.live_mean.planning, summary.live_mean.overrun, summary.live_mean.elapsed,
+          problem.deadline() * problem.step_seconds());
+    }
+    if (!timeline_data.empty()) {
+      fmt::print("timeline             episode {}: {}{}\n", options->timeline_episode, timeline_data.string(),
+                 options->no_plot ? "" : ", " + timeline_png.string());
+    }
     fmt::print("refinements started  {:.2f} per episode\n", refinements_started);
     if (exact) fmt::print("model, exact         {:.4f}\n", exact->success_probability);
   });

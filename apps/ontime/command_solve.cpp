@@ -26,7 +26,7 @@ void add_solve_command(CLI::App& app) {
   command->add_flag("--json", options->json, "Print JSON");
   command->callback([options] {
     const Problem problem = load_problem(options->instance);
-    check_state_cap_memory(problem, options->max_states);
+    check_state_cap_memory(problem, options->max_states, options->instance);
     const Mdp mdp(problem);
     const auto started = std::chrono::steady_clock::now();
     OptimalSolver solver(mdp, options->max_states);

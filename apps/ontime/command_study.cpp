@@ -77,7 +77,9 @@ std::vector<Problem> prepare(const StudyOptions& options, const std::string& kin
   const ParameterValues parameters = options.allocator.values();
   check_tree_memory(options.searcher, parameters, options.episodes, options.threads);
   if (kind == "anytime") {
-    for (const Problem& problem : problems) check_state_cap_memory(problem, max_states_of(parameters));
+    for (std::size_t i = 0; i < problems.size(); ++i) {
+      check_state_cap_memory(problems[i], max_states_of(parameters), options.instances[i]);
+    }
   }
   return problems;
 }

@@ -257,7 +257,7 @@ void add_table_command(CLI::App& app) {
           std::any_of(options->solvers.begin(), options->solvers.end(), [](const std::string& solver) {
             return allocator_registry().find(solver).capabilities.has(Capability::optimal);
           });
-      if (exact_work) check_state_cap_memory(problems[i], max_states.back());
+      if (exact_work) check_state_cap_memory(problems[i], max_states.back(), options->instances[i]);
       for (const std::string& solver : options->solvers) {
         options->monte_carlo.check_tree_memory(solver, parameters);
         factories[i].push_back(make_allocator_factory(solver, *mdps[i], parameters));

@@ -138,6 +138,16 @@ void check_solver_names(const std::vector<std::string>& names) {
 
 void print_json(const Json& value) { fmt::print("{}\n", value.dump(2)); }
 
+std::string csv_field(std::string_view text) {
+  std::string quoted = "\"";
+  for (const char c : text) {
+    if (c == '"') quoted += '"';
+    quoted += c;
+  }
+  quoted += '"';
+  return quoted;
+}
+
 ProgressBar::ProgressBar(std::string label) : label_(std::move(label)), enabled_(::isatty(STDERR_FILENO) != 0) {}
 
 ProgressBar::~ProgressBar() {

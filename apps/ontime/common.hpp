@@ -8,6 +8,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "ontime/allocator_registry.hpp"
@@ -80,6 +81,9 @@ void check_solver_names(const std::vector<std::string>& names);
 
 // Prints JSON to stdout, two-space indented.
 void print_json(const Json& value);
+
+// `text` as one CSV field: in double quotes, inner quotes doubled.
+std::string csv_field(std::string_view text);
 
 // A progress bar on stderr, shown only when stderr is a terminal.
 class ProgressBar {

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "ontime/error.hpp"
+#include "ontime/state.hpp"
 
 namespace ontime::cli {
 namespace {
@@ -61,7 +62,13 @@ void check_memory_for(std::string_view option, double bytes) {
   }
 }
 
-void check_state_cap_memory(const Problem& problem, std::size_t max_states) {
+void check_state_cap_memory(const Problem& problem, std::size_t max_states, const std::string& source) {
+  if (problem.skeleton_count() > kMaxExactSkeletons) {
+    throw InputError(source, "skeletons",
+                     fmt::format("{} skeletons; exact solving and exact evaluation take at most {} (sampled "
+                                 "evaluation and the approximate allocators take any number)",
+                                 problem.skeleton_count(), kMaxExactSkeletons));
+  }
   const double slot_bytes =
       problem.skeleton_count() <= 4 && problem.deadline() <= 253 ? 33 : (problem.skeleton_count() <= 10 ? 49 : 99);
   check_memory_for(fmt::format("--max-states {}", max_states), 3.0 * slot_bytes * static_cast<double>(max_states));

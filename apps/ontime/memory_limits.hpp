@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
 
 #include "ontime/problem.hpp"
@@ -19,9 +20,11 @@ std::optional<std::uint64_t> available_memory_bytes();
 // exceeds the available memory.
 void check_memory_for(std::string_view option, double bytes);
 
-// The same for the exact solver's and the exact evaluation's state cap on `problem`: the table's
-// slot per state (optimal.hpp), doubled by its power-of-two growth and by 1.5 while it grows,
-// is the most they can hold before the cap stops them.
-void check_state_cap_memory(const Problem& problem, std::size_t max_states);
+// Checks, before exact work on `problem` (read from `source`) starts, that the exact solver and
+// the exact evaluation take it: InputError naming the source when it has more skeletons than
+// kMaxExactSkeletons; UsageError as above when their state cap could need more memory than is
+// available (the table's slot per state, optimal.hpp, doubled by its power-of-two growth and by
+// 1.5 while it grows, is the most they can hold before the cap stops them).
+void check_state_cap_memory(const Problem& problem, std::size_t max_states, const std::string& source);
 
 }  // namespace ontime::cli

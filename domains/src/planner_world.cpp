@@ -1,5 +1,6 @@
 #include "ontime/domains/planner_world.hpp"
 
+#include <chrono>
 #include <string>
 
 #include "ontime/fitting.hpp"
@@ -36,11 +37,18 @@ Observation PlannerWorld::step(int action, Steps spent) {
     ++started_;
   }
   const double step_seconds = problem_->step_seconds();
-  if (refinement->advance(static_cast<double>(spent + 1) * step_seconds) != RefinementStatus::found) {
-    return Observation::not_yet();
-  }
+  const double real_start = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  const double effort_start = refinement->effort().seconds();
+  const RefinementStatus status = refinement->advance(static_cast<double>(spent + 1) * step_seconds);
+  const double real_end = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  nominal_clock_.count_call(real_end - real_start, refinement->effort().seconds() - effort_start);
+  if (status != RefinementStatus::found) return Observation::not_yet();
   ++found_;
   return Observation::found(steps_to_complete(refinement->execution_seconds(), step_seconds));
+}
+
+const Clock* PlannerWorld::clock() const noexcept {
+  return options_.effort.unit == EffortUnit::collision_checks ? &nominal_clock_ : nullptr;
 }
 
 void PlannerWorld::collect_statistics(Statistics& statistics) const {

@@ -12,10 +12,16 @@
 // (skeleton, position): everything that does not depend on `spent` is computed once, when the
 // table is built, and a query is one dot product of at most D - used terms.
 //
-// Cost: building is O(sum_k A_k * D * (|supp p| + |supp e| * |N|)) time and
-// O(sum_k A_k * D) memory; a query is O(D - used) time with no allocation.
+// Two more tables per (skeleton, position) make most queries O(1): PS with nothing yet spent on
+// the action (every skeleton the allocator has not just worked on), and an upper bound on PS
+// whatever was spent (the largest G(v) beyond `used`, as PS averages G over the planning time),
+// with which a caller can skip skeletons that cannot win.
+//
+// Cost: building is O(sum_k A_k * D * (D + |supp e| * |N|)) time and O(sum_k A_k * D) memory; a
+// query is O(1) with nothing spent and O(D - used) otherwise, with no allocation.
 
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -46,7 +52,25 @@ class ContiguousSuccessTable {
   // The same, read off an MDP state (0 when k has nothing left to refine).
   double success_probability(const State& state, int k) const noexcept;
 
+  // A number >= success_probability(state, k), read from a table.
+  double upper_bound(const State& state, int k) const noexcept;
+
+  // Table reads for skeleton k at position l (which must exist), used = CT + ET_k: PS with
+  // nothing spent on the action, and a bound on PS whatever was spent.
+  double fresh_success_probability(int k, int l, std::int64_t used) const noexcept {
+    return used < deadline_ ? fresh_[slot(k, l, used)] : 0.0;
+  }
+  double upper_bound(int k, int l, std::int64_t used) const noexcept {
+    return used < deadline_ ? bound_[slot(k, l, used)] : 0.0;
+  }
+
  private:
+  std::size_t slot(int k, int l, std::int64_t used) const noexcept {
+    return (offsets_[static_cast<std::size_t>(k)] + static_cast<std::size_t>(l)) *
+               (static_cast<std::size_t>(deadline_) + 1) +
+           static_cast<std::size_t>(used);
+  }
+
   const Mdp* mdp_;
   Aggregation aggregation_;
   Steps deadline_;
@@ -57,6 +81,11 @@ class ContiguousSuccessTable {
   std::vector<double> planning_;
   // Per action: survival S(spent) for spent = 0 .. D - 1.
   std::vector<double> survival_;
+  // Per (k, l) slot, for used = 0 .. D: PS(k, l, 0, used), and a bound on PS(k, l, any, used).
+  std::vector<double> fresh_;
+  std::vector<double> bound_;
+  // Covers the rounding of a query's sum (at most D terms, each off by a few ulps).
+  static constexpr double kBoundMargin = 1.0 + 1e-9;
 };
 
 }  // namespace ontime

@@ -15,10 +15,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
+#include <vector>
 
 #include "ontime/allocator.hpp"
 #include "ontime/decision_budget.hpp"
 #include "ontime/mdp.hpp"
+#include "ontime/session.hpp"
 #include "ontime/statistics.hpp"
 #include "ontime/world.hpp"
 
@@ -36,13 +39,26 @@ struct EpisodeResult {
   int solution = -1;     // skeleton executed on success
   Steps steps_used = 0;  // steps of effort spent
   int decisions = 0;
+  // Live episodes only: what the session charged, the step clock's verdict on the same calls
+  // (Session::model_status), and the timeline when asked for.
+  LiveTotals live;
+  Status model_status = Status::running;
+  std::vector<LiveStep> timeline;
+};
+
+// Live episodes (session.hpp): each a live session on its world's clock (World::clock(), else
+// the steady clock).
+struct LiveRun {
+  LiveOptions options;
+  bool keep_timeline = false;  // copy each episode's timeline into its EpisodeResult
 };
 
 // Runs the episode with seed `seed` (see above): every decision within `budget` (unset: the
-// allocator's own), each timed when `timer` is given. An idle step (a skeleton with nothing left
-// to refine) is reported without asking the world.
+// allocator's own), each timed when `timer` is given; a live episode when `live` is set. An
+// idle step (a skeleton with nothing left to refine) is reported without asking the world.
 EpisodeResult run_episode(const Mdp& mdp, Allocator& allocator, World& world, std::uint64_t seed,
-                          const DecisionBudget& budget = {}, DecisionTimer* timer = nullptr);
+                          const DecisionBudget& budget = {}, DecisionTimer* timer = nullptr,
+                          const std::optional<LiveRun>& live = std::nullopt);
 
 struct MonteCarloOptions {
   std::uint64_t episodes = 10'000;
@@ -57,6 +73,11 @@ struct MonteCarloOptions {
   // Checked before each episode, from every thread (so it must be thread-safe): once it returns
   // true, no episode starts and the run ends by throwing Cancelled.
   std::function<bool()> stop;
+  // Live episodes.
+  std::optional<LiveRun> live;
+  // Called with every episode's result (from any thread, so it must be thread-safe; episodes
+  // are numbered 0 .. episodes - 1).
+  std::function<void(std::uint64_t episode, const EpisodeResult& result)> on_episode;
 };
 
 struct LatencySummary {
@@ -96,6 +117,9 @@ struct MonteCarloResult {
   double seconds = 0;                    // wall-clock time of the whole run
   Statistics statistics;                 // the allocators' counters, merged over threads
   Statistics world_statistics;           // the worlds' counters, merged over threads
+  LiveTotals live_mean;                  // live runs: the mean charges of an episode
+  std::uint64_t model_successes = 0;     // live runs: successes by the step clock
+  std::uint64_t model_undecided = 0;     // live runs: episodes the step clock had not decided
 };
 
 // Runs `options.episodes` episodes, seeded as above. Each thread gets its own allocator from

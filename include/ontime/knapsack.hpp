@@ -29,7 +29,8 @@ struct Knapsack {
 };
 
 // Reads {"capacity": W, "items": [{"weight": w, "value": v}, ...]} with positive integers.
-// The reduction's limits apply: at most Problem::kMaxSkeletons items and W <= kMaxDeadline.
+// The reduction's limits apply: at most kMaxExactSkeletons items (it is there to be solved
+// exactly) and W <= kMaxDeadline.
 // Throws InputError naming the file, the JSON path and the rule.
 Knapsack load_knapsack(const std::filesystem::path& path);
 Knapsack parse_knapsack(std::string_view text, std::string_view source);

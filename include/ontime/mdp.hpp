@@ -8,6 +8,9 @@
 // Success as soon as a skeleton completes with CT' + ET <= D; failure when CT' >= D without
 // success, or earlier, as soon as no skeleton can still succeed (this changes no value).
 //
+// The functions of a state are templates on its type S: State, or the exact solver's fixed-size
+// copy of it (anything with time, refined[k], spent[k] and execution[k]).
+//
 // An Mdp refers to its Problem, which must outlive it. Its precomputed tables (hazards,
 // execution supports, lower bounds on remaining time) make a transition O(K) with no
 // allocation.
@@ -23,18 +26,28 @@
 
 namespace ontime {
 
-// A short list of skeleton indices, without allocation (at most Problem::kMaxSkeletons).
+// A list of skeleton indices: inline, without allocation, for up to kInlineSkeletons entries;
+// a longer list (wide problems only) moves to the heap.
 class ChoiceList {
  public:
-  void push_back(int choice) noexcept { items_[size_++] = static_cast<std::uint8_t>(choice); }
-  int operator[](std::size_t i) const noexcept { return items_[i]; }
+  void push_back(int choice) {
+    if (size_ < inline_.size()) {
+      inline_[size_] = static_cast<std::uint16_t>(choice);
+    } else {
+      if (size_ == inline_.size()) heap_.assign(inline_.begin(), inline_.end());
+      heap_.push_back(static_cast<std::uint16_t>(choice));
+    }
+    ++size_;
+  }
+  int operator[](std::size_t i) const noexcept { return begin()[i]; }
   std::size_t size() const noexcept { return size_; }
   bool empty() const noexcept { return size_ == 0; }
-  const std::uint8_t* begin() const noexcept { return items_.data(); }
-  const std::uint8_t* end() const noexcept { return items_.data() + size_; }
+  const std::uint16_t* begin() const noexcept { return size_ > inline_.size() ? heap_.data() : inline_.data(); }
+  const std::uint16_t* end() const noexcept { return begin() + size_; }
 
  private:
-  std::array<std::uint8_t, Problem::kMaxSkeletons> items_{};
+  std::array<std::uint16_t, kInlineSkeletons> inline_{};
+  std::vector<std::uint16_t> heap_;
   std::size_t size_ = 0;
 };
 
@@ -55,10 +68,11 @@ class Mdp {
   int skeleton_count() const noexcept { return skeleton_count_; }
   Steps deadline() const noexcept { return deadline_; }
 
-  State start() const noexcept { return State{}; }
+  State start() const { return State(static_cast<std::size_t>(skeleton_count_)); }
 
   // The action skeleton k refines next, or -1 when it is fully refined (choosing it idles).
-  int next_action(const State& state, int k) const noexcept {
+  template <class S>
+  int next_action(const S& state, int k) const noexcept {
     const int refined = state.refined[static_cast<std::size_t>(k)];
     return refined < lengths_[static_cast<std::size_t>(k)]
                ? paths_[offsets_[static_cast<std::size_t>(k)] + static_cast<std::size_t>(refined)]
@@ -68,44 +82,51 @@ class Mdp {
   // Applies one step of effort on skeleton `choice` with its observed result, in place.
   // Throws UsageError when the choice or the observation is impossible (a refinement reported
   // for an idle choice, a negative execution time); `state` is then left as it was.
-  Status apply(State& state, int choice, const Observation& observation) const;
+  template <class S>
+  Status apply(S& state, int choice, const Observation& observation) const;
 
   // The skeleton that succeeded in the last `apply` that returned success: the lowest-index
   // skeleton that ends with the refined action and meets the deadline.
-  int completed_skeleton(const State& state, int choice) const;
+  template <class S>
+  int completed_skeleton(const S& state, int choice) const;
 
   // Calls visit(probability, status, next_state) for every outcome of choosing `choice` in
   // `state` (SPEC §2). Outcomes with zero probability are skipped; execution times that
   // cannot meet the deadline are merged into one outcome.
-  template <class Visitor>
-  void for_each_outcome(const State& state, int choice, Visitor&& visit) const;
+  template <class S, class Visitor>
+  void for_each_outcome(const S& state, int choice, Visitor&& visit) const;
 
   // Calls visit(probability, observation) for every observation choosing `choice` in
   // `state` can produce, in the order of for_each_outcome, without applying them.
-  template <class Visitor>
-  void for_each_observation(const State& state, int choice, Visitor&& visit) const;
+  template <class S, class Visitor>
+  void for_each_observation(const S& state, int choice, Visitor&& visit) const;
 
   // Draws the observation of one step on `choice` from the model (hazard, then execution).
-  template <class Generator>
-  Observation sample_observation(const State& state, int choice, Generator& generator) const;
+  template <class S, class Generator>
+  Observation sample_observation(const S& state, int choice, Generator& generator) const;
 
   // The choices worth considering: one per group of skeletons sharing their next action
   // (named by the group's lowest index), and only groups in which some skeleton can still
   // succeed. In increasing index order. Spending a step elsewhere cannot raise the success
   // probability.
-  ChoiceList useful_choices(const State& state) const noexcept;
+  template <class S>
+  ChoiceList useful_choices(const S& state) const;
   // Whether some skeleton sharing the next action of `action`'s group can still succeed.
-  bool group_can_succeed(const State& state, int action) const noexcept;
+  template <class S>
+  bool group_can_succeed(const S& state, int action) const noexcept;
 
   // Whether skeleton k can still succeed from this state: it has actions left and the
   // least time it can still need (earliest completion of the current action given the
   // steps spent, plus the fastest planning and execution of the rest) fits the deadline.
-  bool can_succeed(const State& state, int k) const noexcept;
-  bool any_can_succeed(const State& state) const noexcept;
+  template <class S>
+  bool can_succeed(const S& state, int k) const noexcept;
+  template <class S>
+  bool any_can_succeed(const S& state) const noexcept;
 
   // The choice of an allocator when no skeleton can succeed any more (every choice is as
   // good): the lowest-index skeleton with actions left, else 0.
-  int first_with_work_left(const State& state) const noexcept;
+  template <class S>
+  int first_with_work_left(const S& state) const noexcept;
 
   // P(the next step of effort on `action` finds a motion | `spent` steps did not).
   double hazard(int action, Steps spent) const noexcept {
@@ -115,6 +136,11 @@ class Mdp {
   }
 
  private:
+  // The UsageErrors of apply (out of line: the templates stay free of message building).
+  [[noreturn]] void reject_choice(int choice) const;
+  [[noreturn]] void reject_idle_refinement(int choice) const;
+  [[noreturn]] static void reject_execution(Steps execution);
+
   struct ExecutionOutcome {
     Steps steps;  // deadline + 1 stands for "too slow or never"
     double probability;
@@ -137,8 +163,8 @@ class Mdp {
   std::vector<Steps> min_execution_;                               // per action, kNever if none
 };
 
-template <class Visitor>
-void Mdp::for_each_observation(const State& state, int choice, Visitor&& visit) const {
+template <class S, class Visitor>
+void Mdp::for_each_observation(const S& state, int choice, Visitor&& visit) const {
   const int action = next_action(state, choice);
   if (action < 0) {
     visit(1.0, Observation::not_yet());
@@ -153,17 +179,17 @@ void Mdp::for_each_observation(const State& state, int choice, Visitor&& visit) 
   }
 }
 
-template <class Visitor>
-void Mdp::for_each_outcome(const State& state, int choice, Visitor&& visit) const {
+template <class S, class Visitor>
+void Mdp::for_each_outcome(const S& state, int choice, Visitor&& visit) const {
   for_each_observation(state, choice, [&](double probability, const Observation& observation) {
-    State next = state;
+    S next = state;
     const Status status = apply(next, choice, observation);
     visit(probability, status, next);
   });
 }
 
-template <class Generator>
-Observation Mdp::sample_observation(const State& state, int choice, Generator& generator) const {
+template <class S, class Generator>
+Observation Mdp::sample_observation(const S& state, int choice, Generator& generator) const {
   const int action = next_action(state, choice);
   if (action < 0) return Observation::not_yet();
   const double found = hazard(action, state.spent[static_cast<std::size_t>(choice)]);
@@ -172,6 +198,109 @@ Observation Mdp::sample_observation(const State& state, int choice, Generator& g
   const std::size_t drawn = sample_index(
       outcomes.size(), [&outcomes](std::size_t i) { return outcomes[i].probability; }, generator);
   return Observation::found(outcomes[drawn].steps);
+}
+
+template <class S>
+bool Mdp::can_succeed(const S& state, int k) const noexcept {
+  const int action = next_action(state, k);
+  if (action < 0) return false;
+  const auto slot = static_cast<std::size_t>(k);
+  const Steps spent = state.spent[slot];
+  if (spent > deadline_) return false;
+  const Steps finish = next_finish_[static_cast<std::size_t>(action) * static_cast<std::size_t>(deadline_ + 1) +
+                                    static_cast<std::size_t>(spent)];
+  const Steps execution = min_execution_[static_cast<std::size_t>(action)];
+  if (finish == kNever || execution == kNever) return false;
+  const std::int64_t need = std::int64_t{state.time} + state.execution[slot] + finish + execution +
+                            rest_[offsets_[slot] + slot + state.refined[slot] + 1];
+  return need <= deadline_;
+}
+
+template <class S>
+bool Mdp::any_can_succeed(const S& state) const noexcept {
+  for (int k = 0; k < skeleton_count_; ++k) {
+    if (can_succeed(state, k)) return true;
+  }
+  return false;
+}
+
+template <class S>
+int Mdp::first_with_work_left(const S& state) const noexcept {
+  for (int k = 0; k < skeleton_count_; ++k) {
+    if (next_action(state, k) >= 0) return k;
+  }
+  return 0;
+}
+
+template <class S>
+bool Mdp::group_can_succeed(const S& state, int action) const noexcept {
+  for (const int member : problem_->members(action)) {
+    if (can_succeed(state, member)) return true;
+  }
+  return false;
+}
+
+template <class S>
+ChoiceList Mdp::useful_choices(const S& state) const {
+  ChoiceList choices;
+  for (int k = 0; k < skeleton_count_; ++k) {
+    const int action = next_action(state, k);
+    if (action < 0 || problem_->members(action).front() != k) continue;
+    if (group_can_succeed(state, action)) choices.push_back(k);
+  }
+  return choices;
+}
+
+template <class S>
+Status Mdp::apply(S& state, int choice, const Observation& observation) const {
+  if (choice < 0 || choice >= skeleton_count_) {
+    reject_choice(choice);
+  }
+  const int action = next_action(state, choice);
+  // Checked before the state changes, so that a rejected observation leaves it as it was.
+  if (observation.refined && action < 0) {
+    reject_idle_refinement(choice);
+  }
+  if (observation.refined && observation.execution < 0) {
+    reject_execution(observation.execution);
+  }
+  ++state.time;
+  // An idle step (action < 0) only spends time.
+  if (action >= 0 && !observation.refined) {
+    for (const int member : problem_->members(action)) {
+      std::uint16_t& spent = state.spent[static_cast<std::size_t>(member)];
+      if (spent <= deadline_) ++spent;
+    }
+  } else if (action >= 0) {
+    const std::int64_t total =
+        observation.execution == kNever
+            ? std::int64_t{deadline_} + 1
+            : std::int64_t{state.execution[static_cast<std::size_t>(choice)]} + observation.execution;
+    const std::uint16_t execution = saturate_execution(total);
+    for (const int member : problem_->members(action)) {
+      const auto slot = static_cast<std::size_t>(member);
+      ++state.refined[slot];
+      state.spent[slot] = 0;
+      state.execution[slot] = execution;
+    }
+    if (problem_->completes_a_skeleton(action) && std::int64_t{state.time} + execution <= deadline_) {
+      return Status::success;
+    }
+  }
+  if (state.time >= deadline_ || !any_can_succeed(state)) return Status::failure;
+  return Status::running;
+}
+
+template <class S>
+int Mdp::completed_skeleton(const S& state, int choice) const {
+  const auto slot = static_cast<std::size_t>(choice);
+  if (state.refined[slot] == 0) return -1;
+  const int action = paths_[offsets_[slot] + state.refined[slot] - 1U];
+  for (const int member : problem_->members(action)) {
+    const auto index = static_cast<std::size_t>(member);
+    if (state.refined[index] == lengths_[index]) return member;
+  }
+  return -1;
 }
 
 }  // namespace ontime

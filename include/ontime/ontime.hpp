@@ -10,6 +10,8 @@
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/allocators/ppo.hpp"
 #include "ontime/allocators/round_robin.hpp"
+#include "ontime/allocators/thompson.hpp"
+#include "ontime/clock.hpp"
 #include "ontime/contiguous_success.hpp"
 #include "ontime/distribution.hpp"
 #include "ontime/episode_runner.hpp"

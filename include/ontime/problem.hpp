@@ -24,7 +24,9 @@ struct Action {
 class Problem {
  public:
   static constexpr Steps kMaxDeadline = 10'000;
-  static constexpr int kMaxSkeletons = 16;        // fixed-size MDP states (see State)
+  // Skeleton indices are stored in 16 bits (choice lists, search trees); the exact solver
+  // takes far fewer (kMaxExactSkeletons in state.hpp).
+  static constexpr int kMaxSkeletons = 65'535;
   static constexpr int kMaxSkeletonLength = 255;  // l_k is stored in 8 bits
 
   // skeletons[k] lists indices into `actions`. Throws UsageError when a rule of

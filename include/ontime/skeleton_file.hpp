@@ -3,7 +3,7 @@
 // member of a JSON object. Instance files (SPEC §5) and domain world files have one, and so
 // may a file that holds nothing else: {"skeletons": [["a", "b"], ["a", "c"]]}. Other members
 // are ignored. The rules of SPEC §1 on skeletons are checked while reading (non-empty, at
-// most 16 skeletons of at most 255 ids, no id twice in one skeleton, no skeleton twice,
+// most Problem::kMaxSkeletons skeletons of at most 255 ids, no id twice in one skeleton, no skeleton twice,
 // sharing along a common prefix); a violation raises InputError with the file, the JSON path
 // (`skeletons[1][2]`) and the rule.
 

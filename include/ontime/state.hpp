@@ -1,29 +1,135 @@
 #pragma once
-// The MDP state of SPEC §2 in a compact, fixed-size, trivially copyable form.
+// The MDP state of SPEC §2: the steps used and, per skeleton, the actions refined, the steps
+// spent on the current action and the execution time of the refined ones.
 //
-// 82 bytes for up to Problem::kMaxSkeletons skeletons; unused slots stay zero so that the
-// whole object can be compared and hashed as raw bytes.
+// Up to kInlineSkeletons skeletons the per-skeleton values live inside the object, so that
+// the hot paths (transitions, searches, exact solving) copy a state without allocating;
+// beyond, they live in one heap array per field, sized once by Mdp::start(). Unused inline
+// slots stay zero, so that equal states compare equal whatever their history. The exact
+// solver and exact evaluation key their tables by a compact copy and accept at most
+// kMaxExactSkeletons skeletons.
 
+#include <algorithm>
 #include <array>
+#include <cassert>
 #include <cstddef>
 #include <cstdint>
-
-#include "ontime/problem.hpp"
+#include <memory>
 
 namespace ontime {
 
+// Skeletons whose per-skeleton values a State holds without a heap allocation.
+inline constexpr int kInlineSkeletons = 16;
+// The most skeletons the exact solver (`optimal`) and exact evaluation take: their memo tables
+// are keyed by a fixed-size copy of the state.
+inline constexpr int kMaxExactSkeletons = kInlineSkeletons;
+
+// One value per skeleton: inline for up to kInlineSkeletons, else in a heap array. Written by
+// hand rather than with a small-vector library because State is part of the public interface,
+// which stays free of third-party headers, and because a copy must reuse an existing heap
+// array of the same size (a search copies one root state into its scratch state per
+// iteration without allocating).
+template <class T>
+class PerSkeleton {
+ public:
+  PerSkeleton() noexcept : data_(inline_.data()) {}
+  // Zero values for `count` skeletons.
+  explicit PerSkeleton(std::size_t count) : PerSkeleton() {
+    if (count > static_cast<std::size_t>(kInlineSkeletons)) {
+      heap_ = std::make_unique<T[]>(count);
+      heap_count_ = count;
+      data_ = heap_.get();
+    }
+  }
+  // Copies and moves keep data_ on their own storage. The inline case (every problem of up to
+  // kInlineSkeletons skeletons, and every exact search) is a plain copy of the arrays.
+  PerSkeleton(const PerSkeleton& other) : inline_(other.inline_), data_(inline_.data()) {
+    if (other.heap_) [[unlikely]]
+      assign_heap(other);
+  }
+  PerSkeleton& operator=(const PerSkeleton& other) {
+    if (!other.heap_ && !heap_) [[likely]] {
+      inline_ = other.inline_;
+    } else if (this != &other) {
+      inline_ = other.inline_;
+      assign_heap(other);
+    }
+    return *this;
+  }
+  PerSkeleton(PerSkeleton&& other) noexcept
+      : inline_(other.inline_), heap_count_(other.heap_count_), heap_(std::move(other.heap_)) {
+    data_ = heap_ ? heap_.get() : inline_.data();
+    other.heap_count_ = 0;
+    other.data_ = other.inline_.data();
+  }
+  PerSkeleton& operator=(PerSkeleton&& other) noexcept {
+    if (this != &other) {
+      inline_ = other.inline_;
+      heap_count_ = other.heap_count_;
+      heap_ = std::move(other.heap_);
+      data_ = heap_ ? heap_.get() : inline_.data();
+      other.heap_count_ = 0;
+      other.data_ = other.inline_.data();
+    }
+    return *this;
+  }
+  ~PerSkeleton() = default;
+
+  T& operator[](std::size_t k) noexcept {
+    assert(k < capacity());
+    return data_[k];
+  }
+  const T& operator[](std::size_t k) const noexcept {
+    assert(k < capacity());
+    return data_[k];
+  }
+  T* data() noexcept { return data_; }
+  const T* data() const noexcept { return data_; }
+  // Skeletons this object has room for.
+  std::size_t capacity() const noexcept { return heap_ ? heap_count_ : inline_.size(); }
+
+  friend bool operator==(const PerSkeleton& a, const PerSkeleton& b) noexcept {
+    return a.capacity() == b.capacity() && std::equal(a.data_, a.data_ + a.capacity(), b.data_);
+  }
+
+ private:
+  // Takes other's heap array (reusing this one's when the sizes match), or drops this one's.
+  void assign_heap(const PerSkeleton& other) {
+    if (!other.heap_) {
+      heap_.reset();
+      heap_count_ = 0;
+      data_ = inline_.data();
+      return;
+    }
+    if (heap_count_ != other.heap_count_) {
+      heap_ = std::make_unique_for_overwrite<T[]>(other.heap_count_);
+      heap_count_ = other.heap_count_;
+    }
+    std::copy_n(other.heap_.get(), heap_count_, heap_.get());
+    data_ = heap_.get();
+  }
+
+  std::array<T, kInlineSkeletons> inline_{};
+  T* data_;  // inline_.data() or heap_.get()
+  std::size_t heap_count_ = 0;
+  std::unique_ptr<T[]> heap_;
+};
+
 struct State {
-  std::uint16_t time = 0;                                      // CT: steps used
-  std::array<std::uint8_t, Problem::kMaxSkeletons> refined{};  // l_k: actions refined
-  std::array<std::uint16_t, Problem::kMaxSkeletons> spent{};   // PT_k: steps on action l_k
+  State() noexcept = default;
+  // The start state of a problem with `skeleton_count` skeletons (Mdp::start() makes it).
+  explicit State(std::size_t skeleton_count)
+      : refined(skeleton_count), spent(skeleton_count), execution(skeleton_count) {}
+
+  std::uint16_t time = 0;             // CT: steps used
+  PerSkeleton<std::uint8_t> refined;  // l_k: actions refined
+  PerSkeleton<std::uint16_t> spent;   // PT_k: steps on action l_k
   // ET_k: execution steps of the refined actions, saturated at deadline + 1 (any larger
   // value is equally too slow, and saturation keeps equivalent states equal).
-  std::array<std::uint16_t, Problem::kMaxSkeletons> execution{};
+  PerSkeleton<std::uint16_t> execution;
 
   friend bool operator==(const State&, const State&) = default;
 };
-
-static_assert(sizeof(State) == 2 + 16 + 32 + 32, "State must have no padding: it is packed and compared as bytes");
 
 enum class Status : std::uint8_t { running, success, failure };
 

@@ -14,6 +14,7 @@
 #include <functional>
 #include <memory>
 
+#include "ontime/clock.hpp"
 #include "ontime/mdp.hpp"
 #include "ontime/statistics.hpp"
 
@@ -35,6 +36,10 @@ class World {
   // Adds this world's counters (work done since it was made, e.g. refinements started) to
   // `statistics`; a sampled world has none.
   virtual void collect_statistics(Statistics& statistics) const { (void)statistics; }
+
+  // The clock live episodes of this world run on (session.hpp), or nullptr for the steady
+  // clock: a simulated world can keep a manual clock that its steps advance.
+  virtual const Clock* clock() const noexcept { return nullptr; }
 };
 
 using WorldFactory = std::function<std::unique_ptr<World>()>;

@@ -22,7 +22,8 @@ class EnvironmentCore {
       : mdp_(std::move(mdp)),
         world_(*mdp_->problem, 0),
         seed_(seed),
-        features_(static_cast<std::size_t>(feature_count(mdp_->mdp.skeleton_count()))) {}
+        features_(static_cast<std::size_t>(feature_count(mdp_->mdp.skeleton_count()))),
+        state_(mdp_->mdp.start()) {}
 
   int skeleton_count() const { return mdp_->mdp.skeleton_count(); }
   int feature_size() const { return static_cast<int>(features_); }
@@ -81,7 +82,7 @@ class EnvironmentCore {
   std::uint64_t seed_;
   std::uint64_t episode_ = 0;
   std::size_t features_;
-  State state_{};
+  State state_;
   Status status_ = Status::failure;  // no episode yet: step() needs a reset() first
 };
 

@@ -5,18 +5,38 @@
 namespace ontime {
 
 DpRerunAllocator::DpRerunAllocator(const Mdp& mdp, Aggregation aggregation)
-    : mdp_(&mdp), table_(std::make_shared<ContiguousSuccessTable>(mdp, aggregation)) {}
+    : DpRerunAllocator(mdp, std::make_shared<ContiguousSuccessTable>(mdp, aggregation)) {}
 
-DpRerunAllocator::DpRerunAllocator(const Mdp& mdp, std::shared_ptr<const ContiguousSuccessTable> table) noexcept
-    : mdp_(&mdp), table_(std::move(table)) {}
+DpRerunAllocator::DpRerunAllocator(const Mdp& mdp, std::shared_ptr<const ContiguousSuccessTable> table)
+    : mdp_(&mdp), table_(std::move(table)) {
+  worked_on_.reserve(static_cast<std::size_t>(mdp.skeleton_count()));  // no allocation when deciding
+}
 
 int DpRerunAllocator::choose(const State& state) {
+  // The largest PS, ties to the lowest index. Skeletons worked on (PT_k > 0) need a dot product:
+  // they are left for a second pass, where those whose bound is below the best are skipped.
   int best = -1;
   double best_value = -1;
+  worked_on_.clear();
+  const std::uint8_t* refined = state.refined.data();
+  const std::uint16_t* spent = state.spent.data();
+  const std::uint16_t* execution = state.execution.data();
   for (int k = 0; k < mdp_->skeleton_count(); ++k) {
     if (mdp_->next_action(state, k) < 0) continue;
-    const double value = table_->success_probability(state, k);
+    if (spent[k] != 0) {
+      worked_on_.push_back(k);
+      continue;
+    }
+    const double value = table_->fresh_success_probability(k, refined[k], std::int64_t{state.time} + execution[k]);
     if (value > best_value) {
+      best_value = value;
+      best = k;
+    }
+  }
+  for (const int k : worked_on_) {
+    if (table_->upper_bound(k, refined[k], std::int64_t{state.time} + execution[k]) < best_value) continue;
+    const double value = table_->success_probability(state, k);
+    if (value > best_value || (value == best_value && k < best)) {
       best_value = value;
       best = k;
     }

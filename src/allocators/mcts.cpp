@@ -70,7 +70,7 @@ bool MctsAllocator::expand(std::uint32_t node, const State& state) {
   nodes_[node].edge_count = static_cast<std::uint16_t>(choices.size());
   for (const int choice : choices) {
     Edge edge;
-    edge.choice = static_cast<std::uint8_t>(choice);
+    edge.choice = static_cast<std::uint16_t>(choice);
     edges_.push_back(edge);
   }
   return true;
@@ -108,7 +108,7 @@ std::uint32_t MctsAllocator::select_edge(const DecisionNode& node) const {
   return best;
 }
 
-double MctsAllocator::rollout(State state) {
+double MctsAllocator::rollout(State& state) {
   for (;;) {
     int choice;
     if (rollout_policy_) {
@@ -127,7 +127,10 @@ double MctsAllocator::rollout(State state) {
 
 bool MctsAllocator::iterate() {
   path_.clear();
-  State state = root_state_;
+  // One scratch state, assigned rather than copied: a wide problem's state then reuses its
+  // heap arrays from iteration to iteration.
+  State& state = scratch_state_;
+  state = root_state_;
   std::uint32_t node = 0;
   double reward = 0.0;
   for (;;) {

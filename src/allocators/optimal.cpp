@@ -10,20 +10,20 @@ namespace ontime {
 namespace {
 
 // Choices and state keys of the optimal solver; Words > 0 packs keys into that many 64-bit
-// words (detail::pack), 0 keeps full states.
+// words (detail::pack), 0 keys by the whole state (detail::compact).
 template <std::size_t Words>
 class OptimalPolicy {
  public:
   explicit OptimalPolicy(const Mdp& mdp) : mdp_(&mdp) {}
 
-  void choices(const State& state, std::vector<int>& out) const {
+  void choices(const detail::CompactState& state, std::vector<int>& out) const {
     for (const int choice : mdp_->useful_choices(state)) out.push_back(choice);
   }
 
   // Skeletons in a group that can no longer succeed influence nothing: their slots are
   // blanked so that states differing only there share one memo entry.
-  auto key(const State& state) const {
-    State key = state;
+  auto key(const detail::CompactState& state) const {
+    detail::CompactState key = state;
     for (int k = 0; k < mdp_->skeleton_count(); ++k) {
       const int action = mdp_->next_action(state, k);
       if (action >= 0 && mdp_->group_can_succeed(state, action)) continue;
@@ -88,7 +88,7 @@ double OptimalSolver::solve(const State& state) {
 std::optional<int> OptimalSolver::best_choice(const State& state) const {
   return std::visit(
       [&state](const auto& search) -> std::optional<int> {
-        const auto found = search.memo().find(search.policy().key(state));
+        const auto found = search.memo().find(search.key_of(state));
         if (found == search.memo().end() || found->second.choice < 0) return std::nullopt;
         return found->second.choice;
       },

@@ -60,7 +60,6 @@ inline const std::array kBadInputs{
     BadInput{"skeleton_duplicate.json", "skeletons[2]", "the same skeleton as skeletons[0]"},
     BadInput{"sharing_other_position.json", "skeletons[1][1]", "at another position"},
     BadInput{"sharing_other_prefix.json", "skeletons[1][1]", "the actions before it differ"},
-    BadInput{"too_many_skeletons.json", "skeletons", "at most 16 skeletons"},
     BadInput{"skeleton_too_long.json", "skeletons[0]", "at most 255 actions"},
 };
 

@@ -28,12 +28,7 @@ Distribution random_distribution(SplitMix64& generator, Steps first, Steps last)
   return Distribution::from_pmf(std::move(masses));
 }
 
-}  // namespace
-
-Problem random_instance(std::uint64_t seed, int max_skeletons, int max_length, Steps max_deadline) {
-  SplitMix64 generator(seed);
-  const Steps deadline = uniform_int(generator, 2, max_deadline);
-  const int skeleton_count = uniform_int(generator, 1, max_skeletons);
+Problem build_instance(SplitMix64& generator, std::string name, Steps deadline, int skeleton_count, int max_length) {
   std::vector<Action> actions;
   std::vector<std::vector<int>> skeletons;
   const auto new_action = [&] {
@@ -60,7 +55,21 @@ Problem random_instance(std::uint64_t seed, int max_skeletons, int max_length, S
     for (const auto& existing : skeletons) duplicate = duplicate || existing == path;
     if (!duplicate) skeletons.push_back(std::move(path));
   }
-  return Problem("random-" + std::to_string(seed), deadline, 1.0, std::move(actions), std::move(skeletons));
+  return Problem(std::move(name), deadline, 1.0, std::move(actions), std::move(skeletons));
+}
+
+}  // namespace
+
+Problem random_instance(std::uint64_t seed, int max_skeletons, int max_length, Steps max_deadline) {
+  SplitMix64 generator(seed);
+  const Steps deadline = uniform_int(generator, 2, max_deadline);
+  const int skeleton_count = uniform_int(generator, 1, max_skeletons);
+  return build_instance(generator, "random-" + std::to_string(seed), deadline, skeleton_count, max_length);
+}
+
+Problem wide_instance(std::uint64_t seed, int skeleton_count, int max_length, Steps deadline) {
+  SplitMix64 generator(seed);
+  return build_instance(generator, "wide-" + std::to_string(skeleton_count), deadline, skeleton_count, max_length);
 }
 
 }  // namespace ontime::testing

@@ -6,11 +6,13 @@
 // spent, and spends the step on the largest (ties: lowest index). Aggregation `sum` by
 // default (reproduces Table I); `max` and `self` are selectable.
 // No optimality guarantee; in the paper's instances it comes close to the optimum.
-// Cost: the Eq. (1) tables are built once per problem and shared; a decision is K dot
-// products of at most D - CT - ET_k terms, with no allocation (well under a microsecond on
-// the paper's instances, see docs/performance.md).
+// Cost: the Eq. (1) tables are built once per problem and shared. A decision reads PS from a
+// table for every skeleton with nothing spent on its current action, and computes the dot
+// product (at most D - CT - ET_k terms) only for the others whose table bound could beat the
+// best so far: O(K) with a few dot products, no allocation (see docs/performance.md).
 
 #include <memory>
+#include <vector>
 
 #include "ontime/allocator.hpp"
 #include "ontime/contiguous_success.hpp"
@@ -20,7 +22,7 @@ namespace ontime {
 class DpRerunAllocator final : public Allocator {
  public:
   DpRerunAllocator(const Mdp& mdp, Aggregation aggregation = Aggregation::sum);
-  DpRerunAllocator(const Mdp& mdp, std::shared_ptr<const ContiguousSuccessTable> table) noexcept;
+  DpRerunAllocator(const Mdp& mdp, std::shared_ptr<const ContiguousSuccessTable> table);
 
   std::string_view name() const noexcept override { return "dp-rerun"; }
   int choose(const State& state) override;
@@ -30,6 +32,7 @@ class DpRerunAllocator final : public Allocator {
  private:
   const Mdp* mdp_;
   std::shared_ptr<const ContiguousSuccessTable> table_;
+  std::vector<int> worked_on_;  // skeletons with steps spent on their current action (scratch)
 };
 
 }  // namespace ontime

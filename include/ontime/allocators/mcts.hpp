@@ -85,7 +85,7 @@ class MctsAllocator final : public Allocator {
     std::uint32_t visits = 0;
     std::uint32_t successes = 0;
     std::uint16_t outcome_count = 0;
-    std::uint8_t choice = 0;
+    std::uint16_t choice = 0;  // skeleton index (Problem::kMaxSkeletons fits)
   };
   struct Outcome {
     double probability;
@@ -102,8 +102,8 @@ class MctsAllocator final : public Allocator {
   static double estimate(const Edge& edge) noexcept {
     return edge.visits == 0 ? 0.0 : static_cast<double>(edge.successes) / edge.visits;
   }
-  bool iterate();  // false: memory cap reached
-  double rollout(State state);
+  bool iterate();                // false: memory cap reached
+  double rollout(State& state);  // plays on from `state`, changing it
   void reroot(std::uint32_t new_root);
   bool would_exceed_memory(std::size_t nodes, std::size_t edges, std::size_t outcomes) const;
 
@@ -112,6 +112,7 @@ class MctsAllocator final : public Allocator {
   std::unique_ptr<Allocator> rollout_policy_;
   SplitMix64 generator_{0};
   State root_state_;
+  State scratch_state_;  // the state of the current iteration
   bool has_tree_ = false;
   std::vector<DecisionNode> nodes_;  // nodes_[0] is the root
   std::vector<Edge> edges_;

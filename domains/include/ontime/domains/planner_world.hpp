@@ -31,6 +31,21 @@ struct PlannerWorldOptions {
   bool independent_starts = false;
 };
 
+// The clock of live episodes in the collision-checks unit: the steady clock, except that each
+// planner call counts as the nominal seconds of its collision checks instead of the real time
+// it took. The allocator's thinking and the caller's time stay real, so a live episode on it
+// charges them against a planner as slow as the model says.
+class NominalPlanningClock final : public Clock {
+ public:
+  double now() const override { return steady_.now() + offset_; }
+  // A planner call took `real_seconds` and counts as `nominal_seconds`.
+  void count_call(double real_seconds, double nominal_seconds) noexcept { offset_ += nominal_seconds - real_seconds; }
+
+ private:
+  SteadyClock steady_;
+  double offset_ = 0;
+};
+
 // Counters: "refinements_started" (interleaved ones included) and "refinements_found" (those
 // that found a motion), summed over the episodes since the world was made.
 class PlannerWorld final : public World {
@@ -42,6 +57,9 @@ class PlannerWorld final : public World {
   void begin_episode(std::uint64_t seed) override;
   Observation step(int action, Steps spent) override;
   void collect_statistics(Statistics& statistics) const override;
+  // Live episodes: the nominal planning clock in the collision-checks unit; the steady clock
+  // (nullptr) in the wall-clock unit, where planner calls take the time they take.
+  const Clock* clock() const noexcept override;
 
  private:
   const Domain* domain_;
@@ -51,6 +69,7 @@ class PlannerWorld final : public World {
   std::vector<std::unique_ptr<Refinement>> refinements_;  // by action, in this episode
   std::uint64_t started_ = 0;
   std::uint64_t found_ = 0;
+  NominalPlanningClock nominal_clock_;
 };
 
 // One planner world per thread, for the episode runner; the arguments must outlive the worlds.
