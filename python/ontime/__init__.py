@@ -29,6 +29,8 @@ from ._ontime import (  # noqa: F401  (re-exported)
     Distribution,
     Error,
     InputError,
+    LiveSession,
+    ManualClock,
     Mdp,
     Problem,
     ResourceLimitError,
@@ -50,7 +52,8 @@ from . import _ontime
 __version__ = "0.1.0"
 
 __all__ = [
-    "NEVER", "Action", "Allocator", "Decision", "Distribution", "Error", "InputError", "Mdp", "Problem",
+    "NEVER", "Action", "Allocator", "Decision", "Distribution", "Error", "InputError", "LiveSession",
+    "ManualClock", "Mdp", "Problem",
     "ResourceLimitError", "Session", "State", "Status", "UsageError", "World", "allocators", "evaluate",
     "fit", "load_problem", "make_allocator", "read_planner_log", "run_episodes", "solve", "train_ppo",
     "write_planner_log",

@@ -8,11 +8,13 @@
 #include <atomic>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
 #include "ontime/allocator.hpp"
 #include "ontime/allocator_registry.hpp"
+#include "ontime/error.hpp"
 #include "ontime/mdp.hpp"
 #include "ontime/problem.hpp"
 #include "ontime/state.hpp"
@@ -32,6 +34,37 @@ struct MdpHandle {
 struct StateView {
   State state;
   int skeletons = 0;
+};
+
+// Session calls out of turn raise std::logic_error in C++: a usage error for a Python caller.
+template <class Call>
+auto session_call(Call&& call) {
+  try {
+    return call();
+  } catch (const UsageError&) {
+    throw;
+  } catch (const std::logic_error& error) {
+    throw UsageError(error.what());
+  }
+}
+
+inline const char* status_name(Status status) {
+  switch (status) {
+    case Status::running:
+      return "running";
+    case Status::success:
+      return "success";
+    case Status::failure:
+      return "failure";
+  }
+  return "?";
+}
+
+// A decision as Python sees it; the problem names its action.
+struct DecisionView {
+  int skeleton = -1;
+  int action = -1;
+  std::shared_ptr<const Problem> problem;
 };
 
 // An MdpHandle from a Problem, an Mdp or a path to an instance file (loaded).
@@ -71,6 +104,7 @@ void run_interruptibly(const std::function<void(const std::function<bool()>& sto
 void bind_model(py::module_& m);
 void bind_running(py::module_& m);
 void bind_environment(py::module_& m);
+void bind_live(py::module_& m);
 void bind_domains(py::module_& m);
 
 }  // namespace ontime::python

@@ -205,6 +205,7 @@ PYBIND11_MODULE(_ontime, m) {
   bind_model(m);
   bind_running(m);
   bind_environment(m);
+  bind_live(m);
   py::module_ domains = m.def_submodule("domains", "OnTime's TAMP domains (OMPL, FCL, KDL), when built.");
   bind_domains(domains);
 }

@@ -28,12 +28,6 @@ DecisionBudget budget_of(std::optional<std::uint64_t> iterations, std::optional<
   return {};
 }
 
-struct DecisionView {
-  int skeleton = -1;
-  int action = -1;
-  std::shared_ptr<const Problem> problem;
-};
-
 struct SessionHandle {
   SessionHandle(std::shared_ptr<AllocatorHandle> handle, std::uint64_t seed_value, DecisionBudget default_budget)
       : allocator(std::move(handle)),
@@ -43,30 +37,6 @@ struct SessionHandle {
   Session session;
   DecisionBudget budget;
 };
-
-// Session calls out of turn raise std::logic_error in C++: a usage error for a Python caller.
-template <class Call>
-auto session_call(Call&& call) {
-  try {
-    return call();
-  } catch (const UsageError&) {
-    throw;
-  } catch (const std::logic_error& error) {
-    throw UsageError(error.what());
-  }
-}
-
-const char* status_name(Status status) {
-  switch (status) {
-    case Status::running:
-      return "running";
-    case Status::success:
-      return "success";
-    case Status::failure:
-      return "failure";
-  }
-  return "?";
-}
 
 // A World implemented in Python (a subclass of ontime.World), called with the GIL held.
 class PythonWorld final : public World {
