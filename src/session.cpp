@@ -26,13 +26,7 @@ void check_seconds(double seconds, const char* what) {
 }  // namespace
 
 Session::Session(const Mdp& mdp, Allocator& allocator, std::uint64_t seed)
-    : mdp_(&mdp),
-      allocator_(&allocator),
-      state_(mdp.start()),
-      before_(state_),
-      action_execution_steps_(static_cast<std::size_t>(mdp.problem().action_count()), -1),
-      action_execution_seconds_(static_cast<std::size_t>(mdp.problem().action_count()), -1.0),
-      seed_(seed) {
+    : mdp_(&mdp), allocator_(&allocator), state_(mdp.start()), before_(state_), seed_(seed) {
   allocator_->begin_episode(seed);
 }
 
@@ -68,6 +62,9 @@ void Session::start_live(const Clock& clock, LiveOptions options) {
   }
   clock_ = &clock;
   live_ = options;
+  // Execution seconds per action: the plan's seconds at success (owning sessions have them already).
+  action_execution_steps_.resize(static_cast<std::size_t>(mdp_->problem().action_count()), -1);
+  action_execution_seconds_.resize(static_cast<std::size_t>(mdp_->problem().action_count()), -1.0);
   step_seconds_ = mdp_->problem().step_seconds();
   model_state_ = state_;
   timeline_.reserve(static_cast<std::size_t>(mdp_->deadline()));
@@ -187,7 +184,9 @@ Status Session::report(const Observation& observation, double execution_seconds)
   const Status model_status = mdp_->apply(state_, choice, observation);
   pending_ = -1;
   const int action = mdp_->next_action(before_, choice);
-  if (action >= 0 && observation.refined) {
+  // Only live and owning sessions keep what each action revealed; a plain session (an episode of
+  // a Monte Carlo run) does no work for it.
+  if (action >= 0 && observation.refined && !action_execution_steps_.empty()) {
     const auto slot = static_cast<std::size_t>(action);
     action_execution_steps_[slot] =
         observation.execution == kNever ? mdp_->deadline() + 1 : std::min(observation.execution, mdp_->deadline() + 1);

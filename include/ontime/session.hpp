@@ -183,8 +183,8 @@ class Session {
   int pending_ = -1;
   int solution_ = -1;
 
-  // What every action revealed (by action index; actions are only ever appended): its
-  // execution once refined, in steps and seconds, -1 before.
+  // Live and owning sessions: what every action revealed (by action index; actions are only
+  // ever appended): its execution once refined, in steps and seconds, -1 before. Empty otherwise.
   std::vector<Steps> action_execution_steps_;
   std::vector<double> action_execution_seconds_;
 
