@@ -8,7 +8,7 @@ packages=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev nlohmann-json3-dev libcli11-dev libfmt-dev libabsl-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libompl-dev libfcl-dev liborocos-kdl-dev
+  libompl-dev libfcl-dev liborocos-kdl-dev libigraph-dev
   libboost-serialization-dev libboost-filesystem-dev libboost-system-dev
   python3 python3-matplotlib python3-numpy
   python3-dev pybind11-dev python3-pybind11 python3-pytest

@@ -57,15 +57,40 @@ double ci95_half_width(double rate, std::uint64_t episodes) noexcept {
   return 1.96 * std::sqrt(rate * (1.0 - rate) / static_cast<double>(episodes));
 }
 
-EpisodeResult run_episode(const Mdp& mdp, Allocator& allocator, World& world, std::uint64_t seed,
-                          const DecisionBudget& budget, DecisionTimer* timer, const std::optional<LiveRun>& live) {
-  static const SteadyClock steady_clock;
-  world.begin_episode(seed);
-  const Clock& clock = world.clock() != nullptr ? *world.clock() : steady_clock;
-  Session session = live ? Session(mdp, allocator, stream_seed(seed, 1), clock, live->options)
-                         : Session(mdp, allocator, stream_seed(seed, 1));
+namespace {
+
+// The task planner's turn in a streaming episode, between two decisions.
+struct Arrivals {
+  const StreamingRun* streaming = nullptr;
+  World* world = nullptr;
+  bool open = true;          // the planner may find more
+  int steps_since_last = 0;  // steps decided since the last skeleton arrived
+};
+
+void take_next_skeleton(Session& session, Arrivals& arrivals) {
+  std::optional<FoundSkeleton> found;
+  if (session.problem().skeleton_count() < arrivals.streaming->max_skeletons) found = arrivals.world->next_skeleton();
+  if (!found) {
+    arrivals.open = false;
+    session.expect_more_skeletons(false);
+    return;
+  }
+  if (session.is_live()) session.charge_outside(found->charged_seconds);
+  session.add_skeleton(found->action_ids, std::move(found->new_actions));
+  arrivals.steps_since_last = 0;
+}
+
+// The one loop of every episode: decide, step the world, report, until the session ends (and,
+// in a streaming episode, let skeletons arrive between decisions).
+EpisodeResult drive(Session& session, World& world, const DecisionBudget& budget, DecisionTimer* timer,
+                    const std::optional<LiveRun>& live, Arrivals* arrivals) {
   EpisodeResult result;
   while (session.status() == Status::running) {
+    if (arrivals != nullptr && arrivals->open &&
+        (arrivals->steps_since_last >= arrivals->streaming->period || !session.can_succeed())) {
+      take_next_skeleton(session, *arrivals);
+      continue;
+    }
     Decision decision;
     if (timer != nullptr) {
       const auto start = std::chrono::steady_clock::now();
@@ -83,15 +108,65 @@ EpisodeResult run_episode(const Mdp& mdp, Allocator& allocator, World& world, st
       const Steps spent = session.state().spent[static_cast<std::size_t>(decision.skeleton)];
       session.report(world.step(decision.action, spent));
     }
+    if (arrivals != nullptr) ++arrivals->steps_since_last;
   }
   result.status = session.status();
   result.solution = session.solution();
   result.steps_used = session.steps_used();
+  result.skeletons = session.problem().skeleton_count();
   if (live) {
     result.live = session.totals();
     result.model_status = session.model_status();
     if (live->keep_timeline) result.timeline = session.timeline();
   }
+  return result;
+}
+
+const Clock& clock_of(const World& world) {
+  static const SteadyClock steady_clock;
+  return world.clock() != nullptr ? *world.clock() : steady_clock;
+}
+
+}  // namespace
+
+EpisodeResult run_episode(const Mdp& mdp, Allocator& allocator, World& world, std::uint64_t seed,
+                          const DecisionBudget& budget, DecisionTimer* timer, const std::optional<LiveRun>& live) {
+  world.begin_episode(seed);
+  Session session = live ? Session(mdp, allocator, stream_seed(seed, 1), clock_of(world), live->options)
+                         : Session(mdp, allocator, stream_seed(seed, 1));
+  return drive(session, world, budget, timer, live, nullptr);
+}
+
+EpisodeResult run_streaming_episode(const StreamingRun& streaming, World& world, std::uint64_t seed,
+                                    const DecisionBudget& budget, DecisionTimer* timer,
+                                    const std::optional<LiveRun>& live) {
+  if (streaming.max_skeletons < 1 || streaming.period < 1) {
+    throw UsageError("streaming episodes need at least 1 skeleton and a period of at least 1 step");
+  }
+  world.begin_episode(seed);
+  const Clock& clock = clock_of(world);
+  const double search_began = clock.now();
+  std::optional<FoundSkeleton> first = world.next_skeleton();
+  const double first_search = clock.now() - search_began;
+  if (!first) return EpisodeResult{};  // no skeleton at all: a failure without a decision
+  std::vector<int> path;
+  for (const std::string& id : first->action_ids) {
+    int index = -1;
+    for (std::size_t a = 0; a < first->new_actions.size() && index < 0; ++a) {
+      if (first->new_actions[a].id == id) index = static_cast<int>(a);
+    }
+    if (index < 0) throw UsageError("the first skeleton found names action '" + id + "' without bringing it");
+    path.push_back(index);
+  }
+  Problem problem(streaming.name, streaming.deadline, streaming.step_seconds, std::move(first->new_actions),
+                  {std::move(path)});
+  Session session(std::move(problem), streaming.make_allocator, stream_seed(seed, 1), live ? &clock : nullptr,
+                  live ? live->options : LiveOptions{});
+  Arrivals arrivals{&streaming, &world, streaming.max_skeletons > 1, 0};
+  session.expect_more_skeletons(arrivals.open);
+  if (live) session.charge_outside(first->charged_seconds + first_search);
+  EpisodeResult result = drive(session, world, budget, timer, live, &arrivals);
+  if (live && live->keep_timeline) result.problem = std::make_shared<const Problem>(session.problem());
   return result;
 }
 
@@ -146,8 +221,13 @@ LatencySummary LatencyHistogram::summary() const {
   return summary;
 }
 
-MonteCarloResult run_episodes(const Mdp& mdp, const WorldFactory& worlds, const AllocatorFactory& allocators,
-                              const MonteCarloOptions& options) {
+namespace {
+
+// Runs the episodes of run_episodes and run_streaming_episodes on threads: `run_one(run, seed)`
+// runs one episode with the thread's world (and allocator, when `allocators` is given).
+template <class RunOne>
+MonteCarloResult run_many(const WorldFactory& worlds, const AllocatorFactory* allocators,
+                          const MonteCarloOptions& options, const RunOne& run_one) {
   const auto started = std::chrono::steady_clock::now();
   // Episodes are handed out in blocks: the hand-out and the progress report cost little even
   // when an episode takes a fraction of a microsecond. Short runs (often of long episodes,
@@ -158,14 +238,12 @@ MonteCarloResult run_episodes(const Mdp& mdp, const WorldFactory& worlds, const 
   std::mutex progress_mutex;
   for_each_block(options.episodes, options.threads, block, [&](unsigned thread) {
     ThreadRun& run = runs[thread];
-    run.allocator = allocators();
+    if (allocators != nullptr) run.allocator = (*allocators)();
     run.world = worlds();
     return [&](std::uint64_t begin, std::uint64_t end) {
       for (std::uint64_t episode = begin; episode < end; ++episode) {
         if (options.stop && options.stop()) throw Cancelled("episodes stopped at the caller's request");
-        const EpisodeResult result =
-            run_episode(mdp, *run.allocator, *run.world, stream_seed(options.seed, episode), options.decision_budget,
-                        options.time_decisions ? &run.timer : nullptr, options.live);
+        const EpisodeResult result = run_one(run, stream_seed(options.seed, episode));
         if (result.status == Status::success) ++run.successes;
         if (options.live) {
           add_totals(run.live_nanoseconds, result.live);
@@ -192,7 +270,7 @@ MonteCarloResult run_episodes(const Mdp& mdp, const WorldFactory& worlds, const 
     result.successes += run.successes;
     decisions.merge(run.timer.decisions);
     episode_totals.merge(run.timer.episodes);
-    run.allocator->collect_statistics(result.statistics);
+    if (run.allocator) run.allocator->collect_statistics(result.statistics);
     run.world->collect_statistics(result.world_statistics);
     for (std::size_t i = 0; i < live_nanoseconds.size(); ++i) live_nanoseconds[i] += run.live_nanoseconds[i];
     result.model_successes += run.model_successes;
@@ -212,6 +290,24 @@ MonteCarloResult run_episodes(const Mdp& mdp, const WorldFactory& worlds, const 
   result.episode_decision_time = episode_totals.summary();
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
+}
+
+}  // namespace
+
+MonteCarloResult run_episodes(const Mdp& mdp, const WorldFactory& worlds, const AllocatorFactory& allocators,
+                              const MonteCarloOptions& options) {
+  return run_many(worlds, &allocators, options, [&](ThreadRun& run, std::uint64_t seed) {
+    return run_episode(mdp, *run.allocator, *run.world, seed, options.decision_budget,
+                       options.time_decisions ? &run.timer : nullptr, options.live);
+  });
+}
+
+MonteCarloResult run_streaming_episodes(const StreamingRun& streaming, const WorldFactory& worlds,
+                                        const MonteCarloOptions& options) {
+  return run_many(worlds, nullptr, options, [&](ThreadRun& run, std::uint64_t seed) {
+    return run_streaming_episode(streaming, *run.world, seed, options.decision_budget,
+                                 options.time_decisions ? &run.timer : nullptr, options.live);
+  });
 }
 
 }  // namespace ontime

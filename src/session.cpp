@@ -103,9 +103,26 @@ void Session::charge_outside(double seconds) {
 void Session::end_if_out_of_time() {
   const double elapsed = elapsed_seconds();
   state_.time = static_cast<std::uint16_t>(std::max<Steps>(state_.time, steps_at(elapsed)));
-  if (state_.time >= mdp_->deadline() || !mdp_->any_can_succeed(state_)) {
+  if (state_.time >= mdp_->deadline() || out_of_skeletons()) {
     status_ = Status::failure;
     ended_at_ = elapsed;
+  }
+}
+
+bool Session::out_of_skeletons() const { return !more_expected_ && !mdp_->any_can_succeed(state_); }
+
+void Session::expect_more_skeletons(bool expected) {
+  if (owned_problem_ == nullptr) {
+    throw std::logic_error(
+        "expect_more_skeletons needs a session that owns its problem (made with an allocator maker)");
+  }
+  more_expected_ = expected;
+  if (clock_ != nullptr && model_status_ == Status::running && !expected && !mdp_->any_can_succeed(model_state_)) {
+    model_status_ = Status::failure;
+  }
+  if (status_ == Status::running && pending_ < 0 && out_of_skeletons()) {
+    status_ = Status::failure;
+    if (clock_ != nullptr) ended_at_ = elapsed_seconds();
   }
 }
 
@@ -196,12 +213,19 @@ Status Session::report(const Observation& observation, double execution_seconds)
   }
   if (clock_ == nullptr) {
     status_ = model_status;
+    // Skeletons still to come keep a session going that its present ones cannot save.
+    if (status_ == Status::failure && more_expected_ && state_.time < mdp_->deadline()) status_ = Status::running;
     if (status_ == Status::success) solution_ = mdp_->completed_skeleton(state_, choice);
     allocator_->observe(before_, choice, state_, status_);
     return status_;
   }
 
-  if (model_status_ == Status::running) model_status_ = mdp_->apply(model_state_, choice, observation);
+  if (model_status_ == Status::running) {
+    model_status_ = mdp_->apply(model_state_, choice, observation);
+    if (model_status_ == Status::failure && more_expected_ && model_state_.time < mdp_->deadline()) {
+      model_status_ = Status::running;
+    }
+  }
   const double reported = clock_->now();
   double planning = reported - decided_at_;
   if (action < 0 && planning < step_seconds_) {
@@ -249,7 +273,7 @@ Status Session::report(const Observation& observation, double execution_seconds)
       break;
     }
   }
-  if (status_ == Status::running && (state_.time >= mdp_->deadline() || !mdp_->any_can_succeed(state_))) {
+  if (status_ == Status::running && (state_.time >= mdp_->deadline() || out_of_skeletons())) {
     status_ = Status::failure;
     ended_at_ = elapsed;
   }
@@ -313,9 +337,11 @@ void Session::change_skeletons(std::vector<Action> actions, std::vector<std::vec
   allocator_->begin_episode(stream_seed(seed_, ++changes_));
   if (clock_ != nullptr) {
     model_state_ = std::move(model);
-    if (model_status_ == Status::running && !mdp_->any_can_succeed(model_state_)) model_status_ = Status::failure;
+    if (model_status_ == Status::running && !more_expected_ && !mdp_->any_can_succeed(model_state_)) {
+      model_status_ = Status::failure;
+    }
   }
-  if (!mdp_->any_can_succeed(state_)) {
+  if (out_of_skeletons()) {
     status_ = Status::failure;
     if (clock_ != nullptr) ended_at_ = elapsed_seconds();
   }

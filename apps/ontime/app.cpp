@@ -46,8 +46,9 @@ std::unique_ptr<CLI::App> make_app() {
   add_collect_command(*app);
   add_map_command(*app);
   add_run_command(*app);
+  add_tamp_command(*app);
 #else
-  for (const char* name : {"collect", "map", "run"}) add_unavailable_domain_command(*app, name);
+  for (const char* name : {"collect", "map", "run", "tamp"}) add_unavailable_domain_command(*app, name);
 #endif
   add_allocators_command(*app);
   return app;

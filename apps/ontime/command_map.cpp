@@ -15,15 +15,6 @@
 #include "python_runner.hpp"
 
 namespace ontime::cli {
-namespace {
-
-Json points_json(const std::vector<std::array<double, 2>>& points) {
-  Json list = Json::array();
-  for (const auto& point : points) list.push_back({point[0], point[1]});
-  return list;
-}
-
-}  // namespace
 
 void add_map_command(CLI::App& app) {
   struct Options {

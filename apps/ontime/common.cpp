@@ -138,6 +138,12 @@ void check_solver_names(const std::vector<std::string>& names) {
 
 void print_json(const Json& value) { fmt::print("{}\n", value.dump(2)); }
 
+Json points_json(const std::vector<std::array<double, 2>>& points) {
+  Json list = Json::array();
+  for (const auto& point : points) list.push_back({point[0], point[1]});
+  return list;
+}
+
 std::string csv_field(std::string_view text) {
   std::string quoted = "\"";
   for (const char c : text) {

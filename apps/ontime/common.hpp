@@ -2,6 +2,7 @@
 // Shared pieces of the `ontime` commands: registration, option groups, output helpers.
 
 #include <CLI/CLI.hpp>
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -31,6 +32,7 @@ void add_plot_command(CLI::App& app);
 void add_collect_command(CLI::App& app);
 void add_map_command(CLI::App& app);
 void add_run_command(CLI::App& app);
+void add_tamp_command(CLI::App& app);
 void add_allocators_command(CLI::App& app);
 
 // The allocator kinds and their parameters as Markdown tables (`ontime allocators`).
@@ -81,6 +83,9 @@ void check_solver_names(const std::vector<std::string>& names);
 
 // Prints JSON to stdout, two-space indented.
 void print_json(const Json& value);
+
+// Points of the plane (e.g. of a drawing) as a JSON list of [x, y].
+Json points_json(const std::vector<std::array<double, 2>>& points);
 
 // `text` as one CSV field: in double quotes, inner quotes doubled.
 std::string csv_field(std::string_view text);

@@ -1,6 +1,9 @@
 #include "ontime/domains/planner_world.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <stdexcept>
 #include <string>
 
 #include "ontime/fitting.hpp"
@@ -9,21 +12,80 @@
 namespace ontime::domains {
 
 PlannerWorld::PlannerWorld(const Domain& domain, const Problem& problem, const PlannerWorldOptions& options)
-    : domain_(&domain),
-      problem_(&problem),
-      options_(options),
-      refinements_(static_cast<std::size_t>(problem.action_count())) {}
+    : domain_(&domain), step_seconds_(problem.step_seconds()), options_(options) {
+  for (int a = 0; a < problem.action_count(); ++a)
+    actions_.push_back(TreeAction{problem.action(a).id, problem.parent(a)});
+  refinements_.resize(actions_.size());
+}
+
+PlannerWorld::PlannerWorld(const Domain& domain, const StreamingWorldOptions& streaming,
+                           const PlannerWorldOptions& options)
+    : domain_(&domain), step_seconds_(0), options_(options), streaming_(streaming) {
+  if (streaming.library == nullptr) throw std::invalid_argument("a streaming world needs a library of actions");
+  if (!streaming.task_planners) throw std::invalid_argument("a streaming world needs a task planner");
+  if (!(streaming.seconds_per_skeleton >= 0) || std::isinf(streaming.seconds_per_skeleton)) {
+    throw std::invalid_argument("the search charge per skeleton must be a finite time >= 0");
+  }
+  step_seconds_ = streaming.library->step_seconds();
+  task_planner_ = streaming.task_planners();
+}
 
 void PlannerWorld::begin_episode(std::uint64_t seed) {
   seed_ = seed;
   for (std::unique_ptr<Refinement>& refinement : refinements_) refinement.reset();
+  if (task_planner_) {
+    task_planner_->restart();
+    actions_.clear();
+    node_ids_.clear();
+    refinements_.clear();
+  }
+}
+
+std::optional<FoundSkeleton> PlannerWorld::next_skeleton() {
+  if (!task_planner_) return std::nullopt;
+  std::optional<std::vector<std::string>> moves = task_planner_->next();
+  if (!moves) return std::nullopt;
+  FoundSkeleton found;
+  found.charged_seconds = streaming_.seconds_per_skeleton;
+  int parent = -1;
+  for (const std::string& move : *moves) {
+    int node = -1;
+    for (std::size_t a = 0; a < actions_.size() && node < 0; ++a) {
+      if (actions_[a].parent == parent && actions_[a].action == move) node = static_cast<int>(a);
+    }
+    if (node < 0) {
+      const int known = streaming_.library->find_action(move);
+      if (known < 0) {
+        throw std::invalid_argument("the task planner's action '" + move + "' is not in the library " +
+                                    streaming_.library->name());
+      }
+      std::string id = move;
+      for (int copy = 2; std::find(node_ids_.begin(), node_ids_.end(), id) != node_ids_.end(); ++copy) {
+        id = move + "#" + std::to_string(copy);
+      }
+      Action action = streaming_.library->action(known);
+      action.id = id;
+      found.new_actions.push_back(std::move(action));
+      node = static_cast<int>(actions_.size());
+      actions_.push_back(TreeAction{move, parent});
+      node_ids_.push_back(id);
+      refinements_.emplace_back();
+    }
+    found.action_ids.push_back(node_ids_[static_cast<std::size_t>(node)]);
+    parent = node;
+  }
+  return found;
+}
+
+const Refinement* PlannerWorld::refinement(int action) const {
+  return refinements_.at(static_cast<std::size_t>(action)).get();
 }
 
 Observation PlannerWorld::step(int action, Steps spent) {
   std::unique_ptr<Refinement>& refinement = refinements_.at(static_cast<std::size_t>(action));
   if (!refinement) {
-    const int parent = problem_->parent(action);
-    const std::string& id = problem_->action(action).id;
+    const int parent = actions_[static_cast<std::size_t>(action)].parent;
+    const std::string& id = actions_[static_cast<std::size_t>(action)].action;
     const auto stream = 2 * static_cast<std::uint64_t>(action);
     Configuration start;
     if (parent < 0) {
@@ -36,7 +98,7 @@ Observation PlannerWorld::step(int action, Steps spent) {
     refinement = domain_->refine(id, start, stream_seed(seed_, stream), options_.effort);
     ++started_;
   }
-  const double step_seconds = problem_->step_seconds();
+  const double step_seconds = step_seconds_;
   const double real_start = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
   const double effort_start = refinement->effort().seconds();
   const RefinementStatus status = refinement->advance(static_cast<double>(spent + 1) * step_seconds);
@@ -54,6 +116,11 @@ const Clock* PlannerWorld::clock() const noexcept {
 void PlannerWorld::collect_statistics(Statistics& statistics) const {
   statistics.add("refinements_started", static_cast<double>(started_));
   statistics.add("refinements_found", static_cast<double>(found_));
+}
+
+WorldFactory streaming_planner_worlds(const Domain& domain, const StreamingWorldOptions& streaming,
+                                      const PlannerWorldOptions& options) {
+  return [&domain, streaming, options] { return std::make_unique<PlannerWorld>(domain, streaming, options); };
 }
 
 WorldFactory planner_worlds(const Domain& domain, const Problem& problem, const PlannerWorldOptions& options) {

@@ -15,7 +15,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "ontime/allocator.hpp"
@@ -44,6 +46,10 @@ struct EpisodeResult {
   LiveTotals live;
   Status model_status = Status::running;
   std::vector<LiveStep> timeline;
+  // Streaming episodes: the skeletons found, and (when the timeline is kept) the episode's final
+  // problem, whose action and skeleton indices the timeline uses.
+  int skeletons = 0;
+  std::shared_ptr<const Problem> problem;
 };
 
 // Live episodes (session.hpp): each a live session on its world's clock (World::clock(), else
@@ -59,6 +65,27 @@ struct LiveRun {
 EpisodeResult run_episode(const Mdp& mdp, Allocator& allocator, World& world, std::uint64_t seed,
                           const DecisionBudget& budget = {}, DecisionTimer* timer = nullptr,
                           const std::optional<LiveRun>& live = std::nullopt);
+
+// Episodes whose skeletons stream in from the world (World::next_skeleton), as a task planner
+// running alongside finds them. Each episode's session owns its problem (session.hpp): it begins
+// once the first skeleton is found (a live episode is charged that search, its clock's time and
+// the skeleton's charged seconds), takes the next skeleton after every `period` steps, and at
+// once whenever no skeleton found so far can still succeed, up to `max_skeletons`; the
+// allocator is made anew for each (Session::add_skeleton). An episode whose world finds no
+// skeleton at all fails with no decision.
+struct StreamingRun {
+  std::string name = "streaming";  // of the episodes' problems
+  Steps deadline = 1;
+  double step_seconds = 1;
+  Session::AllocatorMaker make_allocator;
+  int period = 1;
+  int max_skeletons = kMaxExactSkeletons;
+};
+
+// One streaming episode with seed `seed`, as run_episode.
+EpisodeResult run_streaming_episode(const StreamingRun& streaming, World& world, std::uint64_t seed,
+                                    const DecisionBudget& budget = {}, DecisionTimer* timer = nullptr,
+                                    const std::optional<LiveRun>& live = std::nullopt);
 
 struct MonteCarloOptions {
   std::uint64_t episodes = 10'000;
@@ -126,6 +153,11 @@ struct MonteCarloResult {
 // `allocators` and its own world from `worlds`. Throws Cancelled when `options.stop` trips.
 MonteCarloResult run_episodes(const Mdp& mdp, const WorldFactory& worlds, const AllocatorFactory& allocators,
                               const MonteCarloOptions& options);
+
+// Streaming episodes (see StreamingRun), seeded and parallel as run_episodes; the allocators
+// belong to the episodes' sessions, so `statistics` stays empty.
+MonteCarloResult run_streaming_episodes(const StreamingRun& streaming, const WorldFactory& worlds,
+                                        const MonteCarloOptions& options);
 
 // The 95% half-width of SPEC §4 for r successes out of n.
 double ci95_half_width(double rate, std::uint64_t episodes) noexcept;

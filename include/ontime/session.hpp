@@ -142,6 +142,14 @@ class Session {
   // infeasible); later skeletons move down by one index. The last one leaving ends the session
   // as a failure. Same errors as add_skeleton.
   void retire_skeleton(int k);
+  // Sessions that own their problem: while more skeletons are expected (a task planner is still
+  // searching), the session does not end when no skeleton found so far can still succeed; the
+  // caller adds one (can_succeed() tells when it must) or says no more will come, which ends
+  // such a session as a failure. The deadline ends it either way. Throws std::logic_error for a
+  // session that does not own its problem.
+  void expect_more_skeletons(bool expected);
+  // Whether some skeleton can still succeed from the current state.
+  bool can_succeed() const { return mdp_->any_can_succeed(state_); }
 
   Status status() const noexcept { return status_; }
   const State& state() const noexcept { return state_; }
@@ -171,6 +179,8 @@ class Session {
   Status report(const Observation& observation, double execution_seconds);
   Steps steps_at(double seconds) const noexcept;
   void end_if_out_of_time();
+  // No skeleton can succeed and none is expected to come.
+  bool out_of_skeletons() const;
   // Replaces the skeletons (add_skeleton, retire_skeleton) and carries the state over.
   void change_skeletons(std::vector<Action> actions, std::vector<std::vector<int>> skeletons);
   State carried_over(const State& old, const Problem& next) const;
@@ -194,7 +204,8 @@ class Session {
   std::unique_ptr<Allocator> owned_allocator_;
   AllocatorMaker make_allocator_;
   std::uint64_t seed_ = 0;
-  std::uint64_t changes_ = 0;  // skeleton changes so far: the allocator's seed stream
+  std::uint64_t changes_ = 0;   // skeleton changes so far: the allocator's seed stream
+  bool more_expected_ = false;  // expect_more_skeletons()
 
   // Live sessions only.
   const Clock* clock_ = nullptr;

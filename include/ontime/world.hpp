@@ -13,12 +13,24 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include "ontime/clock.hpp"
 #include "ontime/mdp.hpp"
 #include "ontime/statistics.hpp"
 
 namespace ontime {
+
+// A skeleton a task planner running alongside an episode found (World::next_skeleton).
+struct FoundSkeleton {
+  std::vector<std::string> action_ids;  // in order
+  std::vector<Action> new_actions;      // those of its actions no earlier skeleton of the episode had
+  // Search time the episode's clock does not see (e.g. a task planner's nominal cost), charged
+  // to the deadline as outside time.
+  double charged_seconds = 0;
+};
 
 class World {
  public:
@@ -40,6 +52,12 @@ class World {
   // The clock live episodes of this world run on (session.hpp), or nullptr for the steady
   // clock: a simulated world can keep a manual clock that its steps advance.
   virtual const Clock* clock() const noexcept { return nullptr; }
+
+  // Worlds whose skeletons stream in (streaming episodes, episode_runner.hpp): the task
+  // planner's next skeleton of this episode, or nullopt when it has no more. Its actions take
+  // the next action indices of the episode's problem, in the order of new_actions. The default:
+  // a world of fixed skeletons, which has none to add.
+  virtual std::optional<FoundSkeleton> next_skeleton() { return std::nullopt; }
 };
 
 using WorldFactory = std::function<std::unique_ptr<World>()>;

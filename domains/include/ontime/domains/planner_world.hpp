@@ -15,9 +15,13 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
+#include <string>
 #include <vector>
 
+#include "ontime/domains/collection.hpp"
 #include "ontime/domains/domain.hpp"
+#include "ontime/domains/task_planner.hpp"
 #include "ontime/problem.hpp"
 #include "ontime/world.hpp"
 
@@ -46,6 +50,20 @@ class NominalPlanningClock final : public Clock {
   double offset_ = 0;
 };
 
+// Streaming episodes (episode_runner.hpp, run_streaming_episodes): skeletons come from a task
+// planner (task_planner.hpp) as the episode goes, and the distributions of their actions from a
+// library, a problem whose actions are the domain's actions (e.g. fitted from a log of every
+// move). The episode's actions are the nodes of the prefix tree of the skeletons found so far,
+// numbered in the order they appear; a node takes the domain action's id, or, when that id is
+// already a node under another prefix, the id followed by "#2", "#3", ... (the same action
+// reached another way). Each found skeleton is charged `seconds_per_skeleton` of search besides
+// the time the task planner takes on the clock.
+struct StreamingWorldOptions {
+  const Problem* library = nullptr;  // must outlive the worlds
+  TaskPlannerFactory task_planners;
+  double seconds_per_skeleton = 0;
+};
+
 // Counters: "refinements_started" (interleaved ones included) and "refinements_found" (those
 // that found a motion), summed over the episodes since the world was made.
 class PlannerWorld final : public World {
@@ -53,6 +71,9 @@ class PlannerWorld final : public World {
   // The domain and the problem must outlive the world. The problem's action ids must be
   // actions of the domain: step throws std::invalid_argument for one that is not.
   PlannerWorld(const Domain& domain, const Problem& problem, const PlannerWorldOptions& options);
+  // A world whose skeletons stream in (see StreamingWorldOptions). Throws std::invalid_argument
+  // without a library or a task planner factory, or for a negative search charge.
+  PlannerWorld(const Domain& domain, const StreamingWorldOptions& streaming, const PlannerWorldOptions& options);
 
   void begin_episode(std::uint64_t seed) override;
   Observation step(int action, Steps spent) override;
@@ -60,11 +81,22 @@ class PlannerWorld final : public World {
   // Live episodes: the nominal planning clock in the collision-checks unit; the steady clock
   // (nullptr) in the wall-clock unit, where planner calls take the time they take.
   const Clock* clock() const noexcept override;
+  std::optional<FoundSkeleton> next_skeleton() override;
+
+  // The episode's actions so far (domain action ids, prefix-tree parents) and their refinements
+  // (null for an action never picked), for pictures of the last episode.
+  const std::vector<TreeAction>& actions() const noexcept { return actions_; }
+  const Refinement* refinement(int action) const;
 
  private:
   const Domain* domain_;
-  const Problem* problem_;
+  double step_seconds_;
+  std::vector<TreeAction> actions_;  // by action index: the domain's action id and the parent
   PlannerWorldOptions options_;
+  // Streaming worlds only.
+  StreamingWorldOptions streaming_;
+  std::unique_ptr<TaskPlanner> task_planner_;
+  std::vector<std::string> node_ids_;  // by action index: the id in the episode's problem
   std::uint64_t seed_ = 0;
   std::vector<std::unique_ptr<Refinement>> refinements_;  // by action, in this episode
   std::uint64_t started_ = 0;
@@ -74,5 +106,8 @@ class PlannerWorld final : public World {
 
 // One planner world per thread, for the episode runner; the arguments must outlive the worlds.
 WorldFactory planner_worlds(const Domain& domain, const Problem& problem, const PlannerWorldOptions& options);
+// One streaming planner world per thread (each with its own task planner).
+WorldFactory streaming_planner_worlds(const Domain& domain, const StreamingWorldOptions& streaming,
+                                      const PlannerWorldOptions& options);
 
 }  // namespace ontime::domains
