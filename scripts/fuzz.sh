@@ -10,7 +10,7 @@ generator=()
 if command -v ninja >/dev/null 2>&1 && [ ! -f build-fuzz/CMakeCache.txt ]; then generator=(-G Ninja); fi
 cmake -S . -B build-fuzz "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
   -DONTIME_BUILD_FUZZERS=ON -DONTIME_BUILD_APPS=OFF -DONTIME_BUILD_BENCHMARKS=OFF -DBUILD_TESTING=OFF
-cmake --build build-fuzz --parallel "$(nproc)" --target instance_fuzzer planner_log_fuzzer
+cmake --build build-fuzz --parallel "$(nproc)" --target instance_fuzzer planner_log_fuzzer ompl_benchmark_log_fuzzer
 
 run() {
   local target="$1"; shift
@@ -20,3 +20,4 @@ run() {
 }
 run instance_fuzzer ../data/instances/paper ../tests/data/bad ../tests/data/fuzz_regressions ../data/knapsack
 run planner_log_fuzzer ../tests/data/bad_logs ../tests/data/fuzz_regressions ../fuzz/seeds/planner_log
+run ompl_benchmark_log_fuzzer ../tests/data/bad_ompl_logs ../fuzz/seeds/ompl_benchmark_log

@@ -20,6 +20,7 @@
 #include "ontime/instance_io.hpp"
 #include "support/bad_inputs.hpp"
 #include "support/bad_logs.hpp"
+#include "support/bad_ompl_logs.hpp"
 #include "support/mini_world.hpp"
 #include "support/paper.hpp"
 #include "support/process.hpp"
@@ -315,6 +316,97 @@ TEST(Cli, FitNamesTheSkeletonActionMissingFromTheLog) {
             2);
 }
 
+std::string kitchen_log() { return testing::source_path("tests/data/ompl_logs/kitchen.log").string(); }
+
+TEST(Cli, FitReadsOmplBenchmarkLogsThroughAMappingOrAnActionPerLog) {
+  const std::filesystem::path dir = scratch("ompl-fit");
+  const std::string skeletons = (dir / "skeletons.json").string();
+  std::ofstream(skeletons) << R"json({"skeletons": [["move(R1,R2)", "pick(cup)"]]})json";
+  const std::string mapping = (dir / "mapping.json").string();
+  std::ofstream(mapping) << R"json({"rules": [{"planner": "geometric_RRTConnect", "action": "move(R1,R2)"},
+                                             {"planner": "geometric_RRTstar", "action": "pick(cup)"}]})json";
+  const std::string output = (dir / "kitchen.json").string();
+  const auto mapped =
+      ontime({"fit", "--format", "ompl-benchmark", kitchen_log(), "--speed", "0.5", "--mapping", mapping, "--step",
+              "0.5", "--deadline", "30", "--skeletons", skeletons, "-o", output, "--json"});
+  ASSERT_EQ(mapped.exit_code, 0) << mapped.err;
+  const json report = json::parse(mapped.out);
+  EXPECT_EQ(report["format"], "ompl-benchmark");
+  EXPECT_EQ(report["records"].get<int>(), 6);
+  ASSERT_EQ(report["actions"].size(), 2u);
+  EXPECT_EQ(report["actions"][0]["action"], "move(R1,R2)");
+  EXPECT_EQ(report["actions"][0]["found"].get<int>(), 2);
+  EXPECT_EQ(report["actions"][0]["cut_off"].get<int>(), 1);
+  EXPECT_EQ(report["actions"][1]["action"], "pick(cup)");
+  EXPECT_EQ(report["actions"][1]["found"].get<int>(), 1);
+  EXPECT_EQ(report["actions"][1]["cut_off"].get<int>(), 2);
+  // move(R1,R2): found at 0.125 s (1 step) and 1.75 s (4 steps), cut off at 2 s (4 steps survived).
+  const Problem fitted = load_problem(output);
+  const Distribution& planning = fitted.action(0).planning;
+  EXPECT_DOUBLE_EQ(planning.pmf(1), 1.0 / 3.0);
+  EXPECT_DOUBLE_EQ(planning.pmf(4), 1.0 / 3.0);
+  EXPECT_DOUBLE_EQ(planning.never(), 1.0 / 3.0);
+  // Execution: 3.25 / 0.5 = 6.5 s (13 steps) and 4.5 / 0.5 = 9 s (18 steps).
+  const Distribution& execution = fitted.action(0).execution;
+  EXPECT_DOUBLE_EQ(execution.pmf(13), 0.5);
+  EXPECT_DOUBLE_EQ(execution.pmf(18), 0.5);
+
+  // One action per log: the same log twice, every run of each given to one action.
+  const auto per_log =
+      ontime({"fit",      "--format",    "ompl-benchmark", kitchen_log(), kitchen_log(), "--speed", "1",
+              "--action", "move(R1,R2)", "--action",       "pick(cup)",   "--step",      "0.5",     "--deadline",
+              "30",       "--skeletons", skeletons,        "-o",          output,        "--json"});
+  ASSERT_EQ(per_log.exit_code, 0) << per_log.err;
+  const json per_log_report = json::parse(per_log.out);
+  EXPECT_EQ(per_log_report["records"].get<int>(), 12);
+  EXPECT_EQ(per_log_report["actions"][0]["attempts"].get<int>(), 6);
+  EXPECT_EQ(per_log_report["actions"][0]["found"].get<int>(), 3);
+  EXPECT_EQ(per_log_report["actions"][1]["attempts"].get<int>(), 6);
+}
+
+TEST(Cli, FitRefusesOmplOptionsThatDoNotFit) {
+  const std::filesystem::path dir = scratch("ompl-usage");
+  const std::string output = (dir / "never-written.json").string();
+  const auto fit = [&](std::vector<std::string> extra) {
+    std::vector<std::string> arguments{"fit",         "--step",         "1",  "--deadline", "5",
+                                       "--skeletons", paper("figure1"), "-o", output};
+    arguments.insert(arguments.end(), extra.begin(), extra.end());
+    return ontime(arguments);
+  };
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
+      {{"--format", "ompl-benchmark", kitchen_log()}, "needs --speed"},
+      {{"--format", "ompl-benchmark", kitchen_log(), "--speed", "1", "--action", "a", "--action", "b"},
+       "--action is given 2 times for 1 LOG files"},
+      {{"--format", "ompl-benchmark", kitchen_log(), "--speed", "1", "--action", "a", "--mapping", "m.json"},
+       "either --action (one per LOG) or --mapping"},
+      {{kitchen_log(), "--speed", "1"}, "options of --format ompl-benchmark"},
+      {{kitchen_log(), kitchen_log()}, "--format jsonl reads one LOG"},
+      {{"--format", "ompl-benchmark", kitchen_log(), "--speed", "0"}, "--speed"},
+      {{"--format", "ompl", kitchen_log()}, "--format"},
+  };
+  for (const auto& [extra, message] : cases) {
+    const auto result = fit(extra);
+    EXPECT_EQ(result.exit_code, 2) << message << ": " << result.err;
+    EXPECT_NE(result.err.find(message), std::string::npos) << result.err;
+    EXPECT_FALSE(std::filesystem::exists(output));
+  }
+}
+
+TEST(Cli, FitRejectsEveryBadOmplLogWithOneLineNamingFileLineAndRule) {
+  const std::filesystem::path dir = scratch("bad-ompl-logs");
+  for (const testing::BadInput& bad : testing::kBadOmplLogs) {
+    const std::string path = testing::source_path("tests/data/bad_ompl_logs/" + bad.file).string();
+    const std::string output = (dir / "never-written.json").string();
+    const auto result = ontime({"fit", "--format", "ompl-benchmark", path, "--speed", "1", "--step", "1", "--deadline",
+                                "5", "--skeletons", paper("figure1"), "-o", output});
+    EXPECT_EQ(result.exit_code, 2) << bad.file;
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << bad.file << ": " << result.err;
+    EXPECT_NE(result.err.find(path + ": " + bad.place + ": "), std::string::npos) << result.err;
+    EXPECT_NE(result.err.find(bad.rule), std::string::npos) << result.err;
+    EXPECT_FALSE(std::filesystem::exists(output)) << bad.file;
+  }
+}
+
 TEST(Cli, PlotWritesTheHistogramsAndTheirData) {
   const std::filesystem::path dir = scratch("plot");
   const std::string png = (dir / "figure1.png").string();
@@ -371,6 +463,28 @@ TEST(Cli, CollectWritesTheLogAndTheFittedInstance) {
                     testing::source_path("data/domains/navigation.json").string(), "-o", refit, "--name", "navigation"})
                 .exit_code,
             0);
+  EXPECT_EQ(json::parse(read_file(refit))["actions"], json::parse(read_file(instance))["actions"]);
+}
+
+// The OMPL benchmark log of a collection fits (speed 1, planners named by their actions) the same
+// instance as the collection.
+TEST(Cli, CollectWritesAnOmplBenchmarkLogThatFitsTheSameInstance) {
+  const std::filesystem::path dir = scratch("collect-ompl");
+  const std::string log = (dir / "navigation.log").string();
+  const std::string instance = (dir / "navigation.json").string();
+  const auto result = ontime({"collect", "--domain", "navigation", "--trials", "2", "--threads", "2", "--seed", "4",
+                              "--log", log, "--log-format", "ompl-benchmark", "-o", instance, "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const std::string text = read_file(log);
+  EXPECT_EQ(text.substr(0, text.find('\n')), "Experiment navigation");
+  EXPECT_NE(text.find("\n66 seconds per run\n"), std::string::npos) << text;  // 22 steps of 3 s
+  EXPECT_NE(text.find("\n15 planners\n"), std::string::npos);
+  const std::string refit = (dir / "refit.json").string();
+  const auto fit = ontime({"fit", "--format", "ompl-benchmark", log, "--speed", "1", "--step", "3", "--deadline", "22",
+                           "--skeletons", testing::source_path("data/domains/navigation.json").string(), "-o", refit,
+                           "--name", "navigation", "--json"});
+  ASSERT_EQ(fit.exit_code, 0) << fit.err;
+  EXPECT_EQ(json::parse(fit.out)["records"].get<int>(), 30);
   EXPECT_EQ(json::parse(read_file(refit))["actions"], json::parse(read_file(instance))["actions"]);
 }
 

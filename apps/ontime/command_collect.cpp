@@ -18,9 +18,31 @@
 #include "ontime/fitting.hpp"
 #include "ontime/input_file.hpp"
 #include "ontime/instance_io.hpp"
+#include "ontime/ompl_benchmark_log.hpp"
 #include "output_paths.hpp"
 
 namespace ontime::cli {
+namespace {
+
+// --log-format ompl-benchmark: the default log is data/logs/DOMAIN.log, its time limit the cut-off.
+std::filesystem::path default_log_file(const std::string& domain, const std::string& format) {
+  std::filesystem::path path = collected_log_file(domain);
+  return format == "ompl-benchmark" ? path.replace_extension(".log") : path;
+}
+
+OmplLogWriteOptions ompl_log_options(const std::string& domain, const domains::CollectionOptions& collection) {
+  OmplLogWriteOptions options;
+  options.experiment = domain;
+  options.time_limit_seconds = static_cast<double>(collection.budget_steps) * collection.step_seconds;
+  options.seed = collection.seed;
+  options.setup =
+      fmt::format("ontime collect --domain {}: {} trials per action, effort unit {}, step {} s, cut-off {} steps",
+                  domain, collection.trials, domains::effort_unit_name(collection.effort.unit), collection.step_seconds,
+                  collection.budget_steps);
+  return options;
+}
+
+}  // namespace
 
 void add_collect_command(CLI::App& app) {
   struct Options {
@@ -30,6 +52,7 @@ void add_collect_command(CLI::App& app) {
     std::string instance;
     std::string checkpoint;
     std::string effort = "checks";
+    std::string log_format = "jsonl";
     std::uint64_t trials = 1000;
     std::uint64_t seed = 1;
     unsigned threads = 0;
@@ -68,6 +91,9 @@ void add_collect_command(CLI::App& app) {
   add_number_option(*command, "--laplace", options->laplace, "Laplace smoothing of the fit", 0.0);
   command->add_option("--log", options->log,
                       "Planner log to write (default: data/logs/DOMAIN.jsonl in the current directory)");
+  command->add_option("--log-format", options->log_format, "Log format: jsonl or ompl-benchmark (then DOMAIN.log)")
+      ->check(CLI::IsMember({"jsonl", "ompl-benchmark"}))
+      ->capture_default_str();
   command->add_option(
       "-o,--instance", options->instance,
       "Instance to write (default: data/instances/DOMAIN.json in the current directory, where run looks first)");
@@ -81,8 +107,8 @@ void add_collect_command(CLI::App& app) {
         options->world.empty() ? default_world_file(options->domain) : std::filesystem::path(options->world);
     const domains::LoadedDomain loaded = domains::load_domain(options->domain, world);
     const domains::CollectionDefaults& defaults = loaded.defaults.collection;
-    const std::filesystem::path log_path =
-        options->log.empty() ? collected_log_file(options->domain) : std::filesystem::path(options->log);
+    const std::filesystem::path log_path = options->log.empty() ? default_log_file(options->domain, options->log_format)
+                                                                : std::filesystem::path(options->log);
     const std::filesystem::path instance_path =
         options->instance.empty() ? collected_instance_file(options->domain) : std::filesystem::path(options->instance);
 
@@ -115,7 +141,11 @@ void add_collect_command(CLI::App& app) {
     collection.progress = [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); };
     const domains::CollectionResult result = domains::collect(*loaded.domain, collection);
 
-    save_planner_log(result.log, log_path);
+    if (options->log_format == "ompl-benchmark") {
+      save_ompl_benchmark_log(result.log, log_path, ompl_log_options(options->domain, collection));
+    } else {
+      save_planner_log(result.log, log_path);
+    }
     FitOptions fit_options;
     fit_options.step_seconds = collection.step_seconds;
     fit_options.deadline = deadline;

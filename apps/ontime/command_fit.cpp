@@ -1,23 +1,78 @@
 // `ontime fit LOG --step S --deadline D --skeletons FILE --output INSTANCE`: learns each
 // action's planning and execution distributions from a planner log and writes the instance.
+// The log is JSON Lines, or (--format ompl-benchmark) one or more OMPL benchmark logs.
 
 #include <fmt/format.h>
 
 #include <filesystem>
+#include <optional>
+#include <vector>
 
 #include "common.hpp"
 #include "fit_report.hpp"
 #include "number_options.hpp"
+#include "ontime/error.hpp"
 #include "ontime/fitting.hpp"
 #include "ontime/instance_io.hpp"
+#include "ontime/ompl_benchmark_log.hpp"
 #include "ontime/planner_log.hpp"
 #include "output_paths.hpp"
 
 namespace ontime::cli {
+namespace {
+
+struct LogOptions {
+  std::vector<std::string> logs;
+  std::string format = "jsonl";
+  double speed = 0;
+  std::vector<std::string> actions;
+  std::string mapping;
+};
+
+// Refuses options that do not fit the log format, before any log is read.
+void check_log_options(const LogOptions& options) {
+  if (options.format == "jsonl") {
+    if (options.logs.size() != 1)
+      throw UsageError("--format jsonl reads one LOG (got " + std::to_string(options.logs.size()) + ")");
+    if (options.speed > 0 || !options.actions.empty() || !options.mapping.empty()) {
+      throw UsageError("--speed, --action and --mapping are options of --format ompl-benchmark");
+    }
+    return;
+  }
+  if (!(options.speed > 0)) throw UsageError("--format ompl-benchmark needs --speed (path length per second)");
+  if (!options.actions.empty() && !options.mapping.empty()) {
+    throw UsageError("give either --action (one per LOG) or --mapping, not both");
+  }
+  if (!options.actions.empty() && options.actions.size() != options.logs.size()) {
+    throw UsageError("--action is given " + std::to_string(options.actions.size()) + " times for " +
+                     std::to_string(options.logs.size()) + " LOG files: give one per LOG, in the same order");
+  }
+  for (const std::string& action : options.actions) {
+    if (action.empty()) throw UsageError("--action must be a non-empty action id");
+  }
+}
+
+std::vector<RefinementAttempt> load_logs(const LogOptions& options) {
+  if (options.format == "jsonl") return load_planner_log(options.logs.front());
+  std::optional<OmplActionMapping> mapping;
+  if (!options.mapping.empty()) mapping = load_ompl_action_mapping(options.mapping);
+  std::vector<RefinementAttempt> attempts;
+  for (std::size_t i = 0; i < options.logs.size(); ++i) {
+    OmplLogReadOptions read;
+    read.speed = options.speed;
+    if (!options.actions.empty()) read.action = options.actions[i];
+    if (mapping) read.mapping = &*mapping;
+    std::vector<RefinementAttempt> runs = load_ompl_benchmark_log(options.logs[i], read).attempts;
+    attempts.insert(attempts.end(), std::make_move_iterator(runs.begin()), std::make_move_iterator(runs.end()));
+  }
+  return attempts;
+}
+
+}  // namespace
 
 void add_fit_command(CLI::App& app) {
   struct Options {
-    std::string log;
+    LogOptions log;
     std::string skeletons;
     std::string output;
     std::string name;
@@ -29,7 +84,18 @@ void add_fit_command(CLI::App& app) {
   };
   auto options = std::make_shared<Options>();
   CLI::App* command = app.add_subcommand("fit", "Learn an instance's time distributions from a planner log");
-  command->add_option("LOG", options->log, "Planner log (JSON Lines, docs/formats.md)")->required();
+  command->add_option("LOG", options->log.logs, "Planner log (JSON Lines; OMPL benchmark logs: one or more)")
+      ->required();
+  command->add_option("--format", options->log.format, "Log format: jsonl or ompl-benchmark (docs/formats.md)")
+      ->check(CLI::IsMember({"jsonl", "ompl-benchmark"}))
+      ->capture_default_str();
+  add_number_option(*command, "--speed", options->log.speed,
+                    "ompl-benchmark: path length per second of execution (execution time = solution length / speed)",
+                    kPositive, std::numeric_limits<double>::max(), false);
+  command->add_option("--action", options->log.actions,
+                      "ompl-benchmark: the action id of every run of a LOG; once per LOG, in order");
+  command->add_option("--mapping", options->log.mapping,
+                      "ompl-benchmark: JSON file mapping experiment and planner names to action ids");
   add_number_option(*command, "--step", options->step_seconds,
                     "Length of one step in seconds (times are rounded up to steps)", kPositive,
                     std::numeric_limits<double>::max(), false)
@@ -48,20 +114,27 @@ void add_fit_command(CLI::App& app) {
   command->add_option("--description", options->description, "Instance description");
   command->add_flag("--json", options->json, "Print JSON");
   command->callback([options] {
+    check_log_options(options->log);
+    std::vector<std::filesystem::path> inputs(options->log.logs.begin(), options->log.logs.end());
+    inputs.emplace_back(options->skeletons);
+    if (!options->log.mapping.empty()) inputs.emplace_back(options->log.mapping);
     const SkeletonList skeletons = load_skeleton_file(options->skeletons);
-    const std::vector<RefinementAttempt> attempts = load_planner_log(options->log);
-    check_outputs({{"--output", options->output}}, {options->log, options->skeletons});
+    const std::vector<RefinementAttempt> attempts = load_logs(options->log);
+    check_outputs({{"--output", options->output}}, inputs);
+    std::string logs;
+    for (const std::string& log : options->log.logs) logs += (logs.empty() ? "" : ", ") + log;
     FitOptions fit_options;
     fit_options.step_seconds = options->step_seconds;
     fit_options.deadline = options->deadline;
     fit_options.laplace = options->laplace;
     fit_options.name = options->name.empty() ? std::filesystem::path(options->output).stem().string() : options->name;
     fit_options.description = options->description;
-    const FitResult fit = fit_problem(attempts, options->log, skeletons, fit_options);
+    const FitResult fit = fit_problem(attempts, logs, skeletons, fit_options);
     save_problem(fit.problem, options->output);
     if (options->json) {
       Json out;
-      out["log"] = options->log;
+      out["log"] = logs;
+      out["format"] = options->log.format;
       out["records"] = attempts.size();
       out["instance"] = options->output;
       out["deadline"] = options->deadline;
@@ -72,7 +145,7 @@ void add_fit_command(CLI::App& app) {
       return;
     }
     fmt::print("Fitted {} from {} records of {}: deadline {} steps of {} s, Laplace alpha {}.\n\n", options->output,
-               attempts.size(), options->log, options->deadline, options->step_seconds, options->laplace);
+               attempts.size(), logs, options->deadline, options->step_seconds, options->laplace);
     fmt::print("{}", fit_report_markdown(fit));
     fmt::print("\nT: planning steps, X: execution steps (means over the steps within the deadline).\n");
   });
