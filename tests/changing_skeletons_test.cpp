@@ -73,7 +73,8 @@ State replayed(const Problem& problem, const std::vector<std::pair<int, Observat
 TEST(ChangingSkeletons, AnArrivingSkeletonStartsFromWhatWasLearntAndEveryExactAllocatorAgreesWithAFreshOne) {
   const Problem full = testing::paper_instance("instance1");
   ASSERT_GE(full.skeleton_count(), 3);
-  for (const char* name : {"optimal", "dp", "dp-rerun", "greedy", "round-robin"}) {
+  for (const char* name :
+       {"optimal", "dp", "dp-rerun", "greedy", "round-robin", "first-found", "found-order-round-robin"}) {
     SCOPED_TRACE(name);
     for (std::uint64_t seed = 1; seed <= 20; ++seed) {
       Session session(with_skeletons(full, {0, 1}), maker(name), seed);
@@ -180,7 +181,8 @@ TEST(ChangingSkeletons, ARefusedChangeLeavesTheSessionAsItWas) {
 // episode; the same seed gives the same episode.
 TEST(ChangingSkeletons, EveryAllocatorPlaysThroughArrivalsAndRetirements) {
   const Problem full = testing::paper_instance("instance1");
-  for (const char* name : {"mcts", "thompson", "dp", "dp-rerun", "greedy", "round-robin", "optimal"}) {
+  for (const char* name : {"mcts", "thompson", "dp", "dp-rerun", "greedy", "round-robin", "first-found",
+                           "found-order-round-robin", "optimal"}) {
     SCOPED_TRACE(name);
     const auto episode = [&](std::uint64_t seed) {
       Session session(
