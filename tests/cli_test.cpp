@@ -616,6 +616,66 @@ TEST(Cli, CollectWritesWhereRunLooksForItsModel) {
   EXPECT_EQ(json::parse(after.out)["instance"], "data/instances/navigation.json");
 }
 
+// The whole TAMP loop: skeletons streamed by the room-path planner, refined by the real planner,
+// every search charged; its picture's data; bad deadlines and libraries refused before any work.
+TEST(Cli, TampStreamsSkeletonsIntoLiveEpisodes) {
+  const std::filesystem::path dir = scratch("tamp");
+  const std::string world = testing::source_path("data/domains/navigation.json").string();
+  const std::string library = testing::source_path("data/instances/navigation.json").string();
+  const auto result = ontime({"tamp",
+                              "--world",
+                              world,
+                              "--library",
+                              library,
+                              "--deadline",
+                              "45",
+                              "--solver",
+                              "dp-rerun",
+                              "--episodes",
+                              "6",
+                              "--threads",
+                              "1",
+                              "--max-skeletons",
+                              "3",
+                              "--task-seconds",
+                              "0.5",
+                              "--json",
+                              "--picture",
+                              (dir / "episode.png").string(),
+                              "--picture-episode",
+                              "1",
+                              "--no-plot"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const json out = json::parse(result.out);
+  EXPECT_EQ(out["deadline_steps"].get<int>(), 15);
+  ASSERT_EQ(out["episode_results"].size(), 6u);
+  std::uint64_t successes = 0;
+  for (const json& episode : out["episode_results"]) {
+    successes += episode["status"] == "success" ? 1 : 0;
+    const int found = episode["skeletons_found"].get<int>();
+    EXPECT_GE(found, 1);
+    EXPECT_LE(found, 3);
+    // Every skeleton found was charged its half second of search.
+    EXPECT_GE(episode["outside_seconds"].get<double>(), 0.5 * found - 1e-9);
+    EXPECT_LE(episode["elapsed_seconds"].get<double>(), 45.0 + 1e-6);
+  }
+  EXPECT_EQ(out["successes"].get<std::uint64_t>(), successes);
+  const json drawing = json::parse(read_file(dir / "episode.json"));
+  EXPECT_FALSE(drawing["skeletons"].empty());
+  for (const json& skeleton : drawing["skeletons"]) EXPECT_GE(skeleton["points"].size(), 3u);
+  EXPECT_TRUE(std::filesystem::exists(dir / "episode-timeline.csv"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "episode.png"));
+
+  const auto too_short = ontime({"tamp", "--world", world, "--library", library, "--deadline", "2", "--solver", "dp"});
+  EXPECT_EQ(too_short.exit_code, 2);
+  EXPECT_NE(too_short.err.find("--deadline 2"), std::string::npos) << too_short.err;
+  // A library without the moves of the room paths: named, with the action missing.
+  const auto missing =
+      ontime({"tamp", "--world", world, "--library", paper("instance1"), "--deadline", "45", "--solver", "dp"});
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.err.find("instance1.json: actions: no action 'move(R1,"), std::string::npos) << missing.err;
+}
+
 // Live episodes against the real planner: every episode's charges and timeline in the JSON, one
 // episode's timeline as CSV; the live options need a live run.
 TEST(Cli, RunLiveReportsEveryEpisodesChargesAndTimeline) {
