@@ -6,6 +6,7 @@
 #include <cmath>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string>
 
 #include "ontime/error.hpp"
@@ -107,6 +108,20 @@ Distribution estimate_execution(std::span<const Steps> execution_steps, Steps de
     for (std::size_t x = 0; x < size; ++x) masses[x] = (counts[x] + laplace) / total;
   }
   return Distribution::from_pmf(std::move(masses));
+}
+
+SkeletonList single_action_skeletons(std::span<const RefinementAttempt> attempts, std::string_view source) {
+  SkeletonList list{std::string(source), {}};
+  std::set<std::string_view> seen;
+  for (const RefinementAttempt& attempt : attempts) {
+    if (!seen.insert(attempt.action).second) continue;
+    if (list.skeletons.size() == static_cast<std::size_t>(Problem::kMaxSkeletons)) {
+      throw UsageError(std::string(source) + ": more than " + std::to_string(Problem::kMaxSkeletons) +
+                       " actions, one skeleton each, is more skeletons than an instance holds");
+    }
+    list.skeletons.push_back({attempt.action});
+  }
+  return list;
 }
 
 FitResult fit_problem(std::span<const RefinementAttempt> attempts, std::string_view log_source,

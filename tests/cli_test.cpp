@@ -10,7 +10,9 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -407,6 +409,42 @@ TEST(Cli, FitRejectsEveryBadOmplLogWithOneLineNamingFileLineAndRule) {
   }
 }
 
+// --library fits every action of a log as a skeleton of its own: a library of per-action
+// distributions, e.g. of a collection of every doorway move.
+TEST(Cli, FitWithLibraryGivesOneSkeletonPerActionOfTheLog) {
+  const std::filesystem::path dir = scratch("fit-library");
+  const std::string log = (dir / "instance1.jsonl").string();
+  ASSERT_EQ(ontime({"sample-log", paper("instance1"), "--attempts", "50", "-o", log}).exit_code, 0);
+  const std::string library = (dir / "library.json").string();
+  const auto fit = ontime({"fit", log, "--step", "1", "--deadline", "14", "--library", "-o", library, "--json"});
+  ASSERT_EQ(fit.exit_code, 0) << fit.err;
+  const json instance = json::parse(read_file(library));
+  ASSERT_EQ(instance["actions"].size(), 9u);  // instance 1 uses 9 actions
+  ASSERT_EQ(instance["skeletons"].size(), 9u);
+  std::set<std::string> skeleton_actions;
+  for (const json& skeleton : instance["skeletons"]) {
+    ASSERT_EQ(skeleton.size(), 1u);
+    skeleton_actions.insert(skeleton[0].get<std::string>());
+  }
+  for (const auto& [id, action] : instance["actions"].items()) EXPECT_EQ(skeleton_actions.count(id), 1u) << id;
+  // The same distributions as a fit along the instance's own skeletons.
+  const std::string along = (dir / "along.json").string();
+  ASSERT_EQ(
+      ontime({"fit", log, "--step", "1", "--deadline", "14", "--skeletons", paper("instance1"), "-o", along}).exit_code,
+      0);
+  EXPECT_EQ(instance["actions"], json::parse(read_file(along))["actions"]);
+  // Exactly one of --skeletons and --library.
+  const auto neither = ontime({"fit", log, "--step", "1", "--deadline", "14", "-o", (dir / "x.json").string()});
+  EXPECT_EQ(neither.exit_code, 2);
+  EXPECT_EQ(std::count(neither.err.begin(), neither.err.end(), '\n'), 1) << neither.err;
+  EXPECT_NE(neither.err.find("--skeletons FILE or --library"), std::string::npos) << neither.err;
+  EXPECT_EQ(ontime({"fit", log, "--step", "1", "--deadline", "14", "--library", "--skeletons", paper("instance1"), "-o",
+                    (dir / "x.json").string()})
+                .exit_code,
+            2);
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.json"));
+}
+
 TEST(Cli, PlotWritesTheHistogramsAndTheirData) {
   const std::filesystem::path dir = scratch("plot");
   const std::string png = (dir / "figure1.png").string();
@@ -582,6 +620,111 @@ TEST(Cli, MapDrawsTheWorldAndOneMotionPerSkeleton) {
   const json drawing = json::parse(read_file(dir / "map.json"));
   EXPECT_EQ(drawing["paths"].size(), 4u);
   EXPECT_GT(drawing["polygons"].size(), 13u);
+}
+
+TEST(Cli, GenerateWorldWritesTheSameBuildingForTheSameSeed) {
+  const std::filesystem::path dir = scratch("generate-world");
+  const std::string first = (dir / "first.json").string();
+  const auto result = ontime({"generate-world", "--seed", "1", "-o", first});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("30 rooms, 39 doors"), std::string::npos) << result.out;
+  // The committed building is seed 1 with the defaults.
+  EXPECT_EQ(read_file(first), read_file(testing::source_path("data/domains/building-6x5.json")));
+  const std::string other = (dir / "other.json").string();
+  ASSERT_EQ(ontime({"generate-world", "--rows", "3", "--cols", "4", "--room-size", "5", "--door-density", "1", "--seed",
+                    "2", "-o", other})
+                .exit_code,
+            0);
+  const json world = json::parse(read_file(other));
+  EXPECT_EQ(world["name"], "building-3x4");
+  EXPECT_EQ(world["rooms"].size(), 12u);
+  EXPECT_EQ(world["doors"].size(), 17u);  // every neighbour pair: 3 x 3 + 2 x 4
+  EXPECT_FALSE(world.contains("skeletons"));
+  EXPECT_EQ(world["rooms"]["R12"]["max"], json::array({20, 15}));
+  // Bad options: exit 2, one line, nothing written.
+  const std::string never = (dir / "never.json").string();
+  for (const std::vector<std::string>& bad : std::vector<std::vector<std::string>>{
+           {"--rows", "0"},
+           {"--cols", "51"},
+           {"--rows", "1", "--cols", "1"},
+           {"--room-size", "2"},
+           {"--door-density", "1.5"},
+           {"--narrow-doors", "-0.1"},
+           {"--seed", "-1"},
+       }) {
+    std::vector<std::string> arguments{"generate-world", "-o", never};
+    arguments.insert(arguments.end(), bad.begin(), bad.end());
+    const auto refused = ontime(arguments);
+    EXPECT_EQ(refused.exit_code, 2) << bad[0];
+    EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+    EXPECT_FALSE(std::filesystem::exists(never)) << bad[0];
+  }
+  EXPECT_EQ(ontime({"generate-world"}).exit_code, 2);  // -o is required
+  const auto missing = ontime({"generate-world", "-o", (dir / "no" / "such" / "folder.json").string()});
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_EQ(std::count(missing.err.begin(), missing.err.end(), '\n'), 1) << missing.err;
+}
+
+TEST(Cli, MapDrawsAGeneratedBuildingWithoutSkeletons) {
+  const std::filesystem::path dir = scratch("map-building");
+  const std::string png = (dir / "building.png").string();
+  const auto result = ontime({"map", "--domain", "navigation", "--world",
+                              testing::source_path("data/domains/building-6x5.json").string(), "-o", png});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(read_file(png).substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  const json drawing = json::parse(read_file(dir / "building.json"));
+  EXPECT_EQ(drawing["paths"].size(), 0u);
+  std::size_t rooms = 0;
+  for (const json& polygon : drawing["polygons"]) rooms += polygon["kind"] == "room" ? 1 : 0;
+  EXPECT_EQ(rooms, 30u);
+}
+
+// --every-action refines every doorway move in both directions, whatever the skeletons, and
+// fits an instance with one skeleton per move.
+TEST(Cli, CollectEveryActionCoversEveryDirectedDoor) {
+  const std::filesystem::path dir = scratch("collect-every-action");
+  const std::string world_file = (dir / "small.json").string();
+  ASSERT_EQ(ontime({"generate-world", "--rows", "2", "--cols", "2", "--seed", "3", "-o", world_file}).exit_code, 0);
+  const std::size_t doors = json::parse(read_file(world_file))["doors"].size();
+  const std::string log = (dir / "small.jsonl").string();
+  const std::string instance = (dir / "small-moves.json").string();
+  const auto result = ontime({"collect", "--domain", "navigation", "--world", world_file, "--every-action", "--trials",
+                              "2", "--threads", "2", "--log", log, "-o", instance, "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const json out = json::parse(result.out);
+  EXPECT_EQ(out["attempts"].get<std::size_t>(), 2 * 2 * doors);
+  EXPECT_TRUE(out["every_action"].get<bool>());
+  const json fitted = json::parse(read_file(instance));
+  ASSERT_EQ(fitted["skeletons"].size(), 2 * doors);
+  std::set<std::string> moves;
+  for (const json& skeleton : fitted["skeletons"]) {
+    ASSERT_EQ(skeleton.size(), 1u);
+    moves.insert(skeleton[0].get<std::string>());
+  }
+  for (const json& door : json::parse(read_file(world_file))["doors"]) {
+    const std::string a = door["rooms"][0], b = door["rooms"][1];
+    EXPECT_EQ(moves.count("move(" + a + "," + b + ")"), 1u);
+    EXPECT_EQ(moves.count("move(" + b + "," + a + ")"), 1u);
+  }
+  // fit --library gives the collection's instance back.
+  const std::string refit = (dir / "refit.json").string();
+  ASSERT_EQ(ontime({"fit", log, "--step", "3", "--deadline", "22", "--library", "-o", refit, "--name", "navigation"})
+                .exit_code,
+            0);
+  EXPECT_EQ(json::parse(read_file(refit))["actions"], fitted["actions"]);
+  EXPECT_EQ(json::parse(read_file(refit))["skeletons"], fitted["skeletons"]);
+  // Without skeletons and without --every-action there is nothing to collect.
+  const auto nothing = ontime({"collect", "--domain", "navigation", "--world", world_file, "--trials", "1", "--log",
+                               (dir / "n.jsonl").string(), "-o", (dir / "n.json").string()});
+  EXPECT_EQ(nothing.exit_code, 2);
+  EXPECT_EQ(std::count(nothing.err.begin(), nothing.err.end(), '\n'), 1) << nothing.err;
+  EXPECT_NE(nothing.err.find("has no skeletons"), std::string::npos) << nothing.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "n.jsonl.checkpoint"));
+  // A domain that cannot list its actions refuses --every-action.
+  const auto kitchen = ontime({"collect", "--domain", "manipulation", "--every-action", "--trials", "1", "--log",
+                               (dir / "k.jsonl").string(), "-o", (dir / "k.json").string()});
+  EXPECT_EQ(kitchen.exit_code, 2);
+  EXPECT_NE(kitchen.err.find("cannot list every action"), std::string::npos) << kitchen.err;
 }
 
 // Without output options, collect writes into the current directory's data/, and run takes its
@@ -888,7 +1031,7 @@ TEST(Cli, HelpIsAvailableForEveryCommand) {
     EXPECT_EQ(result.exit_code, 0) << command;
     EXPECT_NE(result.out.find("--domain"), std::string::npos) << command;
   }
-  for (const char* command : {"fit", "sample-log", "plot"}) {
+  for (const char* command : {"fit", "sample-log", "plot", "generate-world"}) {
     const auto result = ontime({command, "--help"});
     EXPECT_EQ(result.exit_code, 0) << command;
     EXPECT_NE(result.out.find("--output"), std::string::npos) << command;

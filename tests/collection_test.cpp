@@ -5,11 +5,13 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <stdexcept>
 
 #include "ontime/domains/collection_journal.hpp"
 #include "ontime/domains/manipulation.hpp"
 #include "ontime/domains/navigation.hpp"
+#include "ontime/domains/navigation_generator.hpp"
 #include "ontime/error.hpp"
 #include "ontime/fitting.hpp"
 #include "ontime/planner_log.hpp"
@@ -240,6 +242,94 @@ TEST(CollectionJournal, RefusesAnotherCollectionAndNeverDropsWorkSilently) {
     EXPECT_EQ(error.place(), "line 2");
   }
   std::filesystem::remove(path);
+}
+
+// A small generated building (2 x 3 rooms) without skeletons.
+const NavigationDomain& small_building() {
+  static const NavigationDomain domain([] {
+    BuildingOptions building;
+    building.rows = 2;
+    building.cols = 3;
+    building.seed = 5;
+    return generate_navigation_world(building);
+  }());
+  return domain;
+}
+
+TEST(Collection, EveryActionCollectsEachDirectedDoorOnceFromItsOwnStart) {
+  const NavigationDomain& domain = small_building();
+  const NavigationWorld& world = domain.world();
+  CollectionOptions settings = options(3, 4, 1);
+  settings.every_action = true;
+  const std::vector<TreeAction> actions = collection_actions(domain, settings);
+  ASSERT_EQ(actions.size(), 2 * world.doors.size());
+  std::set<std::pair<std::string, std::string>> moves;
+  for (const TreeAction& node : actions) {
+    EXPECT_EQ(node.parent, -1);
+    const std::vector<std::string> rooms = move_rooms(node.action);
+    moves.emplace(rooms.at(0), rooms.at(1));
+    // Out of the start room from the start pose; any other move from a pose drawn in its room.
+    EXPECT_EQ(node.fallback_start, rooms[0] != world.start_room) << node.action;
+  }
+  for (const Door& door : world.doors) {
+    EXPECT_EQ(moves.count({door.rooms[0], door.rooms[1]}), 1u);
+    EXPECT_EQ(moves.count({door.rooms[1], door.rooms[0]}), 1u);
+  }
+
+  const CollectionResult one = collect(domain, settings);
+  settings.threads = 2;
+  const CollectionResult two = collect(domain, settings);
+  ASSERT_EQ(one.log.size(), 3 * actions.size());
+  EXPECT_EQ(text(one.log), text(two.log));
+  EXPECT_EQ(one.collision_checks, two.collision_checks);
+  for (std::size_t i = 0; i < one.log.size(); ++i) {
+    EXPECT_EQ(one.log[i].action, actions[i / 3].action);
+    EXPECT_EQ(one.log[i].trial, i % 3);
+  }
+  // The log fits as a library: one single-action skeleton per directed door, in log order.
+  const SkeletonList library = single_action_skeletons(one.log, "every.jsonl");
+  ASSERT_EQ(library.skeletons.size(), actions.size());
+  for (std::size_t a = 0; a < actions.size(); ++a) {
+    EXPECT_EQ(library.skeletons[a], std::vector<std::string>{actions[a].action});
+  }
+  FitOptions fit;
+  fit.step_seconds = 3.0;
+  fit.deadline = 22;
+  const FitResult fitted = fit_problem(one.log, "every.jsonl", library, fit);
+  EXPECT_EQ(fitted.problem.skeleton_count(), static_cast<int>(actions.size()));
+}
+
+TEST(Collection, AWorldWithoutSkeletonsNeedsEveryAction) {
+  EXPECT_TRUE(small_building().skeletons().empty());
+  EXPECT_THROW(collect(small_building(), options(1, 1, 1)), UsageError);
+  // A domain that cannot list its actions refuses the every-action collection.
+  CollectionOptions settings = kitchen_options(1, 1, 1, 1);
+  settings.every_action = true;
+  EXPECT_THROW(collect(kitchen(), settings), UsageError);
+}
+
+TEST(CollectionJournal, AnEveryActionCollectionResumesToTheSameLog) {
+  CollectionOptions settings = options(2, 6, 2);
+  settings.every_action = true;
+  const std::string whole = text(collect(small_building(), settings).log);
+  const auto path = fresh("every-action.checkpoint");
+  {
+    CollectionJournal journal(path, small_building(), settings, "world text", false);
+    CollectionOptions interrupted = settings;
+    interrupted.journal = &journal;
+    interrupted.progress = [](std::uint64_t done, std::uint64_t) {
+      if (done == 10) throw std::runtime_error("interrupted");
+    };
+    EXPECT_THROW(collect(small_building(), interrupted), std::runtime_error);
+  }
+  EXPECT_NE(contents(path).find("\"every_action\":true"), std::string::npos);
+  CollectionJournal journal(path, small_building(), settings, "world text", true);
+  EXPECT_GE(journal.finished().size(), 10u);
+  CollectionOptions resumed = settings;
+  resumed.journal = &journal;
+  resumed.threads = 1;
+  EXPECT_EQ(text(collect(small_building(), resumed).log), whole);
+  journal.remove();
 }
 
 TEST(Collection, TheKitchenGivesIdenticalLogsForIdenticalSeedsWhateverTheThreads) {

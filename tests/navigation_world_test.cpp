@@ -218,6 +218,15 @@ TEST(NavigationWorld, MalformedTextIsReportedWithLineAndColumn) {
   }
 }
 
+// Skeletons are optional: a world may be only a map, its skeletons left to a task planner.
+TEST(NavigationWorld, AWorldWithoutSkeletonsHasNone) {
+  ordered_json world = ordered_json::parse(testing::kMiniWorld);
+  world.erase("skeletons");
+  const NavigationWorld read = parse_navigation_world(world.dump(), "map.json");
+  EXPECT_TRUE(read.skeletons.empty());
+  EXPECT_EQ(read.doors.size(), 3u);
+}
+
 TEST(NavigationWorld, TheMiniWorldIsValid) {
   const NavigationWorld world = parse_navigation_world(testing::kMiniWorld, "mini.json");
   EXPECT_EQ(world.room_paths("A", "C"), (std::vector<std::vector<std::string>>{{"A", "B", "C"}}));

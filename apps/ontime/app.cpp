@@ -1,6 +1,6 @@
 // The whole `ontime` command line: every command registered on one CLI::App. The domain
-// commands (collect, map, run) exist only in the domains build (ONTIME_BUILD_DOMAINS, which
-// needs OMPL, FCL and KDL); without it they are listed and refused.
+// commands (collect, map, run, generate-world) exist only in the domains build
+// (ONTIME_BUILD_DOMAINS, which needs OMPL, FCL and KDL); without it they are listed and refused.
 
 #include <string>
 
@@ -47,8 +47,10 @@ std::unique_ptr<CLI::App> make_app() {
   add_map_command(*app);
   add_run_command(*app);
   add_tamp_command(*app);
+  add_generate_world_command(*app);
 #else
-  for (const char* name : {"collect", "map", "run", "tamp"}) add_unavailable_domain_command(*app, name);
+  for (const char* name : {"collect", "map", "run", "tamp", "generate-world"})
+    add_unavailable_domain_command(*app, name);
 #endif
   add_allocators_command(*app);
   return app;

@@ -2,6 +2,7 @@
 // N times with the real motion planner, writes the planner log and fits the instance. Every
 // finished trial goes to a checkpoint first, so that an interrupted collection can be resumed
 // (--resume) with the same result; the checkpoint is deleted once the outputs are written.
+// With --every-action: every action the domain can refine instead, each on its own.
 
 #include <fmt/format.h>
 
@@ -62,6 +63,7 @@ void add_collect_command(CLI::App& app) {
     double checks_per_second = 0;
     double laplace = 0;
     bool resume = false;
+    bool every_action = false;
     bool json = false;
   };
   auto options = std::make_shared<Options>();
@@ -101,6 +103,9 @@ void add_collect_command(CLI::App& app) {
                       "Journal of finished trials, kept until the outputs are written (default: LOG.checkpoint)");
   command->add_flag("--resume", options->resume,
                     "Continue the collection recorded in the checkpoint, if there is one (same settings, same result)");
+  command->add_flag("--every-action", options->every_action,
+                    "Refine every action of the domain on its own (navigation: every doorway move, both ways) "
+                    "instead of the skeletons' actions; the instance gets one skeleton per action");
   command->add_flag("--json", options->json, "Print JSON");
   command->callback([options] {
     const std::filesystem::path world =
@@ -122,6 +127,7 @@ void add_collect_command(CLI::App& app) {
     collection.step_seconds = options->step_seconds > 0 ? options->step_seconds : defaults.step_seconds;
     const Steps deadline = options->deadline > 0 ? options->deadline : defaults.deadline;
     collection.budget_steps = options->budget > 0 ? options->budget : deadline;
+    collection.every_action = options->every_action;
     const std::filesystem::path checkpoint_path = options->checkpoint.empty()
                                                       ? std::filesystem::path(log_path.string() + ".checkpoint")
                                                       : std::filesystem::path(options->checkpoint);
@@ -159,7 +165,8 @@ void add_collect_command(CLI::App& app) {
             ? fmt::format(" at {} checks per second", collection.effort.checks_per_second)
             : std::string(),
         collection.step_seconds, collection.budget_steps);
-    const SkeletonList skeletons{world.string(), loaded.domain->skeletons()};
+    const SkeletonList skeletons = options->every_action ? single_action_skeletons(result.log, log_path.string())
+                                                         : SkeletonList{world.string(), loaded.domain->skeletons()};
     const FitResult fit = fit_problem(result.log, log_path.string(), skeletons, fit_options);
     save_problem(fit.problem, instance_path);
     journal.remove();
@@ -171,6 +178,7 @@ void add_collect_command(CLI::App& app) {
       out["domain"] = options->domain;
       out["world"] = world.string();
       out["trials"] = options->trials;
+      out["every_action"] = options->every_action;
       out["seed"] = options->seed;
       out["effort"] = options->effort;
       out["step_seconds"] = collection.step_seconds;

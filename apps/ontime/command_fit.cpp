@@ -1,6 +1,8 @@
 // `ontime fit LOG --step S --deadline D --skeletons FILE --output INSTANCE`: learns each
 // action's planning and execution distributions from a planner log and writes the instance.
-// The log is JSON Lines, or (--format ompl-benchmark) one or more OMPL benchmark logs.
+// The log is JSON Lines, or (--format ompl-benchmark) one or more OMPL benchmark logs. With
+// --library instead of --skeletons: every action of the logs, one skeleton each (a library of
+// per-action distributions, e.g. of `collect --every-action`).
 
 #include <fmt/format.h>
 
@@ -80,6 +82,7 @@ void add_fit_command(CLI::App& app) {
     double step_seconds = 1.0;
     Steps deadline = 0;
     double laplace = 0;
+    bool library = false;
     bool json = false;
   };
   auto options = std::make_shared<Options>();
@@ -104,10 +107,13 @@ void add_fit_command(CLI::App& app) {
                     "Deadline D in steps; planning or execution beyond it is \"never\"", Steps{1},
                     Problem::kMaxDeadline, false)
       ->required();
+  CLI::Option* skeletons_option = command->add_option(
+      "--skeletons", options->skeletons,
+      "JSON file whose 'skeletons' member lists the plan skeletons (an instance or world file will do)");
   command
-      ->add_option("--skeletons", options->skeletons,
-                   "JSON file whose 'skeletons' member lists the plan skeletons (an instance or world file will do)")
-      ->required();
+      ->add_flag("--library", options->library,
+                 "Instead of --skeletons: every action of the log as a skeleton of its own, in the log's order")
+      ->excludes(skeletons_option);
   command->add_option("-o,--output", options->output, "Instance file to write (SPEC §5)")->required();
   add_number_option(*command, "--laplace", options->laplace, "Laplace (add-alpha) smoothing of the estimates", 0.0);
   command->add_option("--name", options->name, "Instance name (default: the output file's stem)");
@@ -115,14 +121,17 @@ void add_fit_command(CLI::App& app) {
   command->add_flag("--json", options->json, "Print JSON");
   command->callback([options] {
     check_log_options(options->log);
+    if (options->skeletons.empty() && !options->library) throw UsageError("give --skeletons FILE or --library");
     std::vector<std::filesystem::path> inputs(options->log.logs.begin(), options->log.logs.end());
-    inputs.emplace_back(options->skeletons);
+    if (!options->library) inputs.emplace_back(options->skeletons);
     if (!options->log.mapping.empty()) inputs.emplace_back(options->log.mapping);
-    const SkeletonList skeletons = load_skeleton_file(options->skeletons);
+    SkeletonList skeletons;
+    if (!options->library) skeletons = load_skeleton_file(options->skeletons);
     const std::vector<RefinementAttempt> attempts = load_logs(options->log);
-    check_outputs({{"--output", options->output}}, inputs);
     std::string logs;
     for (const std::string& log : options->log.logs) logs += (logs.empty() ? "" : ", ") + log;
+    if (options->library) skeletons = single_action_skeletons(attempts, logs);
+    check_outputs({{"--output", options->output}}, inputs);
     FitOptions fit_options;
     fit_options.step_seconds = options->step_seconds;
     fit_options.deadline = options->deadline;

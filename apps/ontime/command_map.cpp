@@ -1,5 +1,6 @@
 // `ontime map --domain NAME`: a picture of the domain's world with one refined motion per
-// skeleton. The drawing primitives are written first as JSON beside the PNG.
+// skeleton (none when the world has no skeletons). The drawing primitives are written first as
+// JSON beside the PNG.
 
 #include <fmt/format.h>
 
@@ -48,7 +49,11 @@ void add_map_command(CLI::App& app) {
 
     const domains::Scene scene = domain.scene();
     Json drawing;
-    drawing["title"] = fmt::format("{}: one refined motion per skeleton (seed {})", scene.title, options->seed);
+    // A world without skeletons (a generated building) is drawn without motions.
+    const auto& skeletons = domain.skeletons();
+    drawing["title"] = skeletons.empty()
+                           ? scene.title
+                           : fmt::format("{}: one refined motion per skeleton (seed {})", scene.title, options->seed);
     drawing["polygons"] = Json::array();
     for (const domains::ScenePolygon& polygon : scene.polygons) {
       drawing["polygons"].push_back({{"kind", polygon.kind},
@@ -57,7 +62,6 @@ void add_map_command(CLI::App& app) {
                                      {"points", points_json(polygon.points)}});
     }
     drawing["paths"] = Json::array();
-    const auto& skeletons = domain.skeletons();
     for (std::size_t k = 0; k < skeletons.size(); ++k) {
       const auto motions = domains::refine_skeleton(domain, skeletons[k], stream_seed(options->seed, k), settings);
       std::vector<std::array<double, 2>> points;

@@ -72,10 +72,29 @@ std::vector<TreeAction> skeleton_tree(const std::vector<std::vector<std::string>
   return tree;
 }
 
+std::vector<TreeAction> every_action_list(const Domain& domain) {
+  std::vector<TreeAction> list;
+  for (const StandaloneAction& action : domain.every_action()) {
+    list.push_back(TreeAction{action.action, -1, !action.from_initial_configuration});
+  }
+  if (list.empty()) throw UsageError("the " + domain.name() + " domain cannot list every action it refines");
+  return list;
+}
+
+std::vector<TreeAction> collection_actions(const Domain& domain, const CollectionOptions& options) {
+  if (options.every_action) return every_action_list(domain);
+  std::vector<TreeAction> tree = skeleton_tree(domain.skeletons());
+  if (tree.empty()) {
+    throw UsageError("the " + domain.name() +
+                     " world has no skeletons: collect every action on its own instead (--every-action)");
+  }
+  return tree;
+}
+
 CollectionResult collect(const Domain& domain, const CollectionOptions& options) {
   check_options(options);
   const auto started = std::chrono::steady_clock::now();
-  const std::vector<TreeAction> tree = skeleton_tree(domain.skeletons());
+  const std::vector<TreeAction> tree = collection_actions(domain, options);
   const std::uint64_t total = options.trials * tree.size();
   std::uint64_t finished = 0;
   std::mutex progress_mutex;
@@ -108,9 +127,9 @@ CollectionResult collect(const Domain& domain, const CollectionOptions& options)
           }
           const std::uint64_t trial_seed = stream_seed(action_seed, t);
           Configuration start;
-          if (starts == nullptr) {
+          if (starts == nullptr && !node.fallback_start) {
             start = domain.initial_configuration();
-          } else if (!starts->empty()) {
+          } else if (starts != nullptr && !starts->empty()) {
             start = (*starts)[t % starts->size()];
           } else {
             start = domain.fallback_start(node.action, stream_seed(trial_seed, 1));

@@ -33,7 +33,7 @@ std::string fingerprint(std::string_view text) {
 
 Json settings(const Domain& domain, const CollectionOptions& options, std::string_view world_text) {
   Json actions = Json::array();
-  for (const TreeAction& node : skeleton_tree(domain.skeletons())) actions.push_back(node.action);
+  for (const TreeAction& node : collection_actions(domain, options)) actions.push_back(node.action);
   Json line;
   line["ontime_collection_journal"] = 1;
   line["domain"] = domain.name();
@@ -44,6 +44,8 @@ Json settings(const Domain& domain, const CollectionOptions& options, std::strin
   line["checks_per_second"] = options.effort.checks_per_second;
   line["step_seconds"] = options.step_seconds;
   line["budget_steps"] = options.budget_steps;
+  // Only when set, so that the checkpoints of skeleton-tree collections stay as they were.
+  if (options.every_action) line["every_action"] = true;
   line["actions"] = actions;
   return line;
 }

@@ -1,6 +1,8 @@
 #include <cmath>
 #include <numbers>
+#include <set>
 #include <stdexcept>
+#include <utility>
 
 #include "navigation_refinement.hpp"
 #include "ompl_support.hpp"
@@ -49,6 +51,18 @@ Configuration NavigationDomain::fallback_start(const std::string& action, std::u
     if (!collision.collides(pose)) return {pose.x, pose.y, pose.theta};
   }
   throw std::runtime_error("no collision-free pose found in room " + room.id);
+}
+
+std::vector<StandaloneAction> NavigationDomain::every_action() const {
+  std::vector<StandaloneAction> actions;
+  std::set<std::pair<std::string, std::string>> listed;  // two doors between two rooms: one move
+  for (const Door& door : world_.doors) {
+    for (const auto& [from, to] : {std::pair{door.rooms[0], door.rooms[1]}, std::pair{door.rooms[1], door.rooms[0]}}) {
+      if (!listed.emplace(from, to).second) continue;
+      actions.push_back(StandaloneAction{"move(" + from + "," + to + ")", from == world_.start_room});
+    }
+  }
+  return actions;
 }
 
 double NavigationDomain::execution_seconds(const std::vector<Pose>& poses) const {

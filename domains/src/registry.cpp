@@ -12,6 +12,8 @@ std::string Domain::describe(const std::vector<std::string>& skeleton) const {
   return text;
 }
 
+std::vector<StandaloneAction> Domain::every_action() const { return {}; }
+
 std::vector<std::string> domain_names() { return {"navigation", "manipulation"}; }
 
 LoadedDomain load_domain(std::string_view name, const std::filesystem::path& world_file) {

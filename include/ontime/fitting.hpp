@@ -69,6 +69,12 @@ struct FitResult {
   std::vector<ActionFit> actions;  // in the order of problem.actions()
 };
 
+// A library of per-action distributions: one skeleton of one action for each action of the log,
+// in the order of its first record (e.g. a collection of every doorway move of a building, which
+// no list of skeletons covers). `source` names the log in messages. Throws UsageError for a log
+// of more than Problem::kMaxSkeletons actions.
+SkeletonList single_action_skeletons(std::span<const RefinementAttempt> attempts, std::string_view source);
+
 // The instance for `skeletons` fitted from `attempts` (records of actions no skeleton uses are
 // ignored). `log_source` names the log in messages. Throws InputError at the skeleton file's
 // place when a skeleton's action has no record in the log, UsageError for bad options.

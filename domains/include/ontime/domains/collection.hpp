@@ -9,6 +9,9 @@
 // allocator would give it (advance(1 step), advance(2 steps), ...), and is cut off after
 // `budget_steps` steps without a motion.
 //
+// With CollectionOptions::every_action, the actions are instead every action the domain can
+// refine, each on its own (every_action_list): a library that covers any skeleton.
+//
 // Determinism: trial t of the a-th action of the tree draws everything from
 // stream_seed(stream_seed(seed, a), t), whichever thread runs it, and the log lists actions in
 // tree order and trials in order. In the collision-checks effort unit the same seed therefore
@@ -30,11 +33,23 @@ class CollectionJournal;
 
 // The actions of the skeletons' prefix tree, parents before children (breadth first, in order
 // of first appearance), each with the index of the action before it (-1 for a first action).
+// An action without a parent starts at the domain's initial configuration, or, when
+// `fallback_start` is set, at a start the domain draws (Domain::fallback_start) for each trial.
 struct TreeAction {
   std::string action;
   int parent = -1;
+  bool fallback_start = false;
 };
 std::vector<TreeAction> skeleton_tree(const std::vector<std::vector<std::string>>& skeletons);
+
+// Domain::every_action() as actions without parents: those that may start at the initial
+// configuration start there, every other one at a fallback start. Navigation: a move out of the
+// start room starts at the start pose, any other move(Ri,Rj) at a collision-free pose drawn
+// uniformly in Ri — the distribution of where a move(Rh,Ri) ends, since its goal pose is drawn
+// uniformly among the collision-free poses of Ri. (Within a skeleton the end is also
+// conditioned on that move having been found, which favours easy goals slightly.) Throws
+// UsageError when the domain cannot list its actions.
+std::vector<TreeAction> every_action_list(const Domain& domain);
 
 struct CollectionOptions {
   std::uint64_t trials = 1000;  // attempts per action
@@ -43,6 +58,9 @@ struct CollectionOptions {
   EffortSettings effort;
   double step_seconds = 1.0;  // one step of effort
   Steps budget_steps = 1;     // cut-off
+  // Collect every action of the domain on its own (every_action_list) instead of the actions of
+  // its skeleton tree.
+  bool every_action = false;
   // Called with the number of attempts done and the total (from one thread at a time).
   std::function<void(std::uint64_t done, std::uint64_t total)> progress;
   // When set: trials it holds are taken from it instead of being run again, and every trial
@@ -51,10 +69,14 @@ struct CollectionOptions {
 };
 
 struct CollectionResult {
-  std::vector<RefinementAttempt> log;  // actions in tree order, trials in order
+  std::vector<RefinementAttempt> log;  // actions in collection_actions() order, trials in order
   std::uint64_t collision_checks = 0;  // over all attempts
   double seconds = 0;                  // wall-clock time of the collection
 };
+
+// The actions a collection with these options refines, in log order: every_action_list(domain)
+// or skeleton_tree(domain.skeletons()); UsageError when that is empty.
+std::vector<TreeAction> collection_actions(const Domain& domain, const CollectionOptions& options);
 
 CollectionResult collect(const Domain& domain, const CollectionOptions& options);
 

@@ -6,7 +6,7 @@
 // A trial of an action starts where a successful refinement of the action before it ended, so
 // the journal keeps, besides the trial's log record, the configuration its refinement ended in.
 // Its first line states everything the results depend on (domain, world file contents, trials,
-// seed, effort unit and rate, step, cut-off, the actions of the skeleton tree); resuming with
+// seed, effort unit and rate, step, cut-off, the actions collected); resuming with
 // other settings is refused. The journal is JSON Lines, one line per trial written with one
 // write(2) call, doubles in round-trip precision:
 //
@@ -32,7 +32,7 @@ namespace ontime::domains {
 struct CollectionOptions;
 
 struct JournalTrial {
-  std::size_t action = 0;  // index in skeleton_tree(domain.skeletons())
+  std::size_t action = 0;  // index in collection_actions(domain, options)
   RefinementAttempt attempt;
   std::optional<Configuration> end;  // where a successful refinement ended
 };

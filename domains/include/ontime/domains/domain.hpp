@@ -58,6 +58,13 @@ struct Scene {
   std::vector<ScenePolygon> polygons;
 };
 
+// An action of Domain::every_action(), and where a refinement of it may start without an action
+// before it: at the domain's initial configuration, or at a start drawn by fallback_start().
+struct StandaloneAction {
+  std::string action;
+  bool from_initial_configuration = false;
+};
+
 class Domain {
  public:
   virtual ~Domain() = default;
@@ -76,6 +83,11 @@ class Domain {
   // A start for `action` drawn from `seed` when no refinement of the action before it
   // succeeded (so there is no end configuration to start from).
   virtual Configuration fallback_start(const std::string& action, std::uint64_t seed) const = 0;
+
+  // Every action the domain can refine, each on its own (no skeleton needed), so that a
+  // collection of them covers any skeleton a task planner may produce later (navigation: one
+  // move per door and direction). Empty when the domain cannot list them (the default).
+  virtual std::vector<StandaloneAction> every_action() const;
 
   // The world, and a motion as a polyline of the robot's reference point (seen from above).
   virtual Scene scene() const = 0;

@@ -21,6 +21,9 @@ class NavigationDomain final : public Domain {
   std::unique_ptr<Refinement> refine(const std::string& action, const Configuration& start, std::uint64_t seed,
                                      const EffortSettings& effort) const override;
   Configuration fallback_start(const std::string& action, std::uint64_t seed) const override;
+  // move(A,B) and move(B,A) for every pair of rooms a door joins, in the order of the doors; the
+  // moves out of the start room start at the start pose.
+  std::vector<StandaloneAction> every_action() const override;
   Scene scene() const override;
   std::vector<std::array<double, 2>> trace(const std::vector<Configuration>& motion) const override;
   std::vector<std::array<double, 2>> outline(const Configuration& configuration) const override;

@@ -62,7 +62,7 @@ struct NavigationWorld {
   RobotModel robot;
   PlannerSettings planner;
   CollectionDefaults collection;
-  std::vector<std::vector<std::string>> skeletons;  // move(Ri,Rj) action ids
+  std::vector<std::vector<std::string>> skeletons;  // move(Ri,Rj) action ids; none when the file has none
 
   // Index of the room with this id, or -1.
   int room_index(std::string_view id) const noexcept;

@@ -1,0 +1,60 @@
+#pragma once
+// Generated navigation worlds: an office building of rows x cols square rooms, written as a world
+// file of the existing format (docs/domains.md), everything drawn from one seed.
+//
+// Doors: a random spanning tree of the grid of rooms (every room reachable) plus extra doors
+// between other neighbours until `door_density` of all neighbour pairs have one, so that many
+// room paths of about the same length lead from the start room (bottom left) to the goal room
+// (top right, the opposite corner). A share of the doors is narrow (a little wider than the
+// robot with its clearance: slow to refine), the others comfortable.
+//
+// Furniture varies by room: some rooms stay empty, some get a few pieces against the walls,
+// some are cluttered with turned boxes. Every room keeps clear a disc around each of its doors,
+// a corridor from each door to the room's centre and a disc at the centre, and any two pieces
+// of furniture are far enough apart for the robot to pass between them; the generator then
+// checks with the collision checker that the robot can drive every door_route, so every door
+// is passable and every room can be crossed from any of its doors to any other.
+//
+// Same options, same seed: the same file, byte for byte.
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "ontime/domains/navigation_world.hpp"
+
+namespace ontime::domains {
+
+struct BuildingOptions {
+  int rows = 6;                    // rooms along y
+  int cols = 5;                    // rooms along x
+  double room_size = 4.0;          // metres, every room square; at least kMinBuildingRoomSize
+  double door_density = 0.8;       // share of neighbour pairs joined by a door (at least a spanning tree)
+  double narrow_door_share = 0.2;  // share of doors that are narrow
+  std::uint64_t seed = 1;
+  std::string name;  // default: building-ROWSxCOLS
+};
+
+// The clear zones around doors and the centre need this much room (metres).
+inline constexpr double kMinBuildingRoomSize = 3.0;
+inline constexpr double kMaxBuildingRoomSize = 20.0;
+inline constexpr int kMaxBuildingSide = 50;
+
+// The world file's text. Throws std::invalid_argument for options out of range (rows or cols
+// below 1 or above kMaxBuildingSide, a single room, a room size out of range, shares outside
+// [0, 1]).
+std::string generate_navigation_world_text(const BuildingOptions& options);
+
+// The same world, read back with the world file's checker (source: the world's name).
+NavigationWorld generate_navigation_world(const BuildingOptions& options);
+
+// The route the generator keeps free for `door` and one of its two rooms, `room`: from the door's
+// centre straight into the room (facing across the door) to a pose 0.6 m from the wall, a turn on
+// the spot there, a straight drive to the room's centre and a turn on the spot there; poses at
+// most `spacing` metres (or 0.1 rad) apart. Throws std::invalid_argument when `room` is not one of
+// the door's rooms.
+std::vector<Pose> door_route(const NavigationWorld& world, const Door& door, std::string_view room,
+                             double spacing = 0.05);
+
+}  // namespace ontime::domains
