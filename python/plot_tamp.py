@@ -5,26 +5,21 @@ Reads the JSON that `ontime tamp --picture` writes: {"title", "polygons": [...as
 "skeletons": [{"index", "label", "planning_seconds", "executed", "points"?}], "motions":
 [{"action", "executed", "points"}]}. A skeleton with "points" (a navigation room path) is drawn
 through its doors, its colour and width growing with its planning seconds (an action shared by
-several skeletons counts for each);
-the plan executed is drawn black and thick.Found motions are drawn thin,
-    the executed ones bold
-        .Exit statuses : see ontime_plotting
-        .""
-         "
+several skeletons counts for each); the plan executed is drawn black and thick. Found motions are
+drawn thin in red, the executed ones bold. Exit statuses: see ontime_plotting.
+"""
 
-                         import argparse
+import argparse
 
-#Sets the Agg backend : import it first.
-                             from ontime_plotting import TITLE_CHARACTERS,
-    bad_input, label, read_json, run,
-    save_atomically
+# Sets the Agg backend: import it first.
+from ontime_plotting import TITLE_CHARACTERS, bad_input, label, read_json, run, save_atomically
 
-        import matplotlib.pyplot as plt #noqa : E402 from matplotlib import cm,
-    colors #noqa : E402
+import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib import cm, colors  # noqa: E402
 
-                       from plot_map import draw #noqa : E402
+from plot_map import draw  # noqa: E402
 
-                                                             MAX_LEGEND = 12 #skeletons listed in the legend; the others are drawn unlabelled
+MAX_LEGEND = 12  # skeletons listed in the legend; the others are drawn unlabelled
 
 
 def check_drawing(drawing):
@@ -70,12 +65,12 @@ def main():
     most = max([skeleton["planning_seconds"] for skeleton in skeletons] + [1e-9])
     scale = colors.Normalize(vmin=0, vmax=most)
     colour_map = plt.get_cmap("viridis_r")
-#Least effort first, so that the skeletons that got the most are drawn on top.
+    # Least effort first, so that the skeletons that got the most are drawn on top.
     for skeleton in sorted(skeletons, key=lambda s: s["planning_seconds"]):
         points = skeleton.get("points")
         if not points:
             continue
-#Skeletons sharing doors would hide each other : each is shifted a little.
+        # Skeletons sharing doors would hide each other: each is shifted a little.
         shift = 0.08 * (skeleton["index"] % 7 - 3)
         seconds = skeleton["planning_seconds"]
         name = label(skeleton["label"]) + f" ({seconds:.1f} s)" if skeleton["index"] < MAX_LEGEND else None

@@ -4,17 +4,17 @@
 # `ontime tamp --json` run per allocator and deadline, gathered into a CSV and drawn into a PNG
 # by python/plot_tamp_comparison.py. Settings through the environment (defaults in brackets):
 #   WORLD [data/domains/building-6x5.json]   LIBRARY [data/instances/building-6x5-moves.json]
-#   DEADLINES [60,75,90,105,120,150]         SOLVERS [first-found,found-order-round-robin,dp-rerun,thompson,mcts]
-#   EPISODES [200]   SEED [1]   TAMP_OPTIONS [--max-skeletons 16 --task-seconds 0.5 --arrival-period 2]
+#   DEADLINES [120,150,180,210,240,300]       SOLVERS [first-found,found-order-round-robin,dp-rerun,thompson,mcts]
+#   EPISODES [300]   SEED [1]   TAMP_OPTIONS [--max-skeletons 16 --task-seconds 0.5 --arrival-period 2]
 #   OUT [docs/images/tamp-comparison]  (writes OUT.csv and OUT.png)
 # mcts runs with --iterations 1000 (a live episode charges its real thinking; see docs/tamp.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 WORLD=${WORLD:-data/domains/building-6x5.json}
 LIBRARY=${LIBRARY:-data/instances/building-6x5-moves.json}
-DEADLINES=${DEADLINES:-60,75,90,105,120,150}
+DEADLINES=${DEADLINES:-120,150,180,210,240,300}
 SOLVERS=${SOLVERS:-first-found,found-order-round-robin,dp-rerun,thompson,mcts}
-EPISODES=${EPISODES:-200}
+EPISODES=${EPISODES:-300}
 SEED=${SEED:-1}
 TAMP_OPTIONS=${TAMP_OPTIONS:---max-skeletons 16 --task-seconds 0.5 --arrival-period 2}
 OUT=${OUT:-docs/images/tamp-comparison}

@@ -214,6 +214,20 @@ void add_tamp_command(CLI::App& app) {
     planner.effort.checks_per_second = loaded.defaults.collection.checks_per_second;
 
     MonteCarloOptions episodes;
+    // An anytime allocator given its own budget (--iterations, --time-budget) thinks that much per
+    // decision, charged all the same; otherwise the session gives it decision_share of a slice.
+    const AllocatorKind& kind = allocator_registry().find(solver);
+    const ParameterReader reader(kind, parameters);
+    if (kind.capabilities.has(Capability::anytime) && (reader.given("iterations") || reader.given("time-budget"))) {
+      const double seconds = reader.given("time-budget") ? reader.real("time-budget") : 0.0;
+      if (!reader.given("iterations")) {
+        if (seconds > 0) episodes.decision_budget = DecisionBudget::seconds(seconds);
+      } else if (seconds > 0) {
+        episodes.decision_budget = DecisionBudget::either(reader.integer("iterations"), seconds);
+      } else {
+        episodes.decision_budget = DecisionBudget::iterations(reader.integer("iterations"));
+      }
+    }
     episodes.episodes = options->episodes;
     episodes.seed = options->seed;
     episodes.threads = options->threads;
@@ -241,8 +255,9 @@ void add_tamp_command(CLI::App& app) {
       domains::PlannerWorld world(domain, stream, planner);
       LiveRun live = *episodes.live;
       live.keep_timeline = true;
-      const EpisodeResult shown = run_streaming_episode(
-          streaming, world, stream_seed(options->seed, options->picture_episode), {}, nullptr, live);
+      const EpisodeResult shown =
+          run_streaming_episode(streaming, world, stream_seed(options->seed, options->picture_episode),
+                                episodes.decision_budget, nullptr, live);
       if (shown.problem != nullptr) {
         const std::string title =
             fmt::format("{} on {}, episode {}: {} at {:.1f} s of {:.1f} s, {} skeletons", options->solver,
