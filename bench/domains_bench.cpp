@@ -16,6 +16,7 @@
 #include "ontime/domains/manipulation_collision.hpp"
 #include "ontime/domains/navigation.hpp"
 #include "ontime/domains/navigation_collision.hpp"
+#include "ontime/domains/task_planner.hpp"
 #include "ontime/random.hpp"
 
 namespace {
@@ -131,5 +132,18 @@ void BM_ManipulationRefinement(benchmark::State& bench) { refinement_benchmark(b
 BENCHMARK(BM_ManipulationRefinement)->DenseRange(0, 35)->Unit(benchmark::kMillisecond);
 
 }  // namespace
+
+// The task planner of `ontime tamp` on the generated 30-room building: the first `range(0)` room
+// paths from start to goal in order of length, computed from scratch (a new factory each time).
+void BM_RoomPathsBuilding(benchmark::State& bench) {
+  static const ontime::domains::NavigationWorld world =
+      ontime::domains::load_navigation_world(std::string(ONTIME_SOURCE_DIR) + "/data/domains/building-6x5.json");
+  const auto paths = static_cast<int>(bench.range(0));
+  for (auto _ : bench) {
+    const auto planner = ontime::domains::room_path_planners(world, paths)();
+    for (int k = 0; k < paths; ++k) benchmark::DoNotOptimize(planner->next());
+  }
+}
+BENCHMARK(BM_RoomPathsBuilding)->Arg(1)->Arg(16)->Arg(64)->Unit(benchmark::kMicrosecond);
 
 BENCHMARK_MAIN();
