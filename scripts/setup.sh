@@ -13,6 +13,11 @@ packages=(
   python3 python3-matplotlib python3-numpy
   python3-dev pybind11-dev python3-pybind11 python3-pytest
   clang libclang-rt-14-dev clang-format
+  # MPI for the split commands; a single-node SLURM cluster for their check (scripts/cluster/).
+  # (libpmix-dev must be there before slurmd first starts, or `srun --mpi=pmix` hangs: slurmd
+  # is only ever started by scripts/cluster/slurm-up.sh, after this.)
+  openmpi-bin libopenmpi-dev libpmix-dev bc
+  munge slurmctld slurmd slurm-client
 )
 
 missing=()
@@ -33,5 +38,16 @@ if [ "$(id -u)" -ne 0 ]; then
 fi
 
 echo "setup: installing ${missing[*]}"
+# Without systemd the maintainer scripts of munge, slurmctld and slurmd start those daemons
+# through their init.d scripts, SLURM's with a system-wide /etc/slurm/slurm.conf that does not
+# exist, and the installation fails. A policy-rc.d that answers 101 ("action forbidden") stops
+# that (OnTime starts the daemons itself, scripts/cluster/slurm-up.sh); it is written only for
+# the installation, and only when the machine has none of its own.
+policy=/usr/sbin/policy-rc.d
+if [ ! -e "$policy" ]; then
+  printf '#!/bin/sh\nexit 101\n' | "${sudo_cmd[@]}" tee "$policy" > /dev/null
+  "${sudo_cmd[@]}" chmod 755 "$policy"
+  trap '"${sudo_cmd[@]}" rm -f "$policy"' EXIT
+fi
 "${sudo_cmd[@]}" apt-get update -q
 DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"

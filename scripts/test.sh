@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Sets up the machine, checks the C++ formatting (clang-format, .clang-format), builds OnTime
-# with warnings as errors and runs every test (the C++ suites, then the Python package's pytest suite); then the core
+# with warnings as errors and runs every test (the C++ suites, then the Python package's pytest suite, then the
+# MPI and SLURM check of scripts/cluster/check.sh); then the core
 # alone without OMPL, FCL and KDL (build-core/: build, tests, install, consumer); then builds
 # the suite again with AddressSanitizer and UndefinedBehaviorSanitizer (build-sanitize/) and
 # runs it there too (warnings are checked by the first build; GCC warns falsely inside the
@@ -13,6 +14,9 @@ cd "$(dirname "$0")/.."
 ctest --test-dir build --parallel "$(nproc)" --output-on-failure --label-exclude python
 # The Python package's pytest suite, verbose so that its closing line shows.
 ctest --test-dir build --label-regex python --output-on-failure --verbose
+# Split over MPI ranks (mpirun, and srun on a single-node SLURM cluster brought up for it): the
+# same files as one process, byte for byte, and no work lost when a rank dies.
+./scripts/cluster/check.sh build/ontime
 
 # The core without the domains: configured with OMPL, FCL and KDL hidden from find_package, it
 # builds, passes its tests, installs, and an outside project builds against the install (the

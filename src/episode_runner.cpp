@@ -9,9 +9,11 @@
 #include <mutex>
 #include <vector>
 
+#include "ontime/byte_packing.hpp"
 #include "ontime/error.hpp"
 #include "ontime/parallel.hpp"
 #include "ontime/random.hpp"
+#include "ontime/ranks.hpp"
 #include "ontime/session.hpp"
 
 namespace ontime {
@@ -223,25 +225,141 @@ LatencySummary LatencyHistogram::summary() const {
 
 namespace {
 
-// Runs the episodes of run_episodes and run_streaming_episodes on threads: `run_one(run, seed)`
-// runs one episode with the thread's world (and allocator, when `allocators` is given).
+// What a rank's threads found, merged: the part of a MonteCarloResult that ranks exchange.
+struct RankPart {
+  std::uint64_t successes = 0;
+  std::uint64_t model_successes = 0;
+  std::uint64_t model_undecided = 0;
+  std::array<std::int64_t, 5> live_nanoseconds{};
+  LatencyHistogram decisions;
+  LatencyHistogram episode_totals;
+  Statistics statistics;
+  Statistics world_statistics;
+
+  void merge(const RankPart& other) {
+    successes += other.successes;
+    model_successes += other.model_successes;
+    model_undecided += other.model_undecided;
+    for (std::size_t i = 0; i < live_nanoseconds.size(); ++i) live_nanoseconds[i] += other.live_nanoseconds[i];
+    decisions.merge(other.decisions);
+    episode_totals.merge(other.episode_totals);
+    statistics.merge(other.statistics);
+    world_statistics.merge(other.world_statistics);
+  }
+};
+
+void pack_statistics(BytePacker& packer, const Statistics& statistics) {
+  packer.put<std::uint64_t>(statistics.counters().size());
+  for (const Statistics::Counter& counter : statistics.counters()) {
+    packer.put_string(counter.name);
+    packer.put(counter.value);
+    packer.put(counter.merge);
+  }
+}
+
+Statistics unpack_statistics(ByteUnpacker& unpacker) {
+  Statistics statistics;
+  for (auto count = unpacker.get<std::uint64_t>(); count > 0; --count) {
+    const std::string name = unpacker.get_string();
+    const auto value = unpacker.get<double>();
+    statistics.add(name, value, unpacker.get<Statistics::Merge>());
+  }
+  return statistics;
+}
+
+// An episode's result as ranks exchange it (all but `problem`, which stays with its rank).
+void pack_episode(BytePacker& packer, std::uint64_t episode, const EpisodeResult& result) {
+  packer.put(episode);
+  packer.put(result.status);
+  packer.put(result.solution);
+  packer.put(result.steps_used);
+  packer.put(result.decisions);
+  packer.put(result.live);
+  packer.put(result.model_status);
+  packer.put_vector(result.timeline);
+  packer.put(result.skeletons);
+}
+
+EpisodeResult unpack_episode(ByteUnpacker& unpacker, std::uint64_t& episode) {
+  episode = unpacker.get<std::uint64_t>();
+  EpisodeResult result;
+  result.status = unpacker.get<Status>();
+  result.solution = unpacker.get<int>();
+  result.steps_used = unpacker.get<Steps>();
+  result.decisions = unpacker.get<int>();
+  result.live = unpacker.get<LiveTotals>();
+  result.model_status = unpacker.get<Status>();
+  result.timeline = unpacker.get_vector<LiveStep>();
+  result.skeletons = unpacker.get<int>();
+  return result;
+}
+
+// Merges this rank's part with every other rank's, in rank order (so that every rank holds the
+// same totals), and hands the other ranks' episode results (`episodes`: this rank's, packed with
+// pack_episode) to `on_episode`.
+void merge_ranks(const Ranks& ranks, RankPart& part, const std::string& episodes, const MonteCarloOptions& options) {
+  BytePacker packer;
+  packer.put(part.successes);
+  packer.put(part.model_successes);
+  packer.put(part.model_undecided);
+  packer.put(part.live_nanoseconds);
+  packer.put(part.decisions);
+  packer.put(part.episode_totals);
+  pack_statistics(packer, part.statistics);
+  pack_statistics(packer, part.world_statistics);
+  packer.put_string(episodes);
+  const std::vector<std::string> parts = ranks.all_gather(packer.bytes());
+  RankPart merged;
+  for (std::size_t r = 0; r < parts.size(); ++r) {
+    ByteUnpacker unpacker(parts[r]);
+    RankPart other;
+    other.successes = unpacker.get<std::uint64_t>();
+    other.model_successes = unpacker.get<std::uint64_t>();
+    other.model_undecided = unpacker.get<std::uint64_t>();
+    other.live_nanoseconds = unpacker.get<std::array<std::int64_t, 5>>();
+    other.decisions = unpacker.get<LatencyHistogram>();
+    other.episode_totals = unpacker.get<LatencyHistogram>();
+    other.statistics = unpack_statistics(unpacker);
+    other.world_statistics = unpack_statistics(unpacker);
+    merged.merge(other);
+    const std::string results = unpacker.get_string();
+    if (!options.on_episode || static_cast<int>(r) == ranks.rank()) continue;
+    ByteUnpacker episode_unpacker(results);
+    while (!episode_unpacker.done()) {
+      std::uint64_t episode = 0;
+      const EpisodeResult result = unpack_episode(episode_unpacker, episode);
+      options.on_episode(episode, result);
+    }
+  }
+  part = std::move(merged);
+}
+
+// Runs the episodes of run_episodes and run_streaming_episodes on threads (this rank's share of
+// them when options.ranks splits the run): `run_one(run, seed)` runs one episode with the
+// thread's world (and allocator, when `allocators` is given).
 template <class RunOne>
 MonteCarloResult run_many(const WorldFactory& worlds, const AllocatorFactory* allocators,
                           const MonteCarloOptions& options, const RunOne& run_one) {
   const auto started = std::chrono::steady_clock::now();
+  const bool split = split_over_ranks(options.ranks);
+  const UnitShare share = unit_share(options.episodes, options.ranks);
+  const std::uint64_t count = share.end - share.begin;
   // Episodes are handed out in blocks: the hand-out and the progress report cost little even
   // when an episode takes a fraction of a microsecond. Short runs (often of long episodes,
   // against a real planner) get smaller blocks, so that every thread has some.
-  std::vector<ThreadRun> runs(worker_count(options.episodes, options.threads));
-  const std::uint64_t block = std::clamp<std::uint64_t>(options.episodes / (8 * runs.size()), 1, 256);
+  std::vector<ThreadRun> runs(worker_count(count, options.threads));
+  const std::uint64_t block = std::clamp<std::uint64_t>(count / (8 * runs.size()), 1, 256);
   std::atomic<std::uint64_t> done{0};
   std::mutex progress_mutex;
-  for_each_block(options.episodes, options.threads, block, [&](unsigned thread) {
+  // Split runs: this rank's episode results, packed for the other ranks' on_episode.
+  std::string packed_episodes;
+  std::mutex packed_mutex;
+  for_each_block(count, options.threads, block, [&](unsigned thread) {
     ThreadRun& run = runs[thread];
     if (allocators != nullptr) run.allocator = (*allocators)();
     run.world = worlds();
     return [&](std::uint64_t begin, std::uint64_t end) {
-      for (std::uint64_t episode = begin; episode < end; ++episode) {
+      for (std::uint64_t episode = share.begin + begin; episode < share.begin + end; ++episode) {
         if (options.stop && options.stop()) throw Cancelled("episodes stopped at the caller's request");
         const EpisodeResult result = run_one(run, stream_seed(options.seed, episode));
         if (result.status == Status::success) ++run.successes;
@@ -250,44 +368,57 @@ MonteCarloResult run_many(const WorldFactory& worlds, const AllocatorFactory* al
           if (result.model_status == Status::success) ++run.model_successes;
           if (result.model_status == Status::running) ++run.model_undecided;
         }
-        if (options.on_episode) options.on_episode(episode, result);
+        if (options.on_episode) {
+          options.on_episode(episode, result);
+          if (split) {
+            BytePacker packer;
+            pack_episode(packer, episode, result);
+            const std::lock_guard lock(packed_mutex);
+            packed_episodes += packer.bytes();
+          }
+        }
         if (options.time_decisions) run.timer.end_episode();
       }
       const std::uint64_t finished = done.fetch_add(end - begin) + (end - begin);
       if (options.progress) {
         const std::lock_guard lock(progress_mutex);
-        options.progress(finished, options.episodes);
+        options.progress(finished, count);
       }
     };
   });
 
+  RankPart part;
+  for (ThreadRun& run : runs) {
+    part.successes += run.successes;
+    part.decisions.merge(run.timer.decisions);
+    part.episode_totals.merge(run.timer.episodes);
+    if (run.allocator) run.allocator->collect_statistics(part.statistics);
+    if (run.world) run.world->collect_statistics(part.world_statistics);
+    for (std::size_t i = 0; i < part.live_nanoseconds.size(); ++i) part.live_nanoseconds[i] += run.live_nanoseconds[i];
+    part.model_successes += run.model_successes;
+    part.model_undecided += run.model_undecided;
+  }
+  if (split) merge_ranks(*options.ranks, part, packed_episodes, options);
+
   MonteCarloResult result;
   result.episodes = options.episodes;
-  LatencyHistogram decisions;
-  LatencyHistogram episode_totals;
-  std::array<std::int64_t, 5> live_nanoseconds{};
-  for (ThreadRun& run : runs) {
-    result.successes += run.successes;
-    decisions.merge(run.timer.decisions);
-    episode_totals.merge(run.timer.episodes);
-    if (run.allocator) run.allocator->collect_statistics(result.statistics);
-    run.world->collect_statistics(result.world_statistics);
-    for (std::size_t i = 0; i < live_nanoseconds.size(); ++i) live_nanoseconds[i] += run.live_nanoseconds[i];
-    result.model_successes += run.model_successes;
-    result.model_undecided += run.model_undecided;
-  }
+  result.successes = part.successes;
+  result.statistics = std::move(part.statistics);
+  result.world_statistics = std::move(part.world_statistics);
+  result.model_successes = part.model_successes;
+  result.model_undecided = part.model_undecided;
   if (options.episodes > 0) {
     const double scale = 1e-9 / static_cast<double>(options.episodes);
-    result.live_mean = {
-        static_cast<double>(live_nanoseconds[0]) * scale, static_cast<double>(live_nanoseconds[1]) * scale,
-        static_cast<double>(live_nanoseconds[2]) * scale, static_cast<double>(live_nanoseconds[3]) * scale,
-        static_cast<double>(live_nanoseconds[4]) * scale};
+    const auto& sums = part.live_nanoseconds;
+    result.live_mean = {static_cast<double>(sums[0]) * scale, static_cast<double>(sums[1]) * scale,
+                        static_cast<double>(sums[2]) * scale, static_cast<double>(sums[3]) * scale,
+                        static_cast<double>(sums[4]) * scale};
   }
   result.success_rate =
       options.episodes == 0 ? 0.0 : static_cast<double>(result.successes) / static_cast<double>(options.episodes);
   result.ci95 = ci95_half_width(result.success_rate, options.episodes);
-  result.decision_time = decisions.summary();
-  result.episode_decision_time = episode_totals.summary();
+  result.decision_time = part.decisions.summary();
+  result.episode_decision_time = part.episode_totals.summary();
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "ontime/allocators/optimal.hpp"
+#include "ontime/byte_packing.hpp"
 #include "ontime/error.hpp"
 #include "ontime/random.hpp"
 #include "ontime/simulator.hpp"
@@ -47,6 +48,7 @@ class ProgressTracker {
     options.episodes = settings_.episodes;
     options.seed = settings_.seed;
     options.threads = settings_.threads;
+    options.ranks = settings_.ranks;
     const std::uint64_t before = done_;
     if (settings_.progress) {
       options.progress = [this, before](std::uint64_t done, std::uint64_t) {
@@ -86,6 +88,16 @@ StudyPair make_pair(const Mdp& mdp, const StudySettings& settings) {
   }
   return {registry.make_factory(settings.searcher, mdp, settings.parameters),
           registry.make_factory(settings.reference, mdp, settings.parameters)};
+}
+
+// The reference's mean time per decision, as rank 0 measured it when the study is split over
+// ranks (each rank would otherwise give the searcher its own budget).
+double reference_decision_seconds(const Mdp& mdp, const AllocatorFactory& reference, const StudySettings& settings) {
+  const double seconds = mean_decision_seconds(mdp, reference, settings.seed);
+  if (!split_over_ranks(settings.ranks)) return seconds;
+  BytePacker packer;
+  packer.put(seconds);
+  return ByteUnpacker(settings.ranks->all_gather(packer.bytes()).front()).get<double>();
 }
 
 }  // namespace
@@ -128,7 +140,7 @@ EqualTimeStudy equal_time_study(const Mdp& mdp, const StudySettings& settings) {
   const StudyPair pair = make_pair(mdp, settings);
   ProgressTracker tracker(settings, 2 * settings.episodes);
   EqualTimeStudy study;
-  study.reference_decision_seconds = mean_decision_seconds(mdp, pair.reference, settings.seed);
+  study.reference_decision_seconds = reference_decision_seconds(mdp, pair.reference, settings);
   study.reference = tracker.run(mdp, pair.reference);
   study.searcher = tracker.run(mdp, pair.searcher, DecisionBudget::seconds(study.reference_decision_seconds));
   return study;
@@ -144,7 +156,7 @@ AnytimeStudy anytime_study(const Mdp& mdp, const std::vector<double>& log10_mult
   const StudyPair pair = make_pair(mdp, settings);
   ProgressTracker tracker(settings, (log10_multipliers.size() + 1) * settings.episodes);
   AnytimeStudy study;
-  study.reference_decision_seconds = mean_decision_seconds(mdp, pair.reference, settings.seed);
+  study.reference_decision_seconds = reference_decision_seconds(mdp, pair.reference, settings);
   study.optimum = optimum_of(mdp, settings.parameters);
   study.reference = tracker.run(mdp, pair.reference);
   for (const double exponent : log10_multipliers) {

@@ -17,6 +17,7 @@
 #include "ontime/planner_log.hpp"
 #include "support/mini_world.hpp"
 #include "support/paper.hpp"
+#include "support/thread_ranks.hpp"
 
 namespace ontime::domains {
 namespace {
@@ -342,6 +343,71 @@ TEST(Collection, TheKitchenGivesIdenticalLogsForIdenticalSeedsWhateverTheThreads
   std::size_t found = 0;
   for (const RefinementAttempt& attempt : one.log) found += attempt.found ? 1 : 0;
   EXPECT_GT(found, 20u);
+}
+
+// Split over ranks (played by threads here), a collection gives every rank one process's log.
+TEST(Collection, RanksCollectTheLogOfOneProcess) {
+  CollectionOptions settings = options(5, 9, 1);
+  const std::string whole = text(collect(office(), settings).log);
+  CollectionOptions every = options(2, 6, 1);
+  every.every_action = true;
+  const std::string every_whole = text(collect(small_building(), every).log);
+  for (const int size : {2, 3}) {
+    std::vector<std::string> logs(static_cast<std::size_t>(size)), every_logs(static_cast<std::size_t>(size));
+    testing::run_on_ranks(size, [&](const Ranks& ranks) {
+      CollectionOptions split = settings;
+      split.ranks = &ranks;
+      logs[static_cast<std::size_t>(ranks.rank())] = text(collect(office(), split).log);
+      CollectionOptions every_split = every;
+      every_split.ranks = &ranks;
+      every_logs[static_cast<std::size_t>(ranks.rank())] = text(collect(small_building(), every_split).log);
+    });
+    for (int rank = 0; rank < size; ++rank) {
+      EXPECT_EQ(logs[static_cast<std::size_t>(rank)], whole) << size << " ranks, rank " << rank;
+      EXPECT_EQ(every_logs[static_cast<std::size_t>(rank)], every_whole) << size << " ranks, rank " << rank;
+    }
+  }
+}
+
+// Each rank journals its own trials in its own file; a collection cut short on 2 ranks resumes
+// on 3 ranks, or on one process, to the log of an uninterrupted one, and then the files go.
+TEST(CollectionJournal, EveryRanksFinishedTrialsResumeUnderAnyNumberOfRanks) {
+  const CollectionOptions settings = options(4, 9, 1);
+  const std::string whole = text(collect(office(), settings).log);
+  for (const int resumed_on : {1, 3}) {
+    const auto path = fresh("ranks.checkpoint");
+    testing::run_on_ranks(2, [&](const Ranks& ranks) {
+      CollectionJournal journal(path, office(), settings, "world text", false, &ranks);
+      CollectionOptions interrupted = settings;
+      interrupted.journal = &journal;
+      interrupted.ranks = &ranks;
+      // Both ranks stop within the first layer (6 trials each), as a cancelled job would.
+      interrupted.progress = [](std::uint64_t done, std::uint64_t) {
+        if (done == 3) throw std::runtime_error("cancelled");
+      };
+      EXPECT_THROW(collect(office(), interrupted), std::runtime_error);
+    });
+    ASSERT_TRUE(std::filesystem::exists(path));
+    ASSERT_TRUE(std::filesystem::exists(CollectionJournal::part_path(path, 1)));
+    EXPECT_EQ(CollectionJournal::parts(path).size(), 2u);
+    EXPECT_THROW(CollectionJournal(path, office(), settings, "world text", false), UsageError);
+    {
+      const CollectionJournal read(path, office(), settings, "world text", true);
+      EXPECT_EQ(read.finished().size(), 6u);  // 3 trials from each rank's file
+    }
+    std::vector<std::string> logs(static_cast<std::size_t>(resumed_on));
+    testing::run_on_ranks(resumed_on, [&](const Ranks& ranks) {
+      CollectionJournal journal(path, office(), settings, "world text", true, &ranks);
+      CollectionOptions resumed = settings;
+      resumed.journal = &journal;
+      resumed.ranks = &ranks;
+      logs[static_cast<std::size_t>(ranks.rank())] = text(collect(office(), resumed).log);
+      journal.remove();
+    });
+    for (const std::string& log : logs) EXPECT_EQ(log, whole) << "resumed on " << resumed_on;
+    EXPECT_TRUE(CollectionJournal::parts(path).empty()) << "resumed on " << resumed_on;
+    EXPECT_FALSE(std::filesystem::exists(CollectionJournal::part_path(path, 2)));
+  }
 }
 
 }  // namespace

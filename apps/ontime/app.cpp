@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "cluster_job.hpp"
 #include "common.hpp"
 #include "ontime/error.hpp"
 
@@ -53,6 +54,21 @@ std::unique_ptr<CLI::App> make_app() {
     add_unavailable_domain_command(*app, name);
 #endif
   add_allocators_command(*app);
+  // In an MPI job of several ranks, only the commands that split their work run (cluster_job.hpp).
+  if (split_over_ranks(job_ranks())) {
+    for (CLI::App* command : app->get_subcommands({})) {
+      const std::string name = command->get_name();
+      if (name == "collect" || name == "evaluate" || name == "table" || name == "study" || name == "run" ||
+          name == "tamp") {
+        continue;
+      }
+      command->preparse_callback([name](std::size_t) {
+        throw UsageError("'" + name +
+                         "' does not split its work over MPI ranks (collect, evaluate, table, study, run and tamp "
+                         "do): run it as one process");
+      });
+    }
+  }
   return app;
 }
 

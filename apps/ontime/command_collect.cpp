@@ -8,6 +8,7 @@
 
 #include <filesystem>
 
+#include "cluster_job.hpp"
 #include "common.hpp"
 #include "data_paths.hpp"
 #include "fit_report.hpp"
@@ -128,6 +129,7 @@ void add_collect_command(CLI::App& app) {
     const Steps deadline = options->deadline > 0 ? options->deadline : defaults.deadline;
     collection.budget_steps = options->budget > 0 ? options->budget : deadline;
     collection.every_action = options->every_action;
+    collection.ranks = job_ranks();
     const std::filesystem::path checkpoint_path = options->checkpoint.empty()
                                                       ? std::filesystem::path(log_path.string() + ".checkpoint")
                                                       : std::filesystem::path(options->checkpoint);
@@ -135,17 +137,21 @@ void add_collect_command(CLI::App& app) {
     check_outputs({{"--log", log_path}, {"--instance", instance_path}, {"--checkpoint", checkpoint_path}}, {world},
                   MissingFolder::create);
     // The journal refuses this too; the command's refusal names the option that resumes.
-    if (!options->resume && std::filesystem::exists(checkpoint_path)) {
-      throw UsageError(checkpoint_path.string() +
+    if (!options->resume && !domains::CollectionJournal::parts(checkpoint_path).empty()) {
+      throw UsageError(domains::CollectionJournal::parts(checkpoint_path).front().string() +
                        ": the checkpoint of an unfinished collection is there; resume it (--resume) or delete it");
     }
     domains::CollectionJournal journal(checkpoint_path, *loaded.domain, collection, read_input_file(world, "world"),
-                                       options->resume);
+                                       options->resume, collection.ranks);
     collection.journal = &journal;
     const std::size_t resumed = journal.finished().size();
     ProgressBar bar("collect " + options->domain);
     collection.progress = [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); };
     const domains::CollectionResult result = domains::collect(*loaded.domain, collection);
+    if (!is_job_root()) {  // rank 0 writes the outputs, then every rank's checkpoint goes
+      journal.remove();
+      return;
+    }
 
     if (options->log_format == "ompl-benchmark") {
       save_ompl_benchmark_log(result.log, log_path, ompl_log_options(options->domain, collection));

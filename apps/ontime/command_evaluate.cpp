@@ -16,6 +16,7 @@ void add_evaluate_command(CLI::App& app) {
     std::string solver;
     bool exact = false;
     bool json = false;
+    bool no_timing = false;
     AllocatorFlags allocator;
     MonteCarloFlags monte_carlo;
   };
@@ -25,6 +26,9 @@ void add_evaluate_command(CLI::App& app) {
   add_solver_option(*command, options->solver);
   command->add_flag("--exact", options->exact, "Also compute the exact success probability (no sampling)");
   command->add_flag("--json", options->json, "Print JSON");
+  command->add_flag("--no-timing", options->no_timing,
+                    "Leave out the decision times and the run time, so that the output depends only on the inputs "
+                    "(the same seed gives the same bytes for any thread or rank count)");
   options->monte_carlo.add_to(*command);
   options->allocator.add_to(*command);
   command->callback([options] {
@@ -39,6 +43,7 @@ void add_evaluate_command(CLI::App& app) {
     const AllocatorFactory factory = make_allocator_factory(options->solver, mdp, parameters);
 
     MonteCarloOptions monte_carlo = options->monte_carlo.options();
+    monte_carlo.time_decisions = !options->no_timing;
     ProgressBar bar("evaluate " + options->solver);
     monte_carlo.progress = [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); };
     const MonteCarloResult result = run_monte_carlo(mdp, factory, monte_carlo);
@@ -58,12 +63,14 @@ void add_evaluate_command(CLI::App& app) {
       out["successes"] = result.successes;
       out["success_rate"] = result.success_rate;
       out["ci95"] = result.ci95;
-      out["decision_time_us"] = {{"median", result.decision_time.median_us},
-                                 {"p99", result.decision_time.p99_us},
-                                 {"mean", result.decision_time.mean_us},
-                                 {"max", result.decision_time.max_us},
-                                 {"decisions", result.decision_time.decisions}};
-      out["seconds"] = result.seconds;
+      if (!options->no_timing) {
+        out["decision_time_us"] = {{"median", result.decision_time.median_us},
+                                   {"p99", result.decision_time.p99_us},
+                                   {"mean", result.decision_time.mean_us},
+                                   {"max", result.decision_time.max_us},
+                                   {"decisions", result.decision_time.decisions}};
+        out["seconds"] = result.seconds;
+      }
       if (exact) {
         out["exact_success_probability"] = exact->success_probability;
         out["exact_states"] = exact->states;
@@ -76,6 +83,7 @@ void add_evaluate_command(CLI::App& app) {
     fmt::print("success rate    {:.4f} ± {:.4f}  ({} of {} episodes, seed {})\n", result.success_rate, result.ci95,
                result.successes, result.episodes, options->monte_carlo.seed);
     if (exact) fmt::print("exact           {:.6f}  ({} states)\n", exact->success_probability, exact->states);
+    if (options->no_timing) return;
     fmt::print("decision time   median {:.3f} µs, p99 {:.3f} µs, mean {:.3f} µs, max {:.3f} µs over {} decisions\n",
                result.decision_time.median_us, result.decision_time.p99_us, result.decision_time.mean_us,
                result.decision_time.max_us, result.decision_time.decisions);

@@ -12,6 +12,7 @@
 #include <span>
 #include <vector>
 
+#include "cluster_job.hpp"
 #include "common.hpp"
 #include "data_paths.hpp"
 #include "live_report.hpp"
@@ -127,6 +128,7 @@ void add_run_command(CLI::App& app) {
     episodes.episodes = options->episodes;
     episodes.seed = options->seed;
     episodes.threads = options->threads;
+    episodes.ranks = job_ranks();
     std::vector<EpisodeResult> results;
     if (live) {
       episodes.live = LiveRun{LiveOptions{.decision_share = options->decision_share}, true};
@@ -145,7 +147,7 @@ void add_run_command(CLI::App& app) {
       const auto allocator = factory();
       exact = evaluate_exactly(mdp, *allocator, max_states_of(parameters));
     }
-    if (!timeline_data.empty()) {
+    if (!timeline_data.empty() && is_job_root()) {  // rank 0 writes
       const EpisodeResult& shown = results[options->timeline_episode];
       write_file_atomically(timeline_data, timeline_csv(problem, shown));
       if (!options->no_plot) {

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <limits>
 
+#include "cluster_job.hpp"
 #include "common.hpp"
 #include "memory_limits.hpp"
 #include "number_options.hpp"
@@ -85,6 +86,7 @@ std::vector<Problem> prepare(const StudyOptions& options, const std::string& kin
 }
 
 void finish(const StudyOptions& options, const std::string& kind, const std::string& csv) {
+  if (!is_job_root()) return;  // rank 0 writes
   const std::string csv_path = output_of(options, kind, ".csv").string();
   write_file_atomically(csv_path, csv);
   fmt::print("wrote {}\n", csv_path);
@@ -101,6 +103,7 @@ StudySettings settings_of(const StudyOptions& options, ProgressBar& bar, std::si
   settings.episodes = options.episodes;
   settings.seed = options.seed;
   settings.threads = options.threads;
+  settings.ranks = job_ranks();
   settings.searcher = options.searcher;
   settings.reference = options.reference;
   settings.parameters = options.allocator.values();

@@ -17,6 +17,7 @@
 #include <set>
 #include <vector>
 
+#include "cluster_job.hpp"
 #include "common.hpp"
 #include "data_paths.hpp"
 #include "live_report.hpp"
@@ -231,6 +232,7 @@ void add_tamp_command(CLI::App& app) {
     episodes.episodes = options->episodes;
     episodes.seed = options->seed;
     episodes.threads = options->threads;
+    episodes.ranks = job_ranks();
     episodes.live = LiveRun{LiveOptions{.decision_share = options->decision_share}, options->json};
     std::vector<EpisodeResult> results(options->episodes);
     std::vector<int> skeletons_found(options->episodes, 0);
@@ -251,7 +253,7 @@ void add_tamp_command(CLI::App& app) {
     const double deadline_seconds = streaming.deadline * streaming.step_seconds;
 
     // The picture: the episode run again on its own, so that its world still holds its motions.
-    if (!map_data.empty()) {
+    if (!map_data.empty() && is_job_root()) {  // rank 0 draws and writes
       domains::PlannerWorld world(domain, stream, planner);
       LiveRun live = *episodes.live;
       live.keep_timeline = true;

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <thread>
 
+#include "cluster_job.hpp"
 #include "memory_limits.hpp"
 #include "number_options.hpp"
 #include "ontime/allocators/optimal.hpp"
@@ -94,6 +95,7 @@ MonteCarloOptions MonteCarloFlags::options() const {
   options.episodes = episodes;
   options.seed = seed;
   options.threads = threads;
+  options.ranks = job_ranks();
   return options;
 }
 
@@ -154,7 +156,9 @@ std::string csv_field(std::string_view text) {
   return quoted;
 }
 
-ProgressBar::ProgressBar(std::string label) : label_(std::move(label)), enabled_(::isatty(STDERR_FILENO) != 0) {}
+// Only the rank that prints shows a bar.
+ProgressBar::ProgressBar(std::string label)
+    : label_(std::move(label)), enabled_(::isatty(STDERR_FILENO) != 0 && is_job_root()) {}
 
 ProgressBar::~ProgressBar() {
   if (enabled_ && last_percent_ >= 0) fmt::print(stderr, "\r\033[K");

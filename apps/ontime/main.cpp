@@ -9,7 +9,10 @@
 #include <exception>
 #include <memory>
 #include <new>
+#include <string>
+#include <utility>
 
+#include "cluster_job.hpp"
 #include "common.hpp"
 #include "ontime/error.hpp"
 
@@ -18,33 +21,44 @@ namespace {
 constexpr int kUsageExit = 2;
 constexpr int kInternalExit = 1;
 
-int report(const char* kind, const char* message, int code) {
-  fmt::print(stderr, "ontime: {}: {}\n", kind, message);
-  return code;
+// Runs the command line and returns the exit code, with the message to print, if any.
+std::pair<int, std::string> run(int& argc, char**& argv) {
+  const auto failure = [](const char* kind, const char* message, int code) {
+    return std::pair<int, std::string>{code, fmt::format("ontime: {}: {}", kind, message)};
+  };
+  try {
+    // An MPI launcher's process joins its job first: rank 0 alone prints, and errors are
+    // reported once (cluster_job.hpp).
+    ontime::cli::join_cluster_job(argc, argv);
+    const std::unique_ptr<CLI::App> application = ontime::cli::make_app();
+    CLI::App& app = *application;
+    try {
+      app.parse(argc, argv);
+    } catch (const CLI::ParseError& error) {
+      if (error.get_exit_code() == 0) {  // --help, --version
+        if (ontime::cli::is_job_root()) return {app.exit(error), std::string()};
+        return {0, std::string()};
+      }
+      return {kUsageExit,
+              fmt::format("ontime: usage error: {} (see 'ontime --help' or 'ontime COMMAND --help')", error.what())};
+    }
+  } catch (const ontime::InputError& error) {
+    return failure("error", error.what(), kUsageExit);
+  } catch (const ontime::UsageError& error) {
+    return failure("usage error", error.what(), kUsageExit);
+  } catch (const ontime::ResourceLimitError& error) {
+    return failure("resource limit", error.what(), kUsageExit);
+  } catch (const std::bad_alloc&) {
+    return failure("internal error", "out of memory", kInternalExit);
+  } catch (const std::exception& error) {
+    return failure("internal error", error.what(), kInternalExit);
+  }
+  return {0, std::string()};
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::unique_ptr<CLI::App> application = ontime::cli::make_app();
-  CLI::App& app = *application;
-
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& error) {
-    if (error.get_exit_code() == 0) return app.exit(error);  // --help, --version
-    fmt::print(stderr, "ontime: usage error: {} (see 'ontime --help' or 'ontime COMMAND --help')\n", error.what());
-    return kUsageExit;
-  } catch (const ontime::InputError& error) {
-    return report("error", error.what(), kUsageExit);
-  } catch (const ontime::UsageError& error) {
-    return report("usage error", error.what(), kUsageExit);
-  } catch (const ontime::ResourceLimitError& error) {
-    return report("resource limit", error.what(), kUsageExit);
-  } catch (const std::bad_alloc&) {
-    return report("internal error", "out of memory", kInternalExit);
-  } catch (const std::exception& error) {
-    return report("internal error", error.what(), kInternalExit);
-  }
-  return 0;
+  const auto [code, message] = run(argc, argv);
+  return ontime::cli::leave_cluster_job(code, message.empty() ? nullptr : message.c_str());
 }

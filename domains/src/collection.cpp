@@ -7,10 +7,12 @@
 #include <optional>
 #include <stdexcept>
 
+#include "ontime/byte_packing.hpp"
 #include "ontime/domains/collection_journal.hpp"
 #include "ontime/error.hpp"
 #include "ontime/parallel.hpp"
 #include "ontime/random.hpp"
+#include "ontime/ranks.hpp"
 
 namespace ontime::domains {
 namespace {
@@ -50,6 +52,46 @@ void check_options(const CollectionOptions& options) {
   if (options.effort.unit == EffortUnit::collision_checks && !(options.effort.checks_per_second > 0)) {
     throw std::invalid_argument("the checks per second must be positive");
   }
+}
+
+// Sends the outcomes of the trials this rank ran (`mine`) to every other rank and takes in
+// theirs; returns how many trials the other ranks ran.
+std::uint64_t exchange_outcomes(const Ranks& ranks, const std::vector<TreeAction>& tree,
+                                const std::vector<std::pair<std::size_t, std::uint64_t>>& mine,
+                                std::vector<std::vector<Outcome>>& outcomes, std::vector<std::vector<bool>>& done) {
+  BytePacker packer;
+  for (const auto& [a, t] : mine) {
+    const Outcome& outcome = outcomes[a][t];
+    packer.put<std::uint64_t>(a);
+    packer.put(t);
+    packer.put(outcome.attempt.planning_seconds);
+    packer.put(outcome.attempt.found);
+    packer.put(outcome.attempt.execution_seconds);
+    packer.put(outcome.attempt.collision_checks);
+    packer.put(outcome.end.has_value());
+    if (outcome.end) packer.put_vector(*outcome.end);
+  }
+  const std::vector<std::string> parts = ranks.all_gather(packer.bytes());
+  std::uint64_t received = 0;
+  for (std::size_t r = 0; r < parts.size(); ++r) {
+    if (static_cast<int>(r) == ranks.rank()) continue;
+    ByteUnpacker unpacker(parts[r]);
+    while (!unpacker.done()) {
+      const auto a = static_cast<std::size_t>(unpacker.get<std::uint64_t>());
+      const auto t = unpacker.get<std::uint64_t>();
+      Outcome& outcome = outcomes.at(a).at(t);
+      outcome.attempt.action = tree.at(a).action;
+      outcome.attempt.trial = t;
+      outcome.attempt.planning_seconds = unpacker.get<double>();
+      outcome.attempt.found = unpacker.get<bool>();
+      outcome.attempt.execution_seconds = unpacker.get<double>();
+      outcome.attempt.collision_checks = unpacker.get<std::optional<std::uint64_t>>();
+      if (unpacker.get<bool>()) outcome.end = unpacker.get_vector<double>();
+      done[a][t] = true;
+      ++received;
+    }
+  }
+  return received;
 }
 
 }  // namespace
@@ -99,33 +141,57 @@ CollectionResult collect(const Domain& domain, const CollectionOptions& options)
   std::uint64_t finished = 0;
   std::mutex progress_mutex;
 
-  // Trials an earlier, interrupted run finished: resumed[a][t].
-  std::vector<std::vector<const JournalTrial*>> resumed(tree.size(),
-                                                        std::vector<const JournalTrial*>(options.trials, nullptr));
+  // outcomes[a][t]: trial t of action a, once run (or read back from the journal).
+  std::vector<std::vector<Outcome>> outcomes(tree.size(), std::vector<Outcome>(options.trials));
+  std::vector<std::vector<bool>> done(tree.size(), std::vector<bool>(options.trials, false));
   if (options.journal != nullptr) {
     for (const JournalTrial& trial : options.journal->finished()) {
-      resumed.at(trial.action).at(trial.attempt.trial.value()) = &trial;
+      const std::uint64_t t = trial.attempt.trial.value();
+      outcomes.at(trial.action).at(t) = Outcome{trial.attempt, trial.end};
+      done[trial.action][t] = true;
       ++finished;
     }
   }
 
+  // The actions in layers by their depth in the tree: an action's trials need the ends of its
+  // parent's, so a layer starts once the layer before has ended; within a layer every trial of
+  // every action is independent. (The tree lists parents before children.)
+  std::vector<std::size_t> depth(tree.size(), 0);
+  std::size_t layers = 0;
+  for (std::size_t a = 0; a < tree.size(); ++a) {
+    if (tree[a].parent >= 0) depth[a] = depth[static_cast<std::size_t>(tree[a].parent)] + 1;
+    layers = std::max(layers, depth[a] + 1);
+  }
+
   // ends[a]: end configurations of the successful refinements of action a, in trial order.
   std::vector<std::vector<Configuration>> ends(tree.size());
-  CollectionResult result;
-  for (std::size_t a = 0; a < tree.size(); ++a) {
-    const TreeAction& node = tree[a];
-    const std::uint64_t action_seed = stream_seed(options.seed, a);
-    const std::vector<Configuration>* starts = node.parent < 0 ? nullptr : &ends[static_cast<std::size_t>(node.parent)];
-    std::vector<Outcome> outcomes(options.trials);
+  const Ranks* ranks = options.ranks;
+  const int rank = ranks == nullptr ? 0 : ranks->rank();
+  const int rank_count = ranks == nullptr ? 1 : ranks->size();
+  for (std::size_t layer = 0; layer < layers; ++layer) {
+    // The layer's trials still to run, in tree and trial order; rank r runs every rank_count-th
+    // of them from the r-th, so that each rank gets a like share of every action.
+    std::vector<std::pair<std::size_t, std::uint64_t>> pending;
+    for (std::size_t a = 0; a < tree.size(); ++a) {
+      if (depth[a] != layer) continue;
+      for (std::uint64_t t = 0; t < options.trials; ++t) {
+        if (!done[a][t]) pending.emplace_back(a, t);
+      }
+    }
+    std::vector<std::pair<std::size_t, std::uint64_t>> mine;
+    for (std::size_t i = static_cast<std::size_t>(rank); i < pending.size();
+         i += static_cast<std::size_t>(rank_count)) {
+      mine.push_back(pending[i]);
+    }
     // A trial is seconds of planning: hand them out one by one.
-    for_each_block(options.trials, options.threads, 1, [&](unsigned) {
+    for_each_block(mine.size(), options.threads, 1, [&](unsigned) {
       return [&](std::uint64_t begin, std::uint64_t end) {
-        for (std::uint64_t t = begin; t < end; ++t) {
-          if (const JournalTrial* earlier = resumed[a][t]) {
-            outcomes[t] = Outcome{earlier->attempt, earlier->end};
-            continue;
-          }
-          const std::uint64_t trial_seed = stream_seed(action_seed, t);
+        for (std::uint64_t i = begin; i < end; ++i) {
+          const auto [a, t] = mine[i];
+          const TreeAction& node = tree[a];
+          const std::vector<Configuration>* starts =
+              node.parent < 0 ? nullptr : &ends[static_cast<std::size_t>(node.parent)];
+          const std::uint64_t trial_seed = stream_seed(stream_seed(options.seed, a), t);
           Configuration start;
           if (starts == nullptr && !node.fallback_start) {
             start = domain.initial_configuration();
@@ -134,10 +200,10 @@ CollectionResult collect(const Domain& domain, const CollectionOptions& options)
           } else {
             start = domain.fallback_start(node.action, stream_seed(trial_seed, 1));
           }
-          outcomes[t] = attempt_once(domain, node.action, start, stream_seed(trial_seed, 0), options);
-          outcomes[t].attempt.trial = t;
-          if (options.journal != nullptr)
-            options.journal->record(JournalTrial{a, outcomes[t].attempt, outcomes[t].end});
+          Outcome& outcome = outcomes[a][t];
+          outcome = attempt_once(domain, node.action, start, stream_seed(trial_seed, 0), options);
+          outcome.attempt.trial = t;
+          if (options.journal != nullptr) options.journal->record(JournalTrial{a, outcome.attempt, outcome.end});
           if (options.progress) {
             const std::lock_guard lock(progress_mutex);
             options.progress(++finished, total);
@@ -145,8 +211,23 @@ CollectionResult collect(const Domain& domain, const CollectionOptions& options)
         }
       };
     });
-    for (Outcome& outcome : outcomes) {
-      if (outcome.end) ends[a].push_back(std::move(*outcome.end));
+    for (const auto& [a, t] : mine) done[a][t] = true;
+    if (split_over_ranks(ranks)) {
+      finished += exchange_outcomes(*ranks, tree, mine, outcomes, done);
+      if (options.progress) options.progress(finished, total);
+    }
+    for (std::size_t a = 0; a < tree.size(); ++a) {
+      if (depth[a] != layer) continue;
+      for (const Outcome& outcome : outcomes[a]) {
+        if (outcome.end) ends[a].push_back(*outcome.end);
+      }
+    }
+  }
+
+  CollectionResult result;
+  result.log.reserve(total);
+  for (std::vector<Outcome>& trials : outcomes) {
+    for (Outcome& outcome : trials) {
       result.collision_checks += outcome.attempt.collision_checks.value_or(0);
       result.log.push_back(std::move(outcome.attempt));
     }

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <nlohmann/json.hpp>
@@ -61,82 +62,121 @@ void write_all(int descriptor, const std::string& text, const std::filesystem::p
   }
 }
 
+// Reads the trials of one journal file into `finished` (those not already there from another
+// rank's file: the same trial gives the same record whichever rank ran it) and returns how many
+// of its bytes are whole lines.
+std::size_t read_part(const std::filesystem::path& path, const Json& expected, const CollectionOptions& options,
+                      std::vector<JournalTrial>& finished, std::set<std::pair<std::size_t, std::uint64_t>>& known) {
+  const std::string source = path.string();
+  const std::string text = ontime::read_input_file(path, "collection journal");
+  std::set<std::pair<std::size_t, std::uint64_t>> seen;  // in this file
+  std::size_t start = 0, number = 0, keep = 0;
+  while (start < text.size()) {
+    const std::size_t end = text.find('\n', start);
+    if (end == std::string::npos) break;  // a last line cut short: dropped
+    ++number;
+    const std::string place = "line " + std::to_string(number);
+    const std::string_view line(text.data() + start, end - start);
+    Json value;
+    try {
+      value = ontime::detail::parse_json_strict<Json>(line, source);
+    } catch (const InputError& bad) {
+      throw InputError(source, place, bad.rule());
+    }
+    if (number == 1) {
+      for (const auto& [key, wanted] : expected.items()) {
+        if (!value.is_object() || !value.contains(key) || value[key] != wanted) {
+          throw InputError(source, place,
+                           "the checkpoint of another collection ('" + key + "' is " +
+                               (value.is_object() && value.contains(key) ? value[key].dump() : std::string("missing")) +
+                               " there, " + wanted.dump() + " here); delete it to start over");
+        }
+      }
+    } else {
+      if (!value.is_object() || !value.contains("action") || !value["action"].is_number_unsigned() ||
+          value["action"].get<std::size_t>() >= expected["actions"].size() || !value.contains("record") ||
+          !value["record"].is_object()) {
+        throw InputError(source, place, "a trial needs 'action' (an index into the actions of line 1) and 'record'");
+      }
+      JournalTrial trial;
+      trial.action = value["action"].get<std::size_t>();
+      const std::vector<RefinementAttempt> records =
+          parse_planner_log(value["record"].dump() + "\n", source + " " + place);
+      trial.attempt = records.front();
+      if (trial.attempt.action != expected["actions"][trial.action].get<std::string>() || !trial.attempt.trial ||
+          *trial.attempt.trial >= options.trials || !seen.emplace(trial.action, *trial.attempt.trial).second) {
+        throw InputError(source, place, "a trial that does not belong to this collection or is there twice");
+      }
+      if (value.contains("end")) {
+        if (!value["end"].is_array()) throw InputError(source, place, "'end' must be an array of numbers");
+        Configuration configuration;
+        for (const Json& number_value : value["end"]) {
+          if (!number_value.is_number()) throw InputError(source, place, "'end' must be an array of numbers");
+          configuration.push_back(number_value.get<double>());
+        }
+        trial.end = std::move(configuration);
+      }
+      if (known.emplace(trial.action, *trial.attempt.trial).second) finished.push_back(std::move(trial));
+    }
+    start = end + 1;
+    keep = start;
+  }
+  return keep;
+}
+
 }  // namespace
 
-CollectionJournal::CollectionJournal(std::filesystem::path path, const Domain& domain, const CollectionOptions& options,
-                                     std::string_view world_text, bool resume)
-    : path_(std::move(path)) {
-  const Json expected = settings(domain, options, world_text);
-  const std::string source = path_.string();
+std::filesystem::path CollectionJournal::part_path(const std::filesystem::path& path, int rank) {
+  if (rank == 0) return path;
+  return std::filesystem::path(path.string() + kRankSuffix + std::to_string(rank));
+}
+
+std::vector<std::filesystem::path> CollectionJournal::parts(const std::filesystem::path& path) {
+  std::vector<std::filesystem::path> found;
   std::error_code error;
-  const bool exists = std::filesystem::exists(path_, error);
-  std::size_t keep = 0;  // bytes of the existing file to keep (whole lines)
-  if (exists && !resume) {
-    throw UsageError(source +
+  if (std::filesystem::exists(path, error)) found.push_back(path);
+  const std::filesystem::path folder = path.parent_path().empty() ? std::filesystem::path(".") : path.parent_path();
+  const std::string prefix = path.filename().string() + kRankSuffix;
+  std::vector<std::pair<int, std::filesystem::path>> ranked;
+  for (std::filesystem::directory_iterator entry(folder, error), last; !error && entry != last;
+       entry.increment(error)) {
+    const std::string name = entry->path().filename().string();
+    if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string digits = name.substr(prefix.size());
+    if (digits.size() > 6 || digits.find_first_not_of("0123456789") != std::string::npos || digits[0] == '0') continue;
+    ranked.emplace_back(std::stoi(digits), part_path(path, std::stoi(digits)));
+  }
+  std::sort(ranked.begin(), ranked.end());
+  for (auto& [rank, part] : ranked) found.push_back(std::move(part));
+  return found;
+}
+
+CollectionJournal::CollectionJournal(std::filesystem::path path, const Domain& domain, const CollectionOptions& options,
+                                     std::string_view world_text, bool resume, const Ranks* ranks)
+    : path_(std::move(path)), ranks_(ranks) {
+  const Json expected = settings(domain, options, world_text);
+  const std::vector<std::filesystem::path> existing = parts(path_);
+  if (!existing.empty() && !resume) {
+    throw UsageError(existing.front().string() +
                      ": the checkpoint of an unfinished collection is there; resume the collection or delete it");
   }
-  if (exists) {
-    const std::string text = ontime::read_input_file(path_, "collection journal");
-    std::set<std::pair<std::size_t, std::uint64_t>> seen;
-    std::size_t start = 0, number = 0;
-    while (start < text.size()) {
-      const std::size_t end = text.find('\n', start);
-      if (end == std::string::npos) break;  // a last line cut short: dropped
-      ++number;
-      const std::string place = "line " + std::to_string(number);
-      const std::string_view line(text.data() + start, end - start);
-      Json value;
-      try {
-        value = ontime::detail::parse_json_strict<Json>(line, source);
-      } catch (const InputError& bad) {
-        throw InputError(source, place, bad.rule());
-      }
-      if (number == 1) {
-        for (const auto& [key, wanted] : expected.items()) {
-          if (!value.is_object() || !value.contains(key) || value[key] != wanted) {
-            throw InputError(
-                source, place,
-                "the checkpoint of another collection ('" + key + "' is " +
-                    (value.is_object() && value.contains(key) ? value[key].dump() : std::string("missing")) +
-                    " there, " + wanted.dump() + " here); delete it to start over");
-          }
-        }
-      } else {
-        if (!value.is_object() || !value.contains("action") || !value["action"].is_number_unsigned() ||
-            value["action"].get<std::size_t>() >= expected["actions"].size() || !value.contains("record") ||
-            !value["record"].is_object()) {
-          throw InputError(source, place, "a trial needs 'action' (an index into the actions of line 1) and 'record'");
-        }
-        JournalTrial trial;
-        trial.action = value["action"].get<std::size_t>();
-        const std::vector<RefinementAttempt> records =
-            parse_planner_log(value["record"].dump() + "\n", source + " " + place);
-        trial.attempt = records.front();
-        if (trial.attempt.action != expected["actions"][trial.action].get<std::string>() || !trial.attempt.trial ||
-            *trial.attempt.trial >= options.trials || !seen.emplace(trial.action, *trial.attempt.trial).second) {
-          throw InputError(source, place, "a trial that does not belong to this collection or is there twice");
-        }
-        if (value.contains("end")) {
-          if (!value["end"].is_array()) throw InputError(source, place, "'end' must be an array of numbers");
-          Configuration configuration;
-          for (const Json& number_value : value["end"]) {
-            if (!number_value.is_number()) throw InputError(source, place, "'end' must be an array of numbers");
-            configuration.push_back(number_value.get<double>());
-          }
-          trial.end = std::move(configuration);
-        }
-        finished_.push_back(std::move(trial));
-      }
-      start = end + 1;
-      keep = start;
-    }
+  const std::filesystem::path own = part_path(path_, ranks == nullptr ? 0 : ranks->rank());
+  std::size_t keep = 0;  // bytes of this rank's file to keep (whole lines)
+  std::set<std::pair<std::size_t, std::uint64_t>> known;
+  for (const std::filesystem::path& part : existing) {
+    const std::size_t whole = read_part(part, expected, options, finished_, known);
+    if (part == own) keep = whole;
   }
-  descriptor_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
+  // Every rank has read every file before any rank creates its own.
+  if (split_over_ranks(ranks)) ranks->all_gather({});
+  own_ = own;
+  const std::string source = own_.string();
+  descriptor_ = ::open(own_.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
   if (descriptor_ < 0) throw std::runtime_error(source + ": cannot open the checkpoint (" + std::strerror(errno) + ")");
   if (::ftruncate(descriptor_, static_cast<off_t>(keep)) != 0 || ::lseek(descriptor_, 0, SEEK_END) < 0) {
     throw std::runtime_error(source + ": cannot prepare the checkpoint (" + std::strerror(errno) + ")");
   }
-  if (keep == 0) write_all(descriptor_, expected.dump() + "\n", path_);
+  if (keep == 0) write_all(descriptor_, expected.dump() + "\n", own_);
 }
 
 CollectionJournal::~CollectionJournal() {
@@ -150,14 +190,19 @@ void CollectionJournal::record(const JournalTrial& trial) {
   if (trial.end) line["end"] = *trial.end;
   const std::string text = line.dump() + "\n";
   const std::lock_guard lock(mutex_);
-  write_all(descriptor_, text, path_);
+  write_all(descriptor_, text, own_);
 }
 
 void CollectionJournal::remove() {
-  const std::lock_guard lock(mutex_);
-  if (descriptor_ >= 0) ::close(descriptor_);
-  descriptor_ = -1;
-  std::filesystem::remove(path_);
+  {
+    const std::lock_guard lock(mutex_);
+    if (descriptor_ >= 0) ::close(descriptor_);
+    descriptor_ = -1;
+  }
+  // Every rank has closed its file (its last trial was exchanged) before rank 0 deletes them all.
+  if (split_over_ranks(ranks_)) ranks_->all_gather({});
+  if (!is_root_rank(ranks_)) return;
+  for (const std::filesystem::path& part : parts(path_)) std::filesystem::remove(part);
 }
 
 }  // namespace ontime::domains

@@ -9,7 +9,8 @@
 // s_e = stream_seed(S, e); its world begins from s_e and its allocator from stream_seed(s_e, 1).
 // An episode is thus the same whichever thread runs it and whatever ran before it on that
 // thread, so the results do not depend on the thread count, and every episode's allocator has
-// its own random stream.
+// its own random stream. Nor on the number of processes: a run split over MPI ranks
+// (MonteCarloOptions::ranks) gives each rank a contiguous share of the episodes.
 
 #include <array>
 #include <cstddef>
@@ -23,6 +24,7 @@
 #include "ontime/allocator.hpp"
 #include "ontime/decision_budget.hpp"
 #include "ontime/mdp.hpp"
+#include "ontime/ranks.hpp"
 #include "ontime/session.hpp"
 #include "ontime/statistics.hpp"
 #include "ontime/world.hpp"
@@ -103,8 +105,14 @@ struct MonteCarloOptions {
   // Live episodes.
   std::optional<LiveRun> live;
   // Called with every episode's result (from any thread, so it must be thread-safe; episodes
-  // are numbered 0 .. episodes - 1).
+  // are numbered 0 .. episodes - 1). In a run split over ranks, every rank gets every episode:
+  // its own as they end, the other ranks' (without `problem`) once all have ended.
   std::function<void(std::uint64_t episode, const EpisodeResult& result)> on_episode;
+  // When set, the episodes are split over these ranks (ranks.hpp): each runs its share on its
+  // own threads, then they exchange their results, and every rank returns the same totals (the
+  // numbers of one process, latencies aside). Every rank must make the same call. `progress`
+  // counts the rank's own share.
+  const Ranks* ranks = nullptr;
 };
 
 struct LatencySummary {

@@ -30,6 +30,10 @@ struct StudySettings {
   ParameterValues parameters;          // of both kinds (the searcher's time is set per study)
   // Called with the episodes done so far in this study and its total.
   std::function<void(std::uint64_t done, std::uint64_t total)> progress;
+  // When set, every evaluation's episodes are split over these ranks (MonteCarloOptions::ranks),
+  // and the reference's time per decision is rank 0's measurement, so that every rank gives the
+  // searcher the same budget.
+  const Ranks* ranks = nullptr;
 };
 
 // Mean seconds one decision of the allocator takes, over the states it meets in `episodes` of

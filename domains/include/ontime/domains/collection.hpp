@@ -15,8 +15,13 @@
 // Determinism: trial t of the a-th action of the tree draws everything from
 // stream_seed(stream_seed(seed, a), t), whichever thread runs it, and the log lists actions in
 // tree order and trials in order. In the collision-checks effort unit the same seed therefore
-// gives the same log byte for byte, for any number of threads, and a collection resumed from its
-// journal (collection_journal.hpp) the same log as one never interrupted.
+// gives the same log byte for byte, for any number of threads or of MPI ranks
+// (CollectionOptions::ranks), and a collection resumed from its journal (collection_journal.hpp)
+// the same log as one never interrupted.
+//
+// The trials run layer by layer, a layer being the actions of one depth in the tree (a
+// collection of every action is one layer): within a layer all trials are independent and go to
+// the threads (and ranks) together, so a slow action does not hold up the others.
 
 #include <cstdint>
 #include <functional>
@@ -26,6 +31,7 @@
 #include "ontime/distribution.hpp"
 #include "ontime/domains/domain.hpp"
 #include "ontime/planner_log.hpp"
+#include "ontime/ranks.hpp"
 
 namespace ontime::domains {
 
@@ -66,6 +72,11 @@ struct CollectionOptions {
   // When set: trials it holds are taken from it instead of being run again, and every trial
   // run is recorded in it as soon as it is finished.
   CollectionJournal* journal = nullptr;
+  // When set, the trials are split over these ranks (ontime/ranks.hpp; every rank makes the same
+  // call with its own journal): each rank runs its share of a layer of the tree (the actions of
+  // one depth) on its own threads, then the ranks exchange the outcomes, and every rank returns
+  // the whole log, the same as one process's.
+  const Ranks* ranks = nullptr;
 };
 
 struct CollectionResult {

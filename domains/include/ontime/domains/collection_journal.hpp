@@ -15,6 +15,11 @@
 //
 // A last line cut short (by a crash during the write) is dropped on resuming; any other bad line
 // is an InputError naming the file, the line and the rule.
+//
+// A collection split over MPI ranks keeps one journal file per rank, each complete with its
+// settings line: rank 0 the file at `path`, rank r > 0 `path.rank-r`. Every rank reads them all
+// on resuming, so a collection resumes under any number of ranks (or one process) from what any
+// rank finished.
 
 #include <cstdint>
 #include <filesystem>
@@ -26,6 +31,7 @@
 
 #include "ontime/domains/domain.hpp"
 #include "ontime/planner_log.hpp"
+#include "ontime/ranks.hpp"
 
 namespace ontime::domains {
 
@@ -45,8 +51,15 @@ class CollectionJournal {
   //  - a file and `resume`: reads its trials (checking its settings are these: InputError
   //    otherwise) and appends after them;
   //  - a file and not `resume`: UsageError, so that the work it holds is not lost by accident.
+  //  With `ranks`, every rank makes this call: each reads every rank's file (parts()) and
+  //  writes its own (part_path()).
   CollectionJournal(std::filesystem::path path, const Domain& domain, const CollectionOptions& options,
-                    std::string_view world_text, bool resume);
+                    std::string_view world_text, bool resume, const Ranks* ranks = nullptr);
+
+  // The file rank `rank` writes for the journal at `path`.
+  static std::filesystem::path part_path(const std::filesystem::path& path, int rank);
+  // The journal files there are for `path`: its own, then those of ranks 1, 2, ... that exist.
+  static std::vector<std::filesystem::path> parts(const std::filesystem::path& path);
   ~CollectionJournal();
   CollectionJournal(const CollectionJournal&) = delete;
   CollectionJournal& operator=(const CollectionJournal&) = delete;
@@ -58,11 +71,15 @@ class CollectionJournal {
   // Appends a finished trial (thread-safe). Throws std::runtime_error when the write fails.
   void record(const JournalTrial& trial);
 
-  // Closes and deletes the file, once the collection's outputs are written.
+  // Closes and deletes the files, once the collection's outputs are written (with ranks: every
+  // rank calls it, after rank 0 has written them; rank 0 deletes every rank's file).
   void remove();
 
  private:
+  static constexpr const char* kRankSuffix = ".rank-";
   std::filesystem::path path_;
+  std::filesystem::path own_;  // this rank's file
+  const Ranks* ranks_ = nullptr;
   std::vector<JournalTrial> finished_;
   int descriptor_ = -1;
   std::mutex mutex_;

@@ -1,0 +1,48 @@
+#pragma once
+// The processes one run is split over: the ranks of an MPI job started by `mpirun` or
+// `srun --mpi=pmix`, as the library sees them. The library never talks to MPI itself (the core
+// does not depend on it): the caller hands it a Ranks, and the library splits its independent
+// units (episodes, collection trials) over the ranks, runs its share on its own threads and
+// exchanges the results with all_gather, once per batch of units.
+//
+// Determinism: every unit draws its randomness from its own seeded stream and results are
+// merged in unit order (or by sums of integers and maxima), so a run split over any number of
+// ranks gives the numbers of one process, to the byte.
+//
+// A null `const Ranks*` means one process; so does a Ranks of size 1.
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace ontime {
+
+class Ranks {
+ public:
+  virtual ~Ranks() = default;
+  virtual int rank() const noexcept = 0;  // 0 .. size() - 1
+  virtual int size() const noexcept = 0;  // at least 1
+  // Every rank's `bytes`, in rank order, on every rank. Collective: every rank must call it, in
+  // the same order; it returns once all have.
+  virtual std::vector<std::string> all_gather(std::string_view bytes) const = 0;
+};
+
+// The units [begin, end) of `count` that rank `rank` of `size` takes: contiguous shares whose
+// sizes differ by at most one, in rank order.
+struct UnitShare {
+  std::uint64_t begin = 0;
+  std::uint64_t end = 0;
+};
+UnitShare unit_share(std::uint64_t count, int rank, int size) noexcept;
+inline UnitShare unit_share(std::uint64_t count, const Ranks* ranks) noexcept {
+  return ranks == nullptr ? UnitShare{0, count} : unit_share(count, ranks->rank(), ranks->size());
+}
+
+// True when `ranks` splits work over more than one process.
+inline bool split_over_ranks(const Ranks* ranks) noexcept { return ranks != nullptr && ranks->size() > 1; }
+
+// Rank 0 of `ranks` (true for one process): the rank that writes a run's outputs.
+inline bool is_root_rank(const Ranks* ranks) noexcept { return ranks == nullptr || ranks->rank() == 0; }
+
+}  // namespace ontime
