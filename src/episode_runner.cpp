@@ -342,8 +342,8 @@ MonteCarloResult run_many(const WorldFactory& worlds, const AllocatorFactory* al
                           const MonteCarloOptions& options, const RunOne& run_one) {
   const auto started = std::chrono::steady_clock::now();
   const bool split = split_over_ranks(options.ranks);
-  const UnitShare share = unit_share(options.episodes, options.ranks);
-  const std::uint64_t count = share.end - share.begin;
+  const RankUnits mine = rank_units(options.episodes, options.ranks);
+  const std::uint64_t count = mine.count;
   // Episodes are handed out in blocks: the hand-out and the progress report cost little even
   // when an episode takes a fraction of a microsecond. Short runs (often of long episodes,
   // against a real planner) get smaller blocks, so that every thread has some.
@@ -359,7 +359,8 @@ MonteCarloResult run_many(const WorldFactory& worlds, const AllocatorFactory* al
     if (allocators != nullptr) run.allocator = (*allocators)();
     run.world = worlds();
     return [&](std::uint64_t begin, std::uint64_t end) {
-      for (std::uint64_t episode = share.begin + begin; episode < share.begin + end; ++episode) {
+      for (std::uint64_t local = begin; local < end; ++local) {
+        const std::uint64_t episode = mine.unit(local);
         if (options.stop && options.stop()) throw Cancelled("episodes stopped at the caller's request");
         const EpisodeResult result = run_one(run, stream_seed(options.seed, episode));
         if (result.status == Status::success) ++run.successes;

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <mutex>
 #include <stdexcept>
@@ -21,22 +22,32 @@
 namespace ontime {
 namespace {
 
-TEST(Ranks, SharesAreContiguousCoverEveryUnitOnceAndDifferByAtMostOne) {
+TEST(Ranks, RanksTakeInterleavedUnitsAndTogetherEveryUnitOnce) {
   for (const std::uint64_t count : {0ULL, 1ULL, 2ULL, 7ULL, 100ULL, 1001ULL}) {
     for (const int size : {1, 2, 3, 8}) {
-      std::uint64_t next = 0, smallest = count, largest = 0;
+      std::vector<int> taken(count, 0);
+      std::uint64_t smallest = count, largest = 0;
       for (int rank = 0; rank < size; ++rank) {
-        const UnitShare share = unit_share(count, rank, size);
-        EXPECT_EQ(share.begin, next) << count << " " << size;
-        next = share.end;
-        smallest = std::min(smallest, share.end - share.begin);
-        largest = std::max(largest, share.end - share.begin);
+        const RankUnits units = rank_units(count, rank, size);
+        for (std::uint64_t i = 0; i < units.count; ++i) {
+          ASSERT_LT(units.unit(i), count);
+          ++taken[units.unit(i)];
+          if (i > 0) {
+            EXPECT_EQ(units.unit(i) - units.unit(i - 1), static_cast<std::uint64_t>(size));
+          }
+        }
+        smallest = std::min(smallest, units.count);
+        largest = std::max(largest, units.count);
       }
-      EXPECT_EQ(next, count);
+      EXPECT_EQ(std::count(taken.begin(), taken.end(), 1), static_cast<std::ptrdiff_t>(count)) << count << " " << size;
       EXPECT_LE(largest - smallest, 1u);
     }
   }
-  EXPECT_EQ(unit_share(10, nullptr).end, 10u);
+  const RankUnits alone = rank_units(10, nullptr);
+  EXPECT_EQ(alone.count, 10u);
+  EXPECT_EQ(alone.unit(9), 9u);
+  EXPECT_EQ(rank_units(10, 2, 3).unit(0), 2u);
+  EXPECT_EQ(rank_units(10, 2, 3).count, 3u);  // 2, 5, 8
 }
 
 TEST(Ranks, PackedValuesReadBackInOrderAndAShortBufferIsAnError) {

@@ -166,11 +166,9 @@ CollectionResult collect(const Domain& domain, const CollectionOptions& options)
   // ends[a]: end configurations of the successful refinements of action a, in trial order.
   std::vector<std::vector<Configuration>> ends(tree.size());
   const Ranks* ranks = options.ranks;
-  const int rank = ranks == nullptr ? 0 : ranks->rank();
-  const int rank_count = ranks == nullptr ? 1 : ranks->size();
   for (std::size_t layer = 0; layer < layers; ++layer) {
-    // The layer's trials still to run, in tree and trial order; rank r runs every rank_count-th
-    // of them from the r-th, so that each rank gets a like share of every action.
+    // The layer's trials still to run, in tree and trial order; each rank runs its interleaved
+    // share of them (rank_units), a like share of every action.
     std::vector<std::pair<std::size_t, std::uint64_t>> pending;
     for (std::size_t a = 0; a < tree.size(); ++a) {
       if (depth[a] != layer) continue;
@@ -179,10 +177,8 @@ CollectionResult collect(const Domain& domain, const CollectionOptions& options)
       }
     }
     std::vector<std::pair<std::size_t, std::uint64_t>> mine;
-    for (std::size_t i = static_cast<std::size_t>(rank); i < pending.size();
-         i += static_cast<std::size_t>(rank_count)) {
-      mine.push_back(pending[i]);
-    }
+    const RankUnits units = rank_units(pending.size(), ranks);
+    for (std::uint64_t i = 0; i < units.count; ++i) mine.push_back(pending[units.unit(i)]);
     // A trial is seconds of planning: hand them out one by one.
     for_each_block(mine.size(), options.threads, 1, [&](unsigned) {
       return [&](std::uint64_t begin, std::uint64_t end) {

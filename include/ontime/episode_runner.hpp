@@ -10,7 +10,7 @@
 // An episode is thus the same whichever thread runs it and whatever ran before it on that
 // thread, so the results do not depend on the thread count, and every episode's allocator has
 // its own random stream. Nor on the number of processes: a run split over MPI ranks
-// (MonteCarloOptions::ranks) gives each rank a contiguous share of the episodes.
+// (MonteCarloOptions::ranks) gives each rank an interleaved share of the episodes (rank_units).
 
 #include <array>
 #include <cstddef>

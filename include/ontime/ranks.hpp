@@ -28,15 +28,19 @@ class Ranks {
   virtual std::vector<std::string> all_gather(std::string_view bytes) const = 0;
 };
 
-// The units [begin, end) of `count` that rank `rank` of `size` takes: contiguous shares whose
-// sizes differ by at most one, in rank order.
-struct UnitShare {
-  std::uint64_t begin = 0;
-  std::uint64_t end = 0;
+// The units of 0 .. count - 1 that rank `rank` of `size` takes: rank, rank + size,
+// rank + 2 size, ... Interleaved rather than contiguous, so that every rank gets units from all
+// along the list and the ranks' loads stay alike when units differ in cost along it (episodes
+// of a long run, the trials of one action after another's).
+struct RankUnits {
+  std::uint64_t first = 0;
+  std::uint64_t stride = 1;
+  std::uint64_t count = 0;  // how many units the rank takes
+  std::uint64_t unit(std::uint64_t i) const noexcept { return first + i * stride; }
 };
-UnitShare unit_share(std::uint64_t count, int rank, int size) noexcept;
-inline UnitShare unit_share(std::uint64_t count, const Ranks* ranks) noexcept {
-  return ranks == nullptr ? UnitShare{0, count} : unit_share(count, ranks->rank(), ranks->size());
+RankUnits rank_units(std::uint64_t count, int rank, int size) noexcept;
+inline RankUnits rank_units(std::uint64_t count, const Ranks* ranks) noexcept {
+  return ranks == nullptr ? RankUnits{0, 1, count} : rank_units(count, ranks->rank(), ranks->size());
 }
 
 // True when `ranks` splits work over more than one process.
