@@ -73,6 +73,30 @@ TEST(Cli, EvaluateWritesTheDocumentedKeys) {
   EXPECT_EQ(json::parse(single.out)["successes"], out["successes"]);
 }
 
+// Without the measured times, the output depends only on the inputs: the same bytes for any
+// thread count, with the successes of a timed run.
+TEST(Cli, EvaluateWithoutTimingPrintsTheSameBytesForAnyThreadCount) {
+  const std::vector<std::string> command{"evaluate", paper("instance3"), "--solver", "mcts",   "--iterations",
+                                         "100",      "--episodes",       "300",      "--seed", "5",
+                                         "--json",   "--no-timing"};
+  auto with_threads = [&](const char* threads) {
+    std::vector<std::string> arguments = command;
+    arguments.insert(arguments.end(), {"--threads", threads});
+    return ontime(arguments);
+  };
+  const auto one = with_threads("1");
+  ASSERT_EQ(one.exit_code, 0) << one.err;
+  EXPECT_EQ(with_threads("3").out, one.out);
+  const json out = json::parse(one.out);
+  EXPECT_FALSE(out.contains("decision_time_us"));
+  EXPECT_FALSE(out.contains("seconds"));
+  std::vector<std::string> timed(command.begin(), command.end() - 1);
+  const auto with_timing = ontime(timed);
+  ASSERT_EQ(with_timing.exit_code, 0) << with_timing.err;
+  EXPECT_EQ(json::parse(with_timing.out)["successes"], out["successes"]);
+  EXPECT_TRUE(json::parse(with_timing.out).contains("decision_time_us"));
+}
+
 TEST(Cli, TablePrintsOneRowPerInstanceAndTheOptimum) {
   const auto result = ontime(
       {"table", paper("instance2"), paper("instance4"), "--episodes", "500", "--exact", "--solvers", "dp,greedy"});
