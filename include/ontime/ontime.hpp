@@ -37,4 +37,5 @@
 #include "ontime/simulator.hpp"
 #include "ontime/skeleton_file.hpp"
 #include "ontime/state.hpp"
+#include "ontime/value_bounds.hpp"
 #include "ontime/world.hpp"
