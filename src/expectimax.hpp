@@ -129,6 +129,25 @@ struct CompactStateHash {
   }
 };
 
+// Above any reachable PT or ET (its low byte, 255, is above them too when packed): the value of
+// a blanked slot.
+inline constexpr std::uint16_t kBlankCounter = 0xFFFF;
+
+// Blanks, in place, the slots of skeletons whose group can no longer succeed (refined 0, spent
+// and execution kBlankCounter): they influence neither the value nor the choices, so states
+// that differ only there are one state to the exact solvers. A blanked state evolves like the
+// original (a blanked skeleton shares no action with a skeleton that can still succeed).
+inline void blank_hopeless(const Mdp& mdp, CompactState& state) noexcept {
+  for (int k = 0; k < mdp.skeleton_count(); ++k) {
+    const int action = mdp.next_action(state, k);
+    if (action >= 0 && mdp.group_can_succeed(state, action)) continue;
+    const auto slot = static_cast<std::size_t>(k);
+    state.refined[slot] = 0;
+    state.spent[slot] = kBlankCounter;
+    state.execution[slot] = kBlankCounter;
+  }
+}
+
 // Throws UsageError when the problem has more skeletons than the exact solvers' keys hold.
 inline void require_exact_size(const Mdp& mdp, const std::string& what) {
   if (mdp.skeleton_count() > kMaxExactSkeletons) {

@@ -140,7 +140,7 @@ TEST(Cli, UsageErrorsExitWithTwo) {
   EXPECT_NE(unknown.err.find("unknown solver 'oracle'"), std::string::npos) << unknown.err;
   EXPECT_EQ(ontime({"evaluate", paper("figure1"), "--solver", "dp", "--episodes", "0"}).exit_code, 2);
   EXPECT_EQ(ontime({"table", paper("figure1"), "--solvers", "dp,nope"}).exit_code, 2);
-  const auto capped = ontime({"solve", paper("instance1"), "--max-states", "20"});
+  const auto capped = ontime({"solve", paper("instance1"), "--max-states", "20", "--method", "memoised"});
   EXPECT_EQ(capped.exit_code, 2);
   EXPECT_NE(capped.err.find("cap of 20 states"), std::string::npos) << capped.err;
 }
@@ -488,9 +488,11 @@ TEST(Cli, TableReportsAnExactPartOverTheCapInItsCell) {
   const auto text = ontime({"table", paper("instance1"), "--solvers", "dp,round-robin", "--episodes", "200", "--exact",
                             "--max-states", "100"});
   ASSERT_EQ(text.exit_code, 0) << text.err;
-  EXPECT_NE(text.out.find("(0.9340)"), std::string::npos) << text.out;                 // dp: 48 states
-  EXPECT_NE(text.out.find("(cap reached)"), std::string::npos) << text.out;            // round-robin: 143
-  EXPECT_NE(text.out.find("optimum over 100 states"), std::string::npos) << text.out;  // 872 states
+  EXPECT_NE(text.out.find("(0.9340)"), std::string::npos) << text.out;       // dp: 48 states
+  EXPECT_NE(text.out.find("(cap reached)"), std::string::npos) << text.out;  // round-robin: 143
+  // The optimum (872 states) past the cap: the layered solver's interval after 49 states (5 layers).
+  EXPECT_NE(text.out.find("optimum over 49 states (certified interval)"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("[0.9360, 0.9939]"), std::string::npos) << text.out;
   const auto as_json = ontime({"table", paper("instance1"), "--solvers", "dp,round-robin", "--episodes", "200",
                                "--exact", "--max-states", "100", "--json"});
   ASSERT_EQ(as_json.exit_code, 0) << as_json.err;
@@ -501,6 +503,8 @@ TEST(Cli, TableReportsAnExactPartOverTheCapInItsCell) {
   EXPECT_FALSE(row["solvers"]["round-robin"].contains("exact_success_probability"));
   EXPECT_TRUE(row["optimum"]["cap_reached"].get<bool>());
   EXPECT_FALSE(row.contains("optimal_success_probability"));
+  EXPECT_LE(row["optimum"]["lower_bound"].get<double>(), 0.942);
+  EXPECT_GE(row["optimum"]["upper_bound"].get<double>(), 0.942);
 }
 
 TEST(Cli, CollectWritesTheLogAndTheFittedInstance) {
@@ -1552,7 +1556,8 @@ TEST(Cli, AnInstanceDeadlineBeyondItsTypeIsQuotedAsWritten) {
 
 // A cap the memory cannot hold would end in "out of memory" instead of the cap's clean stop.
 TEST(Cli, CapsBeyondTheAvailableMemoryAreRefusedBeforeStarting) {
-  const auto states = ontime({"solve", paper("figure1"), "--max-states", "18446744073709551615"});
+  const auto states =
+      ontime({"solve", paper("figure1"), "--max-states", "18446744073709551615", "--method", "memoised"});
   EXPECT_EQ(states.exit_code, 2);
   EXPECT_NE(states.err.find("--max-states 18446744073709551615: would need up to"), std::string::npos) << states.err;
   const auto tree = ontime({"evaluate", paper("figure1"), "--solver", "mcts", "--max-tree-mib", "16777216",
@@ -1564,6 +1569,49 @@ TEST(Cli, CapsBeyondTheAvailableMemoryAreRefusedBeforeStarting) {
                              "5", "--threads", "1"});
   EXPECT_EQ(table.exit_code, 2);
   EXPECT_EQ(ontime({"solve", paper("figure1"), "--max-states", "1000"}).exit_code, 0);
+  const auto memory = ontime({"solve", paper("figure1"), "--max-memory-mib", "1099511627776"});
+  EXPECT_EQ(memory.exit_code, 2);
+  EXPECT_NE(memory.err.find("--max-memory-mib: would need up to"), std::string::npos) << memory.err;
+}
+
+TEST(Cli, SolveGivesTheOptimumOrACertifiedIntervalWithItsLayers) {
+  const auto exact = ontime({"solve", paper("instance1"), "--json", "--stats"});
+  ASSERT_EQ(exact.exit_code, 0) << exact.err;
+  const json solved = json::parse(exact.out);
+  EXPECT_EQ(solved["optimal_success_probability"].get<double>(), 0.942);
+  EXPECT_EQ(solved["lower_bound"].get<double>(), 0.942);
+  EXPECT_EQ(solved["upper_bound"].get<double>(), 0.942);
+  EXPECT_TRUE(solved["exact"].get<bool>());
+  EXPECT_EQ(solved["states"].get<int>(), 872);
+  int states = 0;
+  for (const json& layer : solved["layers"]) states += layer["states"].get<int>();
+  EXPECT_EQ(states, 872);
+  EXPECT_EQ(solved["layers"][0]["states"].get<int>(), 1);
+
+  const auto capped = ontime({"solve", paper("instance1"), "--json", "--max-states", "100"});
+  ASSERT_EQ(capped.exit_code, 0) << capped.err;
+  const json bounded = json::parse(capped.out);
+  EXPECT_TRUE(bounded["optimal_success_probability"].is_null());
+  EXPECT_FALSE(bounded["exact"].get<bool>());
+  EXPECT_LE(bounded["lower_bound"].get<double>(), 0.942);
+  EXPECT_GE(bounded["upper_bound"].get<double>(), 0.942);
+  EXPECT_LE(bounded["states"].get<int>(), 100);
+  EXPECT_NE(bounded["stopped_by"].get<std::string>().find("cap of 100 states"), std::string::npos);
+
+  const auto directory = scratch("solve_policy");
+  const std::string policy = (directory / "policy.jsonl").string();
+  const auto written = ontime({"solve", paper("instance1"), "--policy", policy, "--policy-layers", "2"});
+  ASSERT_EQ(written.exit_code, 0) << written.err;
+  std::ifstream in(policy);
+  std::string line;
+  int lines = 0;
+  while (std::getline(in, line)) {
+    const json entry = json::parse(line);
+    EXPECT_LE(entry["time"].get<int>(), 1);
+    EXPECT_EQ(entry["refined"].size(), 4U);
+    ++lines;
+  }
+  EXPECT_EQ(lines, 1 + solved["layers"][1]["states"].get<int>());
 }
 
 }  // namespace

@@ -59,13 +59,14 @@ std::unique_ptr<CLI::App> make_app() {
     for (CLI::App* command : app->get_subcommands({})) {
       const std::string name = command->get_name();
       if (name == "collect" || name == "evaluate" || name == "table" || name == "study" || name == "run" ||
-          name == "tamp") {
+          name == "solve" || name == "tamp") {
         continue;
       }
       command->preparse_callback([name](std::size_t) {
-        throw UsageError("'" + name +
-                         "' does not split its work over MPI ranks (collect, evaluate, table, study, run and tamp "
-                         "do): run it as one process");
+        throw UsageError(
+            "'" + name +
+            "' does not split its work over MPI ranks (collect, evaluate, table, study, run, tamp and solve "
+            "do): run it as one process");
       });
     }
   }

@@ -66,15 +66,19 @@ class MpiRanks final : public Ranks {
   }
   bool gate_passed() const noexcept { return gate_passed_; }
 
-  std::vector<std::string> all_gather(std::string_view bytes) const override {
-    if (!gate_passed_) {
-      for (const int code : gate(0)) {
-        if (code != 0) {
-          peer_failure = code;
-          throw PeerFailed(code);
-        }
+  // The first exchange meets the gate: a rank that failed before it stops every rank.
+  void pass_gate() const {
+    if (gate_passed_) return;
+    for (const int code : gate(0)) {
+      if (code != 0) {
+        peer_failure = code;
+        throw PeerFailed(code);
       }
     }
+  }
+
+  std::vector<std::string> all_gather(std::string_view bytes) const override {
+    pass_gate();
     const auto count = static_cast<std::size_t>(size_);
     const auto own = static_cast<unsigned long long>(bytes.size());
     std::vector<unsigned long long> sizes(count);
@@ -113,6 +117,43 @@ class MpiRanks final : public Ranks {
       }
     }
     return parts;
+  }
+
+  std::vector<std::string> all_to_all(const std::vector<std::string>& parts) const override {
+    pass_gate();
+    const auto count = static_cast<std::size_t>(size_);
+    std::vector<unsigned long long> sizes(count), incoming(count);
+    unsigned long long sent = 0;
+    for (std::size_t r = 0; r < count; ++r) sent += sizes[r] = parts.at(r).size();
+    MPI_Alltoall(sizes.data(), 1, MPI_UNSIGNED_LONG_LONG, incoming.data(), 1, MPI_UNSIGNED_LONG_LONG, MPI_COMM_WORLD);
+    unsigned long long received_total = 0;
+    for (const unsigned long long size : incoming) received_total += size;
+    // MPI counts are ints: the two totals over all ranks decide, so that all take the same path.
+    const unsigned long long largest = std::max(sent, received_total);
+    unsigned long long largest_anywhere = 0;
+    MPI_Allreduce(&largest, &largest_anywhere, 1, MPI_UNSIGNED_LONG_LONG, MPI_MAX, MPI_COMM_WORLD);
+    if (largest_anywhere > static_cast<unsigned long long>(std::numeric_limits<int>::max())) {
+      return Ranks::all_to_all(parts);
+    }
+    std::string out_bytes, in_bytes(received_total, '\0');
+    std::vector<int> out_counts(count), out_offsets(count), in_counts(count), in_offsets(count);
+    int out_offset = 0, in_offset = 0;
+    for (std::size_t r = 0; r < count; ++r) {
+      out_bytes += parts[r];
+      out_counts[r] = static_cast<int>(sizes[r]);
+      out_offsets[r] = out_offset;
+      out_offset += out_counts[r];
+      in_counts[r] = static_cast<int>(incoming[r]);
+      in_offsets[r] = in_offset;
+      in_offset += in_counts[r];
+    }
+    MPI_Alltoallv(out_bytes.data(), out_counts.data(), out_offsets.data(), MPI_BYTE, in_bytes.data(), in_counts.data(),
+                  in_offsets.data(), MPI_BYTE, MPI_COMM_WORLD);
+    std::vector<std::string> received(count);
+    for (std::size_t r = 0; r < count; ++r) {
+      received[r] = in_bytes.substr(static_cast<std::size_t>(in_offsets[r]), incoming[r]);
+    }
+    return received;
   }
 
  private:

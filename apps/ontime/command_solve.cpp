@@ -1,61 +1,244 @@
-// `ontime solve INSTANCE`: the exact optimum by expectimax.
+// `ontime solve INSTANCE`: the exact optimum (layered or memoised expectimax), or a certified
+// interval around it when a cap stops the layered solver.
 
 #include <fmt/core.h>
 
 #include <chrono>
+#include <filesystem>
+#include <fstream>
 
+#include "cluster_job.hpp"
 #include "common.hpp"
 #include "memory_limits.hpp"
 #include "number_options.hpp"
 #include "ontime/allocators/optimal.hpp"
+#include "ontime/atomic_file.hpp"
+#include "ontime/error.hpp"
 #include "ontime/instance_io.hpp"
+#include "ontime/layered_solver.hpp"
 
 namespace ontime::cli {
+namespace {
+
+struct SolveOptions {
+  std::string instance;
+  std::string method = "layered";
+  std::size_t max_states = 0;
+  std::uint64_t max_memory_mib = 0;
+  std::uint64_t max_disk_mib = 0;
+  std::string scratch;
+  std::string policy;
+  int policy_layers = 1;
+  double max_seconds = 0;
+  unsigned threads = 0;
+  bool stats = false;
+  bool json = false;
+};
+
+std::string first_action_of(const Problem& problem, const Mdp& mdp, int first) {
+  return first >= 0 ? problem.action(mdp.next_action(mdp.start(), first)).id : "";
+}
+
+Json state_json(const State& state, int skeletons) {
+  Json refined = Json::array(), spent = Json::array(), execution = Json::array();
+  for (int k = 0; k < skeletons; ++k) {
+    const auto slot = static_cast<std::size_t>(k);
+    refined.push_back(state.refined[slot]);
+    // Blanked slots (skeletons that can no longer succeed) are written as null.
+    spent.push_back(state.spent[slot] == 0xFFFF ? Json(nullptr) : Json(state.spent[slot]));
+    execution.push_back(state.execution[slot] == 0xFFFF ? Json(nullptr) : Json(state.execution[slot]));
+  }
+  return Json{{"time", state.time}, {"refined", refined}, {"spent", spent}, {"execution", execution}};
+}
+
+void run_memoised(const SolveOptions& options, const Problem& problem, const Mdp& mdp) {
+  const std::size_t max_states = options.max_states != 0 ? options.max_states : OptimalSolver::kDefaultMaxStates;
+  check_state_cap_memory(problem, max_states, options.instance);
+  const auto started = std::chrono::steady_clock::now();
+  OptimalSolver solver(mdp, max_states);
+  const double value = solver.solve(mdp.start());
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  const int first = solver.best_choice(mdp.start()).value_or(-1);
+  const std::string first_action = first_action_of(problem, mdp, first);
+  if (options.json) {
+    Json out;
+    out["instance"] = options.instance;
+    out["name"] = problem.name();
+    out["method"] = "memoised";
+    out["optimal_success_probability"] = value;
+    out["lower_bound"] = value;
+    out["upper_bound"] = value;
+    out["exact"] = true;
+    out["states"] = solver.states();
+    out["seconds"] = seconds;
+    out["first_choice"] = first;
+    out["first_action"] = first_action;
+    print_json(out);
+    return;
+  }
+  fmt::print("instance                     {} ({}), deadline {}, {} skeletons\n", options.instance, problem.name(),
+             problem.deadline(), problem.skeleton_count());
+  fmt::print("optimal success probability  {:.6f}\n", value);
+  if (first >= 0) {
+    fmt::print("first choice                 skeleton {} (refine {})\n", first, first_action);
+  } else {
+    fmt::print("first choice                 none (no skeleton can meet the deadline)\n");
+  }
+  fmt::print("states                       {}\n", solver.states());
+  fmt::print("time                         {:.4f} s\n", seconds);
+}
+
+void run_layered(const SolveOptions& options, const Problem& problem, const Mdp& mdp) {
+  LayeredSolveOptions settings;
+  settings.threads = options.threads;
+  settings.max_states = options.max_states;
+  settings.ranks = job_ranks();
+  settings.scratch_directory = options.scratch;
+  settings.policy_layers = options.policy.empty() ? 0 : options.policy_layers;
+  // Unless capped on the command line, stop before the memory and the disk run out: the cap's
+  // clean stop (an interval) rather than an out-of-memory kill or a full disk.
+  if (options.max_memory_mib != 0) {
+    check_memory_for("--max-memory-mib", static_cast<double>(options.max_memory_mib) * 1048576.0);
+    settings.max_memory_bytes = options.max_memory_mib << 20;
+  } else if (const auto available = available_memory_bytes()) {
+    const int ranks_here = settings.ranks != nullptr ? settings.ranks->size() : 1;
+    settings.max_memory_bytes = *available / 10 * 8 / static_cast<std::uint64_t>(ranks_here);
+  }
+  std::error_code error;
+  const std::filesystem::path scratch =
+      options.scratch.empty() ? std::filesystem::temp_directory_path(error) : std::filesystem::path(options.scratch);
+  const auto space = std::filesystem::space(scratch, error);
+  if (!error && !options.scratch.empty() && !std::filesystem::is_directory(scratch)) {
+    throw UsageError("--scratch " + options.scratch + ": not a directory");
+  }
+  if (options.max_disk_mib != 0) {
+    settings.max_disk_bytes = options.max_disk_mib << 20;
+  } else if (!error) {
+    settings.max_disk_bytes = space.available / 10 * 9;
+  }
+  const auto started = std::chrono::steady_clock::now();
+  if (options.max_seconds > 0) {
+    const auto deadline = started + std::chrono::duration<double>(options.max_seconds);
+    settings.stop = [deadline] { return std::chrono::steady_clock::now() >= deadline; };
+  }
+  const LayeredSolution solution = solve_layered(mdp, settings);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  const std::string first_action = first_action_of(problem, mdp, solution.first_choice);
+
+  if (!options.policy.empty() && is_root_rank(settings.ranks)) {
+    std::string lines;
+    for (const PolicyEntry& entry : solution.policy) {
+      Json line = state_json(entry.state, problem.skeleton_count());
+      line["choice"] = entry.choice;
+      line["lower_bound"] = entry.lower;
+      line["upper_bound"] = entry.upper;
+      lines += line.dump() + "\n";
+    }
+    write_file_atomically(options.policy, lines);
+  }
+  if (options.json) {
+    Json out;
+    out["instance"] = options.instance;
+    out["name"] = problem.name();
+    out["method"] = "layered";
+    out["optimal_success_probability"] = solution.exact ? Json(solution.lower) : Json(nullptr);
+    out["lower_bound"] = solution.lower;
+    out["upper_bound"] = solution.upper;
+    out["exact"] = solution.exact;
+    if (!solution.exact) {
+      out["frontier_layer"] = solution.frontier_layer;
+      out["stopped_by"] = solution.stopped_by;
+    }
+    out["states"] = solution.states;
+    out["seconds"] = seconds;
+    out["first_choice"] = solution.first_choice;
+    out["first_action"] = first_action;
+    out["key_bytes"] = solution.key_bytes;
+    out["peak_memory_bytes"] = solution.peak_memory_bytes;
+    out["peak_disk_bytes"] = solution.peak_disk_bytes;
+    if (options.stats) {
+      Json layers = Json::array();
+      for (const LayerFigures& layer : solution.layers) {
+        layers.push_back({{"layer", layer.layer},
+                          {"states", layer.states},
+                          {"forward_seconds", layer.forward_seconds},
+                          {"backward_seconds", layer.backward_seconds}});
+      }
+      out["layers"] = layers;
+    }
+    print_json(out);
+    return;
+  }
+  fmt::print("instance                     {} ({}), deadline {}, {} skeletons\n", options.instance, problem.name(),
+             problem.deadline(), problem.skeleton_count());
+  if (solution.exact) {
+    fmt::print("optimal success probability  {:.6f}\n", solution.lower);
+  } else {
+    fmt::print("optimal success probability  in [{:.6f}, {:.6f}] (width {:.6f})\n", solution.lower, solution.upper,
+               solution.upper - solution.lower);
+    fmt::print("bounded because              {}\n", solution.stopped_by);
+  }
+  if (solution.first_choice >= 0) {
+    fmt::print("first choice                 skeleton {} (refine {}){}\n", solution.first_choice, first_action,
+               solution.exact ? "" : ", the lower bound's policy");
+  } else {
+    fmt::print("first choice                 none (no skeleton can meet the deadline)\n");
+  }
+  fmt::print("states                       {} in {} layers, {} bytes per state\n", solution.states,
+             solution.layers.size(), solution.key_bytes);
+  fmt::print("peak memory, disk            {:.1f} MiB, {:.1f} MiB\n",
+             static_cast<double>(solution.peak_memory_bytes) / 1048576.0,
+             static_cast<double>(solution.peak_disk_bytes) / 1048576.0);
+  fmt::print("time                         {:.4f} s\n", seconds);
+  if (options.stats) {
+    fmt::print("\n| layer | states | forward s | backward s |\n|------:|-------:|----------:|-----------:|\n");
+    for (const LayerFigures& layer : solution.layers) {
+      fmt::print("| {} | {} | {:.3f} | {:.3f} |\n", layer.layer, layer.states, layer.forward_seconds,
+                 layer.backward_seconds);
+    }
+  }
+}
+
+}  // namespace
 
 void add_solve_command(CLI::App& app) {
-  struct Options {
-    std::string instance;
-    std::size_t max_states = OptimalSolver::kDefaultMaxStates;
-    bool json = false;
-  };
-  auto options = std::make_shared<Options>();
-  CLI::App* command = app.add_subcommand("solve", "Exact optimal success probability and first choice (expectimax)");
+  auto options = std::make_shared<SolveOptions>();
+  CLI::App* command = app.add_subcommand(
+      "solve", "Exact optimal success probability and first choice, or a certified interval around it");
   command->add_option("INSTANCE", options->instance, "Instance file (JSON, SPEC §5)")->required();
-  add_number_option(*command, "--max-states", options->max_states, "Stop with an error past this many states",
+  command->add_option("--method", options->method, "layered (default; disk, threads, ranks, bounds) or memoised")
+      ->check(CLI::IsMember({"layered", "memoised"}));
+  add_number_option(*command, "--max-states", options->max_states,
+                    "Cap on states: layered gives an interval past it, memoised stops with an error (default: "
+                    "none for layered, 10000000 for memoised)",
                     std::size_t{1});
+  add_number_option(*command, "--max-memory-mib", options->max_memory_mib,
+                    "Layered: tables one rank may hold (default: 80% of the available memory)", std::uint64_t{1});
+  add_number_option(*command, "--max-disk-mib", options->max_disk_mib,
+                    "Layered: scratch one rank may write (default: 90% of the free space)", std::uint64_t{1});
+  add_number_option(*command, "--max-seconds", options->max_seconds,
+                    "Layered: end the forward pass after this long and give an interval (the backward pass still "
+                    "runs)",
+                    0.0);
+  command->add_option("--scratch", options->scratch, "Layered: directory for the layers' scratch files");
+  command->add_option("--policy", options->policy,
+                      "Layered: write the choice in every state of the first --policy-layers layers (JSON lines)");
+  add_number_option(*command, "--policy-layers", options->policy_layers, "Layers --policy covers (default 1)", 1);
+  add_threads_option(*command, options->threads, "Layered: threads per rank (0: one per hardware thread)");
+  command->add_flag("--stats", options->stats, "Layered: states and time per layer");
   command->add_flag("--json", options->json, "Print JSON");
   command->callback([options] {
     const Problem problem = load_problem(options->instance);
-    check_state_cap_memory(problem, options->max_states, options->instance);
+    if (problem.skeleton_count() > kMaxExactSkeletons) check_state_cap_memory(problem, 1, options->instance);
     const Mdp mdp(problem);
-    const auto started = std::chrono::steady_clock::now();
-    OptimalSolver solver(mdp, options->max_states);
-    const double value = solver.solve(mdp.start());
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    const int first = solver.best_choice(mdp.start()).value_or(-1);
-    const std::string first_action = first >= 0 ? problem.action(mdp.next_action(mdp.start(), first)).id : "";
-    if (options->json) {
-      Json out;
-      out["instance"] = options->instance;
-      out["name"] = problem.name();
-      out["optimal_success_probability"] = value;
-      out["states"] = solver.states();
-      out["seconds"] = seconds;
-      out["first_choice"] = first;
-      out["first_action"] = first_action;
-      print_json(out);
-      return;
-    }
-    fmt::print("instance                     {} ({}), deadline {}, {} skeletons\n", options->instance, problem.name(),
-               problem.deadline(), problem.skeleton_count());
-    fmt::print("optimal success probability  {:.6f}\n", value);
-    if (first >= 0) {
-      fmt::print("first choice                 skeleton {} (refine {})\n", first, first_action);
+    if (options->method == "memoised") {
+      if (split_over_ranks(job_ranks())) {
+        throw UsageError("solve --method memoised does not split over MPI ranks: use --method layered");
+      }
+      run_memoised(*options, problem, mdp);
     } else {
-      fmt::print("first choice                 none (no skeleton can meet the deadline)\n");
+      run_layered(*options, problem, mdp);
     }
-    fmt::print("states                       {}\n", solver.states());
-    fmt::print("time                         {:.4f} s\n", seconds);
   });
 }
 

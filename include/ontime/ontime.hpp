@@ -25,6 +25,7 @@
 #include "ontime/fitting.hpp"
 #include "ontime/instance_io.hpp"
 #include "ontime/knapsack.hpp"
+#include "ontime/layered_solver.hpp"
 #include "ontime/log_sampling.hpp"
 #include "ontime/mdp.hpp"
 #include "ontime/parallel.hpp"

@@ -3,7 +3,8 @@
 // `srun --mpi=pmix`, as the library sees them. The library never talks to MPI itself (the core
 // does not depend on it): the caller hands it a Ranks, and the library splits its independent
 // units (episodes, collection trials) over the ranks, runs its share on its own threads and
-// exchanges the results with all_gather, once per batch of units.
+// exchanges the results with all_gather, once per batch of units (all_to_all where each rank
+// sends each other rank its own part, as the layered exact solver does with the states it finds).
 //
 // Determinism: every unit draws its randomness from its own seeded stream and results are
 // merged in unit order (or by sums of integers and maxima), so a run split over any number of
@@ -26,6 +27,10 @@ class Ranks {
   // Every rank's `bytes`, in rank order, on every rank. Collective: every rank must call it, in
   // the same order; it returns once all have.
   virtual std::vector<std::string> all_gather(std::string_view bytes) const = 0;
+  // Sends parts[r] to rank r (parts has size() entries) and returns what each rank sent to this
+  // one, in rank order. Collective, like all_gather. The default gathers every rank's parts on
+  // every rank (memory for all of them at once); an MPI implementation exchanges only the parts.
+  virtual std::vector<std::string> all_to_all(const std::vector<std::string>& parts) const;
 };
 
 // The units of 0 .. count - 1 that rank `rank` of `size` takes: rank, rank + size,

@@ -13,6 +13,7 @@
 #include "ontime/episode_runner.hpp"
 #include "ontime/error.hpp"
 #include "ontime/evaluation.hpp"
+#include "ontime/layered_solver.hpp"
 #include "ontime/ppo_training.hpp"
 #include "ontime/session.hpp"
 #include "ontime/simulator.hpp"
@@ -391,36 +392,48 @@ void bind_running(py::module_& m) {
 
   m.def(
       "solve",
-      [](const py::object& problem, std::size_t max_states) {
+      [](const py::object& problem, std::size_t max_states, unsigned threads) {
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
         if (max_states == 0) throw UsageError("max_states must be at least 1");
-        double value = 0;
+        LayeredSolution solution;
         double seconds = 0;
-        int first = -1;
-        std::size_t states = 0;
         run_interruptibly([&](const std::function<bool()>& stop, Progress&) {
           const auto started = std::chrono::steady_clock::now();
-          OptimalSolver solver(mdp->mdp, max_states);
-          solver.set_stop(stop);
-          value = solver.solve(mdp->mdp.start());
+          LayeredSolveOptions options;
+          options.max_states = max_states;
+          options.threads = threads;
+          options.stop = stop;
+          solution = solve_layered(mdp->mdp, options);
           seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-          first = solver.best_choice(mdp->mdp.start()).value_or(-1);
-          states = solver.states();
         });
         const Problem& p = *mdp->problem;
+        const int first = solution.first_choice;
         py::dict out;
         out["instance"] = instance_label(problem, p);
         out["name"] = p.name();
-        out["optimal_success_probability"] = value;
-        out["states"] = states;
+        out["method"] = "layered";
+        out["optimal_success_probability"] = solution.exact ? py::object(py::float_(solution.lower)) : py::none();
+        out["lower_bound"] = solution.lower;
+        out["upper_bound"] = solution.upper;
+        out["exact"] = solution.exact;
+        if (!solution.exact) {
+          out["frontier_layer"] = solution.frontier_layer;
+          out["stopped_by"] = solution.stopped_by;
+        }
+        out["states"] = solution.states;
         out["seconds"] = seconds;
         out["first_choice"] = first;
         out["first_action"] = first >= 0 ? p.action(mdp->mdp.next_action(mdp->mdp.start(), first)).id : "";
+        out["key_bytes"] = solution.key_bytes;
+        out["peak_memory_bytes"] = solution.peak_memory_bytes;
+        out["peak_disk_bytes"] = solution.peak_disk_bytes;
         return out;
       },
-      py::arg("problem"), py::arg("max_states") = OptimalSolver::kDefaultMaxStates,
-      "The exact optimal success probability and first choice (expectimax), as `ontime solve --json` "
-      "reports them. Raises ResourceLimitError past max_states; the GIL is released and Ctrl-C stops it.");
+      py::arg("problem"), py::arg("max_states") = OptimalSolver::kDefaultMaxStates, py::arg("threads") = 0,
+      "The exact optimal success probability and first choice (the layered solver), as `ontime solve --json` "
+      "reports them; past max_states states a certified interval [lower_bound, "
+      "upper_bound] instead (optimal_success_probability None). The GIL is released; Ctrl-C stops it "
+      "(KeyboardInterrupt).");
 
   m.def(
       "train_ppo",

@@ -78,6 +78,11 @@ def test_a_non_stationary_allocator_has_no_exact_value():
         ontime.evaluate(str(PAPER_INSTANCES[0]), "mcts", episodes=10, exact=True, iterations=10)
 
 
-def test_a_state_cap_is_a_resource_limit():
-    with pytest.raises(ontime.ResourceLimitError, match="cap of 10 states"):
-        ontime.solve(str(PAPER_INSTANCES[0]), max_states=10)
+def test_a_state_cap_gives_the_clis_certified_interval(cli):
+    path = PAPER_INSTANCES[0]  # instance 1: 872 states
+    got = ontime.solve(str(path), max_states=100)
+    expected = cli("solve", path, "--max-states", 100, "--json")
+    assert got["exact"] is False and got["optimal_success_probability"] is None
+    assert "cap of 100 states" in got["stopped_by"]
+    assert got["lower_bound"] == expected["lower_bound"] and got["upper_bound"] == expected["upper_bound"]
+    assert got["lower_bound"] <= ontime.solve(str(path))["optimal_success_probability"] <= got["upper_bound"]

@@ -20,18 +20,11 @@ class OptimalPolicy {
     for (const int choice : mdp_->useful_choices(state)) out.push_back(choice);
   }
 
-  // Skeletons in a group that can no longer succeed influence nothing: their slots are
-  // blanked so that states differing only there share one memo entry.
+  // Skeletons in a group that can no longer succeed influence nothing: detail::blank_hopeless
+  // blanks their slots so that states differing only there share one memo entry.
   auto key(const detail::CompactState& state) const {
     detail::CompactState key = state;
-    for (int k = 0; k < mdp_->skeleton_count(); ++k) {
-      const int action = mdp_->next_action(state, k);
-      if (action >= 0 && mdp_->group_can_succeed(state, action)) continue;
-      const auto slot = static_cast<std::size_t>(k);
-      key.refined[slot] = 0;
-      key.spent[slot] = kBlank;
-      key.execution[slot] = kBlank;
-    }
+    detail::blank_hopeless(*mdp_, key);
     if constexpr (Words > 0) {
       return detail::pack<Words>(key, mdp_->skeleton_count());
     } else {
@@ -40,9 +33,6 @@ class OptimalPolicy {
   }
 
  private:
-  // Above any reachable PT or ET; its low byte (255) is above them too when packed.
-  static constexpr std::uint16_t kBlank = 0xFFFF;
-
   const Mdp* mdp_;
 };
 
