@@ -505,6 +505,12 @@ TEST(Cli, TableReportsAnExactPartOverTheCapInItsCell) {
   EXPECT_FALSE(row.contains("optimal_success_probability"));
   EXPECT_LE(row["optimum"]["lower_bound"].get<double>(), 0.942);
   EXPECT_GE(row["optimum"]["upper_bound"].get<double>(), 0.942);
+  // An exact cell above the layered lower bound (dp-rerun, 0.9400 > 0.9360) raises it: every
+  // policy's exact value is at most the optimum.
+  const auto raised = ontime(
+      {"table", paper("instance1"), "--solvers", "dp,dp-rerun", "--episodes", "200", "--exact", "--max-states", "100"});
+  ASSERT_EQ(raised.exit_code, 0) << raised.err;
+  EXPECT_NE(raised.out.find("[0.9400, 0.9939]"), std::string::npos) << raised.out;
 }
 
 TEST(Cli, CollectWritesTheLogAndTheFittedInstance) {
@@ -1612,6 +1618,24 @@ TEST(Cli, SolveGivesTheOptimumOrACertifiedIntervalWithItsLayers) {
     ++lines;
   }
   EXPECT_EQ(lines, 1 + solved["layers"][1]["states"].get<int>());
+}
+
+TEST(Cli, SolveNoTimingPrintsTheSameBytesForAnyThreadCount) {
+  const std::vector<std::string> args{"solve",       paper("instance1"), "--json", "--stats",
+                                      "--no-timing", "--max-states",     "300"};
+  auto one = args, two = args;
+  one.insert(one.end(), {"--threads", "1"});
+  two.insert(two.end(), {"--threads", "2"});
+  const auto first = ontime(one);
+  const auto second = ontime(two);
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  EXPECT_EQ(first.out, second.out);
+  const json solved = json::parse(first.out);
+  EXPECT_FALSE(solved.contains("seconds"));
+  EXPECT_FALSE(solved.contains("peak_memory_bytes"));
+  EXPECT_FALSE(solved["layers"][0].contains("forward_seconds"));
+  EXPECT_FALSE(solved["exact"].get<bool>());
+  EXPECT_LT(solved["lower_bound"].get<double>(), solved["upper_bound"].get<double>());
 }
 
 }  // namespace

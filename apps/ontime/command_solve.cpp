@@ -33,6 +33,7 @@ struct SolveOptions {
   unsigned threads = 0;
   bool stats = false;
   bool json = false;
+  bool no_timing = false;
 };
 
 std::string first_action_of(const Problem& problem, const Mdp& mdp, int first) {
@@ -150,19 +151,23 @@ void run_layered(const SolveOptions& options, const Problem& problem, const Mdp&
       out["stopped_by"] = solution.stopped_by;
     }
     out["states"] = solution.states;
-    out["seconds"] = seconds;
+    if (!options.no_timing) out["seconds"] = seconds;
     out["first_choice"] = solution.first_choice;
     out["first_action"] = first_action;
     out["key_bytes"] = solution.key_bytes;
-    out["peak_memory_bytes"] = solution.peak_memory_bytes;
-    out["peak_disk_bytes"] = solution.peak_disk_bytes;
+    if (!options.no_timing) {
+      out["peak_memory_bytes"] = solution.peak_memory_bytes;
+      out["peak_disk_bytes"] = solution.peak_disk_bytes;
+    }
     if (options.stats) {
       Json layers = Json::array();
       for (const LayerFigures& layer : solution.layers) {
-        layers.push_back({{"layer", layer.layer},
-                          {"states", layer.states},
-                          {"forward_seconds", layer.forward_seconds},
-                          {"backward_seconds", layer.backward_seconds}});
+        Json figures{{"layer", layer.layer}, {"states", layer.states}};
+        if (!options.no_timing) {
+          figures["forward_seconds"] = layer.forward_seconds;
+          figures["backward_seconds"] = layer.backward_seconds;
+        }
+        layers.push_back(figures);
       }
       out["layers"] = layers;
     }
@@ -186,11 +191,16 @@ void run_layered(const SolveOptions& options, const Problem& problem, const Mdp&
   }
   fmt::print("states                       {} in {} layers, {} bytes per state\n", solution.states,
              solution.layers.size(), solution.key_bytes);
-  fmt::print("peak memory, disk            {:.1f} MiB, {:.1f} MiB\n",
-             static_cast<double>(solution.peak_memory_bytes) / 1048576.0,
-             static_cast<double>(solution.peak_disk_bytes) / 1048576.0);
-  fmt::print("time                         {:.4f} s\n", seconds);
-  if (options.stats) {
+  if (!options.no_timing) {
+    fmt::print("peak memory, disk            {:.1f} MiB, {:.1f} MiB\n",
+               static_cast<double>(solution.peak_memory_bytes) / 1048576.0,
+               static_cast<double>(solution.peak_disk_bytes) / 1048576.0);
+    fmt::print("time                         {:.4f} s\n", seconds);
+  }
+  if (options.stats && options.no_timing) {
+    fmt::print("\n| layer | states |\n|------:|-------:|\n");
+    for (const LayerFigures& layer : solution.layers) fmt::print("| {} | {} |\n", layer.layer, layer.states);
+  } else if (options.stats) {
     fmt::print("\n| layer | states | forward s | backward s |\n|------:|-------:|----------:|-----------:|\n");
     for (const LayerFigures& layer : solution.layers) {
       fmt::print("| {} | {} | {:.3f} | {:.3f} |\n", layer.layer, layer.states, layer.forward_seconds,
@@ -227,6 +237,8 @@ void add_solve_command(CLI::App& app) {
   add_threads_option(*command, options->threads, "Layered: threads per rank (0: one per hardware thread)");
   command->add_flag("--stats", options->stats, "Layered: states and time per layer");
   command->add_flag("--json", options->json, "Print JSON");
+  command->add_flag("--no-timing", options->no_timing,
+                    "Layered: leave out measured times and memory, so that outputs can be compared byte for byte");
   command->callback([options] {
     const Problem problem = load_problem(options->instance);
     if (problem.skeleton_count() > kMaxExactSkeletons) check_state_cap_memory(problem, 1, options->instance);

@@ -134,7 +134,12 @@ Row measure_row(const TableOptions& options, std::size_t index, const Mdp& mdp,
     if (solution.exact) {
       optimum.value = solution.lower;
     } else {
+      // Every policy's exact success probability is at most the optimum, so the row's exact
+      // cells are lower bounds as certain as the layered solver's own.
       optimum.lower = solution.lower;
+      for (const Cell& cell : row.cells) {
+        if (cell.exact && cell.exact->value) optimum.lower = std::max(*optimum.lower, *cell.exact->value);
+      }
       optimum.upper = solution.upper;
     }
     optimum.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();

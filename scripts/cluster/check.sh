@@ -8,7 +8,10 @@
 #  2. a rank killed in the middle of a 2-rank collection, and a 2-task SLURM job cancelled in
 #     the middle of one: every rank's checkpoint is there, and `--resume` as one process (one
 #     task) completes to the same files;
-#  3. a usage error under mpirun and under srun: reported once, exit 2.
+#  3. a usage error under mpirun and under srun: reported once, exit 2;
+#  4. the layered exact solver on a cut of the kitchen (the paper's manipulation instance, its
+#     first layers up to 300000 states, then a certified interval) and on navigation's fitted
+#     instance: one process, `mpirun -np 2` and a 2-task job give the same output.
 # Usage: scripts/cluster/check.sh [ONTIME]   (default build/ontime; needs root or sudo for SLURM)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -28,6 +31,10 @@ world="$root/data/domains/navigation.json"
 collect=(collect --domain navigation --world "$world" --trials 100 --seed 1 --threads 1 --log nav.jsonl
   --instance nav.json)
 evaluate=(evaluate nav.json --solver dp-rerun --episodes 20000 --seed 1 --threads 1 --json --no-timing)
+kitchen="$root/data/instances/manipulation.json"
+cut=("$kitchen" --max-states 300000 --json --stats --no-timing)
+solve_cut=(solve "${cut[@]}" --threads 1)
+solve_nav=(solve nav.json --threads 1 --json --no-timing)
 
 same() {  # same FILE...: each file of one/ equals the one in the other folders named after it
   local folder=$1
@@ -68,6 +75,7 @@ wait_for_journal() {  # wait_for_journal DIR: until its ranks have journaled som
 
 mkdir -p "$work/one" "$work/mpi" "$work/fault" "$work/slurm-run"
 (cd "$work/one" && "$ontime" "${collect[@]}" > collect.txt && "$ontime" "${evaluate[@]}" > evaluate.json)
+(cd "$work/one" && "$ontime" "${solve_cut[@]}" > solve-cut.json && "$ontime" "${solve_nav[@]}" > solve-nav.json)
 
 # 1a. mpirun -np 2.
 started=$(date +%s.%N)
@@ -75,6 +83,9 @@ started=$(date +%s.%N)
 echo "cluster check: mpirun -np 2 collection took $(echo "$(date +%s.%N) - $started" | bc) s"
 (cd "$work/mpi" && "${mpirun[@]}" "$ontime" "${evaluate[@]}" > evaluate.json)
 same mpi nav.jsonl nav.json evaluate.json
+(cd "$work/mpi" && "${mpirun[@]}" "$ontime" "${solve_cut[@]}" > solve-cut.json)
+(cd "$work/mpi" && "${mpirun[@]}" "$ontime" "${solve_nav[@]}" > solve-nav.json)
+same mpi solve-cut.json solve-nav.json
 
 # 2. A rank that dies: killed once the ranks have journaled some 300 trials between them.
 (cd "$work/fault" && exec "${mpirun[@]}" "$ontime" "${collect[@]}" > collect.txt 2> collect.err) &
@@ -115,6 +126,9 @@ sbatch --wait --ntasks 2 --chdir "$work/slurm-run" --output "$work/slurm-run/eva
   "$root/scripts/cluster/evaluate.sbatch" nav.json --solver dp-rerun --episodes 20000 --seed 1 --json \
   --no-timing > /dev/null
 same slurm-run nav.jsonl nav.json evaluate.json
+sbatch --wait --ntasks 2 --chdir "$work/slurm-run" --output "$work/slurm-run/solve-cut.json" \
+  --error "$work/slurm-run/solve-cut.err" "$root/scripts/cluster/solve.sbatch" "${cut[@]}" > /dev/null
+same slurm-run solve-cut.json
 # A cancelled job: scancel once its ranks have journaled some 300 trials; resubmitted with
 # --resume as a job of one task, it completes to the same files.
 mkdir -p "$work/slurm-cancel"
