@@ -122,7 +122,24 @@ void run_layered(const SolveOptions& options, const Problem& problem, const Mdp&
     const auto deadline = started + std::chrono::duration<double>(options.max_seconds);
     settings.stop = [deadline] { return std::chrono::steady_clock::now() >= deadline; };
   }
-  const LayeredSolution solution = solve_layered(mdp, settings);
+  const LayeredSolution solution = [&] {
+    // Layers, not a percentage: how many there will be, and how large, is what the solve finds
+    // out. The line is cleared (the bar destroyed) before the result is printed.
+    ProgressBar bar("solve");
+    std::uint64_t enumerated = 0;
+    settings.on_layer = [&bar, &enumerated](const LayerFigures& layer) {
+      if (layer.backward) {
+        bar.status(fmt::format("backward pass: layer {} valued ({} states)", layer.layer, layer.states));
+      } else {
+        enumerated += layer.states;
+        bar.status(fmt::format("forward pass: layer {} ({} states) expanded, {} states in all", layer.layer,
+                               layer.states, enumerated));
+      }
+    };
+    LayeredSolution solved = solve_layered(mdp, settings);
+    settings.on_layer = nullptr;
+    return solved;
+  }();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   const std::string first_action = first_action_of(problem, mdp, solution.first_choice);
 

@@ -164,6 +164,13 @@ ProgressBar::~ProgressBar() {
   if (enabled_ && last_percent_ >= 0) fmt::print(stderr, "\r\033[K");
 }
 
+void ProgressBar::status(std::string_view text) {
+  if (!enabled_) return;
+  last_percent_ = 0;  // so that the destructor clears the line
+  fmt::print(stderr, "\r{} {}\033[K", label_, text);
+  std::fflush(stderr);
+}
+
 void ProgressBar::update(std::uint64_t done, std::uint64_t total) {
   if (!enabled_ || total == 0) return;
   const int percent = static_cast<int>(100 * done / total);

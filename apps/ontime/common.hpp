@@ -97,6 +97,8 @@ class ProgressBar {
   explicit ProgressBar(std::string label);
   ~ProgressBar();
   void update(std::uint64_t done, std::uint64_t total);
+  // For work whose total is not known in advance: the label and `text` on one line, redrawn.
+  void status(std::string_view text);
 
  private:
   std::string label_;
