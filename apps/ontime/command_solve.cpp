@@ -96,27 +96,17 @@ void run_layered(const SolveOptions& options, const Problem& problem, const Mdp&
   settings.ranks = job_ranks();
   settings.scratch_directory = options.scratch;
   settings.policy_layers = options.policy.empty() ? 0 : options.policy_layers;
-  // Unless capped on the command line, stop before the memory and the disk run out: the cap's
-  // clean stop (an interval) rather than an out-of-memory kill or a full disk.
   if (options.max_memory_mib != 0) {
     check_memory_for("--max-memory-mib", static_cast<double>(options.max_memory_mib) * 1048576.0);
     settings.max_memory_bytes = options.max_memory_mib << 20;
-  } else if (const auto available = available_memory_bytes()) {
-    const int ranks_here = settings.ranks != nullptr ? settings.ranks->size() : 1;
-    settings.max_memory_bytes = *available / 10 * 8 / static_cast<std::uint64_t>(ranks_here);
   }
   std::error_code error;
-  const std::filesystem::path scratch =
-      options.scratch.empty() ? std::filesystem::temp_directory_path(error) : std::filesystem::path(options.scratch);
-  const auto space = std::filesystem::space(scratch, error);
-  if (!error && !options.scratch.empty() && !std::filesystem::is_directory(scratch)) {
+  if (!options.scratch.empty() && !std::filesystem::is_directory(options.scratch, error)) {
     throw UsageError("--scratch " + options.scratch + ": not a directory");
   }
-  if (options.max_disk_mib != 0) {
-    settings.max_disk_bytes = options.max_disk_mib << 20;
-  } else if (!error) {
-    settings.max_disk_bytes = space.available / 10 * 9;
-  }
+  settings.max_disk_bytes = options.max_disk_mib << 20;
+  // Unless capped on the command line, stop before the memory and the disk run out.
+  apply_default_layered_caps(settings);
   const auto started = std::chrono::steady_clock::now();
   if (options.max_seconds > 0) {
     const auto deadline = started + std::chrono::duration<double>(options.max_seconds);

@@ -127,6 +127,7 @@ Row measure_row(const TableOptions& options, std::size_t index, const Mdp& mdp,
     layered.max_states = max_states;
     layered.ranks = options.monte_carlo.options().ranks;
     layered.threads = options.monte_carlo.threads;
+    apply_default_layered_caps(layered);
     const LayeredSolution solution = solve_layered(mdp, layered);
     ExactPart optimum;
     optimum.states = solution.states;

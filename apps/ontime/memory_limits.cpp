@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -39,6 +40,22 @@ std::optional<std::uint64_t> meminfo_available() {
 std::string gib(double bytes) { return fmt::format("{:.3g} GiB", bytes / (1024.0 * 1024.0 * 1024.0)); }
 
 }  // namespace
+
+void apply_default_layered_caps(LayeredSolveOptions& options) {
+  if (options.max_memory_bytes == 0) {
+    if (const auto available = available_memory_bytes()) {
+      const int ranks = options.ranks != nullptr ? options.ranks->size() : 1;
+      options.max_memory_bytes = *available / 10 * 8 / static_cast<std::uint64_t>(ranks);
+    }
+  }
+  if (options.max_disk_bytes == 0) {
+    std::error_code error;
+    const std::filesystem::path scratch =
+        options.scratch_directory.empty() ? std::filesystem::temp_directory_path(error) : options.scratch_directory;
+    const auto space = std::filesystem::space(scratch, error);
+    if (!error) options.max_disk_bytes = space.available / 10 * 9;
+  }
+}
 
 std::optional<std::uint64_t> available_memory_bytes() {
   std::optional<std::uint64_t> available = meminfo_available();

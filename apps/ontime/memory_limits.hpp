@@ -8,6 +8,7 @@
 #include <string>
 #include <string_view>
 
+#include "ontime/layered_solver.hpp"
 #include "ontime/problem.hpp"
 
 namespace ontime::cli {
@@ -26,5 +27,10 @@ void check_memory_for(std::string_view option, double bytes);
 // available (the table's slot per state, optimal.hpp, doubled by its power-of-two growth and by
 // 1.5 while it grows, is the most they can hold before the cap stops them).
 void check_state_cap_memory(const Problem& problem, std::size_t max_states, const std::string& source);
+
+// Fills in the layered solver's memory and disk caps that are still 0: 80% of the available
+// memory divided among the job's ranks, and 90% of the free space where the scratch files go,
+// so that it stops with a certified interval rather than being killed or filling the disk.
+void apply_default_layered_caps(LayeredSolveOptions& options);
 
 }  // namespace ontime::cli
