@@ -9,7 +9,7 @@ namespace ontime {
 namespace {
 
 // A remaining-time bound that no deadline can meet; sums of a few of them do not overflow.
-constexpr std::int64_t kUnreachable = std::int64_t{1} << 40;
+constexpr std::int64_t kUnreachable = Mdp::kUnreachableNeed;
 
 std::int64_t least_steps(Steps steps) { return steps == kNever ? kUnreachable : steps; }
 
@@ -75,6 +75,14 @@ Mdp::Mdp(const Problem& problem)
       const std::int64_t least = least_steps(action.planning.min_step()) + least_steps(action.execution.min_step());
       rest_[base + static_cast<std::size_t>(l)] =
           std::min(kUnreachable, rest_[base + static_cast<std::size_t>(l) + 1] + least);
+    }
+  }
+  group_rest_.assign(action_count, kUnreachable);
+  for (int k = 0; k < skeleton_count_; ++k) {
+    const std::size_t base = offsets_[static_cast<std::size_t>(k)] + static_cast<std::size_t>(k);
+    for (int l = 0; l < lengths_[static_cast<std::size_t>(k)]; ++l) {
+      std::int64_t& least = group_rest_[static_cast<std::size_t>(problem.action_at(k, l))];
+      least = std::min(least, rest_[base + static_cast<std::size_t>(l) + 1]);
     }
   }
 }

@@ -1,7 +1,8 @@
 // `ontime solve INSTANCE`: the exact optimum (layered or memoised expectimax), or a certified
-// interval around it when a cap stops the layered solver.
+// interval around it when a cap stops the layered solver, a tolerance drops hopeless groups or
+// a split bounds the weaker subtrees.
 
-#include <fmt/core.h>
+#include <fmt/format.h>
 
 #include <chrono>
 #include <filesystem>
@@ -30,6 +31,7 @@ struct SolveOptions {
   std::string policy;
   int policy_layers = 1;
   double max_seconds = 0;
+  double tolerance = 0;
   unsigned threads = 0;
   bool stats = false;
   bool json = false;
@@ -96,6 +98,8 @@ void run_layered(const SolveOptions& options, const Problem& problem, const Mdp&
   settings.ranks = job_ranks();
   settings.scratch_directory = options.scratch;
   settings.policy_layers = options.policy.empty() ? 0 : options.policy_layers;
+  settings.tolerance = options.tolerance;
+  settings.split = options.method == "split" ? SplitMode::always : SplitMode::fallback;
   if (options.max_memory_mib != 0) {
     check_memory_for("--max-memory-mib", static_cast<double>(options.max_memory_mib) * 1048576.0);
     settings.max_memory_bytes = options.max_memory_mib << 20;
@@ -148,14 +152,25 @@ void run_layered(const SolveOptions& options, const Problem& problem, const Mdp&
     Json out;
     out["instance"] = options.instance;
     out["name"] = problem.name();
-    out["method"] = "layered";
+    out["method"] = options.method;
     out["optimal_success_probability"] = solution.exact ? Json(solution.lower) : Json(nullptr);
     out["lower_bound"] = solution.lower;
     out["upper_bound"] = solution.upper;
     out["exact"] = solution.exact;
-    if (!solution.exact) {
+    if (solution.frontier_layer >= 0) {
       out["frontier_layer"] = solution.frontier_layer;
       out["stopped_by"] = solution.stopped_by;
+    }
+    if (options.tolerance > 0) {
+      out["tolerance"] = options.tolerance;
+      out["dropped"] = solution.dropped;
+    }
+    if (!solution.split_kept.empty()) {
+      out["split"] = Json{{"enumerated_skeletons", solution.split_kept},
+                          {"bounded_start_upper", solution.split_weak_upper},
+                          {"lower_bound", solution.split_lower},
+                          {"upper_bound", solution.split_upper},
+                          {"states", solution.split_states}};
     }
     out["states"] = solution.states;
     if (!options.no_timing) out["seconds"] = seconds;
@@ -167,16 +182,20 @@ void run_layered(const SolveOptions& options, const Problem& problem, const Mdp&
       out["peak_disk_bytes"] = solution.peak_disk_bytes;
     }
     if (options.stats) {
-      Json layers = Json::array();
-      for (const LayerFigures& layer : solution.layers) {
-        Json figures{{"layer", layer.layer}, {"states", layer.states}};
-        if (!options.no_timing) {
-          figures["forward_seconds"] = layer.forward_seconds;
-          figures["backward_seconds"] = layer.backward_seconds;
+      const auto layers_json = [&](const std::vector<LayerFigures>& of) {
+        Json layers = Json::array();
+        for (const LayerFigures& layer : of) {
+          Json figures{{"layer", layer.layer}, {"states", layer.states}};
+          if (!options.no_timing) {
+            figures["forward_seconds"] = layer.forward_seconds;
+            figures["backward_seconds"] = layer.backward_seconds;
+          }
+          layers.push_back(figures);
         }
-        layers.push_back(figures);
-      }
-      out["layers"] = layers;
+        return layers;
+      };
+      if (!solution.layers.empty()) out["layers"] = layers_json(solution.layers);
+      if (!solution.split_layers.empty()) out["split"]["layers"] = layers_json(solution.split_layers);
     }
     print_json(out);
     return;
@@ -188,7 +207,17 @@ void run_layered(const SolveOptions& options, const Problem& problem, const Mdp&
   } else {
     fmt::print("optimal success probability  in [{:.6f}, {:.6f}] (width {:.6f})\n", solution.lower, solution.upper,
                solution.upper - solution.lower);
-    fmt::print("bounded because              {}\n", solution.stopped_by);
+  }
+  if (solution.frontier_layer >= 0) fmt::print("whole tree cut                {}\n", solution.stopped_by);
+  if (options.tolerance > 0) {
+    fmt::print("tolerance                    {} ({} outcomes dropped a group)\n", options.tolerance, solution.dropped);
+  }
+  if (!solution.split_kept.empty()) {
+    fmt::print(
+        "split                        skeletons {} enumerated ({} states), the others bounded ({:.6f} at "
+        "most alone): [{:.6f}, {:.6f}]\n",
+        fmt::join(solution.split_kept, ","), solution.split_states, solution.split_weak_upper, solution.split_lower,
+        solution.split_upper);
   }
   if (solution.first_choice >= 0) {
     fmt::print("first choice                 skeleton {} (refine {}){}\n", solution.first_choice, first_action,
@@ -197,23 +226,30 @@ void run_layered(const SolveOptions& options, const Problem& problem, const Mdp&
     fmt::print("first choice                 none (no skeleton can meet the deadline)\n");
   }
   fmt::print("states                       {} in {} layers, {} bytes per state\n", solution.states,
-             solution.layers.size(), solution.key_bytes);
+             solution.layers.size() + solution.split_layers.size(), solution.key_bytes);
   if (!options.no_timing) {
     fmt::print("peak memory, disk            {:.1f} MiB, {:.1f} MiB\n",
                static_cast<double>(solution.peak_memory_bytes) / 1048576.0,
                static_cast<double>(solution.peak_disk_bytes) / 1048576.0);
     fmt::print("time                         {:.4f} s\n", seconds);
   }
-  if (options.stats && options.no_timing) {
-    fmt::print("\n| layer | states |\n|------:|-------:|\n");
-    for (const LayerFigures& layer : solution.layers) fmt::print("| {} | {} |\n", layer.layer, layer.states);
-  } else if (options.stats) {
-    fmt::print("\n| layer | states | forward s | backward s |\n|------:|-------:|----------:|-----------:|\n");
-    for (const LayerFigures& layer : solution.layers) {
+  if (!options.stats) return;
+  const auto print_layers = [&](const std::vector<LayerFigures>& layers, const char* title) {
+    if (layers.empty()) return;
+    fmt::print("\n{}\n", title);
+    if (options.no_timing) {
+      fmt::print("| layer | states |\n|------:|-------:|\n");
+      for (const LayerFigures& layer : layers) fmt::print("| {} | {} |\n", layer.layer, layer.states);
+      return;
+    }
+    fmt::print("| layer | states | forward s | backward s |\n|------:|-------:|----------:|-----------:|\n");
+    for (const LayerFigures& layer : layers) {
       fmt::print("| {} | {} | {:.3f} | {:.3f} |\n", layer.layer, layer.states, layer.forward_seconds,
                  layer.backward_seconds);
     }
-  }
+  };
+  print_layers(solution.layers, "whole tree");
+  print_layers(solution.split_layers, "split (the enumerated subtree; flagged copies one layer on included)");
 }
 
 }  // namespace
@@ -223,8 +259,11 @@ void add_solve_command(CLI::App& app) {
   CLI::App* command = app.add_subcommand(
       "solve", "Exact optimal success probability and first choice, or a certified interval around it");
   command->add_option("INSTANCE", options->instance, "Instance file (JSON, SPEC §5)")->required();
-  command->add_option("--method", options->method, "layered (default; disk, threads, ranks, bounds) or memoised")
-      ->check(CLI::IsMember({"layered", "memoised"}));
+  command
+      ->add_option("--method", options->method,
+                   "layered (default: the whole tree; where a cap cuts it, a split follows), split (the strongest "
+                   "first-action subtree enumerated, the others bounded) or memoised")
+      ->check(CLI::IsMember({"layered", "split", "memoised"}));
   add_number_option(*command, "--max-states", options->max_states,
                     "Cap on states: layered gives an interval past it, memoised stops with an error (default: "
                     "none for layered, 10000000 for memoised)",
@@ -237,6 +276,10 @@ void add_solve_command(CLI::App& app) {
                     "Layered: end the forward pass after this long and give an interval (the backward pass still "
                     "runs)",
                     0.0);
+  add_number_option(*command, "--tolerance", options->tolerance,
+                    "Layered, split: drop groups whose clairvoyant chance alone is below this, with their share in "
+                    "the interval (default 0: none)",
+                    0.0, 1.0);
   command->add_option("--scratch", options->scratch, "Layered: directory for the layers' scratch files");
   command->add_option("--policy", options->policy,
                       "Layered: write the choice in every state of the first --policy-layers layers (JSON lines)");

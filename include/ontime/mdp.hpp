@@ -62,6 +62,14 @@ struct Observation {
 
 class Mdp {
  public:
+  // One execution time an action's motion can take once found, with its probability.
+  struct ExecutionOutcome {
+    Steps steps;  // deadline + 1 stands for "too slow or never"
+    double probability;
+  };
+  // What least_need returns for a skeleton that cannot succeed whatever the time left.
+  static constexpr std::int64_t kUnreachableNeed = std::int64_t{1} << 40;
+
   explicit Mdp(const Problem& problem);
 
   const Problem& problem() const noexcept { return *problem_; }
@@ -123,6 +131,35 @@ class Mdp {
   template <class S>
   bool any_can_succeed(const S& state) const noexcept;
 
+  // The least number of steps after CT that skeleton k still needs to succeed: its ET, the
+  // earliest finish of its current action given the PT_k steps spent, that action's fastest
+  // execution, and the fastest planning and execution of the rest; kUnreachableNeed (or more)
+  // when nothing can make it succeed. can_succeed(state, k) is CT + least_need <= D. The
+  // fields form of the exact solver's successors takes k's refined count, PT and ET.
+  std::int64_t least_need(int k, int refined, std::uint16_t spent, std::uint16_t execution) const noexcept;
+  template <class S>
+  std::int64_t least_need(const S& state, int k) const noexcept {
+    const auto slot = static_cast<std::size_t>(k);
+    return least_need(k, state.refined[slot], state.spent[slot], state.execution[slot]);
+  }
+
+  // The least number of steps after CT before some skeleton whose next action is `action` (they
+  // share its PT and ET) can succeed: the least least_need over them. can_succeed holds for
+  // one of them exactly when CT + group_need <= D.
+  std::int64_t group_need(int action, std::uint16_t spent, std::uint16_t execution) const noexcept {
+    const auto a = static_cast<std::size_t>(action);
+    if (spent > deadline_) return kUnreachableNeed;
+    const Steps finish = next_finish_[a * static_cast<std::size_t>(deadline_ + 1) + spent];
+    const Steps fastest = min_execution_[a];
+    if (finish == kNever || fastest == kNever) return kUnreachableNeed;
+    return std::int64_t{execution} + finish + fastest + group_rest_[a];
+  }
+
+  // The execution outcomes of finding `action`'s motion, in the order for_each_outcome uses.
+  std::span<const ExecutionOutcome> execution_outcomes(int action) const noexcept {
+    return execution_outcomes_[static_cast<std::size_t>(action)];
+  }
+
   // The choice of an allocator when no skeleton can succeed any more (every choice is as
   // good): the lowest-index skeleton with actions left, else 0.
   template <class S>
@@ -141,11 +178,6 @@ class Mdp {
   [[noreturn]] void reject_idle_refinement(int choice) const;
   [[noreturn]] static void reject_execution(Steps execution);
 
-  struct ExecutionOutcome {
-    Steps steps;  // deadline + 1 stands for "too slow or never"
-    double probability;
-  };
-
   std::uint16_t saturate_execution(std::int64_t steps) const noexcept {
     return static_cast<std::uint16_t>(steps > deadline_ ? deadline_ + 1 : steps);
   }
@@ -153,12 +185,13 @@ class Mdp {
   const Problem* problem_;
   int skeleton_count_;
   Steps deadline_;
-  std::vector<int> lengths_;          // A_k
-  std::vector<std::size_t> offsets_;  // start of skeleton k in paths_
-  std::vector<int> paths_;            // actions of all skeletons, concatenated
-  std::vector<std::int64_t> rest_;    // least planning+execution of positions l.. of k (offsets_ + l)
-  std::vector<double> hazards_;       // [action][spent], spent < deadline
-  std::vector<Steps> next_finish_;    // [action][spent]: least t >= 1 with p(spent + t) > 0, or kNever
+  std::vector<int> lengths_;              // A_k
+  std::vector<std::size_t> offsets_;      // start of skeleton k in paths_
+  std::vector<int> paths_;                // actions of all skeletons, concatenated
+  std::vector<std::int64_t> rest_;        // least planning+execution of positions l.. of k (offsets_ + l)
+  std::vector<std::int64_t> group_rest_;  // per action: the least rest_ after it over the skeletons through it
+  std::vector<double> hazards_;           // [action][spent], spent < deadline
+  std::vector<Steps> next_finish_;        // [action][spent]: least t >= 1 with p(spent + t) > 0, or kNever
   std::vector<std::vector<ExecutionOutcome>> execution_outcomes_;  // per action
   std::vector<Steps> min_execution_;                               // per action, kNever if none
 };
@@ -200,20 +233,20 @@ Observation Mdp::sample_observation(const S& state, int choice, Generator& gener
   return Observation::found(outcomes[drawn].steps);
 }
 
+inline std::int64_t Mdp::least_need(int k, int refined, std::uint16_t spent, std::uint16_t execution) const noexcept {
+  const auto slot = static_cast<std::size_t>(k);
+  if (refined >= lengths_[slot] || spent > deadline_) return kUnreachableNeed;
+  const auto action = static_cast<std::size_t>(paths_[offsets_[slot] + static_cast<std::size_t>(refined)]);
+  const Steps finish = next_finish_[action * static_cast<std::size_t>(deadline_ + 1) + spent];
+  const Steps fastest = min_execution_[action];
+  if (finish == kNever || fastest == kNever) return kUnreachableNeed;
+  return std::int64_t{execution} + finish + fastest +
+         rest_[offsets_[slot] + slot + static_cast<std::size_t>(refined) + 1];
+}
+
 template <class S>
 bool Mdp::can_succeed(const S& state, int k) const noexcept {
-  const int action = next_action(state, k);
-  if (action < 0) return false;
-  const auto slot = static_cast<std::size_t>(k);
-  const Steps spent = state.spent[slot];
-  if (spent > deadline_) return false;
-  const Steps finish = next_finish_[static_cast<std::size_t>(action) * static_cast<std::size_t>(deadline_ + 1) +
-                                    static_cast<std::size_t>(spent)];
-  const Steps execution = min_execution_[static_cast<std::size_t>(action)];
-  if (finish == kNever || execution == kNever) return false;
-  const std::int64_t need = std::int64_t{state.time} + state.execution[slot] + finish + execution +
-                            rest_[offsets_[slot] + slot + state.refined[slot] + 1];
-  return need <= deadline_;
+  return std::int64_t{state.time} + least_need(state, k) <= deadline_;
 }
 
 template <class S>

@@ -63,6 +63,25 @@ class ValueBounds {
   template <class S>
   double upper(const S& state) const noexcept;
 
+  // The same from one skeleton's fields (the exact solver's successors, before they are whole
+  // states): commit(k, ...) is commit(state, k); group_upper is G of the group whose next
+  // action is k's (the clairvoyant success probability of that subtree alone, with the budget
+  // D - time - execution), where k must be the group's lowest index.
+  double commit(int k, int refined, std::uint16_t spent, std::uint16_t execution, std::int64_t time) const noexcept {
+    const auto slot = static_cast<std::size_t>(k);
+    const std::size_t at = cell(slot, refined, spent, execution, time);
+    if (at == kNoTable) return 0.0;
+    return commit_[commit_block_[path_start_[slot] + static_cast<std::size_t>(refined)] + at];
+  }
+  double group_upper(int k, int refined, std::uint16_t spent, std::uint16_t execution,
+                     std::int64_t time) const noexcept {
+    const auto slot = static_cast<std::size_t>(k);
+    const std::size_t at = cell(slot, refined, spent, execution, time);
+    if (at == kNoTable) return 0.0;
+    const std::size_t block = reach_block_[path_start_[slot] + static_cast<std::size_t>(refined)];
+    return block == kNoTable ? 0.0 : reach_[block + at];
+  }
+
   // Doubles the tables hold.
   std::size_t table_entries() const noexcept { return commit_.size() + reach_.size(); }
   const Mdp& mdp() const noexcept { return *mdp_; }
@@ -72,13 +91,16 @@ class ValueBounds {
 
   // The index of (spent, budget) in a D x D block when skeleton k can still contribute
   // (actions left, spent < D, budget D - CT - ET_k >= 1), else kNoTable.
-  template <class S>
-  std::size_t cell(const S& state, std::size_t k) const noexcept {
-    if (state.refined[k] >= lengths_[k]) return kNoTable;
-    const std::uint16_t spent = state.spent[k];
-    const std::int64_t budget = std::int64_t{deadline_} - state.time - state.execution[k];
+  std::size_t cell(std::size_t k, int refined, std::uint16_t spent, std::uint16_t execution,
+                   std::int64_t time) const noexcept {
+    if (refined >= lengths_[k]) return kNoTable;
+    const std::int64_t budget = std::int64_t{deadline_} - time - execution;
     if (spent >= deadline_ || budget < 1) return kNoTable;
     return static_cast<std::size_t>(spent) * static_cast<std::size_t>(deadline_) + static_cast<std::size_t>(budget - 1);
+  }
+  template <class S>
+  std::size_t cell(const S& state, std::size_t k) const noexcept {
+    return cell(k, state.refined[k], state.spent[k], state.execution[k], state.time);
   }
 
   const Mdp* mdp_;
@@ -100,9 +122,7 @@ template <class S>
 double ValueBounds::commit(const S& state, int k) const noexcept {
   if (k < 0 || k >= skeleton_count_) return 0.0;
   const auto slot = static_cast<std::size_t>(k);
-  const std::size_t at = cell(state, slot);
-  if (at == kNoTable) return 0.0;
-  return commit_[commit_block_[path_start_[slot] + state.refined[slot]] + at];
+  return commit(k, state.refined[slot], state.spent[slot], state.execution[slot], state.time);
 }
 
 template <class S>
