@@ -163,11 +163,32 @@ std::uint64_t placement_hash(const PackedState<W>& key) noexcept {
   return h ^ (h >> 29);
 }
 
+// Memory one rank's forward pass may still take, shared by its threads: the tables ask before
+// they grow, so that a cap ends the pass cleanly rather than the allocation failing.
+class MemoryBudget {
+ public:
+  explicit MemoryBudget(std::uint64_t cap) : cap_(cap) {}
+  // Takes `bytes` if the total stays within the cap (always when there is no cap).
+  bool take(std::uint64_t bytes) noexcept {
+    const std::uint64_t now = held_.fetch_add(bytes) + bytes;
+    if (cap_ == 0 || now <= cap_) return true;
+    held_.fetch_sub(bytes);
+    return false;
+  }
+  void give(std::uint64_t bytes) noexcept { held_.fetch_sub(bytes); }
+  std::uint64_t held() const noexcept { return held_.load(); }
+
+ private:
+  std::uint64_t cap_;
+  std::atomic<std::uint64_t> held_{0};
+};
+
 // The places of one shard of the next layer: key -> index in the order keys arrived. Written
 // here rather than taken from absl::flat_hash_map because the insertions are the forward pass's
 // main cost and nearly all miss the caches: absl's prefetch brings only the control bytes,
 // while a slot here holds the key and its index together, so one prefetch a few keys ahead
-// brings what the probe reads (linear probing, at most half full).
+// brings what the probe reads (linear probing, at most half full). The keys, in index order,
+// live beside it, reserved as the table grows.
 template <std::size_t W>
 class alignas(64) PlaceTable {  // on lines of its own: each shard's table is another thread's
  public:
@@ -180,32 +201,48 @@ class alignas(64) PlaceTable {  // on lines of its own: each shard's table is an
     if (!slots_.empty()) __builtin_prefetch(&slots_[hash & mask_]);
   }
 
-  // The key's index, inserting it (with the next index, and into `keys`) if it is new.
-  std::uint32_t place(const Key& key, std::uint64_t hash, std::vector<Key>& keys) {
-    if (2 * (size_ + 1) > slots_.size()) grow();
+  // The key's index, inserting it (with the next index) if it is new; false, and nothing
+  // inserted, when the table would have to grow past the budget.
+  bool place(const Key& key, std::uint64_t hash, MemoryBudget& budget, std::uint32_t& index) {
+    if (2 * (keys_.size() + 1) > slots_.size() && !grow(budget)) return false;
     for (std::size_t at = hash & mask_;; at = (at + 1) & mask_) {
       Slot& slot = slots_[at];
       if (slot.index == kEmpty) {
-        slot = {key, static_cast<std::uint32_t>(keys.size())};
-        keys.push_back(key);
-        ++size_;
-        return slot.index;
+        slot = {key, static_cast<std::uint32_t>(keys_.size())};
+        keys_.push_back(key);
+        index = slot.index;
+        return true;
       }
-      if (slot.key == key) return slot.index;
+      if (slot.key == key) {
+        index = slot.index;
+        return true;
+      }
     }
   }
 
-  std::uint64_t bytes() const noexcept { return slots_.capacity() * sizeof(Slot); }
-  void clear() { std::vector<Slot>().swap(slots_), size_ = 0, mask_ = 0; }
+  const std::vector<Key>& keys() const noexcept { return keys_; }
+  std::uint64_t bytes() const noexcept { return slots_.capacity() * sizeof(Slot) + keys_.capacity() * sizeof(Key); }
+  // Frees the table and the keys, giving their memory back to the budget.
+  void clear(MemoryBudget& budget) {
+    budget.give(bytes());
+    std::vector<Slot>().swap(slots_);
+    std::vector<Key>().swap(keys_);
+    mask_ = 0;
+  }
 
  private:
   struct Slot {
     Key key;
     std::uint32_t index = kEmpty;
   };
-  void grow() {
+  bool grow(MemoryBudget& budget) {
+    const std::size_t size = std::max<std::size_t>(1024, 2 * slots_.size());
+    const std::uint64_t old_bytes = bytes();
+    const std::uint64_t new_bytes = size * sizeof(Slot) + size / 2 * sizeof(Key);
+    if (!budget.take(new_bytes)) return false;  // both arrays are held while the slots move
     std::vector<Slot> old = std::move(slots_);
-    slots_.assign(std::max<std::size_t>(1024, 2 * old.size()), Slot{});
+    slots_.assign(size, Slot{});
+    keys_.reserve(size / 2);
     mask_ = slots_.size() - 1;
     for (const Slot& slot : old) {
       if (slot.index == kEmpty) continue;
@@ -213,10 +250,13 @@ class alignas(64) PlaceTable {  // on lines of its own: each shard's table is an
       while (slots_[at].index != kEmpty) at = (at + 1) & mask_;
       slots_[at] = slot;
     }
+    budget.give(old_bytes);
+    budget.give(new_bytes - bytes());  // what the reservation did not use
+    return true;
   }
   std::vector<Slot> slots_;
+  std::vector<Key> keys_;
   std::size_t mask_ = 0;
-  std::size_t size_ = 0;
 };
 
 // Why the forward pass ended early; the lowest nonzero reason over the ranks wins.
@@ -757,9 +797,6 @@ class LayeredSearch {
   struct alignas(64) PendingList {
     std::vector<Pending> list;
   };
-  struct alignas(64) ShardKeys {
-    std::vector<Key> keys;  // in the order of their places
-  };
   struct alignas(64) ThreadBuffers {
     std::vector<PendingList> own;      // per shard
     std::vector<PendingList> foreign;  // per rank
@@ -773,8 +810,12 @@ class LayeredSearch {
     record.foreign.assign(static_cast<std::size_t>(ranks_), {});
     const std::uint64_t block_count = (current.size() + kBlock - 1) / kBlock;
     record.blocks.assign(2 * block_count, 0);
+    // What this layer's expansion holds: this layer's keys, then the tables as they grow, the
+    // chunk's buffers and, over ranks, the foreign entries.
+    MemoryBudget budget(options_->max_memory_bytes);
+    budget.take(current.capacity() * sizeof(Key));
+    std::uint64_t buffer_bytes = 0;
     std::vector<PlaceTable<W>> tables(shards_);
-    std::vector<ShardKeys> shard_keys(shards_);
     // Foreign successors met so far in this layer: (owner, code there) -> entry of record.foreign.
     absl::flat_hash_map<std::uint64_t, std::uint32_t> foreign_entries;
     std::uint32_t foreign_count = 0;
@@ -845,13 +886,17 @@ class LayeredSearch {
       std::vector<std::string> answers(static_cast<std::size_t>(ranks_));
       for (std::size_t r = 0; r < answers.size(); ++r)
         answers[r].resize(asked.empty() ? 0 : asked[r].size() / sizeof(Key) * sizeof(std::uint32_t));
-      std::atomic<bool> overflow{false};
+      std::atomic<bool> overflow{false}, out_of_memory{false};
       for_each_block(shards_, options_->threads, 1, [&](unsigned) {
         return [&](std::uint64_t s, std::uint64_t) {
           auto& table = tables[s];
-          auto& keys = shard_keys[s].keys;
           const auto place = [&](const Key& key, std::uint64_t hash) -> std::uint32_t {
-            const std::uint64_t code = std::uint64_t{table.place(key, hash, keys)} << shard_bits_ | s;
+            std::uint32_t index = 0;
+            if (out_of_memory || !table.place(key, hash, budget, index)) {
+              out_of_memory = true;  // the layer is cut: the codes no longer matter
+              return 0;
+            }
+            const std::uint64_t code = std::uint64_t{index} << shard_bits_ | s;
             if (code >= kForeignBase) overflow = true;
             return static_cast<std::uint32_t>(code);
           };
@@ -882,7 +927,7 @@ class LayeredSearch {
           }
         };
       });
-      if (overflow) {
+      if (overflow && !out_of_memory) {
         throw ResourceLimitError("layer " + std::to_string(t + 1) + ": more states than one rank can index (" +
                                  std::to_string(kForeignBase >> shard_bits_) +
                                  " per thread); split the work over more ranks");
@@ -913,6 +958,32 @@ class LayeredSearch {
           }
         }
       }
+      // Caps, agreed by every rank at the end of each chunk.
+      std::uint64_t chunk_bytes = foreign_entries.capacity() * (sizeof(std::uint64_t) + sizeof(std::uint32_t) + 1);
+      for (const BlockOutput& block : blocks) chunk_bytes += block.codes.capacity() * 4 + block.extras.capacity() * 8;
+      for (const ThreadBuffers& buffer : buffers) {
+        for (const PendingList& list : buffer.own) chunk_bytes += list.list.capacity() * sizeof(Pending);
+        for (const PendingList& list : buffer.foreign) chunk_bytes += list.list.capacity() * sizeof(Pending);
+      }
+      if (chunk_bytes > buffer_bytes && !budget.take(chunk_bytes - buffer_bytes)) out_of_memory = true;
+      buffer_bytes = std::max(buffer_bytes, chunk_bytes);
+      note_memory(budget.held());
+      Cut cut = Cut::none;
+      if (out_of_memory) cut = Cut::memory;
+      if (options_->stop && options_->stop()) cut = Cut::stop;
+      std::uint64_t chunk_disk = 0;
+      for (std::uint64_t b = 0; b < chunk_blocks; ++b) {
+        chunk_disk += blocks[b].codes.size() * sizeof(std::uint32_t) + blocks[b].extras.size() * sizeof(double);
+      }
+      if (options_->max_disk_bytes != 0 && disk_bytes_ + chunk_disk > options_->max_disk_bytes) cut = Cut::disk;
+      if (options_->max_states != 0) {
+        // The next layer already passes the state cap: no need to build the rest of it.
+        std::uint64_t found = 0;
+        for (const PlaceTable<W>& table : tables) found += table.keys().size();
+        if (solution_.states + sum_over_ranks(found) > options_->max_states) cut = Cut::states;
+      }
+      cut = first_cut(cut);
+      if (cut != Cut::none) return cut;
       // The chunk's codes, block by block, to the layer's files.
       for (std::uint64_t b = 0; b < chunk_blocks; ++b) {
         const std::uint64_t index = begin / kBlock + b;
@@ -920,42 +991,36 @@ class LayeredSearch {
         record.blocks[2 * index + 1] = blocks[b].extras.size();
         codes_file.write(blocks[b].codes.data(), blocks[b].codes.size());
         extras_file.write(blocks[b].extras.data(), blocks[b].extras.size());
-        disk_bytes_ += blocks[b].codes.size() * sizeof(std::uint32_t) + blocks[b].extras.size() * sizeof(double);
       }
+      disk_bytes_ += chunk_disk;
       solution_.peak_disk_bytes = std::max(solution_.peak_disk_bytes, disk_bytes_);
-      // Caps, agreed by every rank at the end of each chunk.
-      std::uint64_t held = current.capacity() * sizeof(Key) + foreign_entries.capacity() * 13;
-      for (std::size_t s = 0; s < shards_; ++s) {
-        held += tables[s].bytes() + shard_keys[s].keys.capacity() * sizeof(Key);
-      }
-      for (const BlockOutput& block : blocks) held += block.codes.capacity() * 4 + block.extras.capacity() * 8;
-      note_memory(held);
-      Cut cut = Cut::none;
-      if (options_->max_memory_bytes != 0 && held > options_->max_memory_bytes) cut = Cut::memory;
-      if (options_->max_disk_bytes != 0 && disk_bytes_ > options_->max_disk_bytes) cut = Cut::disk;
-      if (options_->stop && options_->stop()) cut = Cut::stop;
-      cut = first_cut(cut);
-      if (cut != Cut::none) return cut;
     }
     codes_file.close();
     extras_file.close();
-    // The next layer: the shards' keys one after the other.
-    record.next.base.assign(shards_ + 1, 0);
+    // The next layer: the shards' keys one after the other. The backward pass will hold this
+    // layer's keys, values and choices and the next layer's values.
     std::uint64_t total = 0;
-    for (std::size_t s = 0; s < shards_; ++s) {
-      record.next.base[s] = total;
-      total += shard_keys[s].keys.size();
-      tables[s].clear();
+    for (const PlaceTable<W>& table : tables) total += table.keys().size();
+    const std::uint64_t backward_bytes =
+        current.size() * (sizeof(Key) + sizeof(Bounds) + sizeof(int)) + total * sizeof(Bounds);
+    note_memory(backward_bytes);
+    Cut cut = Cut::none;
+    if (!budget.take(total * sizeof(Key)) ||
+        (options_->max_memory_bytes != 0 && backward_bytes > options_->max_memory_bytes)) {
+      cut = Cut::memory;
     }
-    record.next.base[shards_] = total;
+    cut = first_cut(cut);
+    if (cut != Cut::none) return cut;
+    note_memory(budget.held());
+    record.next.base.assign(shards_ + 1, 0);
     next.clear();
     next.reserve(total);
     for (std::size_t s = 0; s < shards_; ++s) {
-      next.insert(next.end(), shard_keys[s].keys.begin(), shard_keys[s].keys.end());
-      std::vector<Key>().swap(shard_keys[s].keys);
+      record.next.base[s] = next.size();
+      next.insert(next.end(), tables[s].keys().begin(), tables[s].keys().end());
+      tables[s].clear(budget);
     }
-    // The backward pass holds this layer's keys and both layers' values.
-    note_memory(current.size() * (sizeof(Key) + 2 * sizeof(Bounds)) + next.size() * 2 * sizeof(Bounds));
+    record.next.base[shards_] = next.size();
     return Cut::none;
   }
 
@@ -1527,6 +1592,8 @@ LayeredSolution solve_split(const Mdp& mdp, const LayeredSolveOptions& options, 
   solution.split_lower = solution.lower;
   solution.split_upper = solution.upper;
   solution.split_states = solution.states;
+  solution.split_frontier_layer = std::exchange(solution.frontier_layer, -1);
+  solution.split_stopped_by = std::exchange(solution.stopped_by, std::string());
   solution.split_layers = std::move(solution.layers);
   solution.layers.clear();
   return solution;
@@ -1566,6 +1633,8 @@ LayeredSolution solve_layered(const Mdp& mdp, const LayeredSolveOptions& options
   whole.split_lower = split.split_lower;
   whole.split_upper = split.split_upper;
   whole.split_states = split.split_states;
+  whole.split_frontier_layer = split.split_frontier_layer;
+  whole.split_stopped_by = std::move(split.split_stopped_by);
   whole.split_layers = std::move(split.split_layers);
   whole.states += split.split_states;
   whole.peak_memory_bytes = std::max(whole.peak_memory_bytes, split.peak_memory_bytes);

@@ -490,8 +490,9 @@ TEST(Cli, TableReportsAnExactPartOverTheCapInItsCell) {
   ASSERT_EQ(text.exit_code, 0) << text.err;
   EXPECT_NE(text.out.find("(0.9340)"), std::string::npos) << text.out;       // dp: 48 states
   EXPECT_NE(text.out.find("(cap reached)"), std::string::npos) << text.out;  // round-robin: 143
-  // The optimum (872 states) past the cap: the layered solver's interval after 49 states (5 layers).
-  EXPECT_NE(text.out.find("optimum over 49 states (certified interval)"), std::string::npos) << text.out;
+  // The optimum (872 states) past the cap: the whole tree's interval after 49 states (5 layers),
+  // then a split's (skeletons 1-3 enumerated, 58 states), the tighter end of each.
+  EXPECT_NE(text.out.find("optimum over 107 states (certified interval)"), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("[0.9360, 0.9939]"), std::string::npos) << text.out;
   const auto as_json = ontime({"table", paper("instance1"), "--solvers", "dp,round-robin", "--episodes", "200",
                                "--exact", "--max-states", "100", "--json"});
@@ -1601,8 +1602,16 @@ TEST(Cli, SolveGivesTheOptimumOrACertifiedIntervalWithItsLayers) {
   EXPECT_FALSE(bounded["exact"].get<bool>());
   EXPECT_LE(bounded["lower_bound"].get<double>(), 0.942);
   EXPECT_GE(bounded["upper_bound"].get<double>(), 0.942);
-  EXPECT_LE(bounded["states"].get<int>(), 100);
+  // The cap holds for each part: the whole tree, then a split of it (instance1's skeletons begin
+  // with two different actions).
+  EXPECT_LE(bounded["states"].get<int>() - bounded["split"]["states"].get<int>(), 100);
+  EXPECT_LE(bounded["split"]["states"].get<int>(), 100);
   EXPECT_NE(bounded["stopped_by"].get<std::string>().find("cap of 100 states"), std::string::npos);
+  EXPECT_NE(bounded["split"]["stopped_by"].get<std::string>().find("cap of 100 states"), std::string::npos);
+  EXPECT_EQ(bounded["split"]["enumerated_skeletons"], json({1, 2, 3}));
+  EXPECT_LE(bounded["split"]["lower_bound"].get<double>(), 0.942);
+  EXPECT_GE(bounded["split"]["upper_bound"].get<double>(), 0.942);
+  EXPECT_LE(bounded["upper_bound"].get<double>(), bounded["split"]["upper_bound"].get<double>());
 
   const auto directory = scratch("solve_policy");
   const std::string policy = (directory / "policy.jsonl").string();

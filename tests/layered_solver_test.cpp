@@ -8,6 +8,8 @@
 
 #include "expectimax.hpp"
 #include "ontime/allocators/optimal.hpp"
+#include "ontime/error.hpp"
+#include "ontime/instance_io.hpp"
 #include "ontime/value_bounds.hpp"
 #include "support/paper.hpp"
 #include "support/random_instances.hpp"
@@ -135,6 +137,7 @@ TEST(LayeredSolver, BoundsHoldTheOptimumWhereverTheyCut) {
     for (const std::uint64_t cap : {1, 3, 10, 30, 100, 300, 1000}) {
       LayeredSolveOptions options;
       options.max_states = cap;
+      options.split = SplitMode::never;  // the whole tree's frontier alone
       const LayeredSolution solution = solve(mdp, options);
       EXPECT_LE(solution.lower, optimum + kRounding) << "seed " << seed << " cap " << cap;
       EXPECT_GE(solution.upper, optimum - kRounding) << "seed " << seed << " cap " << cap;
@@ -213,6 +216,184 @@ TEST(LayeredSolver, ThePolicyOfTheFirstLayersIsTheMemoisedSolversChoices) {
     EXPECT_EQ(entry.lower, memoised.solve(entry.state));
   }
   EXPECT_EQ(solution.policy.front().choice, solution.first_choice);
+}
+
+// The successors are built from the state's key (the chosen group's fields and the groups
+// whose time ran out rewritten), not by the Mdp: on instances with deeper trees and longer
+// deadlines than above, the same values, first choices and state counts as the memoised solver.
+TEST(LayeredSolver, AgreesWithTheMemoisedSolverOnDeeperTrees) {
+  for (std::uint64_t seed = 1; seed <= 60; ++seed) {
+    const Problem problem = testing::random_instance(1000 + seed, 7, 5, 18);
+    const Mdp mdp(problem);
+    expect_same_as_memoised(mdp, "seed " + std::to_string(1000 + seed), 2);
+  }
+}
+
+// Property: whatever the tolerance, the interval holds the optimum; 0 is exact, and dropping
+// groups never enumerates more states.
+TEST(LayeredSolver, ToleranceIntervalsHoldTheOptimum) {
+  int widened = 0;
+  for (std::uint64_t seed = 1; seed <= 200; ++seed) {
+    const Problem problem = testing::random_instance(seed, 6, 4, 16);
+    const Mdp mdp(problem);
+    const double optimum = OptimalSolver(mdp).solve(mdp.start());
+    const LayeredSolution exact = solve(mdp);
+    for (const double tolerance : {0.0, 1e-3, 0.02, 0.1, 0.3}) {
+      LayeredSolveOptions options;
+      options.tolerance = tolerance;
+      const LayeredSolution solution = solve(mdp, options);
+      EXPECT_LE(solution.lower, optimum + kRounding) << "seed " << seed << " tolerance " << tolerance;
+      EXPECT_GE(solution.upper, optimum - kRounding) << "seed " << seed << " tolerance " << tolerance;
+      EXPECT_LE(solution.states, exact.states) << "seed " << seed << " tolerance " << tolerance;
+      EXPECT_EQ(solution.exact, solution.dropped == 0) << "seed " << seed << " tolerance " << tolerance;
+      if (tolerance == 0.0) {
+        EXPECT_EQ(solution.lower, optimum) << "seed " << seed;
+      }
+      if (!solution.exact) ++widened;
+    }
+  }
+  EXPECT_GT(widened, 50);  // the property was put to the test: groups were dropped
+}
+
+// Property: a split's interval holds the optimum, alone, with a tolerance and with a cap.
+TEST(LayeredSolver, SplitIntervalsHoldTheOptimum) {
+  int split = 0;
+  for (std::uint64_t seed = 1; seed <= 300; ++seed) {
+    const Problem problem = testing::random_instance(seed, 6, 4, 16);
+    const Mdp mdp(problem);
+    if (split_plan(mdp).empty()) continue;
+    ++split;
+    const double optimum = OptimalSolver(mdp).solve(mdp.start());
+    for (const double tolerance : {0.0, 0.05}) {
+      for (const std::uint64_t cap : {0, 20}) {
+        LayeredSolveOptions options;
+        options.split = SplitMode::always;
+        options.tolerance = tolerance;
+        options.max_states = cap;
+        const LayeredSolution solution = solve(mdp, options);
+        const std::string where =
+            "seed " + std::to_string(seed) + " tolerance " + std::to_string(tolerance) + " cap " + std::to_string(cap);
+        EXPECT_LE(solution.lower, optimum + kRounding) << where;
+        EXPECT_GE(solution.upper, optimum - kRounding) << where;
+        EXPECT_EQ(solution.split_kept, split_plan(mdp)) << where;
+        EXPECT_TRUE(solution.layers.empty()) << where;
+        EXPECT_FALSE(solution.split_layers.empty()) << where;
+      }
+    }
+  }
+  EXPECT_GT(split, 100);
+}
+
+// The split keeps the subtree whose clairvoyant chance alone is the largest.
+TEST(LayeredSolver, TheSplitKeepsTheStrongestFirstActionSubtree) {
+  const Problem problem = testing::paper_instance("instance1");  // [0] and [1, 2, 3] begin differently
+  const Mdp mdp(problem);
+  const ValueBounds bounds(mdp);
+  const State start = mdp.start();
+  const bool second = bounds.group_upper(1, 0, 0, 0, 0) > bounds.group_upper(0, 0, 0, 0, 0);
+  EXPECT_EQ(split_plan(mdp), second ? std::vector<int>({1, 2, 3}) : std::vector<int>({0}));
+  const Problem shared = testing::paper_instance("instance5");  // all begin with a1_1
+  EXPECT_TRUE(split_plan(Mdp(shared)).empty());
+  LayeredSolveOptions options;
+  options.split = SplitMode::always;
+  const Mdp shared_mdp(shared);
+  EXPECT_THROW(solve(shared_mdp, options), UsageError);
+}
+
+// When the bounded subtrees cannot succeed at all, the split is the exact solve of the rest.
+TEST(LayeredSolver, ASplitWhoseOtherSubtreesCannotSucceedIsExact) {
+  std::vector<Action> actions(3);
+  actions[0] = {"a", Distribution::from_pmf({0.0, 0.3, 0.3, 0.2}), Distribution::from_pmf({0.5, 0.5})};
+  actions[1] = {"b", Distribution::from_pmf({0.0, 0.4, 0.4}), Distribution::from_pmf({0.0, 1.0})};
+  actions[2] = {"c", Distribution::from_pmf({0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0}), Distribution::from_pmf({1.0})};
+  const Problem problem("weak-never", 5, 1.0, std::move(actions), {{0, 1}, {2}});
+  const Mdp mdp(problem);
+  LayeredSolveOptions options;
+  options.split = SplitMode::always;
+  const LayeredSolution solution = solve(mdp, options);
+  EXPECT_TRUE(solution.exact);
+  EXPECT_EQ(solution.split_weak_upper, 0.0);
+  EXPECT_NEAR(solution.lower, OptimalSolver(mdp).solve(mdp.start()), kRounding);
+  EXPECT_EQ(solution.upper, solution.lower);
+}
+
+// The fallback splits only when a cap cut the whole tree, and keeps the tighter end of each
+// interval.
+TEST(LayeredSolver, TheFallbackSplitsOnlyWhereACapCutTheWholeTree) {
+  const Problem problem = testing::paper_instance("instance1");
+  const Mdp mdp(problem);
+  LayeredSolveOptions options;
+  options.split = SplitMode::fallback;
+  const LayeredSolution uncut = solve(mdp, options);
+  EXPECT_TRUE(uncut.exact);
+  EXPECT_TRUE(uncut.split_kept.empty());
+  options.max_states = 100;
+  const LayeredSolution cut = solve(mdp, options);
+  LayeredSolveOptions whole_only = options;
+  whole_only.split = SplitMode::never;
+  const LayeredSolution frontier = solve(mdp, whole_only);
+  LayeredSolveOptions split_only = options;
+  split_only.split = SplitMode::always;
+  const LayeredSolution split = solve(mdp, split_only);
+  ASSERT_FALSE(cut.split_kept.empty());
+  EXPECT_EQ(cut.frontier_layer, frontier.frontier_layer);
+  EXPECT_EQ(cut.lower, std::max(frontier.lower, split.lower));
+  EXPECT_EQ(cut.upper, std::min(frontier.upper, split.upper));
+  EXPECT_EQ(cut.states, frontier.states + split.split_states);
+  EXPECT_LE(cut.lower, uncut.lower + kRounding);
+  EXPECT_GE(cut.upper, uncut.lower - kRounding);
+}
+
+TEST(LayeredSolver, SplitsAndTolerancesGiveTheSameBitsOnOneTwoAndThreeRanks) {
+  for (const char* name : {"instance1", "instance3"}) {
+    const Problem problem = testing::paper_instance(name);
+    const Mdp mdp(problem);
+    for (const double tolerance : {0.0, 0.05}) {
+      LayeredSolveOptions settings;
+      settings.split = SplitMode::always;
+      settings.tolerance = tolerance;
+      const LayeredSolution alone = solve(mdp, settings);
+      for (const int size : {2, 3}) {
+        testing::run_on_ranks(size, [&](const Ranks& ranks) {
+          LayeredSolveOptions options = settings;
+          options.ranks = &ranks;
+          options.threads = 2;
+          const LayeredSolution solution = solve(mdp, options);
+          EXPECT_EQ(solution.lower, alone.lower) << name << " on " << size << " ranks";
+          EXPECT_EQ(solution.upper, alone.upper) << name << " on " << size << " ranks";
+          EXPECT_EQ(solution.first_choice, alone.first_choice);
+          EXPECT_EQ(solution.states, alone.states);
+          EXPECT_EQ(solution.dropped, alone.dropped);
+        });
+      }
+    }
+  }
+}
+
+// A memory cap reached in the middle of a layer (a table that would grow past it) ends the
+// forward pass there, with the interval of the layer before.
+TEST(LayeredSolver, AMemoryCapInTheMiddleOfALayerEndsTheForwardPassCleanly) {
+  // The navigation instance with a deadline of 16 steps: about 150,000 states, tens of MB.
+  const Problem navigation = load_problem(testing::source_path("data/instances/navigation.json"));
+  std::vector<std::vector<int>> skeletons;
+  for (int k = 0; k < navigation.skeleton_count(); ++k) {
+    skeletons.emplace_back(navigation.skeleton(k).begin(), navigation.skeleton(k).end());
+  }
+  const Problem problem("navigation-16", 16, navigation.step_seconds(),
+                        std::vector<Action>(navigation.actions().begin(), navigation.actions().end()), skeletons);
+  const Mdp mdp(problem);
+  const LayeredSolution exact = solve(mdp);
+  ASSERT_TRUE(exact.exact);
+  ASSERT_GT(exact.peak_memory_bytes, 8U << 20);
+  LayeredSolveOptions options;
+  options.max_memory_bytes = exact.peak_memory_bytes / 3;
+  options.split = SplitMode::never;
+  const LayeredSolution cut = solve(mdp, options);
+  EXPECT_FALSE(cut.exact);
+  EXPECT_NE(cut.stopped_by.find("memory cap"), std::string::npos) << cut.stopped_by;
+  EXPECT_LE(cut.peak_memory_bytes, options.max_memory_bytes);
+  EXPECT_LE(cut.lower, exact.lower + kRounding);
+  EXPECT_GE(cut.upper, exact.lower - kRounding);
 }
 
 }  // namespace

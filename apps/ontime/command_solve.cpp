@@ -171,6 +171,10 @@ void run_layered(const SolveOptions& options, const Problem& problem, const Mdp&
                           {"lower_bound", solution.split_lower},
                           {"upper_bound", solution.split_upper},
                           {"states", solution.split_states}};
+      if (solution.split_frontier_layer >= 0) {
+        out["split"]["frontier_layer"] = solution.split_frontier_layer;
+        out["split"]["stopped_by"] = solution.split_stopped_by;
+      }
     }
     out["states"] = solution.states;
     if (!options.no_timing) out["seconds"] = seconds;
@@ -208,7 +212,7 @@ void run_layered(const SolveOptions& options, const Problem& problem, const Mdp&
     fmt::print("optimal success probability  in [{:.6f}, {:.6f}] (width {:.6f})\n", solution.lower, solution.upper,
                solution.upper - solution.lower);
   }
-  if (solution.frontier_layer >= 0) fmt::print("whole tree cut                {}\n", solution.stopped_by);
+  if (solution.frontier_layer >= 0) fmt::print("whole tree cut               {}\n", solution.stopped_by);
   if (options.tolerance > 0) {
     fmt::print("tolerance                    {} ({} outcomes dropped a group)\n", options.tolerance, solution.dropped);
   }

@@ -121,10 +121,12 @@ Row measure_row(const TableOptions& options, std::size_t index, const Mdp& mdp,
     row.cells.push_back(std::move(cell));
   }
   if (options.exact) {
-    // The layered solver: past the state cap it gives a certified interval rather than nothing.
+    // The layered solver: past the state cap it gives a certified interval rather than nothing
+    // (the whole tree's frontier, and a split of it where its first actions differ).
     const auto started = std::chrono::steady_clock::now();
     LayeredSolveOptions layered;
     layered.max_states = max_states;
+    layered.split = SplitMode::fallback;
     layered.ranks = options.monte_carlo.options().ranks;
     layered.threads = options.monte_carlo.threads;
     apply_default_layered_caps(layered);

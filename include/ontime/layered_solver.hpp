@@ -113,6 +113,8 @@ struct LayeredSolution {
   double split_weak_upper = 0;
   double split_lower = 0, split_upper = 0;
   std::uint64_t split_states = 0;
+  int split_frontier_layer = -1;  // the split cut too: its frontier, and why
+  std::string split_stopped_by;
   std::vector<LayerFigures> split_layers;
   // The whole tree's enumeration (empty when split straight away).
   std::vector<LayerFigures> layers;

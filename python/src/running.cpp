@@ -392,9 +392,13 @@ void bind_running(py::module_& m) {
 
   m.def(
       "solve",
-      [](const py::object& problem, std::size_t max_states, unsigned threads) {
+      [](const py::object& problem, std::size_t max_states, unsigned threads, const std::string& method,
+         double tolerance) {
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
         if (max_states == 0) throw UsageError("max_states must be at least 1");
+        if (method != "layered" && method != "split") {
+          throw UsageError("method must be 'layered' or 'split' (got '" + method + "')");
+        }
         LayeredSolution solution;
         double seconds = 0;
         run_interruptibly([&](const std::function<bool()>& stop, Progress&) {
@@ -403,6 +407,8 @@ void bind_running(py::module_& m) {
           options.max_states = max_states;
           options.threads = threads;
           options.stop = stop;
+          options.tolerance = tolerance;
+          options.split = method == "split" ? SplitMode::always : SplitMode::fallback;
           solution = solve_layered(mdp->mdp, options);
           seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
         });
@@ -411,14 +417,31 @@ void bind_running(py::module_& m) {
         py::dict out;
         out["instance"] = instance_label(problem, p);
         out["name"] = p.name();
-        out["method"] = "layered";
+        out["method"] = method;
         out["optimal_success_probability"] = solution.exact ? py::object(py::float_(solution.lower)) : py::none();
         out["lower_bound"] = solution.lower;
         out["upper_bound"] = solution.upper;
         out["exact"] = solution.exact;
-        if (!solution.exact) {
+        if (solution.frontier_layer >= 0) {
           out["frontier_layer"] = solution.frontier_layer;
           out["stopped_by"] = solution.stopped_by;
+        }
+        if (tolerance > 0) {
+          out["tolerance"] = tolerance;
+          out["dropped"] = solution.dropped;
+        }
+        if (!solution.split_kept.empty()) {
+          py::dict split;
+          split["enumerated_skeletons"] = solution.split_kept;
+          split["bounded_start_upper"] = solution.split_weak_upper;
+          split["lower_bound"] = solution.split_lower;
+          split["upper_bound"] = solution.split_upper;
+          split["states"] = solution.split_states;
+          if (solution.split_frontier_layer >= 0) {
+            split["frontier_layer"] = solution.split_frontier_layer;
+            split["stopped_by"] = solution.split_stopped_by;
+          }
+          out["split"] = split;
         }
         out["states"] = solution.states;
         out["seconds"] = seconds;
@@ -430,10 +453,13 @@ void bind_running(py::module_& m) {
         return out;
       },
       py::arg("problem"), py::arg("max_states") = OptimalSolver::kDefaultMaxStates, py::arg("threads") = 0,
+      py::kw_only(), py::arg("method") = "layered", py::arg("tolerance") = 0.0,
       "The exact optimal success probability and first choice (the layered solver), as `ontime solve --json` "
-      "reports them; past max_states states a certified interval [lower_bound, "
-      "upper_bound] instead (optimal_success_probability None). The GIL is released; Ctrl-C stops it "
-      "(KeyboardInterrupt).");
+      "reports them; where max_states cuts the whole tree, a certified interval [lower_bound, upper_bound] "
+      "instead (optimal_success_probability None), tightened by a split when the skeletons' first actions "
+      "differ. method='split' splits straight away (the strongest first-action subtree enumerated, the others "
+      "bounded); tolerance > 0 drops groups whose clairvoyant chance is below it, with their share in the "
+      "interval. The GIL is released; Ctrl-C stops it (KeyboardInterrupt).");
 
   m.def(
       "train_ppo",

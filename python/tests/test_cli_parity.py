@@ -86,3 +86,15 @@ def test_a_state_cap_gives_the_clis_certified_interval(cli):
     assert "cap of 100 states" in got["stopped_by"]
     assert got["lower_bound"] == expected["lower_bound"] and got["upper_bound"] == expected["upper_bound"]
     assert got["lower_bound"] <= ontime.solve(str(path))["optimal_success_probability"] <= got["upper_bound"]
+
+
+@pytest.mark.parametrize("path", [PAPER_INSTANCES[0], PAPER_INSTANCES[2]], ids=lambda p: p.stem)
+def test_a_split_and_a_tolerance_give_the_clis_interval(path, cli):
+    optimum = ontime.solve(str(path))["optimal_success_probability"]
+    got = ontime.solve(str(path), method="split", tolerance=0.01)
+    expected = cli("solve", path, "--method", "split", "--tolerance", 0.01, "--json")
+    assert set(got) == set(expected)
+    assert got["lower_bound"] == expected["lower_bound"] and got["upper_bound"] == expected["upper_bound"]
+    assert got["split"]["enumerated_skeletons"] == expected["split"]["enumerated_skeletons"]
+    assert got["dropped"] == expected["dropped"]
+    assert got["lower_bound"] <= optimum + 1e-12 and optimum - 1e-12 <= got["upper_bound"]
