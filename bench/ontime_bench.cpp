@@ -157,6 +157,32 @@ void BM_OptimalSolve(benchmark::State& bench) {
 }
 BENCHMARK(BM_OptimalSolve)->DenseRange(0, 5)->Unit(benchmark::kMicrosecond);
 
+// The layered solver on the domains (docs/performance.md): the navigation optimum (target
+// <= 10 s and <= 1 GiB on 2 cores) and the kitchen's split interval (target: width <= 0.02).
+// Real time, all hardware threads, once each (seconds of work).
+void time_layered(benchmark::State& bench, const std::string& instance, ontime::SplitMode split) {
+  const ontime::Problem problem =
+      ontime::load_problem(std::string(ONTIME_SOURCE_DIR) + "/data/instances/" + instance + ".json");
+  const ontime::Mdp mdp(problem);
+  ontime::LayeredSolution solution;
+  for (auto _ : bench) {
+    ontime::LayeredSolveOptions options;
+    options.split = split;
+    solution = ontime::solve_layered(mdp, options);
+  }
+  bench.counters["states"] = static_cast<double>(solution.states);
+  bench.counters["peak_MiB"] = static_cast<double>(solution.peak_memory_bytes) / (1 << 20);
+  bench.counters["lower"] = solution.lower;
+  bench.counters["upper"] = solution.upper;
+  bench.SetLabel(problem.name());
+}
+void BM_LayeredNavigationOptimum(benchmark::State& bench) {
+  time_layered(bench, "navigation", ontime::SplitMode::never);
+}
+BENCHMARK(BM_LayeredNavigationOptimum)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+void BM_LayeredKitchenSplit(benchmark::State& bench) { time_layered(bench, "manipulation", ontime::SplitMode::always); }
+BENCHMARK(BM_LayeredKitchenSplit)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+
 // MCTS search throughput from the start state of instance 1, one core (target >= 1e6/s).
 void BM_MctsIterations(benchmark::State& bench) {
   const ontime::Problem problem = paper(1);

@@ -6,9 +6,9 @@
 # data/logs/manipulation.jsonl, fits data/instances/manipulation.json (D = 40), draws the kitchen
 # and the histograms into docs/images/, trains the ppo policy and prints the table with every
 # allocator, exact values where they fit within --max-states, and the optimum's certified
-# interval (the layered solver up to 58 million states: 14 layers of the kitchen's 40, where the
-# layers still grow 2.3-fold per step; dp-rerun's exact value is its lower end).
-# About 20 minutes on 2 cores (collection 8 min, ppo 1.5 min, table 9 min); peak 4.9 GB.
+# interval (the layered solver up to 110 million states a part: the whole tree stops at layer 14
+# of 40, then the split enumerates the skeletons through move+pick(B3) and bounds the others).
+# About 20 minutes on 2 cores (collection 8 min, ppo 1.5 min, table 8.5 min); peak 9.7 GB.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/setup.sh
@@ -19,4 +19,4 @@ build/ontime map --domain manipulation --seed 1 -o docs/images/manipulation-map.
 build/ontime train data/instances/manipulation.json --solver ppo --episodes 10000 --seed 1 \
   --out build/policies/manipulation.json
 build/ontime table data/instances/manipulation.json --solvers mcts,dp,dp-rerun,ppo,round-robin,greedy \
-  --policy build/policies/manipulation.json --exact --episodes 2000 --max-states 58000000
+  --policy build/policies/manipulation.json --exact --episodes 2000 --max-states 110000000

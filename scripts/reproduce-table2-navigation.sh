@@ -4,8 +4,8 @@
 # action of the skeleton tree with OMPL RRT-Connect (deterministic collision-check effort,
 # seed 1), writes data/logs/navigation.jsonl, fits data/instances/navigation.json (D = 22),
 # draws the map and the histograms into docs/images/, trains the ppo policy and prints the table
-# with every allocator, exact values and the exact optimum. About 8 minutes on 2 cores (the
-# table 6 minutes); the exact parts need up to 3.3 GB of memory.
+# with every allocator, exact values and the exact optimum. About 7 minutes on 2 cores (the
+# table 5 minutes); the exact parts need up to 3.3 GB of memory.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/setup.sh
