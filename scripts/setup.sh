@@ -7,6 +7,8 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev nlohmann-json3-dev libcli11-dev libfmt-dev libabsl-dev
+  # SLEEF's deterministic elementary functions (src/portable_math.hpp).
+  libsleef-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libompl-dev libfcl-dev liborocos-kdl-dev libigraph-dev
   libboost-serialization-dev libboost-filesystem-dev libboost-system-dev

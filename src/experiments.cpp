@@ -10,6 +10,7 @@
 #include "ontime/error.hpp"
 #include "ontime/random.hpp"
 #include "ontime/simulator.hpp"
+#include "portable_math.hpp"
 
 namespace ontime {
 namespace {
@@ -162,7 +163,7 @@ AnytimeStudy anytime_study(const Mdp& mdp, const std::vector<double>& log10_mult
   for (const double exponent : log10_multipliers) {
     AnytimePoint point;
     point.log10_multiplier = exponent;
-    point.seconds_per_decision = study.reference_decision_seconds * std::pow(10.0, exponent);
+    point.seconds_per_decision = study.reference_decision_seconds * portable_pow(10.0, exponent);
     point.searcher = tracker.run(mdp, pair.searcher, DecisionBudget::seconds(point.seconds_per_decision));
     study.points.push_back(std::move(point));
   }

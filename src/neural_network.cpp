@@ -3,7 +3,37 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "portable_math.hpp"
+
 namespace ontime {
+namespace {
+
+// dst = lhs * rhs (dst sized by the caller), every coefficient summed over k in increasing order
+// from the k = 0 term: dst(i, j) = ((lhs(i, 0) rhs(0, j) + lhs(i, 1) rhs(1, j)) + ...) + ...
+//
+// Written here rather than with Eigen's operator*: Eigen's matrix product (GEMM) splits the sum
+// over k into blocks whose sizes it derives from the CPU's cache sizes at run time, and sends
+// rows to micro-kernels that keep several partial sums, so float sums were grouped differently
+// on another CPU and the same seed trained another policy. Here each column of dst is a sum of
+// whole columns of lhs, vectorised across rows: every coefficient gets the same additions in the
+// same order whatever the caches, the SIMD width or the alignment. Four terms per pass over the
+// column (one expression, still added left to right) keep it within a small factor of GEMM.
+template <class Lhs, class Rhs, class Dst>
+void ordered_product(const Lhs& lhs, const Rhs& rhs, Dst& dst) {
+  const Eigen::Index depth = lhs.cols();
+  for (Eigen::Index j = 0; j < rhs.cols(); ++j) {
+    auto column = dst.col(j);
+    column = lhs.col(0) * rhs(0, j);
+    Eigen::Index k = 1;
+    for (; k + 4 <= depth; k += 4) {
+      column = column + lhs.col(k) * rhs(k, j) + lhs.col(k + 1) * rhs(k + 1, j) + lhs.col(k + 2) * rhs(k + 2, j) +
+               lhs.col(k + 3) * rhs(k + 3, j);
+    }
+    for (; k < depth; ++k) column += lhs.col(k) * rhs(k, j);
+  }
+}
+
+}  // namespace
 
 template <class Scalar>
 Mlp<Scalar>::Mlp(const std::vector<int>& sizes, SplitMix64& generator) : sizes_(sizes) {
@@ -63,7 +93,8 @@ const typename Mlp<Scalar>::Matrix& Mlp<Scalar>::forward(const Matrix& input) {
   activations_[0] = input;
   for (std::size_t layer = 0; layer < weights_.size(); ++layer) {
     Matrix& out = activations_[layer + 1];
-    out.noalias() = weights_[layer] * activations_[layer];
+    out.resize(weights_[layer].rows(), activations_[layer].cols());
+    ordered_product(weights_[layer], activations_[layer], out);
     out.colwise() += biases_[layer];
     if (layer + 1 < weights_.size()) out = out.array().tanh().matrix();
   }
@@ -74,10 +105,17 @@ template <class Scalar>
 void Mlp<Scalar>::backward(const Matrix& output_gradient) {
   Matrix delta = output_gradient;  // dLoss / d(pre-activation) of the current layer
   for (std::size_t layer = weights_.size(); layer-- > 0;) {
-    weight_gradients_[layer].noalias() = delta * activations_[layer].transpose();
-    bias_gradients_[layer] = delta.rowwise().sum();
+    const Matrix& below = activations_[layer];
+    weight_gradients_[layer].resize(delta.rows(), below.rows());
+    ordered_product(delta, below.transpose(), weight_gradients_[layer]);
+    // The batch's sum in the order of its samples (a product with ones: x * 1 is exact).
+    bias_gradients_[layer].resize(delta.rows());
+    ordered_product(delta, Vector::Ones(delta.cols()), bias_gradients_[layer]);
     if (layer == 0) break;
-    Matrix upstream = weights_[layer].transpose() * delta;
+    // A transposed copy, so that the product runs over its contiguous columns.
+    const Matrix transposed = weights_[layer].transpose();
+    Matrix upstream(transposed.rows(), delta.cols());
+    ordered_product(transposed, delta, upstream);
     // tanh' = 1 - tanh^2, with tanh the stored activation of the layer below.
     delta = upstream.array() * (Scalar(1) - activations_[layer].array().square());
   }
@@ -89,6 +127,8 @@ const typename Mlp<Scalar>::Vector& Mlp<Scalar>::evaluate(const Vector& input) c
   const Vector* current = &input;
   for (std::size_t layer = 0; layer < weights_.size(); ++layer) {
     Vector& out = scratch_[layer];
+    // Eigen's matrix-vector product is kept here (it is faster for one sample): unlike GEMM it
+    // blocks by the shapes alone, never by the caches, and sums each row in column order.
     out.noalias() = weights_[layer] * (*current);
     out += biases_[layer];
     if (layer + 1 < weights_.size()) out = out.array().tanh().matrix();
@@ -115,8 +155,8 @@ void Adam<Scalar>::step(Mlp<Scalar>& network) {
   ++steps_;
   const auto b1 = static_cast<Scalar>(beta1_);
   const auto b2 = static_cast<Scalar>(beta2_);
-  const double correction1 = 1.0 - std::pow(beta1_, static_cast<double>(steps_));
-  const double correction2 = 1.0 - std::pow(beta2_, static_cast<double>(steps_));
+  const double correction1 = 1.0 - portable_pow(beta1_, static_cast<double>(steps_));
+  const double correction2 = 1.0 - portable_pow(beta2_, static_cast<double>(steps_));
   const auto rate = static_cast<Scalar>(learning_rate_ * std::sqrt(correction2) / correction1);
   const auto epsilon = static_cast<Scalar>(epsilon_ * std::sqrt(correction2));
   const auto update = [&](auto& parameter, const auto& gradient, auto& m, auto& v) {

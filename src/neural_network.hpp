@@ -6,8 +6,9 @@
 // Written here rather than taken from a deep-learning framework: Debian offers none as a C++
 // development package that fits a 4-layer MLP without heavy runtime dependencies, and Eigen
 // does the heavy lifting (the matrix products). Samples are columns of a batch matrix.
-// Deterministic: the same seed gives the same weights, and single-threaded Eigen gives the same
-// arithmetic, so training is reproducible bit for bit.
+// Deterministic on every machine: the same seed gives the same weights, and every product sums
+// its terms in one fixed order (not Eigen's GEMM, whose blocking follows the CPU's caches: see
+// ordered_product in neural_network.cpp), so training is reproducible bit for bit anywhere.
 
 #include <Eigen/Core>
 #include <cstdint>

@@ -8,6 +8,7 @@
 #include "ontime/error.hpp"
 #include "ontime/random.hpp"
 #include "ontime/simulator.hpp"
+#include "portable_math.hpp"
 #include "ppo_networks.hpp"
 
 namespace ontime {
@@ -25,9 +26,9 @@ void masked_log_softmax(const Column& logits, const std::uint8_t* valid, int cou
   }
   double total = 0;
   for (int k = 0; k < count; ++k) {
-    if (valid[k] != 0) total += std::exp(static_cast<double>(logits(k)) - largest);
+    if (valid[k] != 0) total += portable_exp(static_cast<double>(logits(k)) - largest);
   }
-  const double log_total = largest + std::log(total);
+  const double log_total = largest + portable_log(total);
   for (int k = 0; k < count; ++k) {
     out[k] = valid[k] != 0 ? static_cast<double>(logits(k)) - log_total : -std::numeric_limits<double>::infinity();
   }
@@ -84,7 +85,7 @@ double clipped_surrogate_loss(const Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen:
                        log_probabilities.data());
     const int action = actions[n];
     const double log_probability = log_probabilities[static_cast<std::size_t>(action)];
-    const double ratio = std::exp(log_probability - old_log_probabilities[n]);
+    const double ratio = portable_exp(log_probability - old_log_probabilities[n]);
     const double advantage = advantages[n];
     const double clipped = std::clamp(ratio, 1.0 - clip, 1.0 + clip);
     loss -= scale * std::min(ratio * advantage, clipped * advantage);
@@ -96,7 +97,7 @@ double clipped_surrogate_loss(const Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen:
     if (slope == 0.0) continue;
     for (int k = 0; k < count; ++k) {
       if (valid[n * static_cast<std::size_t>(count) + static_cast<std::size_t>(k)] == 0) continue;
-      const double probability = std::exp(log_probabilities[static_cast<std::size_t>(k)]);
+      const double probability = portable_exp(log_probabilities[static_cast<std::size_t>(k)]);
       const double d_log_probability = (k == action ? 1.0 : 0.0) - probability;
       gradient(k, column) = static_cast<Scalar>(-scale * slope * d_log_probability);
     }
@@ -160,7 +161,7 @@ class PpoTrainer {
       masked_log_softmax(logits, valid, count_, log_probabilities_.data());
       const double value = networks_.critic.evaluate(features_)(0);
       const auto probability = [&](std::size_t i) {
-        return std::exp(log_probabilities_[static_cast<std::size_t>(choices[i])]);
+        return portable_exp(log_probabilities_[static_cast<std::size_t>(choices[i])]);
       };
       const int action = choices[sample_index(choices.size(), probability, sampling_)];
       const int refining = mdp_.next_action(state, action);

@@ -272,6 +272,27 @@ TEST(Cli, InterruptedTrainingLeavesTheOldFile) {
   EXPECT_NO_THROW(load_ppo_policy(policy));
 }
 
+// glibc picks one of several builds of exp, log and pow by the CPU's features (FMA, AVX2), and
+// they differ in some last bits; GLIBC_TUNABLES masks features as a CPU without them would.
+// Training must give the same policy file under every pick.
+TEST(Cli, TrainingGivesTheSameBytesWhicheverLibmGlibcPicks) {
+  const auto directory = scratch("libm");
+  std::vector<std::string> policies;
+  for (const char* tunables : {"glibc.cpu.hwcaps=", "glibc.cpu.hwcaps=-AVX2,-FMA,-AVX",
+                               "glibc.cpu.hwcaps=-AVX512F,-AVX2,-FMA,-AVX,-SSE4_1,-SSE4_2"}) {
+    const auto policy = directory / ("policy" + std::to_string(policies.size()) + ".json");
+    const auto trained = testing::run_process({"/usr/bin/env", std::string("GLIBC_TUNABLES=") + tunables, ONTIME_CLI,
+                                               "train", paper("instance2"), "--episodes", "1500", "--seed", "3",
+                                               "--out", policy.string(), "--no-plot"});
+    ASSERT_EQ(trained.exit_code, 0) << tunables << ": " << trained.err;
+    std::ifstream in(policy, std::ios::binary);
+    policies.emplace_back(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    ASSERT_GT(policies.back().size(), 1000U);
+  }
+  EXPECT_TRUE(policies[1] == policies[0]);
+  EXPECT_TRUE(policies[2] == policies[0]);
+}
+
 std::string read_file(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   std::ostringstream text;

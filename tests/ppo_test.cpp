@@ -135,6 +135,59 @@ TEST(Ppo, SameSeedSamePolicyByteForByte) {
   EXPECT_NE(first, ppo_policy_to_json(train_ppo(mdp, 300, 10, small).policy));
 }
 
+// Eigen chooses the blocking of its matrix products from the CPU's cache sizes, read at run time;
+// training must not depend on them. Each machine below is simulated by the cache sizes Eigen
+// would read there (L1d, L2 and L3 per core or shared, as CPUID reports them); the policy's bytes
+// must equal those trained under this machine's own sizes. Batches of 2,000 steps: deeper than
+// the blocking depth of any of these L1 sizes, so a product split by the caches would show.
+TEST(Ppo, SamePolicyBytesWhateverTheCpuCaches) {
+  const Problem problem = testing::paper_instance("instance1");
+  const Mdp mdp(problem);
+  PpoHyperparameters h;
+  h.steps_per_epoch = 2'000;
+  h.train_iterations = 20;
+  const std::string here = ppo_policy_to_json(train_ppo(mdp, 1'200, 1, h).policy);
+  struct Caches {
+    const char* machine;
+    std::ptrdiff_t l1, l2, l3;
+  };
+  const Caches machines[] = {
+      {"16 KiB L1d, 256 KiB L2, 2 MiB L3 (a small ARM core)", 16 << 10, 256 << 10, 2 << 20},
+      {"32 KiB, 256 KiB, 8 MiB (an older desktop)", 32 << 10, 256 << 10, 8 << 20},
+      {"32 KiB, 512 KiB, 16 MiB (Zen 2)", 32 << 10, 512 << 10, 16 << 20},
+      {"32 KiB, 1 MiB, 32 MiB (EPYC, Zen 3 and 4)", 32 << 10, 1 << 20, 32 << 20},
+      {"48 KiB, 1.25 MiB, 24 MiB (Ice Lake server)", 48 << 10, 1280 << 10, 24 << 20},
+      {"64 KiB, 2 MiB, 32 MiB (two cores' totals)", 64 << 10, 2 << 20, 32 << 20},
+  };
+  const std::ptrdiff_t l1 = Eigen::l1CacheSize(), l2 = Eigen::l2CacheSize(), l3 = Eigen::l3CacheSize();
+  for (const Caches& caches : machines) {
+    Eigen::setCpuCacheSizes(caches.l1, caches.l2, caches.l3);
+    const std::string there = ppo_policy_to_json(train_ppo(mdp, 1'200, 1, h).policy);
+    Eigen::setCpuCacheSizes(l1, l2, l3);
+    EXPECT_TRUE(there == here) << "another policy under the caches of " << caches.machine;
+  }
+}
+
+// FNV-1a, 64 bits: a digest of a policy file that is the same on every platform.
+std::uint64_t digest(const std::string& bytes) {
+  std::uint64_t hash = 0xcbf29ce484222325ULL;
+  for (const char c : bytes) hash = (hash ^ static_cast<unsigned char>(c)) * 0x100000001b3ULL;
+  return hash;
+}
+
+// The bytes a seed trains are one fact about the trainer, not about the machine or the build:
+// this digest was recorded from a Release build on x86-64, and every build the suite runs in
+// (Release, the core alone, RelWithDebInfo under the sanitizers, Debug) and every CPU must
+// reproduce it. A deliberate change to the trainer changes it, and then Table I's and Table II's
+// ppo cells (README, docs/experiments.md, docs/domains.md) must be measured again.
+TEST(Ppo, TheSameBytesInEveryBuildAndOnEveryMachine) {
+  const Problem problem = testing::paper_instance("instance2");
+  const Mdp mdp(problem);
+  PpoHyperparameters small;
+  small.steps_per_epoch = 500;
+  EXPECT_EQ(digest(ppo_policy_to_json(train_ppo(mdp, 300, 9, small).policy)), 0xf7708d52bc1a0a02ULL);
+}
+
 // Instances where success is impossible from the start (every planning PMF "never", deadline 1,
 // every execution "never") offer no useful choice: every episode is lost before its first step.
 // Training takes no step, writes the untrained policy, and does so the same way every time.

@@ -5,6 +5,7 @@
 #include <limits>
 #include <utility>
 
+#include "../portable_math.hpp"
 #include "ontime/allocator_registry.hpp"
 #include "ontime/error.hpp"
 
@@ -92,7 +93,7 @@ bool MctsAllocator::expand_outcomes(std::uint32_t edge, const State& state) {
 }
 
 std::uint32_t MctsAllocator::select_edge(const DecisionNode& node) const {
-  const double log_visits = std::log(static_cast<double>(std::max<std::uint32_t>(node.visits, 1)));
+  const double log_visits = portable_log(static_cast<double>(std::max<std::uint32_t>(node.visits, 1)));
   std::uint32_t best = node.first_edge;
   double best_score = -1.0;
   for (std::uint32_t e = node.first_edge; e < node.first_edge + node.edge_count; ++e) {
