@@ -12,6 +12,7 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -291,6 +292,42 @@ TEST(Cli, TrainingGivesTheSameBytesWhicheverLibmGlibcPicks) {
   }
   EXPECT_TRUE(policies[1] == policies[0]);
   EXPECT_TRUE(policies[2] == policies[0]);
+}
+
+// Standard error is not a terminal here (a pipe, as in a log or CI): progress comes as plain
+// lines, here one per update (ONTIME_PROGRESS_SECONDS=0), and --quiet silences them.
+TEST(Cli, ProgressLinesInALogAndNoneWhenQuiet) {
+  const auto directory = scratch("progress");
+  const std::string policy = (directory / "policy.json").string();
+  const std::vector<std::string> train = {ONTIME_CLI, "train", paper("instance4"), "--episodes", "3000",
+                                          "--out",    policy,  "--no-plot"};
+  std::vector<std::string> logged = {"/usr/bin/env", "ONTIME_PROGRESS_SECONDS=0"};
+  logged.insert(logged.end(), train.begin(), train.end());
+  const auto result = testing::run_process(logged);
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const std::regex line(R"(ontime train ppo: (\d+)/3000 \((\d+)%\), \d+s elapsed, about \d+s left)");
+  std::istringstream err(result.err);
+  std::vector<std::uint64_t> done;
+  for (std::string text; std::getline(err, text);) {
+    std::smatch match;
+    ASSERT_TRUE(std::regex_match(text, match, line)) << text;
+    done.push_back(std::stoull(match[1]));
+    EXPECT_EQ(std::stoull(match[2]), done.back() * 100 / 3000);
+  }
+  // One line per epoch of at least 4,000 steps (instance 4's episodes are one or two steps long).
+  ASSERT_GE(done.size(), 2U);
+  EXPECT_TRUE(std::is_sorted(done.begin(), done.end()));
+  EXPECT_EQ(done.back(), 3000U);
+
+  logged.push_back("--quiet");
+  const auto quiet = testing::run_process(logged);
+  ASSERT_EQ(quiet.exit_code, 0) << quiet.err;
+  EXPECT_EQ(quiet.err, "");
+
+  const auto bad = testing::run_process({"/usr/bin/env", "ONTIME_PROGRESS_SECONDS=soon", ONTIME_CLI, "train",
+                                         paper("instance4"), "--episodes", "30", "--out", policy, "--no-plot"});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("ONTIME_PROGRESS_SECONDS: must be a number of seconds"), std::string::npos) << bad.err;
 }
 
 std::string read_file(const std::filesystem::path& path) {

@@ -34,6 +34,11 @@ std::unique_ptr<CLI::App> make_app() {
       "ontime");
   app->set_version_flag("--version", std::string("ontime ") + ONTIME_VERSION);
   app->require_subcommand(1);
+  // --quiet belongs to every command: given after the command's name, it falls through to here.
+  app->fallthrough();
+  app->add_flag_callback(
+      "--quiet,-q", [] { set_quiet(true); },
+      "No progress (neither the bar on a terminal nor the lines written to a log)");
   add_solve_command(*app);
   add_evaluate_command(*app);
   add_table_command(*app);

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <thread>
 
 #include "cluster_job.hpp"
@@ -156,24 +157,78 @@ std::string csv_field(std::string_view text) {
   return quoted;
 }
 
-// Only the rank that prints shows a bar.
+namespace {
+bool quiet_progress = false;
+}  // namespace
+
+void set_quiet(bool quiet) noexcept { quiet_progress = quiet; }
+
+double progress_line_seconds() {
+  const char* text = std::getenv("ONTIME_PROGRESS_SECONDS");
+  if (text == nullptr || *text == '\0') return 5.0;
+  char* end = nullptr;
+  const double seconds = std::strtod(text, &end);
+  if (*end != '\0' || !(seconds >= 0) || seconds > 1e6) {
+    throw UsageError(
+        fmt::format("ONTIME_PROGRESS_SECONDS: must be a number of seconds from 0 to 1e6 (got '{}')", text));
+  }
+  return seconds;
+}
+
+std::string progress_duration(double seconds) {
+  const auto whole = static_cast<std::uint64_t>(std::max(0.0, seconds) + 0.5);
+  if (whole >= 3600) return fmt::format("{}h{:02d}m", whole / 3600, whole % 3600 / 60);
+  if (whole >= 60) return fmt::format("{}m{:02d}s", whole / 60, whole % 60);
+  return fmt::format("{}s", whole);
+}
+
+// Only the rank that prints shows progress.
 ProgressBar::ProgressBar(std::string label)
-    : label_(std::move(label)), enabled_(::isatty(STDERR_FILENO) != 0 && is_job_root()) {}
+    : label_(std::move(label)),
+      mode_(quiet_progress || !is_job_root() ? Mode::off
+            : ::isatty(STDERR_FILENO) != 0   ? Mode::bar
+                                             : Mode::lines),
+      started_(std::chrono::steady_clock::now()),
+      next_line_(started_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                std::chrono::duration<double>(mode_ == Mode::lines ? progress_line_seconds() : 0))) {}
 
 ProgressBar::~ProgressBar() {
-  if (enabled_ && last_percent_ >= 0) fmt::print(stderr, "\r\033[K");
+  if (mode_ == Mode::bar && last_percent_ >= 0) fmt::print(stderr, "\r\033[K");
+}
+
+bool ProgressBar::line_due() {
+  const auto now = std::chrono::steady_clock::now();
+  if (now < next_line_) return false;
+  next_line_ = now + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                         std::chrono::duration<double>(progress_line_seconds()));
+  return true;
 }
 
 void ProgressBar::status(std::string_view text) {
-  if (!enabled_) return;
-  last_percent_ = 0;  // so that the destructor clears the line
-  fmt::print(stderr, "\r{} {}\033[K", label_, text);
+  if (mode_ == Mode::bar) {
+    last_percent_ = 0;  // so that the destructor clears the line
+    fmt::print(stderr, "\r{} {}\033[K", label_, text);
+  } else if (mode_ == Mode::lines && line_due()) {
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+    fmt::print(stderr, "ontime {}: {}, {} elapsed\n", label_, text, progress_duration(elapsed));
+  } else {
+    return;
+  }
   std::fflush(stderr);
 }
 
 void ProgressBar::update(std::uint64_t done, std::uint64_t total) {
-  if (!enabled_ || total == 0) return;
-  const int percent = static_cast<int>(100 * done / total);
+  if (mode_ == Mode::off || total == 0) return;
+  const int percent = static_cast<int>(100 * std::min(done, total) / total);
+  if (mode_ == Mode::lines) {
+    if (done == 0 || !line_due()) return;
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+    const double left = elapsed * static_cast<double>(total - std::min(done, total)) / static_cast<double>(done);
+    fmt::print(stderr, "ontime {}: {}/{} ({}%), {} elapsed, about {} left\n", label_, done, total, percent,
+               progress_duration(elapsed), progress_duration(left));
+    std::fflush(stderr);
+    return;
+  }
   if (percent == last_percent_) return;
   last_percent_ = percent;
   constexpr int kWidth = 30;

@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -91,7 +92,10 @@ Json points_json(const std::vector<std::array<double, 2>>& points);
 // `text` as one CSV field: in double quotes, inner quotes doubled.
 std::string csv_field(std::string_view text);
 
-// A progress bar on stderr, shown only when stderr is a terminal.
+// Progress on stderr, on the rank that prints. On a terminal, a bar redrawn in place; otherwise
+// (a log, CI, a pipe) a plain line now and then, at most every progress_line_seconds():
+//   ontime table: 12/35 (34%), 1m12s elapsed, about 2m20s left
+// Nothing at all with --quiet, and no line for work that ends before the first interval.
 class ProgressBar {
  public:
   explicit ProgressBar(std::string label);
@@ -101,9 +105,22 @@ class ProgressBar {
   void status(std::string_view text);
 
  private:
+  enum class Mode { off, bar, lines };
+  // In lines mode: whether a line is due (and, when it is, the clock moves on to the next one).
+  bool line_due();
   std::string label_;
-  bool enabled_;
+  Mode mode_;
   int last_percent_ = -1;
+  std::chrono::steady_clock::time_point started_;
+  std::chrono::steady_clock::time_point next_line_;
 };
+
+// --quiet (every command): no progress bar and no progress lines.
+void set_quiet(bool quiet) noexcept;
+// Seconds between two progress lines when stderr is not a terminal: 5, or the environment's
+// ONTIME_PROGRESS_SECONDS (a number >= 0; 0 prints every change, for tests).
+double progress_line_seconds();
+// "1h02m", "3m07s", "42s": a duration as a progress line shows it.
+std::string progress_duration(double seconds);
 
 }  // namespace ontime::cli
