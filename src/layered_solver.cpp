@@ -1,8 +1,6 @@
 #include "ontime/layered_solver.hpp"
 
 #include <absl/container/flat_hash_map.h>
-#include <stdlib.h>  // mkdtemp
-#include <unistd.h>  // getpid
 
 #include <algorithm>
 #include <array>
@@ -23,6 +21,7 @@
 #include "ontime/error.hpp"
 #include "ontime/parallel.hpp"
 #include "ontime/value_bounds.hpp"
+#include "scratch_directory.hpp"
 
 namespace ontime {
 namespace {
@@ -261,37 +260,6 @@ class alignas(64) PlaceTable {  // on lines of its own: each shard's table is an
 
 // Why the forward pass ended early; the lowest nonzero reason over the ranks wins.
 enum class Cut : std::uint8_t { none = 0, stop, states, memory, disk };
-
-// A private directory for one rank's layer files, removed with everything in it.
-class ScratchDirectory {
- public:
-  ScratchDirectory(const std::filesystem::path& parent_or_empty, int rank) {
-    std::error_code error;
-    const std::filesystem::path parent =
-        parent_or_empty.empty() ? std::filesystem::temp_directory_path(error) : parent_or_empty;
-    std::string pattern =
-        (parent / ("ontime-layers-" + std::to_string(::getpid()) + "-rank" + std::to_string(rank) + "-XXXXXX"))
-            .string();
-    if (error || ::mkdtemp(pattern.data()) == nullptr) {
-      throw UsageError("cannot make a scratch directory for the layers in " + parent.string() +
-                       " (choose another with --scratch)");
-    }
-    path_ = pattern;
-  }
-  ~ScratchDirectory() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path_, ignored);
-  }
-  ScratchDirectory(const ScratchDirectory&) = delete;
-  ScratchDirectory& operator=(const ScratchDirectory&) = delete;
-
-  std::filesystem::path file(int t, const char* what) const {
-    return path_ / ("layer-" + std::to_string(t) + "." + what);
-  }
-
- private:
-  std::filesystem::path path_;
-};
 
 // A scratch file written or read in pieces, with the disk it holds counted; errors name the
 // layer and the file.
@@ -699,7 +667,7 @@ class LayeredSearch {
         threads_(worker_count(std::numeric_limits<std::uint64_t>::max(), options.threads)),
         shard_bits_(static_cast<int>(std::bit_width(std::bit_ceil(threads_) - 1))),
         shards_(std::size_t{1} << shard_bits_),
-        scratch_(options.scratch_directory, rank_) {}
+        scratch_(options.scratch_directory, rank_, options.remove_scratch_on_signal, options.on_stale_scratch) {}
 
   LayeredSolution run() {
     solution_.key_bytes = sizeof(Key);

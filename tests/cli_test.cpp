@@ -330,6 +330,45 @@ TEST(Cli, ProgressLinesInALogAndNoneWhenQuiet) {
   EXPECT_NE(bad.err.find("ONTIME_PROGRESS_SECONDS: must be a number of seconds"), std::string::npos) << bad.err;
 }
 
+// A solve stopped by SIGINT, SIGTERM or SIGHUP removes its scratch, says so in one line and dies
+// of the signal; after SIGKILL (nothing can run), the next solve over the folder removes what was
+// left and says so.
+TEST(Cli, AStoppedOrKilledSolveLeavesNoScratchBehind) {
+  const auto folder = scratch("solve-scratch");
+  const std::string navigation = std::string(ONTIME_SOURCE_DIR) + "/data/instances/navigation.json";
+  const std::vector<std::string> solve = {ONTIME_CLI, "solve", navigation, "--scratch", folder.string(), "--quiet"};
+  const auto layer_files_written = [&folder] {
+    std::error_code error;
+    for (const auto& directory : std::filesystem::directory_iterator(folder, error)) {
+      for ([[maybe_unused]] const auto& file : std::filesystem::directory_iterator(directory.path(), error))
+        return true;
+    }
+    return false;
+  };
+  const auto entries = [&folder] {
+    std::vector<std::filesystem::path> found;
+    for (const auto& entry : std::filesystem::directory_iterator(folder)) found.push_back(entry.path());
+    return found;
+  };
+  for (const auto& [signal_number, name] : {std::pair{SIGTERM, "SIGTERM"}, {SIGINT, "SIGINT"}, {SIGHUP, "SIGHUP"}}) {
+    const auto stopped = testing::run_process(solve, layer_files_written, signal_number);
+    EXPECT_EQ(stopped.exit_code, 128 + signal_number) << stopped.err;
+    const std::regex line("ontime: " + std::string(name) + ": stopped; removed the scratch directory " +
+                          folder.string() + "/ontime-layers-[^/\\n]+-rank0-[^/\\n]{6}\n");
+    EXPECT_TRUE(std::regex_match(stopped.err, line)) << stopped.err;
+    EXPECT_TRUE(entries().empty()) << name;
+  }
+  const auto killed = testing::run_process(solve, layer_files_written, SIGKILL);
+  EXPECT_EQ(killed.exit_code, 128 + SIGKILL);
+  const auto left = entries();
+  ASSERT_EQ(left.size(), 1U);
+  const auto next = ontime({"solve", paper("instance1"), "--scratch", folder.string()});
+  ASSERT_EQ(next.exit_code, 0) << next.err;
+  EXPECT_NE(next.err.find("ontime: removed " + left[0].string() + " ("), std::string::npos) << next.err;
+  EXPECT_NE(next.err.find("the scratch of a run on this host whose process is gone"), std::string::npos) << next.err;
+  EXPECT_TRUE(entries().empty());
+}
+
 std::string read_file(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   std::ostringstream text;

@@ -1,8 +1,12 @@
 #include "ontime/layered_solver.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -11,6 +15,7 @@
 #include "ontime/error.hpp"
 #include "ontime/instance_io.hpp"
 #include "ontime/value_bounds.hpp"
+#include "scratch_directory.hpp"
 #include "support/paper.hpp"
 #include "support/random_instances.hpp"
 #include "support/thread_ranks.hpp"
@@ -394,6 +399,78 @@ TEST(LayeredSolver, AMemoryCapInTheMiddleOfALayerEndsTheForwardPassCleanly) {
   EXPECT_LE(cut.peak_memory_bytes, options.max_memory_bytes);
   EXPECT_LE(cut.lower, exact.lower + kRounding);
   EXPECT_GE(cut.upper, exact.lower - kRounding);
+}
+
+}  // namespace
+}  // namespace ontime
+
+namespace ontime {
+namespace {
+
+std::string this_host() {
+  char name[256] = {};
+  if (::gethostname(name, sizeof name - 1) != 0 || name[0] == '\0') return "localhost";
+  std::string host(name);
+  for (char& c : host) {
+    if (c == '/') c = '_';
+  }
+  return host;
+}
+
+// The process id of a child that has ended and been reaped: a process that is gone.
+long gone_process() {
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  return child;
+}
+
+// Of the scratch directories in a folder, only those of this host's gone processes are removed:
+// never a live process's (this one's, init's), never another host's, never a name of another form.
+TEST(ScratchDirectory, RemovesOnlyTheScratchOfThisHostsGoneProcesses) {
+  const std::filesystem::path folder = std::filesystem::path(::testing::TempDir()) / "stale-scratch";
+  std::filesystem::remove_all(folder);
+  std::filesystem::create_directories(folder);
+  const std::string host = this_host();
+  const long gone = gone_process();
+  const std::string dead = "ontime-layers-" + host + "-" + std::to_string(gone) + "-rank1-aB3dE9";
+  const std::vector<std::string> kept = {
+      "ontime-layers-" + host + "-" + std::to_string(::getpid()) + "-rank0-Qw12Er",  // alive: this process
+      "ontime-layers-" + host + "-1-rank0-Zx98Cv",                                   // alive: init
+      "ontime-layers-another-host-" + std::to_string(gone) + "-rank0-Ty56Ui",        // not seen from here
+      "ontime-layers-" + std::to_string(gone) + "-rank0-Op09As",                     // no host: another form
+      "my-ontime-layers-" + host + "-" + std::to_string(gone) + "-rank0-Df45Gh",
+  };
+  std::filesystem::create_directory(folder / dead);
+  { std::ofstream(folder / dead / "layer-3.codes") << std::string(1000, 'x'); }
+  { std::ofstream(folder / dead / "layer-4.keys") << std::string(24, 'y'); }
+  for (const std::string& name : kept) std::filesystem::create_directory(folder / name);
+
+  std::vector<std::pair<std::filesystem::path, std::uint64_t>> noticed;
+  const int removed = remove_stale_scratch(folder, [&noticed](const std::filesystem::path& path, std::uint64_t bytes) {
+    noticed.emplace_back(path, bytes);
+  });
+  EXPECT_EQ(removed, 1);
+  ASSERT_EQ(noticed.size(), 1U);
+  EXPECT_EQ(noticed[0].first, folder / dead);
+  EXPECT_EQ(noticed[0].second, 1024U);
+  EXPECT_FALSE(std::filesystem::exists(folder / dead));
+  for (const std::string& name : kept) EXPECT_TRUE(std::filesystem::is_directory(folder / name)) << name;
+
+  // A solve over the folder does the same before it starts, and leaves nothing of its own.
+  std::filesystem::create_directory(folder / dead);
+  LayeredSolveOptions options;
+  options.scratch_directory = folder;
+  int reported = 0;
+  options.on_stale_scratch = [&reported](const std::filesystem::path&, std::uint64_t) { ++reported; };
+  const Problem problem = testing::paper_instance("instance1");
+  EXPECT_NEAR(solve_layered(Mdp(problem), options).lower, 0.942, 1e-12);
+  EXPECT_EQ(reported, 1);
+  std::size_t entries = 0;
+  for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(folder)) ++entries;
+  EXPECT_EQ(entries, kept.size());
+  std::filesystem::remove_all(folder);
 }
 
 }  // namespace

@@ -110,7 +110,7 @@ void run_layered(const SolveOptions& options, const Problem& problem, const Mdp&
   }
   settings.max_disk_bytes = options.max_disk_mib << 20;
   // Unless capped on the command line, stop before the memory and the disk run out.
-  apply_default_layered_caps(settings);
+  apply_tool_layered_settings(settings);
   const auto started = std::chrono::steady_clock::now();
   if (options.max_seconds > 0) {
     const auto deadline = started + std::chrono::duration<double>(options.max_seconds);

@@ -129,7 +129,7 @@ Row measure_row(const TableOptions& options, std::size_t index, const Mdp& mdp,
     layered.split = SplitMode::fallback;
     layered.ranks = options.monte_carlo.options().ranks;
     layered.threads = options.monte_carlo.threads;
-    apply_default_layered_caps(layered);
+    apply_tool_layered_settings(layered);
     const LayeredSolution solution = solve_layered(mdp, layered);
     ExactPart optimum;
     optimum.states = solution.states;

@@ -41,7 +41,12 @@ std::string gib(double bytes) { return fmt::format("{:.3g} GiB", bytes / (1024.0
 
 }  // namespace
 
-void apply_default_layered_caps(LayeredSolveOptions& options) {
+void apply_tool_layered_settings(LayeredSolveOptions& options) {
+  options.remove_scratch_on_signal = true;
+  options.on_stale_scratch = [](const std::filesystem::path& directory, std::uint64_t bytes) {
+    fmt::print(stderr, "ontime: removed {} ({:.1f} MiB), the scratch of a run on this host whose process is gone\n",
+               directory.string(), static_cast<double>(bytes) / 1048576.0);
+  };
   if (options.max_memory_bytes == 0) {
     if (const auto available = available_memory_bytes()) {
       const int ranks = options.ranks != nullptr ? options.ranks->size() : 1;

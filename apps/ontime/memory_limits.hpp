@@ -28,9 +28,11 @@ void check_memory_for(std::string_view option, double bytes);
 // 1.5 while it grows, is the most they can hold before the cap stops them).
 void check_state_cap_memory(const Problem& problem, std::size_t max_states, const std::string& source);
 
-// Fills in the layered solver's memory and disk caps that are still 0: 80% of the available
-// memory divided among the job's ranks, and 90% of the free space where the scratch files go,
-// so that it stops with a certified interval rather than being killed or filling the disk.
-void apply_default_layered_caps(LayeredSolveOptions& options);
+// The layered solver as the tool runs it (solve, table --exact). Fills in the memory and disk
+// caps that are still 0: 80% of the available memory divided among the job's ranks, and 90% of
+// the free space where the scratch files go, so that it stops with a certified interval rather
+// than being killed or filling the disk. Removes the scratch on SIGINT, SIGTERM and SIGHUP, and
+// says so on standard error (as it does for each directory a killed run left behind).
+void apply_tool_layered_settings(LayeredSolveOptions& options);
 
 }  // namespace ontime::cli

@@ -75,6 +75,15 @@ struct LayeredSolveOptions {
   // Where the layers' scratch files go (a private directory is made inside, and removed at the
   // end); empty: the system's temporary directory.
   std::filesystem::path scratch_directory;
+  // Scratch directories in that folder left by runs on this host whose process is gone (killed,
+  // crashed) are removed before the solve starts (never a live process's): each is reported
+  // here with the bytes it held.
+  std::function<void(const std::filesystem::path&, std::uint64_t bytes)> on_stale_scratch;
+  // Whether SIGINT, SIGTERM and SIGHUP remove the scratch before the process dies of the signal
+  // (one line on standard error names each directory; a handler installed before runs after).
+  // For programs that end on those signals, such as the ontime tool; off by default, so that a
+  // host program's own handlers (Python's) are left alone.
+  bool remove_scratch_on_signal = false;
   // The optimal (or, when bounded, the lower-bound policy's) choice in every state of the first
   // `policy_layers` layers is returned in LayeredSolution::policy.
   int policy_layers = 0;

@@ -20,7 +20,8 @@ ProcessResult run_process(const std::vector<std::string>& arguments, int interru
   });
 }
 
-ProcessResult run_process(const std::vector<std::string>& arguments, const std::function<bool()>& interrupt_when) {
+ProcessResult run_process(const std::vector<std::string>& arguments, const std::function<bool()>& interrupt_when,
+                          int signal_number) {
   int out_pipe[2], err_pipe[2];
   if (::pipe(out_pipe) != 0 || ::pipe(err_pipe) != 0) throw std::runtime_error("pipe failed");
   const pid_t child = ::fork();
@@ -45,7 +46,7 @@ ProcessResult run_process(const std::vector<std::string>& arguments, const std::
   std::array<char, 4096> buffer{};
   while (open > 0) {
     if (!interrupted && interrupt_when()) {
-      ::kill(child, SIGINT);
+      ::kill(child, signal_number);
       interrupted = true;
     }
     if (::poll(fds.data(), fds.size(), interrupted ? -1 : 5) < 0) {

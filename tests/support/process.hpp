@@ -16,8 +16,9 @@ struct ProcessResult {
 // With interrupt_after_ms >= 0, sends SIGINT to the command after that many milliseconds.
 ProcessResult run_process(const std::vector<std::string>& arguments, int interrupt_after_ms = -1);
 
-// Sends SIGINT to the command as soon as `interrupt_when()` holds (asked every 5 ms while the
-// command runs), at most once.
-ProcessResult run_process(const std::vector<std::string>& arguments, const std::function<bool()>& interrupt_when);
+// Sends `signal_number` (SIGINT unless given) to the command as soon as `interrupt_when()` holds
+// (asked every 5 ms while the command runs), at most once.
+ProcessResult run_process(const std::vector<std::string>& arguments, const std::function<bool()>& interrupt_when,
+                          int signal_number = 2 /* SIGINT */);
 
 }  // namespace ontime::testing
