@@ -952,6 +952,37 @@ TEST(Cli, TampStreamsSkeletonsIntoLiveEpisodes) {
   EXPECT_NE(missing.err.find("instance1.json: actions: no action 'move(R1,"), std::string::npos) << missing.err;
 }
 
+// A building whose goal room has no door: every command that reads the world refuses it with
+// the rule, before any work, and no library's raw warning reaches standard error.
+TEST(Cli, AWorldWhoseGoalCannotBeReachedIsRefused) {
+  const std::filesystem::path dir = scratch("unreachable");
+  json building = json::parse(read_file(testing::source_path("data/domains/building-6x5.json")));
+  json doors = json::array();
+  for (const json& door : building["doors"]) {
+    if (door["rooms"][0] != "R30" && door["rooms"][1] != "R30") doors.push_back(door);
+  }
+  ASSERT_LT(doors.size(), building["doors"].size());
+  building["doors"] = doors;
+  const std::string world = (dir / "walled-in.json").string();
+  std::ofstream(world) << building.dump(2);
+  const std::string library = testing::source_path("data/instances/building-6x5-moves.json").string();
+  const std::string expected = world + ": goal_room: R30 cannot be reached from the start room R1";
+  for (const std::vector<std::string>& command :
+       {std::vector<std::string>{"tamp", "--world", world, "--library", library, "--deadline", "60", "--solver",
+                                 "dp-rerun", "--episodes", "2"},
+        std::vector<std::string>{"collect", "--domain", "navigation", "--world", world, "--every-action", "--trials",
+                                 "2", "--log", (dir / "log.jsonl").string(), "-o", (dir / "instance.json").string()},
+        std::vector<std::string>{"map", "--domain", "navigation", "--world", world, "-o",
+                                 (dir / "map.png").string()}}) {
+    const auto result = ontime(command);
+    EXPECT_EQ(result.exit_code, 2) << command[0] << ": " << result.err;
+    EXPECT_NE(result.err.find(expected), std::string::npos) << command[0] << ": " << result.err;
+    EXPECT_EQ(result.err.find("Warning"), std::string::npos) << command[0] << ": " << result.err;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "log.jsonl"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "map.png"));
+}
+
 // Live episodes against the real planner: every episode's charges and timeline in the JSON, one
 // episode's timeline as CSV; the live options need a live run.
 TEST(Cli, RunLiveReportsEveryEpisodesChargesAndTimeline) {

@@ -156,6 +156,15 @@ TEST(NavigationWorld, EveryBrokenRuleIsReportedWithItsPlace) {
        "start.pose", "not inside the start room A"},
       {"start room", [](ordered_json& w) { w["start"]["room"] = "Q"; }, "start.room", "unknown room 'Q'"},
       {"goal is start", [](ordered_json& w) { w["goal_room"] = "A"; }, "goal_room", "must differ"},
+      {"goal unreachable",
+       [](ordered_json& w) {
+         ordered_json doors = ordered_json::array();
+         for (const auto& door : w["doors"]) {
+           if (door["rooms"][0] != "C" && door["rooms"][1] != "C") doors.push_back(door);
+         }
+         w["doors"] = doors;
+       },
+       "goal_room", "C cannot be reached from the start room A"},
       {"resolution", [](ordered_json& w) { w["planner"]["resolution"] = 0.1; }, "planner.resolution",
        "below the wall thickness"},
       {"range", [](ordered_json& w) { w["planner"]["range"] = 0; }, "planner.range", "positive number"},

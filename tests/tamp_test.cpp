@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "ontime/allocator_registry.hpp"
+#include "ontime/domains/library_messages.hpp"
 #include "ontime/domains/navigation.hpp"
 #include "ontime/domains/planner_world.hpp"
 #include "ontime/domains/task_planner.hpp"
@@ -60,6 +61,29 @@ TEST(RoomPaths, EverySimplePathOnceInOrderOfLength) {
   const TaskPlannerFactory factory = room_path_planners(world, 2);
   const auto first = factory();
   EXPECT_EQ(read_all(*first), std::vector<std::vector<std::string>>(paths.begin(), paths.begin() + 2));
+}
+
+// igraph's warnings reach the program through the library-message sink, never standard error
+// raw. A world changed after it was read (the reader refuses an unreachable goal) makes igraph
+// warn that it cannot reach the goal; the planner then finds no path.
+TEST(RoomPaths, IgraphsWarningsGoThroughTheMessageSink) {
+  NavigationWorld world = fixture().domain.world();
+  std::erase_if(world.doors, [&world](const Door& door) {
+    return door.rooms[0] == world.goal_room || door.rooms[1] == world.goal_room;
+  });
+  std::vector<std::string> messages;
+  set_library_message_sink([&messages](std::string_view library, LibraryMessageLevel level, std::string_view text) {
+    messages.push_back(std::string(library) + (level == LibraryMessageLevel::warning ? " warning: " : " error: ") +
+                       std::string(text));
+  });
+  ::testing::internal::CaptureStderr();
+  const auto planner = room_path_planners(world)();
+  EXPECT_FALSE(planner->next().has_value());
+  const std::string printed = ::testing::internal::GetCapturedStderr();
+  set_library_message_sink(nullptr);
+  EXPECT_EQ(printed, "");
+  ASSERT_EQ(messages.size(), 1U);
+  EXPECT_EQ(messages[0], "igraph warning: Couldn't reach some vertices");
 }
 
 // Hands out the given skeletons in order.

@@ -2,11 +2,20 @@
 // commands (collect, map, run, generate-world) exist only in the domains build
 // (ONTIME_BUILD_DOMAINS, which needs OMPL, FCL and KDL); without it they are listed and refused.
 
+#include <fmt/core.h>
+
+#include <cstdio>
+#include <mutex>
+#include <set>
 #include <string>
+#include <utility>
 
 #include "cluster_job.hpp"
 #include "common.hpp"
 #include "ontime/error.hpp"
+#if ONTIME_WITH_DOMAINS
+#include "ontime/domains/library_messages.hpp"
+#endif
 
 namespace ontime::cli {
 namespace {
@@ -22,6 +31,23 @@ void add_unavailable_domain_command(CLI::App& app, const std::string& name) {
                      "' needs the domains build (OMPL, FCL, KDL): this ontime was built with "
                      "ONTIME_BUILD_DOMAINS=OFF");
   });
+}
+#endif
+
+#if ONTIME_WITH_DOMAINS
+// OMPL's and igraph's warnings and errors, each distinct one once, on the rank that prints: a
+// collection plans thousands of motions, and one cause would otherwise repeat thousands of times.
+void print_library_messages_once() {
+  domains::set_library_message_sink(
+      [](std::string_view library, domains::LibraryMessageLevel level, std::string_view text) {
+        static std::mutex mutex;
+        static std::set<std::pair<std::string, std::string>> printed;
+        if (!is_job_root()) return;
+        const std::lock_guard lock(mutex);
+        if (!printed.emplace(std::string(library), std::string(text)).second) return;
+        fmt::print(stderr, "ontime: {} {}: {}\n", library,
+                   level == domains::LibraryMessageLevel::error ? "error" : "warning", text);
+      });
 }
 #endif
 
@@ -49,6 +75,7 @@ std::unique_ptr<CLI::App> make_app() {
   add_sample_log_command(*app);
   add_plot_command(*app);
 #if ONTIME_WITH_DOMAINS
+  print_library_messages_once();
   add_collect_command(*app);
   add_map_command(*app);
   add_run_command(*app);

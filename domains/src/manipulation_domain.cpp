@@ -5,6 +5,7 @@
 
 #include "manipulation_refinement.hpp"
 #include "ompl_support.hpp"
+#include "ontime/domains/library_messages.hpp"
 #include "ontime/domains/manipulation.hpp"
 #include "ontime/domains/manipulation_collision.hpp"
 #include "ontime/domains/world_types.hpp"
@@ -48,7 +49,9 @@ std::vector<std::array<double, 2>> bar(const Eigen::Vector3d& a, const Eigen::Ve
 
 }  // namespace
 
-ManipulationDomain::ManipulationDomain(ManipulationWorld world) : world_(std::move(world)) { detail::quiet_ompl(); }
+ManipulationDomain::ManipulationDomain(ManipulationWorld world) : world_(std::move(world)) {
+  detail::route_ompl_messages();
+}
 
 KitchenState ManipulationDomain::state(const Configuration& configuration) const {
   if (configuration.size() != kRobotValues + kObjectValues * world_.objects.size()) {

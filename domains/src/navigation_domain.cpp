@@ -6,6 +6,7 @@
 
 #include "navigation_refinement.hpp"
 #include "ompl_support.hpp"
+#include "ontime/domains/library_messages.hpp"
 #include "ontime/domains/navigation.hpp"
 #include "ontime/domains/navigation_collision.hpp"
 #include "ontime/random.hpp"
@@ -20,7 +21,7 @@ Pose pose_of(const Configuration& configuration) {
 
 }  // namespace
 
-NavigationDomain::NavigationDomain(NavigationWorld world) : world_(std::move(world)) { detail::quiet_ompl(); }
+NavigationDomain::NavigationDomain(NavigationWorld world) : world_(std::move(world)) { detail::route_ompl_messages(); }
 
 Configuration NavigationDomain::initial_configuration() const {
   return {world_.start.x, world_.start.y, world_.start.theta};

@@ -75,6 +75,7 @@ class WorldReader : detail::WorldFields {
     read_start(member(root, "", "start"), world);
     world.goal_room = room_id(member(root, "", "goal_room"), "goal_room", world);
     if (world.goal_room == world.start_room) fail("goal_room", "the goal room must differ from the start room");
+    check_goal_reachable(world);
     // Optional: a world may be only a map, its skeletons left to a task planner (a generated
     // building has far too many room paths to list).
     if (root.contains("skeletons")) read_skeletons(text, world);
@@ -227,6 +228,33 @@ class WorldReader : detail::WorldFields {
     }
     if (NavigationCollision(world, world.robot.clearance).collides(world.start)) {
       fail("start.pose", "the robot (with its clearance) collides with a wall or furniture there");
+    }
+  }
+
+  // Through the doors, the goal room must be reachable from the start room: otherwise no room
+  // path exists, and every episode would fail before the first motion is planned.
+  void check_goal_reachable(const NavigationWorld& world) const {
+    std::vector<std::vector<int>> neighbours(world.rooms.size());
+    for (const Door& door : world.doors) {
+      const int a = world.room_index(door.rooms[0]), b = world.room_index(door.rooms[1]);
+      neighbours[static_cast<std::size_t>(a)].push_back(b);
+      neighbours[static_cast<std::size_t>(b)].push_back(a);
+    }
+    std::vector<bool> reached(world.rooms.size(), false);
+    std::vector<int> frontier{world.room_index(world.start_room)};
+    reached[static_cast<std::size_t>(frontier.front())] = true;
+    while (!frontier.empty()) {
+      const int room = frontier.back();
+      frontier.pop_back();
+      for (const int next : neighbours[static_cast<std::size_t>(room)]) {
+        if (!reached[static_cast<std::size_t>(next)]) {
+          reached[static_cast<std::size_t>(next)] = true;
+          frontier.push_back(next);
+        }
+      }
+    }
+    if (!reached[static_cast<std::size_t>(world.room_index(world.goal_room))]) {
+      fail("goal_room", world.goal_room + " cannot be reached from the start room " + world.start_room);
     }
   }
 

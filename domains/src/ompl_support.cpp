@@ -12,11 +12,6 @@ namespace ontime::domains::detail {
 namespace ob = ompl::base;
 namespace og = ompl::geometric;
 
-void quiet_ompl() {
-  static std::once_flag quiet;
-  std::call_once(quiet, [] { ompl::msg::setLogLevel(ompl::msg::LOG_NONE); });
-}
-
 ResumableRrtConnect::ResumableRrtConnect(const ob::SpaceInformationPtr& information, const ob::State* from,
                                          const ob::State* to, double range)
     : problem_(std::make_shared<ob::ProblemDefinition>(information)),

@@ -48,10 +48,6 @@ inline void set_se2_pose(ompl::base::State* state, const Pose& pose) {
   se2->setYaw(pose.theta);
 }
 
-// Silences OMPL's console messages (it reports every planner start and stop; a collection
-// runs thousands), once per process.
-void quiet_ompl();
-
 // Uniform poses (x, y within `bounds` = {min x, min y, max x, max y}, heading uniform) in an
 // SE(2) state space.
 class SeededPoseSampler final : public ompl::base::StateSampler {

@@ -6,6 +6,8 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "ontime/domains/library_messages.hpp"
+
 namespace ontime::domains {
 namespace {
 
@@ -96,6 +98,7 @@ class RoomPaths {
     }
     // igraph reports errors by return code once its default handler (which aborts) is off.
     igraph_set_error_handler(igraph_error_handler_ignore);
+    detail::route_igraph_messages();  // its warnings, through OnTime (handlers are per thread)
     const Graph graph(edges.vector, rooms);
     PathList found;
     if (igraph_get_k_shortest_paths(&graph.graph, &weights.vector, &found.list, nullptr, wanted,
