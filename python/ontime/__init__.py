@@ -116,11 +116,36 @@ def _instance_data(data: Mapping[str, Any]) -> Any:
     return out
 
 
+# Problem dicts and planner records are a few levels deep; json.dumps recurses once per level and
+# would end in RecursionError long before the C++ reader's own limits, so deeper input is refused
+# first, without recursion.
+MAX_NESTING = 256
+
+
+def _check_nesting(value: Any, source: str) -> None:
+    """Raises InputError when dicts and lists inside `value` nest deeper than MAX_NESTING."""
+    stack = [(value, 0, "")]
+    while stack:
+        item, depth, place = stack.pop()
+        if isinstance(item, Mapping):
+            children = ((f"{place}.{key}" if place else str(key), child) for key, child in item.items())
+        elif isinstance(item, (list, tuple)):
+            children = ((f"{place}[{index}]", child) for index, child in enumerate(item))
+        else:
+            continue
+        if depth >= MAX_NESTING:
+            shown = place if len(place) <= 80 else place[:77] + "..."
+            raise InputError(f"{source}: {shown or 'top level'}: nested more than {MAX_NESTING} levels deep "
+                             f"(the limit of dicts and lists given to ontime)")
+        stack.extend((child, depth + 1, child_place) for child_place, child in children)
+
+
 def _problem_from_dict(data: Mapping[str, Any], source: str = "<dict>") -> Problem:
     """An instance from a dict in the instance format (SPEC §5); PMFs and CDFs may be sequences or
     numpy arrays indexed by step. Raises InputError naming the place and the rule, as for a file."""
     if not isinstance(data, Mapping):
         raise InputError(f"{source}: the instance must be a JSON object (a dict), got {type(data).__name__}")
+    _check_nesting(data, source)
     try:
         text = json.dumps(_instance_data(data), allow_nan=True)
     except (TypeError, ValueError) as error:
@@ -139,7 +164,8 @@ Problem.to_dict = _problem_to_dict
 
 def _records_text(records: Iterable[Mapping[str, Any]]) -> str:
     lines = []
-    for record in records:
+    for number, record in enumerate(records, start=1):
+        _check_nesting(record, f"<records>: record {number}")
         if not isinstance(record, Mapping):
             lines.append(json.dumps(record) if isinstance(record, (list, str, int, float)) else "null")
         else:

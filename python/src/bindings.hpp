@@ -6,10 +6,14 @@
 #include <pybind11/pybind11.h>
 
 #include <atomic>
+#include <cmath>
+#include <cstddef>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 #include "ontime/allocator.hpp"
@@ -22,6 +26,54 @@
 namespace ontime::python {
 
 namespace py = pybind11;
+
+// ---- numeric arguments that know their name and range ----
+// pybind11 answers a negative count or a seed of 2**64 with a TypeError that lists signatures.
+// A parameter declared as Number<T, "name", min, max> takes any Python int (or, for reals, any
+// int or float; numpy scalars through __index__ / __float__) and raises UsageError naming the
+// parameter and its rule otherwise, as the command line and make_allocator do.
+template <std::size_t N>
+struct ParameterName {
+  char text[N]{};
+  constexpr ParameterName(const char (&name)[N]) {  // NOLINT: implicit, for template arguments
+    for (std::size_t i = 0; i < N; ++i) text[i] = name[i];
+  }
+};
+
+template <class T, ParameterName Name, T Min = std::numeric_limits<T>::lowest(), T Max = std::numeric_limits<T>::max()>
+struct Number {
+  static_assert(std::is_arithmetic_v<T> && !std::is_same_v<T, bool>);
+  T value{};
+  operator T() const noexcept { return value; }  // NOLINT: used as the number it holds
+};
+
+// "parameter 'NAME': RULE (got WHAT)" as a UsageError.
+[[noreturn]] void refuse_number(const char* name, const std::string& rule, py::handle got);
+
+template <class T>
+std::string number_rule(T min, T max) {
+  const auto text = [](T x) {
+    if constexpr (std::is_integral_v<T>) {
+      return std::to_string(x);
+    } else {
+      return std::string(py::str(py::float_(static_cast<double>(x))));
+    }
+  };
+  const char* kind = std::is_integral_v<T>     ? "must be a whole number"
+                     : std::isinf(double(max)) ? "must be a number"
+                                               : "must be a finite number";
+  const bool low = min != std::numeric_limits<T>::lowest(), high = max != std::numeric_limits<T>::max();
+  if (low && !high) return std::string(kind) + " >= " + text(min);
+  if (!low && high && !std::is_integral_v<T>) return std::string(kind) + " <= " + text(max);
+  return std::string(kind) + " from " + text(min) + " to " + text(max);
+}
+
+// Seeds, counts and thread counts, named as the functions name them.
+using Seed = Number<std::uint64_t, "seed">;
+using Episodes = Number<std::uint64_t, "episodes", 1>;
+using Threads = Number<unsigned, "threads", 0, 1024>;
+using Iterations = Number<std::uint64_t, "iterations", 1>;
+using Seconds = Number<double, "seconds", 0.0>;
 
 // An Mdp with the Problem it refers to (an Mdp keeps a reference only).
 struct MdpHandle {
@@ -108,3 +160,52 @@ void bind_live(py::module_& m);
 void bind_domains(py::module_& m);
 
 }  // namespace ontime::python
+
+namespace pybind11::detail {
+
+template <class T, ontime::python::ParameterName Name, T Min, T Max>
+struct type_caster<ontime::python::Number<T, Name, Min, Max>> {
+  using Value = ontime::python::Number<T, Name, Min, Max>;
+  PYBIND11_TYPE_CASTER(Value, const_name<std::is_integral_v<T>>("int", "float"));
+
+  bool load(handle source, bool /*convert*/) {
+    PyObject* object = source.ptr();
+    const std::string rule = ontime::python::number_rule<T>(Min, Max);
+    if (object == nullptr || PyBool_Check(object)) ontime::python::refuse_number(Name.text, rule, source);
+    if constexpr (std::is_integral_v<T>) {
+      if (!PyIndex_Check(object)) ontime::python::refuse_number(Name.text, rule, source);
+      const auto whole = reinterpret_steal<pybind11::int_>(PyNumber_Index(object));
+      if (!whole) throw error_already_set();
+      if (whole < pybind11::int_(Min) || whole > pybind11::int_(Max))
+        ontime::python::refuse_number(Name.text, rule, source);
+      value.value = pybind11::cast<T>(whole);
+    } else {
+      if (!PyFloat_Check(object) && !PyLong_Check(object) && !hasattr(source, "__float__")) {
+        ontime::python::refuse_number(Name.text, rule, source);
+      }
+      const double real = PyFloat_AsDouble(object);
+      if (real == -1.0 && PyErr_Occurred() != nullptr) {
+        PyErr_Clear();  // e.g. an int too large for a double
+        ontime::python::refuse_number(Name.text, rule, source);
+      }
+      // Infinity only where the range ends there (an execution time that cannot be executed).
+      const bool infinite_allowed = std::isinf(static_cast<double>(Max));
+      if (std::isnan(real) || (std::isinf(real) && !(infinite_allowed && real > 0)) ||
+          real < static_cast<double>(Min) || real > static_cast<double>(Max)) {
+        ontime::python::refuse_number(Name.text, rule, source);
+      }
+      value.value = static_cast<T>(real);
+    }
+    return true;
+  }
+
+  static handle cast(const Value& number, return_value_policy, handle) {
+    if constexpr (std::is_integral_v<T>) {
+      return pybind11::int_(number.value).release();
+    } else {
+      return pybind11::float_(static_cast<double>(number.value)).release();
+    }
+  }
+};
+
+}  // namespace pybind11::detail

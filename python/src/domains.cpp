@@ -85,8 +85,9 @@ void bind_domains(py::module_& m) {
 
   m.def(
       "collect",
-      [](const std::shared_ptr<DomainHandle>& domain, std::uint64_t trials, std::uint64_t seed, unsigned threads,
-         const std::string& effort, double checks_per_second, double step_seconds, Steps budget_steps,
+      [](const std::shared_ptr<DomainHandle>& domain, Number<std::uint64_t, "trials", 1> trials, Seed seed,
+         Threads threads, const std::string& effort, Number<double, "checks_per_second", 0.0> checks_per_second,
+         Number<double, "step_seconds", 0.0> step_seconds, Number<Steps, "budget_steps", 0> budget_steps,
          const py::object& progress) {
         if (trials == 0) throw UsageError("trials must be at least 1");
         domains::CollectionOptions options;
@@ -121,9 +122,9 @@ void bind_domains(py::module_& m) {
   m.def(
       "run",
       [](const std::shared_ptr<DomainHandle>& domain, const py::object& problem, const std::string& solver,
-         std::uint64_t episodes, std::uint64_t seed, unsigned threads, const std::string& effort,
-         double checks_per_second, bool independent_starts, bool exact, const py::object& progress,
-         const py::kwargs& kwargs) {
+         Episodes episodes, Seed seed, Threads threads, const std::string& effort,
+         Number<double, "checks_per_second", 0.0> checks_per_second, bool independent_starts, bool exact,
+         const py::object& progress, const py::kwargs& kwargs) {
         if (episodes == 0) throw UsageError("episodes must be at least 1");
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
         const ParameterValues values = parameter_values(kwargs);

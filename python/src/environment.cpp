@@ -30,7 +30,7 @@ class EnvironmentCore {
 
   // Episode e after the seed was last set draws its hidden world from stream_seed(seed, e), as
   // episode e of the episode runner does.
-  py::array_t<float> reset(std::optional<std::uint64_t> seed) {
+  py::array_t<float> reset(std::optional<Seed> seed) {
     if (seed) {
       seed_ = *seed;
       episode_ = 0;
@@ -90,7 +90,7 @@ class EnvironmentCore {
 
 void bind_environment(py::module_& m) {
   py::class_<EnvironmentCore>(m, "_EnvironmentCore")
-      .def(py::init([](const py::object& problem, std::uint64_t seed) {
+      .def(py::init([](const py::object& problem, Seed seed) {
              return std::make_unique<EnvironmentCore>(to_mdp(problem), seed);
            }),
            py::arg("problem"), py::arg("seed"))

@@ -67,9 +67,10 @@ py::dict step_dict(const LiveStep& step, const Problem& problem) {
 void bind_live(py::module_& m) {
   py::class_<ManualClock>(m, "ManualClock",
                           "A clock that stands still until advanced: a live session's time in tests and simulations.")
-      .def(py::init<double>(), py::arg("start") = 0.0)
-      .def("advance", &ManualClock::advance, py::arg("seconds"),
-           "Moves the clock on by `seconds` (>= 0, finite; UsageError otherwise).")
+      .def(py::init([](Number<double, "start"> start) { return ManualClock(start); }), py::arg("start") = 0.0)
+      .def(
+          "advance", [](ManualClock& clock, Seconds seconds) { clock.advance(seconds); }, py::arg("seconds"),
+          "Moves the clock on by `seconds` (>= 0, finite; UsageError otherwise).")
       .def_property_readonly("now", &ManualClock::now, "Seconds since the clock's origin.")
       .def("__repr__", [](const ManualClock& c) { return "ontime.ManualClock(now=" + std::to_string(c.now()) + ")"; });
 
@@ -88,8 +89,8 @@ void bind_live(py::module_& m) {
       "(`allocator`, a registry name, with its parameters as keyword arguments) is made anew for each set. "
       "`clock`: an ontime.ManualClock, or None for the steady clock. `decision_share`: the share of a slice "
       "an anytime allocator (mcts) thinks per decision.")
-      .def(py::init([](const py::object& problem, const std::string& allocator, std::uint64_t seed,
-                       const py::object& clock, double decision_share, const py::kwargs& kwargs) {
+      .def(py::init([](const py::object& problem, const std::string& allocator, Seed seed, const py::object& clock,
+                       Number<double, "decision_share", 0.0, 1.0> decision_share, const py::kwargs& kwargs) {
              if (!clock.is_none() && !py::isinstance<ManualClock>(clock)) {
                throw UsageError("clock must be an ontime.ManualClock or None (the steady clock)");
              }
@@ -113,14 +114,15 @@ void bind_live(py::module_& m) {
           "The planner's call found no motion. Returns the status.")
       .def(
           "report_refined_seconds",
-          [](LiveSessionHandle& h, double seconds) {
+          [](LiveSessionHandle& h,
+             Number<double, "execution_seconds", 0.0, std::numeric_limits<double>::infinity()> seconds) {
             return session_call([&] { return h.session.report_refined_seconds(seconds); });
           },
           py::arg("execution_seconds"),
           "The call found a motion taking `execution_seconds` to execute (math.inf: it cannot be executed).")
       .def(
           "charge_outside",
-          [](LiveSessionHandle& h, double seconds) { session_call([&] { h.session.charge_outside(seconds); }); },
+          [](LiveSessionHandle& h, Seconds seconds) { session_call([&] { h.session.charge_outside(seconds); }); },
           py::arg("seconds"), "Time the clock did not see but the deadline must.")
       .def(
           "add_skeleton",
@@ -134,7 +136,7 @@ void bind_live(py::module_& m) {
           "(ontime.Action objects, e.g. Problem.from_dict(...).actions). Returns its index.")
       .def(
           "retire_skeleton",
-          [](LiveSessionHandle& h, int k) {
+          [](LiveSessionHandle& h, Number<int, "skeleton", 0> k) {
             session_call([&] { h.session.retire_skeleton(k); });
             h.current = std::make_shared<const Problem>(h.session.problem());
           },

@@ -76,8 +76,11 @@ void bind_model(py::module_& m) {
           },
           "P(T = t) for t = 0, 1, ... as a numpy array (zero beyond its end).")
       .def_property_readonly("never", &Distribution::never, "P(T is never): the mass no listed step covers.")
-      .def("cdf", &Distribution::cdf, py::arg("t"), "P(T <= t).")
-      .def("survival", &Distribution::survival, py::arg("t"), "P(T > t), \"never\" included.")
+      .def(
+          "cdf", [](const Distribution& d, Number<Steps, "t"> t) { return d.cdf(t); }, py::arg("t"), "P(T <= t).")
+      .def(
+          "survival", [](const Distribution& d, Number<Steps, "t"> t) { return d.survival(t); }, py::arg("t"),
+          "P(T > t), \"never\" included.")
       .def("hazard", &Distribution::hazard, py::arg("spent"),
            "P(T = spent + 1 | T > spent): the chance that one more step finishes.")
       .def("mean_finite", &Distribution::mean_finite, "E[T | T finite] (inf when nothing is finite).")
@@ -88,7 +91,9 @@ void bind_model(py::module_& m) {
           "max_step", [](const Distribution& d) { return step_or_none(d.max_step()); },
           "Largest step with positive mass, or None.")
       .def(
-          "quantile", [](const Distribution& d, double u) { return step_or_none(d.quantile(u)); }, py::arg("u"),
+          "quantile",
+          [](const Distribution& d, Number<double, "u", 0.0, 1.0> u) { return step_or_none(d.quantile(u)); },
+          py::arg("u"),
           "The smallest t with cdf(t) > u, or None (\"never\").")
       .def(py::self == py::self)  // NOLINT(misc-redundant-expression)
       .def("__repr__", [](const Distribution& d) {
@@ -206,7 +211,10 @@ void bind_model(py::module_& m) {
           },
           "The start state.")
       .def(
-          "next_action", [](const MdpHandle& h, const StateView& s, int k) { return h.mdp.next_action(s.state, k); },
+          "next_action",
+          [](const MdpHandle& h, const StateView& s, Number<int, "skeleton", 0> k) {
+            return h.mdp.next_action(s.state, k);
+          },
           py::arg("state"), py::arg("skeleton"), "The action skeleton k refines next, or -1 when it is fully refined.")
       .def(
           "useful_choices",
@@ -217,7 +225,10 @@ void bind_model(py::module_& m) {
           },
           py::arg("state"), "The choices worth considering (one per group sharing a next action), ascending.")
       .def(
-          "can_succeed", [](const MdpHandle& h, const StateView& s, int k) { return h.mdp.can_succeed(s.state, k); },
+          "can_succeed",
+          [](const MdpHandle& h, const StateView& s, Number<int, "skeleton", 0> k) {
+            return h.mdp.can_succeed(s.state, k);
+          },
           py::arg("state"), py::arg("skeleton"), "Whether skeleton k can still meet the deadline from this state.");
 
   // Planner logs and fitting. Records given from Python are read as JSON Lines text by the
@@ -251,7 +262,8 @@ void bind_model(py::module_& m) {
   m.def(
       "_fit",
       [](const std::string& log, bool log_is_path, const std::string& skeleton_data, bool skeletons_are_path,
-         double step, Steps deadline, double laplace, const std::string& name, const std::string& description) {
+         Number<double, "step", 0.0> step, Number<Steps, "deadline", 1> deadline,
+         Number<double, "laplace", 0.0> laplace, const std::string& name, const std::string& description) {
         const std::string log_source = log_is_path ? log : "<records>";
         const std::vector<RefinementAttempt> attempts =
             log_is_path ? load_planner_log(log) : parse_planner_log(log, log_source);

@@ -33,6 +33,18 @@ std::shared_ptr<MdpHandle> to_mdp(const py::object& source) {
                        std::string(py::str(py::type::of(source).attr("__name__"))));
 }
 
+void refuse_number(const char* name, const std::string& rule, py::handle got) {
+  std::string shown;
+  if (PyBool_Check(got.ptr())) {
+    shown = "a bool";
+  } else if (py::isinstance<py::int_>(got) || py::isinstance<py::float_>(got)) {
+    shown = py::str(got);
+  } else {
+    shown = "a " + std::string(py::str(py::type::of(got).attr("__name__")));
+  }
+  throw UsageError("parameter '" + std::string(name) + "': " + rule + " (got " + shown + ")");
+}
+
 std::string instance_label(const py::object& source, const Problem& problem) {
   if (py::isinstance<py::str>(source) || py::hasattr(source, "__fspath__")) {
     return py::str(py::module_::import("os").attr("fspath")(source));

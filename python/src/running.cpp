@@ -22,7 +22,7 @@ namespace ontime::python {
 
 namespace {
 
-DecisionBudget budget_of(std::optional<std::uint64_t> iterations, std::optional<double> seconds) {
+DecisionBudget budget_of(std::optional<Iterations> iterations, std::optional<Seconds> seconds) {
   if (iterations && seconds) return DecisionBudget::either(*iterations, *seconds);
   if (iterations) return DecisionBudget::iterations(*iterations);
   if (seconds) return DecisionBudget::seconds(*seconds);
@@ -174,12 +174,12 @@ void bind_running(py::module_& m) {
           "is_stationary", [](const AllocatorHandle& h) { return h.allocator->is_stationary(); },
           "True when its choice is a function of the state alone (exact evaluation applies).")
       .def(
-          "begin_episode", [](AllocatorHandle& h, std::uint64_t seed) { h.allocator->begin_episode(seed); },
-          py::arg("seed"), "Starts a new episode; `seed` seeds its randomness.")
+          "begin_episode", [](AllocatorHandle& h, Seed seed) { h.allocator->begin_episode(seed); }, py::arg("seed"),
+          "Starts a new episode; `seed` seeds its randomness.")
       .def(
           "choose",
-          [](AllocatorHandle& h, const StateView& state, std::optional<std::uint64_t> iterations,
-             std::optional<double> seconds) {
+          [](AllocatorHandle& h, const StateView& state, std::optional<Iterations> iterations,
+             std::optional<Seconds> seconds) {
             const DecisionBudget budget = budget_of(iterations, seconds);
             const py::gil_scoped_release release;
             return h.allocator->choose(state.state, budget);
@@ -236,8 +236,8 @@ void bind_running(py::module_& m) {
       "    if session.status == ontime.Status.success: execute(session.solution)\n\n"
       "`iterations` / `seconds` set the per-decision budget of an anytime allocator (mcts) for every decision; "
       "choose() may override it for one. The allocator must not serve another session at the same time.")
-      .def(py::init([](std::shared_ptr<AllocatorHandle> allocator, std::uint64_t seed,
-                       std::optional<std::uint64_t> iterations, std::optional<double> seconds) {
+      .def(py::init([](std::shared_ptr<AllocatorHandle> allocator, Seed seed, std::optional<Iterations> iterations,
+                       std::optional<Seconds> seconds) {
              return std::make_unique<SessionHandle>(std::move(allocator), seed, budget_of(iterations, seconds));
            }),
            py::arg("allocator"), py::arg("seed") = 0, py::kw_only(), py::arg("iterations") = py::none(),
@@ -252,7 +252,7 @@ void bind_running(py::module_& m) {
           "Asks the allocator for the next step (within the session's budget).")
       .def(
           "choose",
-          [](SessionHandle& h, std::optional<std::uint64_t> iterations, std::optional<double> seconds) {
+          [](SessionHandle& h, std::optional<Iterations> iterations, std::optional<Seconds> seconds) {
             const DecisionBudget budget = budget_of(iterations, seconds);
             const int skeleton = session_call([&] { return h.session.choose(budget).skeleton; });
             return DecisionView{skeleton, h.session.mdp().next_action(h.session.state(), skeleton),
@@ -294,8 +294,8 @@ void bind_running(py::module_& m) {
 
   m.def(
       "run_episodes",
-      [](const py::object& problem, const py::object& world, const py::object& allocator, std::uint64_t episodes,
-         std::uint64_t seed, unsigned threads, std::optional<std::uint64_t> iterations, std::optional<double> seconds,
+      [](const py::object& problem, const py::object& world, const py::object& allocator, Episodes episodes, Seed seed,
+         Threads threads, std::optional<Iterations> iterations, std::optional<Seconds> seconds,
          const py::object& progress, const py::kwargs& kwargs) {
         check_episodes(episodes);
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
@@ -360,8 +360,8 @@ void bind_running(py::module_& m) {
 
   m.def(
       "evaluate",
-      [](const py::object& problem, const std::string& solver, std::uint64_t episodes, std::uint64_t seed,
-         unsigned threads, bool exact, const py::object& progress, const py::kwargs& kwargs) {
+      [](const py::object& problem, const std::string& solver, Episodes episodes, Seed seed, Threads threads,
+         bool exact, const py::object& progress, const py::kwargs& kwargs) {
         check_episodes(episodes);
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
         const ParameterValues values = parameter_values(kwargs);
@@ -392,8 +392,8 @@ void bind_running(py::module_& m) {
 
   m.def(
       "solve",
-      [](const py::object& problem, std::size_t max_states, unsigned threads, const std::string& method,
-         double tolerance) {
+      [](const py::object& problem, Number<std::uint64_t, "max_states", 1> max_states, Threads threads,
+         const std::string& method, Number<double, "tolerance", 0.0, 1.0> tolerance) {
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
         if (max_states == 0) throw UsageError("max_states must be at least 1");
         if (method != "layered" && method != "split") {
@@ -463,8 +463,7 @@ void bind_running(py::module_& m) {
 
   m.def(
       "train_ppo",
-      [](const py::object& problem, const py::object& out, std::uint64_t episodes, std::uint64_t seed,
-         const py::object& progress) {
+      [](const py::object& problem, const py::object& out, Episodes episodes, Seed seed, const py::object& progress) {
         check_episodes(episodes);
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
         const std::string path = py::str(py::module_::import("os").attr("fspath")(out));
