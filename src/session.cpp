@@ -9,6 +9,7 @@
 
 #include "ontime/error.hpp"
 #include "ontime/random.hpp"
+#include "ontime/statistics.hpp"
 
 namespace ontime {
 namespace {
@@ -70,6 +71,12 @@ void Session::start_live(const Clock& clock, LiveOptions options) {
   timeline_.reserve(static_cast<std::size_t>(mdp_->deadline()));
   started_ = clock_->now();
   last_report_ = started_;
+}
+
+std::uint64_t Session::search_iterations() const {
+  Statistics statistics;
+  allocator_->collect_statistics(statistics);
+  return static_cast<std::uint64_t>(statistics.find("iterations").value_or(0.0));
 }
 
 double Session::step_seconds() const noexcept { return mdp_->problem().step_seconds(); }
@@ -146,11 +153,21 @@ Decision Session::choose(const DecisionBudget& budget) {
   end_if_out_of_time();
   if (status_ != Status::running) return Decision{};
   DecisionBudget own_budget;
+  const ThinkingModel* model = clock_->thinking_model();
   if (!budget.is_set()) {
     const double left = deadline_seconds() - elapsed_seconds();
-    own_budget = DecisionBudget::seconds(std::max(1e-9, std::min(live_.decision_share * step_seconds_, left)));
+    const double seconds = std::max(1e-9, std::min(live_.decision_share * step_seconds_, left));
+    own_budget = model != nullptr ? DecisionBudget::iterations(model->iterations_within(seconds))
+                                  : DecisionBudget::seconds(seconds);
+  } else if (model != nullptr && budget.max_seconds()) {
+    // On a modelled clock a time budget is the iterations that fit in it: real time would make
+    // the search, and so the report, depend on the machine.
+    const std::uint64_t fit = model->iterations_within(*budget.max_seconds());
+    own_budget = DecisionBudget::iterations(budget.max_iterations() ? std::min(*budget.max_iterations(), fit) : fit);
   }
-  const int choice = allocator_->choose(state_, budget.is_set() ? budget : own_budget);
+  const std::uint64_t searched_before = model != nullptr ? search_iterations() : 0;
+  const int choice = allocator_->choose(state_, own_budget.is_set() ? own_budget : budget);
+  if (model != nullptr) clock_->charge_thinking(search_iterations() - searched_before);
   if (choice < 0 || choice >= mdp_->skeleton_count()) {
     throw UsageError("allocator '" + std::string(allocator_->name()) + "' chose skeleton " + std::to_string(choice) +
                      ", outside [0, " + std::to_string(mdp_->skeleton_count()) + ")");

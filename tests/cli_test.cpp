@@ -983,6 +983,60 @@ TEST(Cli, AWorldWhoseGoalCannotBeReachedIsRefused) {
   EXPECT_FALSE(std::filesystem::exists(dir / "map.png"));
 }
 
+// With --clock model nothing real is on the clock: each decision is charged the model's seconds
+// (here dp-rerun, which does not search: 10 us), the allocator's handling of an outcome nothing,
+// and the episodes are the same, to every charge, for any thread count.
+TEST(Cli, TampOnTheModelledClockReproducesToTheEpisode) {
+  const std::string world = testing::source_path("data/domains/navigation.json").string();
+  const std::string library = testing::source_path("data/instances/navigation.json").string();
+  const auto run = [&](const std::string& threads, const std::string& solver) {
+    std::vector<std::string> command = {"tamp",  "--world",         world,  "--library",  library, "--deadline",
+                                        "45",    "--solver",        solver, "--episodes", "6",     "--threads",
+                                        threads, "--max-skeletons", "3",    "--clock",    "model", "--json"};
+    if (solver == "mcts") command.insert(command.end(), {"--iterations", "40"});
+    const auto result = ontime(command);
+    EXPECT_EQ(result.exit_code, 0) << result.err;
+    json out = json::parse(result.out);
+    out.erase("seconds");  // the run's own duration
+    return out;
+  };
+  const json one = run("1", "dp-rerun");
+  EXPECT_EQ(one, run("2", "dp-rerun"));
+  EXPECT_EQ(one["clock"], "model");
+  std::size_t steps = 0;
+  for (const json& episode : one["episode_results"]) {
+    for (const json& step : episode["timeline"]) {
+      EXPECT_NEAR(step["decision_seconds"].get<double>(), 1e-5, 1e-12);
+      EXPECT_EQ(step["observe_seconds"].get<double>(), 0.0);
+      ++steps;
+    }
+  }
+  EXPECT_GT(steps, 6U);
+  // A searching allocator: 10 us + 2 us for each of its 40 iterations when it searches (not
+  // where one choice is all there is).
+  const json searched = run("2", "mcts");
+  EXPECT_EQ(searched, run("1", "mcts"));
+  std::size_t searches = 0;
+  for (const json& episode : searched["episode_results"]) {
+    for (const json& step : episode["timeline"]) {
+      const double seconds = step["decision_seconds"].get<double>();
+      const bool searched_here = std::abs(seconds - (1e-5 + 40 * 2e-6)) < 1e-12;
+      EXPECT_TRUE(searched_here || std::abs(seconds - 1e-5) < 1e-12) << seconds;
+      searches += searched_here ? 1 : 0;
+    }
+  }
+  EXPECT_GT(searches, 0U);
+
+  const auto real_with_model_options = ontime({"tamp", "--world", world, "--library", library, "--deadline", "45",
+                                               "--solver", "dp-rerun", "--decision-seconds", "0.001"});
+  EXPECT_EQ(real_with_model_options.exit_code, 2);
+  EXPECT_NE(real_with_model_options.err.find("need --clock model"), std::string::npos) << real_with_model_options.err;
+  const auto wall = ontime({"tamp", "--world", world, "--library", library, "--deadline", "45", "--solver", "dp-rerun",
+                            "--clock", "model", "--effort", "wall"});
+  EXPECT_EQ(wall.exit_code, 2);
+  EXPECT_NE(wall.err.find("--clock model needs --effort checks"), std::string::npos) << wall.err;
+}
+
 // Live episodes against the real planner: every episode's charges and timeline in the JSON, one
 // episode's timeline as CSV; the live options need a live run.
 TEST(Cli, RunLiveReportsEveryEpisodesChargesAndTimeline) {

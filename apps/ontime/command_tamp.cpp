@@ -102,6 +102,8 @@ void add_tamp_command(CLI::App& app) {
     int period = 2;
     int max_skeletons = 16;
     double decision_share = 0.5;
+    std::string clock = "real";
+    ThinkingModel thinking;
     std::string picture;
     std::uint64_t picture_episode = 0;
     bool no_plot = false;
@@ -136,6 +138,17 @@ void add_tamp_command(CLI::App& app) {
                     Problem::kMaxSkeletons);
   add_number_option(*command, "--decision-share", options->decision_share,
                     "Share of a slice an anytime allocator thinks per decision (without its own budget)", 1e-9, 1e6);
+  command
+      ->add_option("--clock", options->clock,
+                   "real: the allocator's thinking and the task planner's search take the real time they take (a "
+                   "robot's view); model: thinking is charged by --decision-seconds and --iteration-seconds, and "
+                   "nothing real is on the clock, so the same seed gives the same episodes on any machine (reports)")
+      ->check(CLI::IsMember({"real", "model"}))
+      ->capture_default_str();
+  add_number_option(*command, "--decision-seconds", options->thinking.seconds_per_decision,
+                    "--clock model: seconds charged per decision", 0.0, 1e6);
+  add_number_option(*command, "--iteration-seconds", options->thinking.seconds_per_iteration,
+                    "--clock model: seconds charged per search iteration of an anytime allocator", 1e-12, 1e6);
   command->add_option("--picture", options->picture,
                       "Draw one episode: the map into this PNG (data beside it as .json) and the timeline into "
                       "NAME-timeline.png (data as .csv)");
@@ -146,6 +159,13 @@ void add_tamp_command(CLI::App& app) {
   command->callback([options, command] {
     if (options->picture.empty() && (command->count("--picture-episode") > 0 || options->no_plot)) {
       throw UsageError("--picture-episode and --no-plot need --picture");
+    }
+    if (options->clock == "real" &&
+        (command->count("--decision-seconds") > 0 || command->count("--iteration-seconds") > 0)) {
+      throw UsageError("--decision-seconds and --iteration-seconds need --clock model");
+    }
+    if (options->clock == "model" && options->effort != "checks") {
+      throw UsageError("--clock model needs --effort checks (wall-clock effort is real time)");
     }
     if (options->picture_episode >= options->episodes) {
       throw UsageError(fmt::format("--picture-episode {}: the run has episodes 0 to {}", options->picture_episode,
@@ -213,6 +233,7 @@ void add_tamp_command(CLI::App& app) {
     domains::PlannerWorldOptions planner;
     planner.effort.unit = domains::parse_effort_unit(options->effort);
     planner.effort.checks_per_second = loaded.defaults.collection.checks_per_second;
+    if (options->clock == "model") planner.thinking = options->thinking;
 
     MonteCarloOptions episodes;
     // An anytime allocator given its own budget (--iterations, --time-budget) thinks that much per
@@ -291,6 +312,11 @@ void add_tamp_command(CLI::App& app) {
       out["max_skeletons"] = options->max_skeletons;
       out["effort"] = options->effort;
       out["decision_share"] = options->decision_share;
+      out["clock"] = options->clock;
+      if (options->clock == "model") {
+        out["decision_seconds"] = options->thinking.seconds_per_decision;
+        out["iteration_seconds"] = options->thinking.seconds_per_iteration;
+      }
       out["episodes"] = summary.episodes;
       out["seed"] = options->seed;
       out["successes"] = summary.successes;
@@ -322,6 +348,12 @@ void add_tamp_command(CLI::App& app) {
         summary.live_mean.decision, summary.live_mean.planning, summary.live_mean.overrun, summary.live_mean.outside,
         summary.live_mean.elapsed, deadline_seconds);
     fmt::print("refinements started  {:.2f} per episode\n", refinements_started);
+    if (options->clock == "model") {
+      fmt::print("clock                model: {} s per decision, {} s per search iteration; nothing real\n",
+                 options->thinking.seconds_per_decision, options->thinking.seconds_per_iteration);
+    } else {
+      fmt::print("clock                real (thinking and search as measured; --clock model to reproduce)\n");
+    }
     if (!map_data.empty()) {
       fmt::print("picture              episode {}: {}, {}{}\n", options->picture_episode, map_data.string(),
                  timeline_data.string(),

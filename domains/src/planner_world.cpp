@@ -12,7 +12,7 @@
 namespace ontime::domains {
 
 PlannerWorld::PlannerWorld(const Domain& domain, const Problem& problem, const PlannerWorldOptions& options)
-    : domain_(&domain), step_seconds_(problem.step_seconds()), options_(options) {
+    : domain_(&domain), step_seconds_(problem.step_seconds()), options_(options), nominal_clock_(options.thinking) {
   for (int a = 0; a < problem.action_count(); ++a)
     actions_.push_back(TreeAction{problem.action(a).id, problem.parent(a)});
   refinements_.resize(actions_.size());
@@ -20,7 +20,7 @@ PlannerWorld::PlannerWorld(const Domain& domain, const Problem& problem, const P
 
 PlannerWorld::PlannerWorld(const Domain& domain, const StreamingWorldOptions& streaming,
                            const PlannerWorldOptions& options)
-    : domain_(&domain), step_seconds_(0), options_(options), streaming_(streaming) {
+    : domain_(&domain), step_seconds_(0), options_(options), streaming_(streaming), nominal_clock_(options.thinking) {
   if (streaming.library == nullptr) throw std::invalid_argument("a streaming world needs a library of actions");
   if (!streaming.task_planners) throw std::invalid_argument("a streaming world needs a task planner");
   if (!(streaming.seconds_per_skeleton >= 0) || std::isinf(streaming.seconds_per_skeleton)) {
@@ -32,6 +32,9 @@ PlannerWorld::PlannerWorld(const Domain& domain, const StreamingWorldOptions& st
 
 void PlannerWorld::begin_episode(std::uint64_t seed) {
   seed_ = seed;
+  // Every episode's modelled time starts from 0, so that its sums do not depend on the episodes
+  // this world ran before (which depend on the thread count).
+  nominal_clock_.restart();
   for (std::unique_ptr<Refinement>& refinement : refinements_) refinement.reset();
   if (task_planner_) {
     task_planner_->restart();

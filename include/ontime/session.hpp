@@ -176,6 +176,8 @@ class Session {
 
  private:
   void start_live(const Clock& clock, LiveOptions options);
+  // The search iterations the allocator has run so far (its "iterations" counter; 0 if none).
+  std::uint64_t search_iterations() const;
   Status report(const Observation& observation, double execution_seconds);
   Steps steps_at(double seconds) const noexcept;
   void end_if_out_of_time();

@@ -33,21 +33,43 @@ struct PlannerWorldOptions {
   // the episode's seed) instead of where the refinement before it ended, which removes the
   // dependence between consecutive refinements that the MDP does not model.
   bool independent_starts = false;
+  // Live episodes in the collision-checks unit: charge the allocator's thinking by this model
+  // instead of real time (NominalPlanningClock); nothing real is then on the clock.
+  std::optional<ThinkingModel> thinking;
 };
 
-// The clock of live episodes in the collision-checks unit: the steady clock, except that each
-// planner call counts as the nominal seconds of its collision checks instead of the real time
-// it took. The allocator's thinking and the caller's time stay real, so a live episode on it
-// charges them against a planner as slow as the model says.
+// The clock of live episodes in the collision-checks unit. Each planner call counts as the
+// nominal seconds of its collision checks instead of the real time it took. Without a thinking
+// model it is otherwise the steady clock: the allocator's thinking, the task planner's search and
+// the caller's time stay real, so a live episode charges them against a planner as slow as the
+// model says (a robot's view). With a thinking model nothing real is on it: decisions are charged
+// by the model (clock.hpp), so that the same seed gives the same episodes to the last one on any
+// machine and under any load (reports).
 class NominalPlanningClock final : public Clock {
  public:
-  double now() const override { return steady_.now() + offset_; }
+  explicit NominalPlanningClock(std::optional<ThinkingModel> thinking = std::nullopt) : thinking_(thinking) {}
+  double now() const override { return thinking_ ? modelled_ : steady_.now() + offset_; }
   // A planner call took `real_seconds` and counts as `nominal_seconds`.
-  void count_call(double real_seconds, double nominal_seconds) noexcept { offset_ += nominal_seconds - real_seconds; }
+  void count_call(double real_seconds, double nominal_seconds) noexcept {
+    offset_ += nominal_seconds - real_seconds;
+    modelled_ += nominal_seconds;
+  }
+  // A new episode: the modelled time starts again from 0 (the steady clock cannot).
+  void restart() noexcept { modelled_ = 0; }
+  const ThinkingModel* thinking_model() const noexcept override { return thinking_ ? &*thinking_ : nullptr; }
+  void charge_thinking(std::uint64_t iterations) const override {
+    if (thinking_) {
+      modelled_ += thinking_->seconds_per_decision + thinking_->seconds_per_iteration * static_cast<double>(iterations);
+    }
+  }
 
  private:
   SteadyClock steady_;
+  std::optional<ThinkingModel> thinking_;
   double offset_ = 0;
+  // The modelled time: planner calls and charged thinking. Mutable: sessions hold clocks as
+  // const and charge a decision's thinking through them.
+  mutable double modelled_ = 0;
 };
 
 // Streaming episodes (episode_runner.hpp, run_streaming_episodes): skeletons come from a task
