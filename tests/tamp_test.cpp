@@ -23,7 +23,7 @@ namespace {
 struct Fixture {
   NavigationDomain domain{load_navigation_world(testing::source_path("data/domains/navigation.json"))};
   Problem library{load_problem(testing::source_path("data/instances/navigation.json"))};
-  PlannerWorldOptions options{EffortSettings{EffortUnit::collision_checks, 1200.0}, false};
+  PlannerWorldOptions options{EffortSettings{EffortUnit::collision_checks, 1200.0}, false, std::nullopt};
 };
 
 const Fixture& fixture() {
