@@ -25,7 +25,10 @@ namespace {
 void add_unavailable_domain_command(CLI::App& app, const std::string& name) {
   CLI::App* command =
       app.add_subcommand(name, "(needs the domains build: this ontime was built with ONTIME_BUILD_DOMAINS=OFF)");
+  // Whatever follows the name is this command's (it is refused as a whole): nothing falls through
+  // to the top level, where it would be reported as unexpected arguments instead.
   command->allow_extras();
+  command->fallthrough(false);
   command->callback([name] {
     throw UsageError("'" + name +
                      "' needs the domains build (OMPL, FCL, KDL): this ontime was built with "
