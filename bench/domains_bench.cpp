@@ -17,7 +17,7 @@
 #include "ontime/domains/navigation.hpp"
 #include "ontime/domains/navigation_collision.hpp"
 #include "ontime/domains/task_planner.hpp"
-#include "ontime/random.hpp"
+#include "ontime/util/random.hpp"
 
 namespace {
 

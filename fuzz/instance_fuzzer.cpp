@@ -6,10 +6,10 @@
 #include <cstdint>
 #include <string_view>
 
-#include "ontime/contiguous_success.hpp"
-#include "ontime/error.hpp"
-#include "ontime/instance_io.hpp"
-#include "ontime/mdp.hpp"
+#include "ontime/mdp/mdp.hpp"
+#include "ontime/model/instance_io.hpp"
+#include "ontime/solve/contiguous_success.hpp"
+#include "ontime/util/error.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);

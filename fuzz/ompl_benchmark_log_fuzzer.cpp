@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <string_view>
 
-#include "ontime/error.hpp"
-#include "ontime/ompl_benchmark_log.hpp"
+#include "ontime/model/ompl_benchmark_log.hpp"
+#include "ontime/util/error.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);

@@ -9,10 +9,10 @@
 #include <string>
 #include <string_view>
 
-#include "ontime/error.hpp"
-#include "ontime/fitting.hpp"
-#include "ontime/planner_log.hpp"
-#include "ontime/skeleton_file.hpp"
+#include "ontime/learn/fitting.hpp"
+#include "ontime/model/planner_log.hpp"
+#include "ontime/model/skeleton_file.hpp"
+#include "ontime/util/error.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);

@@ -12,7 +12,7 @@
 
 #include "cluster_job.hpp"
 #include "common.hpp"
-#include "ontime/error.hpp"
+#include "ontime/util/error.hpp"
 #if ONTIME_WITH_DOMAINS
 #include "ontime/domains/library_messages.hpp"
 #endif

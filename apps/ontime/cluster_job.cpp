@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "ontime/error.hpp"
+#include "ontime/util/error.hpp"
 
 #if ONTIME_WITH_MPI
 #include <mpi.h>

@@ -15,7 +15,7 @@
 // (2 for bad input or usage). A rank that fails later, when the others may be waiting on it,
 // prints its message and ends the whole job (MPI_Abort) with its code.
 
-#include "ontime/ranks.hpp"
+#include "ontime/util/ranks.hpp"
 
 namespace ontime::cli {
 

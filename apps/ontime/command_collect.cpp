@@ -16,11 +16,11 @@
 #include "ontime/domains/collection.hpp"
 #include "ontime/domains/collection_journal.hpp"
 #include "ontime/domains/registry.hpp"
-#include "ontime/error.hpp"
-#include "ontime/fitting.hpp"
-#include "ontime/input_file.hpp"
-#include "ontime/instance_io.hpp"
-#include "ontime/ompl_benchmark_log.hpp"
+#include "ontime/learn/fitting.hpp"
+#include "ontime/model/instance_io.hpp"
+#include "ontime/model/ompl_benchmark_log.hpp"
+#include "ontime/util/error.hpp"
+#include "ontime/util/input_file.hpp"
 #include "output_paths.hpp"
 
 namespace ontime::cli {

@@ -6,7 +6,7 @@
 #include "common.hpp"
 #include "memory_limits.hpp"
 #include "ontime/allocators/optimal.hpp"
-#include "ontime/instance_io.hpp"
+#include "ontime/model/instance_io.hpp"
 
 namespace ontime::cli {
 

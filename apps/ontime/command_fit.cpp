@@ -13,11 +13,11 @@
 #include "common.hpp"
 #include "fit_report.hpp"
 #include "number_options.hpp"
-#include "ontime/error.hpp"
-#include "ontime/fitting.hpp"
-#include "ontime/instance_io.hpp"
-#include "ontime/ompl_benchmark_log.hpp"
-#include "ontime/planner_log.hpp"
+#include "ontime/learn/fitting.hpp"
+#include "ontime/model/instance_io.hpp"
+#include "ontime/model/ompl_benchmark_log.hpp"
+#include "ontime/model/planner_log.hpp"
+#include "ontime/util/error.hpp"
 #include "output_paths.hpp"
 
 namespace ontime::cli {

@@ -6,9 +6,9 @@
 
 #include "common.hpp"
 #include "number_options.hpp"
-#include "ontime/atomic_file.hpp"
 #include "ontime/domains/navigation_generator.hpp"
-#include "ontime/error.hpp"
+#include "ontime/util/atomic_file.hpp"
+#include "ontime/util/error.hpp"
 #include "output_paths.hpp"
 
 namespace ontime::cli {

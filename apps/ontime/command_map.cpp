@@ -9,9 +9,9 @@
 #include "common.hpp"
 #include "data_paths.hpp"
 #include "number_options.hpp"
-#include "ontime/atomic_file.hpp"
 #include "ontime/domains/collection.hpp"
 #include "ontime/domains/registry.hpp"
+#include "ontime/util/atomic_file.hpp"
 #include "output_paths.hpp"
 #include "python_runner.hpp"
 

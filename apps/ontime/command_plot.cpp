@@ -7,8 +7,8 @@
 #include <filesystem>
 
 #include "common.hpp"
-#include "ontime/atomic_file.hpp"
-#include "ontime/instance_io.hpp"
+#include "ontime/model/instance_io.hpp"
+#include "ontime/util/atomic_file.hpp"
 #include "output_paths.hpp"
 #include "python_runner.hpp"
 

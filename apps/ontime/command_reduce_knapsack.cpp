@@ -4,8 +4,8 @@
 #include <fmt/format.h>
 
 #include "common.hpp"
-#include "ontime/instance_io.hpp"
-#include "ontime/knapsack.hpp"
+#include "ontime/model/instance_io.hpp"
+#include "ontime/solve/knapsack.hpp"
 #include "output_paths.hpp"
 
 namespace ontime::cli {

@@ -5,10 +5,10 @@
 
 #include "common.hpp"
 #include "number_options.hpp"
-#include "ontime/atomic_file.hpp"
-#include "ontime/instance_io.hpp"
-#include "ontime/log_sampling.hpp"
-#include "ontime/planner_log.hpp"
+#include "ontime/learn/log_sampling.hpp"
+#include "ontime/model/instance_io.hpp"
+#include "ontime/model/planner_log.hpp"
+#include "ontime/util/atomic_file.hpp"
 #include "output_paths.hpp"
 
 namespace ontime::cli {

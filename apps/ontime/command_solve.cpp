@@ -13,10 +13,10 @@
 #include "memory_limits.hpp"
 #include "number_options.hpp"
 #include "ontime/allocators/optimal.hpp"
-#include "ontime/atomic_file.hpp"
-#include "ontime/error.hpp"
-#include "ontime/instance_io.hpp"
-#include "ontime/layered_solver.hpp"
+#include "ontime/model/instance_io.hpp"
+#include "ontime/solve/layered_solver.hpp"
+#include "ontime/util/atomic_file.hpp"
+#include "ontime/util/error.hpp"
 
 namespace ontime::cli {
 namespace {

@@ -18,9 +18,9 @@
 #include "markdown_table.hpp"
 #include "memory_limits.hpp"
 #include "ontime/allocators/optimal.hpp"
-#include "ontime/error.hpp"
-#include "ontime/instance_io.hpp"
-#include "ontime/layered_solver.hpp"
+#include "ontime/model/instance_io.hpp"
+#include "ontime/solve/layered_solver.hpp"
+#include "ontime/util/error.hpp"
 
 namespace ontime::cli {
 namespace {

@@ -10,10 +10,10 @@
 
 #include "common.hpp"
 #include "number_options.hpp"
-#include "ontime/error.hpp"
-#include "ontime/instance_io.hpp"
-#include "ontime/output_set.hpp"
-#include "ontime/ppo_training.hpp"
+#include "ontime/learn/ppo_training.hpp"
+#include "ontime/model/instance_io.hpp"
+#include "ontime/util/error.hpp"
+#include "ontime/util/output_set.hpp"
 #include "output_paths.hpp"
 #include "python_runner.hpp"
 

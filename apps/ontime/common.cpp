@@ -12,7 +12,7 @@
 #include "memory_limits.hpp"
 #include "number_options.hpp"
 #include "ontime/allocators/optimal.hpp"
-#include "ontime/error.hpp"
+#include "ontime/util/error.hpp"
 
 namespace ontime::cli {
 

@@ -13,8 +13,8 @@
 #include <string_view>
 #include <vector>
 
-#include "ontime/allocator_registry.hpp"
-#include "ontime/evaluation.hpp"
+#include "ontime/allocators/allocator_registry.hpp"
+#include "ontime/run/evaluation.hpp"
 
 namespace ontime::cli {
 

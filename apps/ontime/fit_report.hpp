@@ -5,7 +5,7 @@
 #include <string>
 
 #include "common.hpp"
-#include "ontime/fitting.hpp"
+#include "ontime/learn/fitting.hpp"
 
 namespace ontime::cli {
 

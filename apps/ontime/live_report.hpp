@@ -6,8 +6,8 @@
 #include <string>
 
 #include "common.hpp"
-#include "ontime/episode_runner.hpp"
-#include "ontime/problem.hpp"
+#include "ontime/model/problem.hpp"
+#include "ontime/run/episode_runner.hpp"
 
 namespace ontime::cli {
 

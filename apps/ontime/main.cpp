@@ -14,7 +14,7 @@
 
 #include "cluster_job.hpp"
 #include "common.hpp"
-#include "ontime/error.hpp"
+#include "ontime/util/error.hpp"
 
 namespace {
 

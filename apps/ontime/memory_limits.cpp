@@ -9,8 +9,8 @@
 #include <sstream>
 #include <string>
 
-#include "ontime/error.hpp"
-#include "ontime/state.hpp"
+#include "ontime/mdp/state.hpp"
+#include "ontime/util/error.hpp"
 
 namespace ontime::cli {
 namespace {

@@ -8,8 +8,8 @@
 #include <string>
 #include <string_view>
 
-#include "ontime/layered_solver.hpp"
-#include "ontime/problem.hpp"
+#include "ontime/model/problem.hpp"
+#include "ontime/solve/layered_solver.hpp"
 
 namespace ontime::cli {
 

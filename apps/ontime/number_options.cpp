@@ -9,7 +9,7 @@
 #include <optional>
 #include <system_error>
 
-#include "ontime/error.hpp"
+#include "ontime/util/error.hpp"
 
 namespace ontime::cli {
 namespace {

@@ -4,7 +4,7 @@
 
 #include <system_error>
 
-#include "ontime/error.hpp"
+#include "ontime/util/error.hpp"
 
 namespace ontime::cli {
 namespace {

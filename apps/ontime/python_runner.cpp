@@ -16,8 +16,8 @@
 #include <iterator>
 #include <stdexcept>
 
-#include "ontime/atomic_file.hpp"
-#include "ontime/error.hpp"
+#include "ontime/util/atomic_file.hpp"
+#include "ontime/util/error.hpp"
 
 namespace ontime::cli {
 namespace {

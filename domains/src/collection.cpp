@@ -7,12 +7,12 @@
 #include <optional>
 #include <stdexcept>
 
-#include "ontime/byte_packing.hpp"
 #include "ontime/domains/collection_journal.hpp"
-#include "ontime/error.hpp"
-#include "ontime/parallel.hpp"
-#include "ontime/random.hpp"
-#include "ontime/ranks.hpp"
+#include "ontime/util/byte_packing.hpp"
+#include "ontime/util/error.hpp"
+#include "ontime/util/parallel.hpp"
+#include "ontime/util/random.hpp"
+#include "ontime/util/ranks.hpp"
 
 namespace ontime::domains {
 namespace {

@@ -11,8 +11,8 @@
 #include <stdexcept>
 
 #include "ontime/domains/collection.hpp"
-#include "ontime/error.hpp"
-#include "ontime/json_input.hpp"
+#include "ontime/util/error.hpp"
+#include "ontime/util/json_input.hpp"
 
 namespace ontime::domains {
 namespace {

@@ -4,7 +4,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "ontime/error.hpp"
+#include "ontime/util/error.hpp"
 
 namespace ontime::domains {
 

@@ -9,7 +9,7 @@
 #include "ontime/domains/manipulation.hpp"
 #include "ontime/domains/manipulation_collision.hpp"
 #include "ontime/domains/world_types.hpp"
-#include "ontime/random.hpp"
+#include "ontime/util/random.hpp"
 
 namespace ontime::domains {
 namespace {

@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "ontime/domains/manipulation_collision.hpp"
-#include "ontime/skeleton_file.hpp"
+#include "ontime/model/skeleton_file.hpp"
 #include "world_fields.hpp"
 
 namespace ontime::domains {

@@ -9,7 +9,7 @@
 #include "ontime/domains/library_messages.hpp"
 #include "ontime/domains/navigation.hpp"
 #include "ontime/domains/navigation_collision.hpp"
-#include "ontime/random.hpp"
+#include "ontime/util/random.hpp"
 
 namespace ontime::domains {
 namespace {

@@ -11,7 +11,7 @@
 #include <string>
 
 #include "ontime/domains/navigation_collision.hpp"
-#include "ontime/random.hpp"
+#include "ontime/util/random.hpp"
 
 namespace ontime::domains {
 namespace {

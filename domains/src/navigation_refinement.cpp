@@ -10,7 +10,7 @@
 
 #include "ompl_support.hpp"
 #include "ontime/domains/navigation_collision.hpp"
-#include "ontime/random.hpp"
+#include "ontime/util/random.hpp"
 #include "phased_refinement.hpp"
 
 namespace ontime::domains {

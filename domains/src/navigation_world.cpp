@@ -10,9 +10,9 @@
 #include <stdexcept>
 
 #include "ontime/domains/navigation_collision.hpp"
-#include "ontime/error.hpp"
-#include "ontime/problem.hpp"
-#include "ontime/skeleton_file.hpp"
+#include "ontime/model/problem.hpp"
+#include "ontime/model/skeleton_file.hpp"
+#include "ontime/util/error.hpp"
 #include "world_fields.hpp"
 
 namespace ontime::domains {

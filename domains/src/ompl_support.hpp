@@ -32,7 +32,7 @@
 
 #include "ontime/domains/effort.hpp"
 #include "ontime/domains/world_types.hpp"
-#include "ontime/random.hpp"
+#include "ontime/util/random.hpp"
 
 namespace ontime::domains::detail {
 

@@ -6,8 +6,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "ontime/fitting.hpp"
-#include "ontime/random.hpp"
+#include "ontime/learn/fitting.hpp"
+#include "ontime/util/random.hpp"
 
 namespace ontime::domains {
 

@@ -2,7 +2,7 @@
 
 #include "ontime/domains/manipulation.hpp"
 #include "ontime/domains/navigation.hpp"
-#include "ontime/error.hpp"
+#include "ontime/util/error.hpp"
 
 namespace ontime::domains {
 

@@ -9,11 +9,11 @@
 #include <string_view>
 #include <vector>
 
-#include "ontime/distribution.hpp"
 #include "ontime/domains/world_types.hpp"
-#include "ontime/error.hpp"
-#include "ontime/json_input.hpp"
-#include "ontime/problem.hpp"
+#include "ontime/model/distribution.hpp"
+#include "ontime/model/problem.hpp"
+#include "ontime/util/error.hpp"
+#include "ontime/util/json_input.hpp"
 
 namespace ontime::domains::detail {
 

@@ -16,12 +16,12 @@
 #include <type_traits>
 #include <utility>
 
-#include "ontime/allocator.hpp"
-#include "ontime/allocator_registry.hpp"
-#include "ontime/error.hpp"
-#include "ontime/mdp.hpp"
-#include "ontime/problem.hpp"
-#include "ontime/state.hpp"
+#include "ontime/allocators/allocator.hpp"
+#include "ontime/allocators/allocator_registry.hpp"
+#include "ontime/mdp/mdp.hpp"
+#include "ontime/mdp/state.hpp"
+#include "ontime/model/problem.hpp"
+#include "ontime/util/error.hpp"
 
 namespace ontime::python {
 

@@ -5,17 +5,17 @@
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
-#include "ontime/episode_runner.hpp"
-#include "ontime/evaluation.hpp"
-#include "ontime/planner_log.hpp"
+#include "ontime/model/planner_log.hpp"
+#include "ontime/run/episode_runner.hpp"
+#include "ontime/run/evaluation.hpp"
 
 #ifdef ONTIME_PYTHON_DOMAINS
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/domains/collection.hpp"
 #include "ontime/domains/planner_world.hpp"
 #include "ontime/domains/registry.hpp"
-#include "ontime/error.hpp"
-#include "ontime/evaluation.hpp"
+#include "ontime/run/evaluation.hpp"
+#include "ontime/util/error.hpp"
 #endif
 
 namespace ontime::python {

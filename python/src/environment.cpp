@@ -8,9 +8,9 @@
 
 #include "bindings.hpp"
 #include "ontime/allocators/ppo.hpp"
-#include "ontime/error.hpp"
-#include "ontime/random.hpp"
-#include "ontime/simulator.hpp"
+#include "ontime/run/simulator.hpp"
+#include "ontime/util/error.hpp"
+#include "ontime/util/random.hpp"
 
 namespace ontime::python {
 

@@ -10,10 +10,10 @@
 #include <vector>
 
 #include "bindings.hpp"
-#include "ontime/allocator_registry.hpp"
-#include "ontime/clock.hpp"
-#include "ontime/error.hpp"
-#include "ontime/session.hpp"
+#include "ontime/allocators/allocator_registry.hpp"
+#include "ontime/run/clock.hpp"
+#include "ontime/run/session.hpp"
+#include "ontime/util/error.hpp"
 
 namespace ontime::python {
 namespace {

@@ -9,12 +9,12 @@
 #include <sstream>
 
 #include "bindings.hpp"
-#include "ontime/error.hpp"
-#include "ontime/fitting.hpp"
-#include "ontime/instance_io.hpp"
-#include "ontime/planner_log.hpp"
-#include "ontime/skeleton_file.hpp"
-#include "ontime/state.hpp"
+#include "ontime/learn/fitting.hpp"
+#include "ontime/mdp/state.hpp"
+#include "ontime/model/instance_io.hpp"
+#include "ontime/model/planner_log.hpp"
+#include "ontime/model/skeleton_file.hpp"
+#include "ontime/util/error.hpp"
 
 namespace ontime::python {
 

@@ -12,8 +12,8 @@
 #include <thread>
 
 #include "bindings.hpp"
-#include "ontime/error.hpp"
-#include "ontime/instance_io.hpp"
+#include "ontime/model/instance_io.hpp"
+#include "ontime/util/error.hpp"
 
 namespace ontime::python {
 

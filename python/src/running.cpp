@@ -10,13 +10,13 @@
 #include "bindings.hpp"
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/allocators/ppo.hpp"
-#include "ontime/episode_runner.hpp"
-#include "ontime/error.hpp"
-#include "ontime/evaluation.hpp"
-#include "ontime/layered_solver.hpp"
-#include "ontime/ppo_training.hpp"
-#include "ontime/session.hpp"
-#include "ontime/simulator.hpp"
+#include "ontime/learn/ppo_training.hpp"
+#include "ontime/run/episode_runner.hpp"
+#include "ontime/run/evaluation.hpp"
+#include "ontime/run/session.hpp"
+#include "ontime/run/simulator.hpp"
+#include "ontime/solve/layered_solver.hpp"
+#include "ontime/util/error.hpp"
 
 namespace ontime::python {
 

@@ -1,6 +1,6 @@
 #include "ontime/allocators/dp_rerun.hpp"
 
-#include "ontime/allocator_registry.hpp"
+#include "ontime/allocators/allocator_registry.hpp"
 
 namespace ontime {
 

@@ -3,7 +3,7 @@
 #include <bit>
 #include <limits>
 
-#include "ontime/allocator_registry.hpp"
+#include "ontime/allocators/allocator_registry.hpp"
 #include "ontime/allocators/known_dead.hpp"
 
 namespace ontime {

@@ -1,6 +1,6 @@
 #include "ontime/allocators/found_order_round_robin.hpp"
 
-#include "ontime/allocator_registry.hpp"
+#include "ontime/allocators/allocator_registry.hpp"
 #include "ontime/allocators/known_dead.hpp"
 
 namespace ontime {

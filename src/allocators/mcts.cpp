@@ -5,9 +5,9 @@
 #include <limits>
 #include <utility>
 
-#include "../portable_math.hpp"
-#include "ontime/allocator_registry.hpp"
-#include "ontime/error.hpp"
+#include "ontime/allocators/allocator_registry.hpp"
+#include "ontime/util/error.hpp"
+#include "util/portable_math.hpp"
 
 namespace ontime {
 namespace {

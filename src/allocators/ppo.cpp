@@ -2,9 +2,9 @@
 
 #include <string>
 
-#include "../ppo_networks.hpp"
-#include "ontime/allocator_registry.hpp"
-#include "ontime/error.hpp"
+#include "allocators/detail/ppo_networks.hpp"
+#include "ontime/allocators/allocator_registry.hpp"
+#include "ontime/util/error.hpp"
 
 namespace ontime {
 

@@ -2,7 +2,7 @@
 
 #include <limits>
 
-#include "ontime/allocator_registry.hpp"
+#include "ontime/allocators/allocator_registry.hpp"
 
 namespace ontime {
 namespace {

@@ -1,6 +1,6 @@
 #include "support/paper.hpp"
 
-#include "ontime/instance_io.hpp"
+#include "ontime/model/instance_io.hpp"
 
 namespace ontime::testing {
 

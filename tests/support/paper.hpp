@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <string>
 
-#include "ontime/problem.hpp"
+#include "ontime/model/problem.hpp"
 
 namespace ontime::testing {
 

@@ -3,7 +3,7 @@
 #include <string>
 #include <vector>
 
-#include "ontime/random.hpp"
+#include "ontime/util/random.hpp"
 
 namespace ontime::testing {
 namespace {

@@ -4,7 +4,7 @@
 
 #include <cstdint>
 
-#include "ontime/problem.hpp"
+#include "ontime/model/problem.hpp"
 
 namespace ontime::testing {
 

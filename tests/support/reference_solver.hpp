@@ -11,7 +11,7 @@
 #include <map>
 #include <vector>
 
-#include "ontime/problem.hpp"
+#include "ontime/model/problem.hpp"
 
 namespace ontime::testing {
 

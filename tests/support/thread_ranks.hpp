@@ -13,7 +13,7 @@
 #include <thread>
 #include <vector>
 
-#include "ontime/ranks.hpp"
+#include "ontime/util/ranks.hpp"
 
 namespace ontime::testing {
 

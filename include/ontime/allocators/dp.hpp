@@ -6,8 +6,8 @@
 // No guarantee beyond optimality among "one skeleton, refined contiguously" policies.
 // Cost: one ContiguousSuccessTable build at construction; O(1) per decision.
 
-#include "ontime/allocator.hpp"
-#include "ontime/contiguous_success.hpp"
+#include "ontime/allocators/allocator.hpp"
+#include "ontime/solve/contiguous_success.hpp"
 
 namespace ontime {
 

@@ -14,8 +14,8 @@
 #include <memory>
 #include <vector>
 
-#include "ontime/allocator.hpp"
-#include "ontime/contiguous_success.hpp"
+#include "ontime/allocators/allocator.hpp"
+#include "ontime/solve/contiguous_success.hpp"
 
 namespace ontime {
 

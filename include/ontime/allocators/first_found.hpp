@@ -21,8 +21,8 @@
 
 #include <cstdint>
 
-#include "ontime/allocator.hpp"
-#include "ontime/mdp.hpp"
+#include "ontime/allocators/allocator.hpp"
+#include "ontime/mdp/mdp.hpp"
 
 namespace ontime {
 

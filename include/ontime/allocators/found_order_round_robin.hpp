@@ -10,8 +10,8 @@
 // its motion planner in turn and has no model of it. No optimality guarantee.
 // Cost: O(K) per decision (two passes over the skeletons), no allocation.
 
-#include "ontime/allocator.hpp"
-#include "ontime/mdp.hpp"
+#include "ontime/allocators/allocator.hpp"
+#include "ontime/mdp/mdp.hpp"
 
 namespace ontime {
 

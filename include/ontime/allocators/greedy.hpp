@@ -5,8 +5,8 @@
 // Blind to spread and heavy tails, which is what the paper's instances 3-5 expose.
 // Cost: O(sum of support sizes) at construction; O(1) per decision.
 
-#include "ontime/allocator.hpp"
-#include "ontime/mdp.hpp"
+#include "ontime/allocators/allocator.hpp"
+#include "ontime/mdp/mdp.hpp"
 
 namespace ontime {
 

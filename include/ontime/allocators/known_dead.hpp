@@ -14,8 +14,8 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "ontime/mdp.hpp"
-#include "ontime/state.hpp"
+#include "ontime/mdp/mdp.hpp"
+#include "ontime/mdp/state.hpp"
 
 namespace ontime {
 

@@ -30,10 +30,10 @@
 #include <memory>
 #include <vector>
 
-#include "ontime/allocator.hpp"
-#include "ontime/decision_budget.hpp"
-#include "ontime/mdp.hpp"
-#include "ontime/random.hpp"
+#include "ontime/allocators/allocator.hpp"
+#include "ontime/allocators/decision_budget.hpp"
+#include "ontime/mdp/mdp.hpp"
+#include "ontime/util/random.hpp"
 
 namespace ontime {
 

@@ -19,8 +19,8 @@
 #include <string>
 #include <string_view>
 
-#include "ontime/allocator.hpp"
-#include "ontime/mdp.hpp"
+#include "ontime/allocators/allocator.hpp"
+#include "ontime/mdp/mdp.hpp"
 
 namespace ontime {
 

@@ -3,7 +3,7 @@
 // prospects; a skeleton with nothing left to refine spends the step idle.
 // Cost: O(1) per decision; needs no distributions.
 
-#include "ontime/allocator.hpp"
+#include "ontime/allocators/allocator.hpp"
 
 namespace ontime {
 

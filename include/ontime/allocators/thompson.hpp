@@ -22,9 +22,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "ontime/allocator.hpp"
-#include "ontime/mdp.hpp"
-#include "ontime/random.hpp"
+#include "ontime/allocators/allocator.hpp"
+#include "ontime/mdp/mdp.hpp"
+#include "ontime/util/random.hpp"
 
 namespace ontime {
 

@@ -28,10 +28,10 @@
 #include <string>
 #include <vector>
 
-#include "ontime/distribution.hpp"
 #include "ontime/domains/domain.hpp"
-#include "ontime/planner_log.hpp"
-#include "ontime/ranks.hpp"
+#include "ontime/model/distribution.hpp"
+#include "ontime/model/planner_log.hpp"
+#include "ontime/util/ranks.hpp"
 
 namespace ontime::domains {
 

@@ -30,8 +30,8 @@
 #include <vector>
 
 #include "ontime/domains/domain.hpp"
-#include "ontime/planner_log.hpp"
-#include "ontime/ranks.hpp"
+#include "ontime/model/planner_log.hpp"
+#include "ontime/util/ranks.hpp"
 
 namespace ontime::domains {
 

@@ -22,8 +22,8 @@
 #include "ontime/domains/collection.hpp"
 #include "ontime/domains/domain.hpp"
 #include "ontime/domains/task_planner.hpp"
-#include "ontime/problem.hpp"
-#include "ontime/world.hpp"
+#include "ontime/model/problem.hpp"
+#include "ontime/run/world.hpp"
 
 namespace ontime::domains {
 

@@ -6,7 +6,7 @@
 #include <array>
 #include <vector>
 
-#include "ontime/distribution.hpp"
+#include "ontime/model/distribution.hpp"
 
 namespace ontime::domains {
 

@@ -1,0 +1,339 @@
+#pragma once
+// The effort-allocation MDP of SPEC §2: legal choices, the transition of one step of effort,
+// the enumerated outcomes of a choice, and whether a skeleton can still succeed.
+//
+// Choosing skeleton k spends one step on its next action a, for every skeleton whose next
+// action is a (they share it, and share the whole state of it). With the hazard
+// h = p(PT_k + 1) / (1 - F(PT_k)) the motion is found and an execution time x ~ e is drawn.
+// Success as soon as a skeleton completes with CT' + ET <= D; failure when CT' >= D without
+// success, or earlier, as soon as no skeleton can still succeed (this changes no value).
+//
+// The functions of a state are templates on its type S: State, or the exact solver's fixed-size
+// copy of it (anything with time, refined[k], spent[k] and execution[k]).
+//
+// An Mdp refers to its Problem, which must outlive it. Its precomputed tables (hazards,
+// execution supports, lower bounds on remaining time) make a transition O(K) with no
+// allocation.
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "ontime/mdp/state.hpp"
+#include "ontime/model/problem.hpp"
+#include "ontime/util/random.hpp"
+
+namespace ontime {
+
+// A list of skeleton indices: inline, without allocation, for up to kInlineSkeletons entries;
+// a longer list (wide problems only) moves to the heap.
+class ChoiceList {
+ public:
+  void push_back(int choice) {
+    if (size_ < inline_.size()) {
+      inline_[size_] = static_cast<std::uint16_t>(choice);
+    } else {
+      if (size_ == inline_.size()) heap_.assign(inline_.begin(), inline_.end());
+      heap_.push_back(static_cast<std::uint16_t>(choice));
+    }
+    ++size_;
+  }
+  int operator[](std::size_t i) const noexcept { return begin()[i]; }
+  std::size_t size() const noexcept { return size_; }
+  bool empty() const noexcept { return size_ == 0; }
+  const std::uint16_t* begin() const noexcept { return size_ > inline_.size() ? heap_.data() : inline_.data(); }
+  const std::uint16_t* end() const noexcept { return begin() + size_; }
+
+ private:
+  std::array<std::uint16_t, kInlineSkeletons> inline_{};
+  std::vector<std::uint16_t> heap_;
+  std::size_t size_ = 0;
+};
+
+// What one step of refinement effort revealed.
+struct Observation {
+  bool refined = false;  // a motion was found in this step
+  Steps execution = 0;   // its execution time (may be kNever); only when refined
+
+  static constexpr Observation not_yet() noexcept { return {}; }
+  static constexpr Observation found(Steps execution_steps) noexcept { return {true, execution_steps}; }
+};
+
+class Mdp {
+ public:
+  // One execution time an action's motion can take once found, with its probability.
+  struct ExecutionOutcome {
+    Steps steps;  // deadline + 1 stands for "too slow or never"
+    double probability;
+  };
+  // What least_need returns for a skeleton that cannot succeed whatever the time left.
+  static constexpr std::int64_t kUnreachableNeed = std::int64_t{1} << 40;
+
+  explicit Mdp(const Problem& problem);
+
+  const Problem& problem() const noexcept { return *problem_; }
+  int skeleton_count() const noexcept { return skeleton_count_; }
+  Steps deadline() const noexcept { return deadline_; }
+
+  State start() const { return State(static_cast<std::size_t>(skeleton_count_)); }
+
+  // The action skeleton k refines next, or -1 when it is fully refined (choosing it idles).
+  template <class S>
+  int next_action(const S& state, int k) const noexcept {
+    const int refined = state.refined[static_cast<std::size_t>(k)];
+    return refined < lengths_[static_cast<std::size_t>(k)]
+               ? paths_[offsets_[static_cast<std::size_t>(k)] + static_cast<std::size_t>(refined)]
+               : -1;
+  }
+
+  // Applies one step of effort on skeleton `choice` with its observed result, in place.
+  // Throws UsageError when the choice or the observation is impossible (a refinement reported
+  // for an idle choice, a negative execution time); `state` is then left as it was.
+  template <class S>
+  Status apply(S& state, int choice, const Observation& observation) const;
+
+  // The skeleton that succeeded in the last `apply` that returned success: the lowest-index
+  // skeleton that ends with the refined action and meets the deadline.
+  template <class S>
+  int completed_skeleton(const S& state, int choice) const;
+
+  // Calls visit(probability, status, next_state) for every outcome of choosing `choice` in
+  // `state` (SPEC §2). Outcomes with zero probability are skipped; execution times that
+  // cannot meet the deadline are merged into one outcome.
+  template <class S, class Visitor>
+  void for_each_outcome(const S& state, int choice, Visitor&& visit) const;
+
+  // Calls visit(probability, observation) for every observation choosing `choice` in
+  // `state` can produce, in the order of for_each_outcome, without applying them.
+  template <class S, class Visitor>
+  void for_each_observation(const S& state, int choice, Visitor&& visit) const;
+
+  // Draws the observation of one step on `choice` from the model (hazard, then execution).
+  template <class S, class Generator>
+  Observation sample_observation(const S& state, int choice, Generator& generator) const;
+
+  // The choices worth considering: one per group of skeletons sharing their next action
+  // (named by the group's lowest index), and only groups in which some skeleton can still
+  // succeed. In increasing index order. Spending a step elsewhere cannot raise the success
+  // probability.
+  template <class S>
+  ChoiceList useful_choices(const S& state) const;
+  // Whether some skeleton sharing the next action of `action`'s group can still succeed.
+  template <class S>
+  bool group_can_succeed(const S& state, int action) const noexcept;
+
+  // Whether skeleton k can still succeed from this state: it has actions left and the
+  // least time it can still need (earliest completion of the current action given the
+  // steps spent, plus the fastest planning and execution of the rest) fits the deadline.
+  template <class S>
+  bool can_succeed(const S& state, int k) const noexcept;
+  template <class S>
+  bool any_can_succeed(const S& state) const noexcept;
+
+  // The least number of steps after CT that skeleton k still needs to succeed: its ET, the
+  // earliest finish of its current action given the PT_k steps spent, that action's fastest
+  // execution, and the fastest planning and execution of the rest; kUnreachableNeed (or more)
+  // when nothing can make it succeed. can_succeed(state, k) is CT + least_need <= D. The
+  // fields form of the exact solver's successors takes k's refined count, PT and ET.
+  std::int64_t least_need(int k, int refined, std::uint16_t spent, std::uint16_t execution) const noexcept;
+  template <class S>
+  std::int64_t least_need(const S& state, int k) const noexcept {
+    const auto slot = static_cast<std::size_t>(k);
+    return least_need(k, state.refined[slot], state.spent[slot], state.execution[slot]);
+  }
+
+  // The least number of steps after CT before some skeleton whose next action is `action` (they
+  // share its PT and ET) can succeed: the least least_need over them. can_succeed holds for
+  // one of them exactly when CT + group_need <= D.
+  std::int64_t group_need(int action, std::uint16_t spent, std::uint16_t execution) const noexcept {
+    const auto a = static_cast<std::size_t>(action);
+    if (spent > deadline_) return kUnreachableNeed;
+    const Steps finish = next_finish_[a * static_cast<std::size_t>(deadline_ + 1) + spent];
+    const Steps fastest = min_execution_[a];
+    if (finish == kNever || fastest == kNever) return kUnreachableNeed;
+    return std::int64_t{execution} + finish + fastest + group_rest_[a];
+  }
+
+  // The execution outcomes of finding `action`'s motion, in the order for_each_outcome uses.
+  std::span<const ExecutionOutcome> execution_outcomes(int action) const noexcept {
+    return execution_outcomes_[static_cast<std::size_t>(action)];
+  }
+
+  // The choice of an allocator when no skeleton can succeed any more (every choice is as
+  // good): the lowest-index skeleton with actions left, else 0.
+  template <class S>
+  int first_with_work_left(const S& state) const noexcept;
+
+  // P(the next step of effort on `action` finds a motion | `spent` steps did not).
+  double hazard(int action, Steps spent) const noexcept {
+    return spent < deadline_ ? hazards_[static_cast<std::size_t>(action) * static_cast<std::size_t>(deadline_) +
+                                        static_cast<std::size_t>(spent)]
+                             : 0.0;
+  }
+
+ private:
+  // The UsageErrors of apply (out of line: the templates stay free of message building).
+  [[noreturn]] void reject_choice(int choice) const;
+  [[noreturn]] void reject_idle_refinement(int choice) const;
+  [[noreturn]] static void reject_execution(Steps execution);
+
+  std::uint16_t saturate_execution(std::int64_t steps) const noexcept {
+    return static_cast<std::uint16_t>(steps > deadline_ ? deadline_ + 1 : steps);
+  }
+
+  const Problem* problem_;
+  int skeleton_count_;
+  Steps deadline_;
+  std::vector<int> lengths_;              // A_k
+  std::vector<std::size_t> offsets_;      // start of skeleton k in paths_
+  std::vector<int> paths_;                // actions of all skeletons, concatenated
+  std::vector<std::int64_t> rest_;        // least planning+execution of positions l.. of k (offsets_ + l)
+  std::vector<std::int64_t> group_rest_;  // per action: the least rest_ after it over the skeletons through it
+  std::vector<double> hazards_;           // [action][spent], spent < deadline
+  std::vector<Steps> next_finish_;        // [action][spent]: least t >= 1 with p(spent + t) > 0, or kNever
+  std::vector<std::vector<ExecutionOutcome>> execution_outcomes_;  // per action
+  std::vector<Steps> min_execution_;                               // per action, kNever if none
+};
+
+template <class S, class Visitor>
+void Mdp::for_each_observation(const S& state, int choice, Visitor&& visit) const {
+  const int action = next_action(state, choice);
+  if (action < 0) {
+    visit(1.0, Observation::not_yet());
+    return;
+  }
+  const double found = hazard(action, state.spent[static_cast<std::size_t>(choice)]);
+  if (found < 1.0) visit(1.0 - found, Observation::not_yet());
+  if (found > 0.0) {
+    for (const ExecutionOutcome& outcome : execution_outcomes_[static_cast<std::size_t>(action)]) {
+      visit(found * outcome.probability, Observation::found(outcome.steps));
+    }
+  }
+}
+
+template <class S, class Visitor>
+void Mdp::for_each_outcome(const S& state, int choice, Visitor&& visit) const {
+  for_each_observation(state, choice, [&](double probability, const Observation& observation) {
+    S next = state;
+    const Status status = apply(next, choice, observation);
+    visit(probability, status, next);
+  });
+}
+
+template <class S, class Generator>
+Observation Mdp::sample_observation(const S& state, int choice, Generator& generator) const {
+  const int action = next_action(state, choice);
+  if (action < 0) return Observation::not_yet();
+  const double found = hazard(action, state.spent[static_cast<std::size_t>(choice)]);
+  if (!(uniform01(generator) < found)) return Observation::not_yet();
+  const auto& outcomes = execution_outcomes_[static_cast<std::size_t>(action)];
+  const std::size_t drawn = sample_index(
+      outcomes.size(), [&outcomes](std::size_t i) { return outcomes[i].probability; }, generator);
+  return Observation::found(outcomes[drawn].steps);
+}
+
+inline std::int64_t Mdp::least_need(int k, int refined, std::uint16_t spent, std::uint16_t execution) const noexcept {
+  const auto slot = static_cast<std::size_t>(k);
+  if (refined >= lengths_[slot] || spent > deadline_) return kUnreachableNeed;
+  const auto action = static_cast<std::size_t>(paths_[offsets_[slot] + static_cast<std::size_t>(refined)]);
+  const Steps finish = next_finish_[action * static_cast<std::size_t>(deadline_ + 1) + spent];
+  const Steps fastest = min_execution_[action];
+  if (finish == kNever || fastest == kNever) return kUnreachableNeed;
+  return std::int64_t{execution} + finish + fastest +
+         rest_[offsets_[slot] + slot + static_cast<std::size_t>(refined) + 1];
+}
+
+template <class S>
+bool Mdp::can_succeed(const S& state, int k) const noexcept {
+  return std::int64_t{state.time} + least_need(state, k) <= deadline_;
+}
+
+template <class S>
+bool Mdp::any_can_succeed(const S& state) const noexcept {
+  for (int k = 0; k < skeleton_count_; ++k) {
+    if (can_succeed(state, k)) return true;
+  }
+  return false;
+}
+
+template <class S>
+int Mdp::first_with_work_left(const S& state) const noexcept {
+  for (int k = 0; k < skeleton_count_; ++k) {
+    if (next_action(state, k) >= 0) return k;
+  }
+  return 0;
+}
+
+template <class S>
+bool Mdp::group_can_succeed(const S& state, int action) const noexcept {
+  for (const int member : problem_->members(action)) {
+    if (can_succeed(state, member)) return true;
+  }
+  return false;
+}
+
+template <class S>
+ChoiceList Mdp::useful_choices(const S& state) const {
+  ChoiceList choices;
+  for (int k = 0; k < skeleton_count_; ++k) {
+    const int action = next_action(state, k);
+    if (action < 0 || problem_->members(action).front() != k) continue;
+    if (group_can_succeed(state, action)) choices.push_back(k);
+  }
+  return choices;
+}
+
+template <class S>
+Status Mdp::apply(S& state, int choice, const Observation& observation) const {
+  if (choice < 0 || choice >= skeleton_count_) {
+    reject_choice(choice);
+  }
+  const int action = next_action(state, choice);
+  // Checked before the state changes, so that a rejected observation leaves it as it was.
+  if (observation.refined && action < 0) {
+    reject_idle_refinement(choice);
+  }
+  if (observation.refined && observation.execution < 0) {
+    reject_execution(observation.execution);
+  }
+  ++state.time;
+  // An idle step (action < 0) only spends time.
+  if (action >= 0 && !observation.refined) {
+    for (const int member : problem_->members(action)) {
+      std::uint16_t& spent = state.spent[static_cast<std::size_t>(member)];
+      if (spent <= deadline_) ++spent;
+    }
+  } else if (action >= 0) {
+    const std::int64_t total =
+        observation.execution == kNever
+            ? std::int64_t{deadline_} + 1
+            : std::int64_t{state.execution[static_cast<std::size_t>(choice)]} + observation.execution;
+    const std::uint16_t execution = saturate_execution(total);
+    for (const int member : problem_->members(action)) {
+      const auto slot = static_cast<std::size_t>(member);
+      ++state.refined[slot];
+      state.spent[slot] = 0;
+      state.execution[slot] = execution;
+    }
+    if (problem_->completes_a_skeleton(action) && std::int64_t{state.time} + execution <= deadline_) {
+      return Status::success;
+    }
+  }
+  if (state.time >= deadline_ || !any_can_succeed(state)) return Status::failure;
+  return Status::running;
+}
+
+template <class S>
+int Mdp::completed_skeleton(const S& state, int choice) const {
+  const auto slot = static_cast<std::size_t>(choice);
+  if (state.refined[slot] == 0) return -1;
+  const int action = paths_[offsets_[slot] + state.refined[slot] - 1U];
+  for (const int member : problem_->members(action)) {
+    const auto index = static_cast<std::size_t>(member);
+    if (state.refined[index] == lengths_[index]) return member;
+  }
+  return -1;
+}
+
+}  // namespace ontime

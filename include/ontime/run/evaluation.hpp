@@ -1,0 +1,31 @@
+#pragma once
+// Evaluation of allocators: Monte Carlo over seeded simulated episodes (the episode runner in
+// hidden sampled worlds), and exact success probability.
+
+#include <cstddef>
+#include <functional>
+
+#include "ontime/allocators/allocator.hpp"
+#include "ontime/mdp/mdp.hpp"
+#include "ontime/run/episode_runner.hpp"
+
+namespace ontime {
+
+// Runs `options.episodes` episodes in hidden sampled worlds (simulator.hpp): episode i lives in
+// the world drawn from stream_seed(options.seed, i), whichever thread runs it, so the success
+// counts are identical for every thread count. Each thread gets its own allocator from `factory`.
+MonteCarloResult run_monte_carlo(const Mdp& mdp, const AllocatorFactory& factory, const MonteCarloOptions& options);
+
+struct ExactEvaluation {
+  double success_probability = 0;
+  std::size_t states = 0;  // reachable running states under the allocator
+};
+
+// The success probability of a stationary allocator (SPEC §4): a finite sum over the states
+// reachable under its choices, with no sampling. Throws UsageError when the allocator is not
+// stationary, ResourceLimitError past `max_states`, Cancelled once `stop` (checked every few
+// thousand states) returns true.
+ExactEvaluation evaluate_exactly(const Mdp& mdp, Allocator& allocator, std::size_t max_states = 10'000'000,
+                                 const std::function<bool()>& stop = {});
+
+}  // namespace ontime

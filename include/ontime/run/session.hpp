@@ -1,0 +1,227 @@
+#pragma once
+// An online session: the API a caller's own motion planner drives.
+//
+//   ontime::Session session(mdp, allocator);
+//   while (session.status() == ontime::Status::running) {
+//     const auto decision = session.choose();        // which skeleton, which action
+//     // ... spend one step of real planning effort on decision.action ...
+//     if (found) session.report_refined(execution_steps);
+//     else       session.report_not_yet();
+//   }
+//   if (session.status() == ontime::Status::success) execute(session.solution());
+//
+// The session keeps the MDP state, asks the allocator before every step, and reports
+// success (with the skeleton to execute) or failure: the deadline passed, or no skeleton can
+// still meet it, so that no more effort is wasted. The episode runner (episode_runner.hpp)
+// drives the same API against a World.
+//
+// A live session (constructed with a Clock) runs on seconds instead of abstract steps. The
+// deadline is D * step_seconds after the session began, and everything the clock sees counts
+// against it: the allocator's decision time, the planner's call (a slice of step_seconds, and
+// any overrun beyond it), the caller's time between a report and the next decision, and time
+// reported with charge_outside(). The MDP state the allocator sees is derived from the seconds
+// gone, so every allocator stays valid:
+//   CT   = ceil(elapsed / step_seconds)   (a step that overran by more than a slice counts as more)
+//   PT_k += max(1, floor(planning seconds / step_seconds)) for an unsuccessful call
+//   ET_k += ceil(execution seconds / step_seconds) for a found motion
+// (with a tolerance of 1e-9 slices against rounding); an idle step (a skeleton with nothing left
+// to refine) holds at least its slice, as in the model. Success needs the refined skeleton's
+// execution seconds to fit in the seconds left; failure comes when CT reaches D or no skeleton
+// can still succeed. An anytime allocator called without a budget gets decision_share of a
+// slice (at most the seconds left). With a manual clock advanced by exactly one slice per call
+// and no time elsewhere, a live session makes exactly the MDP's transitions.
+//
+// The live overhead per step is a few clock reads and one timeline entry (reserved up front).
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ontime/allocators/allocator.hpp"
+#include "ontime/allocators/decision_budget.hpp"
+#include "ontime/mdp/mdp.hpp"
+#include "ontime/run/clock.hpp"
+
+namespace ontime {
+
+struct LiveOptions {
+  // Share of a slice an anytime allocator may think per decision when the caller passes no
+  // budget of its own; in (0, 1e6].
+  double decision_share = 0.5;
+};
+
+// One step of a live session, in seconds since the session began.
+struct LiveStep {
+  int skeleton = -1;
+  int action = -1;               // -1: an idle step
+  double start = 0;              // when the decision began
+  double outside_seconds = 0;    // caller's time since the previous report (or the start)
+  double decision_seconds = 0;   // the allocator's thinking
+  double planning_seconds = 0;   // the planner's call: its slice and any overrun
+  double overrun_seconds = 0;    // beyond the slice
+  double observe_seconds = 0;    // the allocator taking in the outcome (a search moving its tree)
+  Steps steps_charged = 0;       // CT after the report minus CT before the decision
+  bool refined = false;          // the call found a motion
+  double execution_seconds = 0;  // of that motion, when refined
+};
+
+// What a live session charged, in seconds (decision: the allocator's choices and what it did with
+// their outcomes).
+struct LiveTotals {
+  double decision = 0, planning = 0, overrun = 0, outside = 0;
+  double elapsed = 0;  // at the end of the session (or now, while it runs)
+};
+
+struct Decision {
+  int skeleton = -1;  // the allocator's choice
+  int action = -1;    // the action to refine now, or -1: the step is spent idle
+};
+
+class Session {
+ public:
+  // Makes the allocator of a session whose skeletons change: called with the first Mdp and
+  // again with every new one (e.g. [&](const Mdp& mdp) { return make_allocator_factory(name,
+  // mdp, values)(); }).
+  using AllocatorMaker = std::function<std::unique_ptr<Allocator>(const Mdp&)>;
+
+  // Calls allocator.begin_episode(seed). The Mdp and the allocator must outlive the session.
+  Session(const Mdp& mdp, Allocator& allocator, std::uint64_t seed = 0);
+  // A live session on `clock` (which must outlive it); its deadline starts now. Throws
+  // UsageError for a decision share outside (0, 1e6].
+  Session(const Mdp& mdp, Allocator& allocator, std::uint64_t seed, const Clock& clock, LiveOptions options = {});
+  // A session that owns its problem and its allocator, so that skeletons can arrive and leave
+  // while it runs (add_skeleton, retire_skeleton); live on `clock` unless it is null.
+  Session(Problem problem, AllocatorMaker make_allocator, std::uint64_t seed, const Clock* clock = nullptr,
+          LiveOptions options = {});
+
+  Session(Session&&) noexcept = default;
+  Session& operator=(Session&&) noexcept = default;
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+  ~Session() = default;
+
+  // Asks the allocator for the next step. Throws std::logic_error when the session is over
+  // or a decision is still waiting for its report; UsageError when the allocator returns a
+  // skeleton index out of range. A live session first brings its state up to the clock: when
+  // the deadline passed (or no skeleton can succeed any more) while the caller was away, the
+  // session ends as a failure and the decision has skeleton -1.
+  Decision choose();
+  // The same within `budget` (an anytime allocator's budget for this decision; unset: its own).
+  Decision choose(const DecisionBudget& budget);
+
+  // Reports the outcome of the step just decided. Throws std::logic_error without a
+  // pending decision, and UsageError for a refinement reported on an idle step or a negative
+  // execution time.
+  Status report_not_yet();
+  Status report_refined(Steps execution_steps);
+  Status report(const Observation& observation);
+  // A live session's report of a found motion with its execution time in seconds (the steps
+  // form converts steps to seconds at step_seconds each). Throws UsageError for a negative or
+  // non-finite time; infinity means the motion cannot be executed.
+  Status report_refined_seconds(double execution_seconds);
+
+  // Live sessions: time the clock did not see but the deadline must (e.g. spent on another
+  // clock), added to the seconds gone. Throws UsageError for a negative or non-finite time,
+  // std::logic_error for a session without a clock.
+  void charge_outside(double seconds);
+
+  // Sessions that own their problem: a skeleton arrives. `action_ids` lists its actions in
+  // order; `new_actions` brings those the problem does not know yet, with their distributions.
+  // Known actions are shared, so SPEC §1's prefix rule applies. What was learnt carries over:
+  // the new skeleton starts with the leading actions already refined (their execution times
+  // too) and the effort already spent on its next action. The allocator is made anew for the
+  // new problem and decides from the current state (a search starts a new tree, the exact
+  // solver solves from here within its cap). Returns the skeleton's index. Throws UsageError for
+  // a broken rule or an allocator that cannot take the new problem (the session is then
+  // unchanged), std::logic_error while a decision awaits its report, after the end, or for a
+  // session that does not own its problem.
+  int add_skeleton(const std::vector<std::string>& action_ids, std::vector<Action> new_actions = {});
+  // Sessions that own their problem: skeleton k leaves (e.g. the task planner found it
+  // infeasible); later skeletons move down by one index. The last one leaving ends the session
+  // as a failure. Same errors as add_skeleton.
+  void retire_skeleton(int k);
+  // Sessions that own their problem: while more skeletons are expected (a task planner is still
+  // searching), the session does not end when no skeleton found so far can still succeed; the
+  // caller adds one (can_succeed() tells when it must) or says no more will come, which ends
+  // such a session as a failure. The deadline ends it either way. Throws std::logic_error for a
+  // session that does not own its problem.
+  void expect_more_skeletons(bool expected);
+  // Whether some skeleton can still succeed from the current state.
+  bool can_succeed() const { return mdp_->any_can_succeed(state_); }
+
+  Status status() const noexcept { return status_; }
+  const State& state() const noexcept { return state_; }
+  const Mdp& mdp() const noexcept { return *mdp_; }
+  const Problem& problem() const noexcept { return mdp_->problem(); }
+  // The skeleton to execute after success, -1 before.
+  int solution() const noexcept { return solution_; }
+  // Steps of effort spent so far (CT).
+  Steps steps_used() const noexcept { return state_.time; }
+
+  bool is_live() const noexcept { return clock_ != nullptr; }
+  // Live sessions: D * step_seconds, the seconds gone (frozen when the session ended), the
+  // steps so far, and what was charged.
+  double step_seconds() const noexcept;
+  double deadline_seconds() const noexcept;
+  double elapsed_seconds() const;
+  // One entry per step; its skeleton index is the one at the time of the step.
+  const std::vector<LiveStep>& timeline() const noexcept { return timeline_; }
+  LiveTotals totals() const;
+  // Live sessions: the same planner calls judged by the model's step clock (one step per call,
+  // steps of execution, nothing charged for thinking or overruns): success or failure once that
+  // clock decided, running when the live session ended before it did.
+  Status model_status() const noexcept { return model_status_; }
+
+ private:
+  void start_live(const Clock& clock, LiveOptions options);
+  // The search iterations the allocator has run so far (its "iterations" counter; 0 if none).
+  std::uint64_t search_iterations() const;
+  Status report(const Observation& observation, double execution_seconds);
+  Steps steps_at(double seconds) const noexcept;
+  void end_if_out_of_time();
+  // No skeleton can succeed and none is expected to come.
+  bool out_of_skeletons() const;
+  // Replaces the skeletons (add_skeleton, retire_skeleton) and carries the state over.
+  void change_skeletons(std::vector<Action> actions, std::vector<std::vector<int>> skeletons);
+  State carried_over(const State& old, const Problem& next) const;
+
+  const Mdp* mdp_;
+  Allocator* allocator_;
+  State state_;
+  State before_;  // scratch for observe(): reused, so a wide problem's state is not reallocated
+  Status status_ = Status::running;
+  int pending_ = -1;
+  int solution_ = -1;
+
+  // Live and owning sessions: what every action revealed (by action index; actions are only
+  // ever appended): its execution once refined, in steps and seconds, -1 before. Empty otherwise.
+  std::vector<Steps> action_execution_steps_;
+  std::vector<double> action_execution_seconds_;
+
+  // Sessions that own their problem.
+  std::unique_ptr<Problem> owned_problem_;
+  std::unique_ptr<Mdp> owned_mdp_;
+  std::unique_ptr<Allocator> owned_allocator_;
+  AllocatorMaker make_allocator_;
+  std::uint64_t seed_ = 0;
+  std::uint64_t changes_ = 0;   // skeleton changes so far: the allocator's seed stream
+  bool more_expected_ = false;  // expect_more_skeletons()
+
+  // Live sessions only.
+  const Clock* clock_ = nullptr;
+  LiveOptions live_;
+  double step_seconds_ = 1;
+  double started_ = 0;
+  double charged_outside_ = 0;  // charge_outside() so far
+  double last_report_ = 0;      // clock time of the last report (or the start)
+  double decided_at_ = 0;       // clock time the pending decision was made
+  double ended_at_ = -1;        // elapsed seconds when the session ended
+  State model_state_;           // the step clock's state
+  Status model_status_ = Status::running;
+  std::vector<LiveStep> timeline_;
+  LiveTotals totals_;
+};
+
+}  // namespace ontime

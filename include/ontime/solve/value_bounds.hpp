@@ -1,0 +1,155 @@
+#pragma once
+// Certified bounds on the optimal success probability V*(s) of any state, from tables
+// (docs/theory.md, "Certified bounds on the optimum").
+//
+// lower(s): the exact success probability of the best commit policy, which from s refines
+// one skeleton k at every step until the episode ends. It is the value of a real policy, so
+// lower(s) <= V*(s); lower_choice(s) names the skeleton, and commit(s, k) is the value of
+// committing to k.
+//
+// upper(s): the clairvoyant relaxation. Planning and execution times are drawn before the
+// episode and revealed to an allocator that knows them all; success needs some skeleton whose
+// remaining planning and execution fit the time left. With the remaining actions of distinct
+// groups in disjoint subtrees of the prefix tree, its probability is
+//   upper(s) = 1 - prod over groups g of (1 - G(n_g, PT_g, D - CT - ET_g)),
+// G computed exactly per node by a recursion over the tree; V*(s) <= upper(s). On problems
+// whose prefix tree is one path (one skeleton, or skeletons that are prefixes of each other)
+// both bounds equal V*.
+//
+// A state is anything with time, refined[k], spent[k] and execution[k] (State, or the exact
+// solver's fixed-size copy of it) reachable from the start. A skeleton contributes nothing
+// when it is fully refined, when spent >= D (no further step can find its motion) or when
+// CT + ET_k >= D; in particular slots blanked with spent or execution above D + 1 (the exact
+// solver's keys of skeletons that cannot succeed) are ignored.
+//
+// Cost: the tables hold (nodes + sum of skeleton lengths) * D^2 doubles, built in
+// O((nodes + sum of lengths) * D^2) time; the constructor throws ResourceLimitError past
+// `max_table_entries`. Each bound is then O(K) table lookups, with no allocation. A
+// ValueBounds refers to its Mdp, which must outlive it.
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "ontime/mdp/mdp.hpp"
+
+namespace ontime {
+
+class ValueBounds {
+ public:
+  // 2^26 doubles: 512 MiB.
+  static constexpr std::size_t kDefaultMaxTableEntries = std::size_t{1} << 26;
+
+  // Precomputes the tables. Throws ResourceLimitError when they would hold more than
+  // `max_table_entries` doubles.
+  explicit ValueBounds(const Mdp& mdp, std::size_t max_table_entries = kDefaultMaxTableEntries);
+
+  // The exact success probability of refining skeleton k at every step from `state`.
+  template <class S>
+  double commit(const S& state, int k) const noexcept;
+
+  // A lower bound on V*(state): the largest commit value over the skeletons.
+  template <class S>
+  double lower(const S& state) const noexcept {
+    const int k = lower_choice(state);
+    return k < 0 ? 0.0 : commit(state, k);
+  }
+
+  // The skeleton lower() commits to (the lowest index on ties), -1 when lower() is 0.
+  template <class S>
+  int lower_choice(const S& state) const noexcept;
+
+  // An upper bound on V*(state): the success probability of the clairvoyant relaxation.
+  template <class S>
+  double upper(const S& state) const noexcept;
+
+  // The same from one skeleton's fields (the exact solver's successors, before they are whole
+  // states): commit(k, ...) is commit(state, k); group_upper is G of the group whose next
+  // action is k's (the clairvoyant success probability of that subtree alone, with the budget
+  // D - time - execution), where k must be the group's lowest index.
+  double commit(int k, int refined, std::uint16_t spent, std::uint16_t execution, std::int64_t time) const noexcept {
+    const auto slot = static_cast<std::size_t>(k);
+    const std::size_t at = cell(slot, refined, spent, execution, time);
+    if (at == kNoTable) return 0.0;
+    return commit_[commit_block_[path_start_[slot] + static_cast<std::size_t>(refined)] + at];
+  }
+  double group_upper(int k, int refined, std::uint16_t spent, std::uint16_t execution,
+                     std::int64_t time) const noexcept {
+    const auto slot = static_cast<std::size_t>(k);
+    const std::size_t at = cell(slot, refined, spent, execution, time);
+    if (at == kNoTable) return 0.0;
+    const std::size_t block = reach_block_[path_start_[slot] + static_cast<std::size_t>(refined)];
+    return block == kNoTable ? 0.0 : reach_[block + at];
+  }
+
+  // Doubles the tables hold.
+  std::size_t table_entries() const noexcept { return commit_.size() + reach_.size(); }
+  const Mdp& mdp() const noexcept { return *mdp_; }
+
+ private:
+  static constexpr std::size_t kNoTable = static_cast<std::size_t>(-1);
+
+  // The index of (spent, budget) in a D x D block when skeleton k can still contribute
+  // (actions left, spent < D, budget D - CT - ET_k >= 1), else kNoTable.
+  std::size_t cell(std::size_t k, int refined, std::uint16_t spent, std::uint16_t execution,
+                   std::int64_t time) const noexcept {
+    if (refined >= lengths_[k]) return kNoTable;
+    const std::int64_t budget = std::int64_t{deadline_} - time - execution;
+    if (spent >= deadline_ || budget < 1) return kNoTable;
+    return static_cast<std::size_t>(spent) * static_cast<std::size_t>(deadline_) + static_cast<std::size_t>(budget - 1);
+  }
+  template <class S>
+  std::size_t cell(const S& state, std::size_t k) const noexcept {
+    return cell(k, state.refined[k], state.spent[k], state.execution[k], state.time);
+  }
+
+  const Mdp* mdp_;
+  int skeleton_count_;
+  Steps deadline_;
+  std::vector<int> lengths_;             // A_k
+  std::vector<std::size_t> path_start_;  // start of skeleton k's positions in the per-position arrays
+  // Per position (k, l): the start of C_k[l] in commit_, a D x D block over (spent, budget - 1).
+  std::vector<std::size_t> commit_block_;
+  // Per position (k, l): the start of G of the action at l in reach_ (a D x D block), when k
+  // is the lowest-index skeleton through that action (the one that speaks for its group);
+  // kNoTable otherwise.
+  std::vector<std::size_t> reach_block_;
+  std::vector<double> commit_;
+  std::vector<double> reach_;
+};
+
+template <class S>
+double ValueBounds::commit(const S& state, int k) const noexcept {
+  if (k < 0 || k >= skeleton_count_) return 0.0;
+  const auto slot = static_cast<std::size_t>(k);
+  return commit(k, state.refined[slot], state.spent[slot], state.execution[slot], state.time);
+}
+
+template <class S>
+int ValueBounds::lower_choice(const S& state) const noexcept {
+  int best = -1;
+  double best_value = 0.0;
+  for (int k = 0; k < skeleton_count_; ++k) {
+    const double value = commit(state, k);
+    if (value > best_value) {
+      best_value = value;
+      best = k;
+    }
+  }
+  return best;
+}
+
+template <class S>
+double ValueBounds::upper(const S& state) const noexcept {
+  double all_fail = 1.0;
+  for (std::size_t k = 0; k < static_cast<std::size_t>(skeleton_count_); ++k) {
+    const std::size_t at = cell(state, k);
+    if (at == kNoTable) continue;
+    const std::size_t block = reach_block_[path_start_[k] + state.refined[k]];
+    if (block == kNoTable) continue;  // another member of the group speaks for it
+    all_fail *= 1.0 - reach_[block + at];
+  }
+  return 1.0 - all_fail;
+}
+
+}  // namespace ontime

@@ -1,0 +1,271 @@
+#include "ontime/model/instance_io.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+#include <vector>
+
+#include "model/skeleton_list.hpp"
+#include "ontime/util/atomic_file.hpp"
+#include "ontime/util/error.hpp"
+#include "ontime/util/json_input.hpp"
+
+namespace ontime {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+// Any time of up to Distribution::kMaxStep steps is then a finite number of seconds, with
+// room to spare (planner logs written from the instance never hold an infinity).
+constexpr double kMaxStepSeconds = 1e300;
+
+std::string format_number(double value) {
+  std::ostringstream out;
+  out.precision(12);
+  out << value;
+  return out.str();
+}
+
+class InstanceReader {
+ public:
+  explicit InstanceReader(std::string source) : source_(std::move(source)) {}
+
+  Problem read(std::string_view text) {
+    const Json root = detail::parse_json_strict<Json>(text, source_);
+    if (!root.is_object())
+      fail("top level", "an instance must be a JSON object (got " + detail::describe_json_type(root) + ")");
+    check_keys(root, "", {"name", "description", "deadline", "step_seconds", "actions", "skeletons"});
+
+    std::string name = std::filesystem::path(source_).stem().string();
+    if (root.contains("name")) name = string_at(root["name"], "name");
+    std::string description;
+    if (root.contains("description")) description = string_at(root["description"], "description");
+
+    if (!root.contains("deadline")) fail("top level", "missing required key 'deadline'");
+    const Json& deadline_json = root["deadline"];
+    // A whole number, written `4` or `4.0` (as Python writes floats); the value as written in messages.
+    const bool whole =
+        deadline_json.is_number_integer() ||
+        (deadline_json.is_number_float() && std::trunc(deadline_json.get<double>()) == deadline_json.get<double>());
+    if (!whole) fail("deadline", "must be a whole number of steps (got " + deadline_json.dump() + ")");
+    const std::optional<std::int64_t> deadline = detail::json_whole_number(deadline_json, 1, Problem::kMaxDeadline);
+    if (!deadline) {
+      fail("deadline", "must be between 1 and " + std::to_string(Problem::kMaxDeadline) + " steps (got " +
+                           deadline_json.dump() + ")");
+    }
+
+    double step_seconds = 1.0;
+    if (root.contains("step_seconds")) {
+      const Json& value = root["step_seconds"];
+      if (!value.is_number()) fail("step_seconds", "must be a number (got " + detail::describe_json_type(value) + ")");
+      step_seconds = value.get<double>();
+      if (!(std::isfinite(step_seconds) && step_seconds > 0 && step_seconds <= kMaxStepSeconds)) {
+        fail("step_seconds",
+             "must be a positive number of seconds, at most 1e300 so that times in seconds stay finite (got " +
+                 value.dump() + ")");
+      }
+    }
+
+    std::vector<Action> actions = read_actions(root);
+    std::vector<std::vector<int>> skeletons = read_skeletons(root, actions);
+    try {
+      return Problem(std::move(name), static_cast<Steps>(*deadline), step_seconds, std::move(actions),
+                     std::move(skeletons), std::move(description));
+    } catch (const std::invalid_argument& error) {
+      fail("top level", error.what());  // every rule is checked above with its place; kept as a guard
+    }
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& place, const std::string& rule) const {
+    throw InputError(source_, place, rule);
+  }
+
+  void check_keys(const Json& object, const std::string& path, std::initializer_list<std::string_view> allowed) const {
+    detail::check_known_keys(object, path, allowed, source_);
+  }
+
+  std::string string_at(const Json& value, const std::string& path) const {
+    if (!value.is_string()) fail(path, "must be a string (got " + detail::describe_json_type(value) + ")");
+    return value.get<std::string>();
+  }
+
+  std::vector<Action> read_actions(const Json& root) const {
+    if (!root.contains("actions")) fail("top level", "missing required key 'actions'");
+    const Json& actions_json = root["actions"];
+    if (!actions_json.is_object()) {
+      fail("actions", "must be an object mapping action ids to distributions (got " +
+                          detail::describe_json_type(actions_json) + ")");
+    }
+    if (actions_json.empty()) fail("actions", "at least one action is needed");
+    std::vector<Action> actions;
+    for (const auto& [id, value] : actions_json.items()) {
+      const std::string path = detail::json_member("actions", id);
+      if (id.empty()) fail(path, "action ids must be non-empty");
+      if (!value.is_object())
+        fail(path, "an action must be an object with 'planning' and 'execution' (got " +
+                       detail::describe_json_type(value) + ")");
+      check_keys(value, path, {"planning", "execution"});
+      for (const char* required : {"planning", "execution"}) {
+        if (!value.contains(required)) fail(path, std::string("missing required key '") + required + "'");
+      }
+      Action action;
+      action.id = id;
+      action.planning = read_distribution(value["planning"], detail::json_member(path, "planning"), 1, "planning");
+      action.execution = read_distribution(value["execution"], detail::json_member(path, "execution"), 0, "execution");
+      actions.push_back(std::move(action));
+    }
+    return actions;
+  }
+
+  Steps read_step(const std::string& key, const std::string& path, Steps first, const char* kind) const {
+    // Canonical decimal: "0", or up to nine digits without a leading zero.
+    const bool digits = !key.empty() && key.size() <= 9 &&
+                        std::all_of(key.begin(), key.end(), [](char c) { return c >= '0' && c <= '9'; });
+    if (!digits || (key.size() > 1 && key[0] == '0')) {
+      fail(path, std::string("keys must be whole numbers of steps, written without sign or leading zeros (got '") +
+                     key + "')");
+    }
+    const long step = std::stol(key);
+    if (step < first) {
+      fail(path, std::string(kind) + " steps start at " + std::to_string(first) + " (got " + key + ")");
+    }
+    if (step > Distribution::kMaxStep) {
+      fail(path, "steps above " + std::to_string(Distribution::kMaxStep) + " are not supported (got " + key + ")");
+    }
+    return static_cast<Steps>(step);
+  }
+
+  double read_probability(const Json& value, const std::string& path) const {
+    if (!value.is_number())
+      fail(path, "a probability must be a number (got " + detail::describe_json_type(value) + ")");
+    const double probability = value.get<double>();
+    if (!(probability >= 0.0 && probability <= 1.0 + Distribution::kSumTolerance)) {
+      fail(path, "a probability must be within [0, 1] (got " + value.dump() + ")");
+    }
+    return std::min(probability, 1.0);
+  }
+
+  Distribution read_distribution(const Json& value, const std::string& path, Steps first, const char* kind) const {
+    if (!value.is_object()) {
+      fail(path, "a distribution must be an object {\"pmf\": {...}} or {\"cdf\": {...}} (got " +
+                     detail::describe_json_type(value) + ")");
+    }
+    check_keys(value, path, {"pmf", "cdf"});
+    const bool has_pmf = value.contains("pmf");
+    const bool has_cdf = value.contains("cdf");
+    if (has_pmf == has_cdf) fail(path, "a distribution needs exactly one of 'pmf' or 'cdf'");
+    const char* form = has_pmf ? "pmf" : "cdf";
+    const std::string table_path = detail::json_member(path, form);
+    const Json& table = value[form];
+    if (!table.is_object()) {
+      fail(table_path,
+           "must be an object mapping steps to probabilities (got " + detail::describe_json_type(table) + ")");
+    }
+    std::map<Steps, std::pair<double, std::string>> entries;  // numeric order
+    for (const auto& [key, probability] : table.items()) {
+      const std::string entry_path = detail::json_member(table_path, key);
+      const Steps step = read_step(key, entry_path, first, kind);
+      entries.emplace(step, std::make_pair(read_probability(probability, entry_path), entry_path));
+    }
+    const std::size_t size = entries.empty() ? 0 : static_cast<std::size_t>(entries.rbegin()->first) + 1;
+    std::vector<double> masses(size, 0.0);
+    if (has_pmf) {
+      double total = 0;
+      for (const auto& [step, entry] : entries) {
+        masses[static_cast<std::size_t>(step)] = entry.first;
+        total += entry.first;
+      }
+      if (total > 1.0 + Distribution::kSumTolerance) {
+        fail(table_path, "probabilities sum to " + format_number(total) + ", above 1");
+      }
+    } else {
+      double previous = 0;
+      Steps previous_step = -1;
+      for (const auto& [step, entry] : entries) {
+        if (entry.first < previous) {
+          fail(entry.second, "a CDF must not decrease (" + format_number(entry.first) + " here, after " +
+                                 format_number(previous) + " at step " + std::to_string(previous_step) + ")");
+        }
+        masses[static_cast<std::size_t>(step)] = entry.first - previous;
+        previous = entry.first;
+        previous_step = step;
+      }
+    }
+    try {
+      return Distribution::from_pmf(std::move(masses));
+    } catch (const std::invalid_argument& error) {
+      fail(table_path, error.what());
+    }
+  }
+
+  std::vector<std::vector<int>> read_skeletons(const Json& root, const std::vector<Action>& actions) const {
+    if (!root.contains("skeletons")) fail("top level", "missing required key 'skeletons'");
+    std::map<std::string, int> index_of;
+    for (std::size_t a = 0; a < actions.size(); ++a) index_of.emplace(actions[a].id, static_cast<int>(a));
+    return detail::read_skeleton_list(
+        root["skeletons"], source_,
+        [&index_of](const std::string& id) -> std::optional<int> {
+          const auto known = index_of.find(id);
+          if (known == index_of.end()) return std::nullopt;
+          return known->second;
+        },
+        [&actions](int index) { return actions[static_cast<std::size_t>(index)].id; });
+  }
+
+  std::string source_;
+};
+
+Json distribution_to_json(const Distribution& distribution) {
+  Json pmf = Json::object();
+  const auto masses = distribution.masses();
+  for (std::size_t t = 0; t < masses.size(); ++t) {
+    if (masses[t] > 0) pmf[std::to_string(t)] = masses[t];
+  }
+  return Json{{"pmf", pmf}};
+}
+
+}  // namespace
+
+Problem parse_problem(std::string_view text, std::string_view source) {
+  return InstanceReader(std::string(source)).read(text);
+}
+
+Problem load_problem(const std::filesystem::path& path) {
+  return parse_problem(read_input_file(path, "instance"), path.string());
+}
+
+std::string problem_to_json(const Problem& problem) {
+  Json root = Json::object();
+  root["name"] = problem.name();
+  if (!problem.description().empty()) root["description"] = problem.description();
+  root["deadline"] = problem.deadline();
+  root["step_seconds"] = problem.step_seconds();
+  Json actions = Json::object();
+  for (const Action& action : problem.actions()) {
+    actions[action.id] = Json{{"planning", distribution_to_json(action.planning)},
+                              {"execution", distribution_to_json(action.execution)}};
+  }
+  root["actions"] = actions;
+  Json skeletons = Json::array();
+  for (int k = 0; k < problem.skeleton_count(); ++k) {
+    Json skeleton = Json::array();
+    for (const int action : problem.skeleton(k)) skeleton.push_back(problem.action(action).id);
+    skeletons.push_back(skeleton);
+  }
+  root["skeletons"] = skeletons;
+  return root.dump(2) + "\n";
+}
+
+void save_problem(const Problem& problem, const std::filesystem::path& path) {
+  write_file_atomically(path, problem_to_json(problem));
+}
+
+}  // namespace ontime

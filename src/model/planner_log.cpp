@@ -1,0 +1,141 @@
+#include "ontime/model/planner_log.hpp"
+
+#include <cmath>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <regex>
+
+#include "ontime/util/atomic_file.hpp"
+#include "ontime/util/error.hpp"
+#include "ontime/util/json_input.hpp"
+
+namespace ontime {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+class LineReader {
+ public:
+  LineReader(std::string source, std::size_t line) : source_(std::move(source)), line_(line) {}
+
+  RefinementAttempt read(std::string_view text) const {
+    Json record;
+    try {
+      record = detail::parse_json_strict<Json>(text, source_);
+    } catch (const InputError& error) {
+      // The parser counts lines within this one line; name the line of the file instead.
+      static const std::regex column(R"(line \d+, (column \d+))");
+      std::smatch match;
+      if (std::regex_match(error.place(), match, column))
+        throw InputError(source_, place() + ", " + match[1].str(), error.rule());
+      throw InputError(source_, place() + ": " + error.place(), error.rule());
+    }
+    if (!record.is_object())
+      fail("", "a record must be a JSON object (got " + detail::describe_json_type(record) + ")");
+    for (const auto& [key, value] : record.items()) {
+      if (key != "action" && key != "planning_seconds" && key != "found" && key != "execution_seconds" &&
+          key != "trial" && key != "collision_checks") {
+        fail(key,
+             "unknown key (expected 'action', 'planning_seconds', 'found', 'execution_seconds', 'trial', "
+             "'collision_checks')");
+      }
+    }
+    RefinementAttempt attempt;
+    const Json& action = required(record, "action");
+    if (!action.is_string()) fail("action", "must be a string (got " + detail::describe_json_type(action) + ")");
+    attempt.action = action.get<std::string>();
+    if (attempt.action.empty()) fail("action", "must be a non-empty action id");
+    attempt.planning_seconds = seconds(required(record, "planning_seconds"), "planning_seconds");
+    const Json& found = required(record, "found");
+    if (!found.is_boolean()) fail("found", "must be true or false (got " + detail::describe_json_type(found) + ")");
+    attempt.found = found.get<bool>();
+    if (attempt.found) {
+      if (!record.contains("execution_seconds")) {
+        fail("", "missing required key 'execution_seconds' (a found motion has an execution time)");
+      }
+      attempt.execution_seconds = seconds(record["execution_seconds"], "execution_seconds");
+    } else if (record.contains("execution_seconds")) {
+      fail("execution_seconds", "only a found motion has an execution time ('found' is false)");
+    }
+    if (record.contains("trial")) attempt.trial = count(record["trial"], "trial");
+    if (record.contains("collision_checks"))
+      attempt.collision_checks = count(record["collision_checks"], "collision_checks");
+    return attempt;
+  }
+
+ private:
+  std::string place() const { return "line " + std::to_string(line_); }
+
+  [[noreturn]] void fail(const std::string& key, const std::string& rule) const {
+    throw InputError(source_, key.empty() ? place() : place() + ": " + key, rule);
+  }
+
+  const Json& required(const Json& record, const char* key) const {
+    if (!record.contains(key)) fail("", std::string("missing required key '") + key + "'");
+    return record[key];
+  }
+
+  double seconds(const Json& value, const char* key) const {
+    if (!value.is_number()) fail(key, "must be a number of seconds (got " + detail::describe_json_type(value) + ")");
+    const double result = value.get<double>();
+    if (!(std::isfinite(result) && result >= 0))
+      fail(key, "must be a finite number of seconds >= 0 (got " + value.dump() + ")");
+    return result;
+  }
+
+  // A whole number >= 0, written as an integer or with a zero fraction part (`3.0`).
+  std::uint64_t count(const Json& value, const char* key) const {
+    if (value.is_number_unsigned()) return value.get<std::uint64_t>();
+    const std::optional<std::int64_t> number =
+        detail::json_whole_number(value, 0, std::numeric_limits<std::int64_t>::max());
+    if (!number) fail(key, "must be a whole number >= 0 (got " + value.dump() + ")");
+    return static_cast<std::uint64_t>(*number);
+  }
+
+  std::string source_;
+  std::size_t line_;
+};
+
+}  // namespace
+
+std::vector<RefinementAttempt> parse_planner_log(std::string_view text, std::string_view source) {
+  const std::string name(source);
+  std::vector<RefinementAttempt> attempts;
+  std::size_t line = 0;
+  std::size_t begin = 0;
+  while (begin < text.size()) {
+    std::size_t end = text.find('\n', begin);
+    if (end == std::string_view::npos) end = text.size();
+    ++line;
+    const std::string_view content = text.substr(begin, end - begin);
+    begin = end + 1;
+    if (content.find_first_not_of(" \t\r") == std::string_view::npos) continue;  // blank line
+    attempts.push_back(LineReader(name, line).read(content));
+  }
+  if (attempts.empty()) throw InputError(name, "file", "the log holds no records (one JSON object per line)");
+  return attempts;
+}
+
+std::vector<RefinementAttempt> load_planner_log(const std::filesystem::path& path) {
+  return parse_planner_log(read_input_file(path, "planner log"), path.string());
+}
+
+std::string planner_log_line(const RefinementAttempt& attempt) {
+  Json record = Json::object();
+  record["action"] = attempt.action;
+  if (attempt.trial) record["trial"] = *attempt.trial;
+  record["planning_seconds"] = attempt.planning_seconds;
+  record["found"] = attempt.found;
+  if (attempt.found) record["execution_seconds"] = attempt.execution_seconds;
+  if (attempt.collision_checks) record["collision_checks"] = *attempt.collision_checks;
+  return record.dump() + "\n";
+}
+
+void save_planner_log(std::span<const RefinementAttempt> attempts, const std::filesystem::path& path) {
+  std::string text;
+  for (const RefinementAttempt& attempt : attempts) text += planner_log_line(attempt);
+  write_file_atomically(path, text);
+}
+
+}  // namespace ontime

@@ -1,0 +1,86 @@
+#include "ontime/model/problem.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <string>
+#include <utility>
+
+#include "ontime/util/error.hpp"
+
+namespace ontime {
+namespace {
+
+[[noreturn]] void reject(const std::string& rule) { throw UsageError(rule); }
+
+}  // namespace
+
+Problem::Problem(std::string name, Steps deadline, double step_seconds, std::vector<Action> actions,
+                 std::vector<std::vector<int>> skeletons, std::string description)
+    : name_(std::move(name)),
+      description_(std::move(description)),
+      deadline_(deadline),
+      step_seconds_(step_seconds),
+      actions_(std::move(actions)),
+      skeletons_(std::move(skeletons)) {
+  if (deadline_ < 1 || deadline_ > kMaxDeadline) {
+    reject("deadline must be between 1 and " + std::to_string(kMaxDeadline) + " steps");
+  }
+  if (!(std::isfinite(step_seconds_) && step_seconds_ > 0)) reject("step_seconds must be positive");
+  if (skeletons_.empty()) reject("at least one skeleton is needed");
+  if (skeletons_.size() > static_cast<std::size_t>(kMaxSkeletons)) {
+    reject("at most " + std::to_string(kMaxSkeletons) + " skeletons are supported");
+  }
+  std::set<std::string> ids;
+  for (const Action& action : actions_) {
+    if (action.id.empty()) reject("action ids must be non-empty");
+    if (!ids.insert(action.id).second) reject("action id '" + action.id + "' is listed twice");
+    if (action.planning.pmf(0) > 0) reject("action '" + action.id + "': planning steps start at 1");
+  }
+
+  const std::size_t count = actions_.size();
+  members_.assign(count, {});
+  position_.assign(count, -1);
+  parent_.assign(count, -1);
+  completes_.assign(count, 0);
+  std::set<std::vector<int>> distinct;
+  for (std::size_t k = 0; k < skeletons_.size(); ++k) {
+    const std::vector<int>& path = skeletons_[k];
+    if (path.empty()) reject("skeleton " + std::to_string(k) + " is empty");
+    if (path.size() > static_cast<std::size_t>(kMaxSkeletonLength)) {
+      reject("skeleton " + std::to_string(k) + " is longer than " + std::to_string(kMaxSkeletonLength));
+    }
+    if (!distinct.insert(path).second) reject("skeleton " + std::to_string(k) + " is listed twice");
+    std::set<int> seen;
+    for (std::size_t l = 0; l < path.size(); ++l) {
+      const int action = path[l];
+      if (action < 0 || static_cast<std::size_t>(action) >= count) {
+        reject("skeleton " + std::to_string(k) + " names an unknown action");
+      }
+      if (!seen.insert(action).second) {
+        reject("skeleton " + std::to_string(k) + " repeats action '" + actions_[static_cast<std::size_t>(action)].id +
+               "'");
+      }
+      const auto slot = static_cast<std::size_t>(action);
+      const int parent = l == 0 ? -1 : path[l - 1];
+      if (members_[slot].empty()) {
+        position_[slot] = static_cast<int>(l);
+        parent_[slot] = parent;
+      } else if (position_[slot] != static_cast<int>(l) || parent_[slot] != parent) {
+        reject("action '" + actions_[slot].id +
+               "' is shared by skeletons that differ before it; shared actions must follow a common prefix");
+      }
+      members_[slot].push_back(static_cast<int>(k));
+    }
+    completes_[static_cast<std::size_t>(path.back())] = 1;
+  }
+}
+
+int Problem::find_action(std::string_view id) const noexcept {
+  for (std::size_t i = 0; i < actions_.size(); ++i) {
+    if (actions_[i].id == id) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+}  // namespace ontime

@@ -1,0 +1,75 @@
+#include "ontime/run/evaluation.hpp"
+
+#include <string>
+#include <vector>
+
+#include "ontime/run/simulator.hpp"
+#include "ontime/util/error.hpp"
+#include "solve/expectimax.hpp"
+
+namespace ontime {
+namespace {
+
+// The allocator's own choice is the only choice; states are keyed by their fixed-size copy
+// (packed into Words 64-bit words when Words > 0).
+template <std::size_t Words>
+class StationaryPolicy {
+ public:
+  StationaryPolicy(Allocator& allocator, int skeleton_count)
+      : allocator_(&allocator), skeleton_count_(skeleton_count) {}
+  void choices(const detail::CompactState& state, std::vector<int>& out) const {
+    detail::expanded(state, scratch_);
+    const int choice = allocator_->choose(scratch_);
+    if (choice < 0 || choice >= skeleton_count_) {
+      throw UsageError("allocator '" + std::string(allocator_->name()) + "' chose skeleton " + std::to_string(choice) +
+                       ", outside [0, " + std::to_string(skeleton_count_) + ")");
+    }
+    out.push_back(choice);
+  }
+  auto key(const detail::CompactState& state) const {
+    if constexpr (Words > 0) {
+      return detail::pack<Words>(state, skeleton_count_);
+    } else {
+      return state;
+    }
+  }
+
+ private:
+  Allocator* allocator_;
+  int skeleton_count_;
+  mutable State scratch_;  // the state the allocator is asked about
+};
+
+}  // namespace
+
+MonteCarloResult run_monte_carlo(const Mdp& mdp, const AllocatorFactory& factory, const MonteCarloOptions& options) {
+  return run_episodes(mdp, hidden_worlds(mdp.problem()), factory, options);
+}
+
+ExactEvaluation evaluate_exactly(const Mdp& mdp, Allocator& allocator, std::size_t max_states,
+                                 const std::function<bool()>& stop) {
+  if (!allocator.is_stationary()) {
+    throw UsageError("exact evaluation needs an allocator whose choice depends only on the state; '" +
+                     std::string(allocator.name()) + "' does not (use Monte Carlo)");
+  }
+  allocator.begin_episode(0);
+  const auto run = [&](auto policy) {
+    detail::Expectimax<decltype(policy)> search(mdp, policy, max_states, 0.0,
+                                                "exact evaluation of " + std::string(allocator.name()));
+    search.set_stop(stop);
+    ExactEvaluation result;
+    result.success_probability = search.solve(mdp.start()).value;
+    result.states = search.memo().size();
+    return result;
+  };
+  switch (detail::packed_words(mdp)) {
+    case 2:
+      return run(StationaryPolicy<2>(allocator, mdp.skeleton_count()));
+    case 4:
+      return run(StationaryPolicy<4>(allocator, mdp.skeleton_count()));
+    default:
+      return run(StationaryPolicy<0>(allocator, mdp.skeleton_count()));
+  }
+}
+
+}  // namespace ontime

@@ -1,0 +1,295 @@
+#pragma once
+// Internal: memoised expectimax over the reachable states of the MDP, without recursion.
+//
+// V(s) = max over c in choices(s) of  sum_o P(o | s, c) * ([o is success] + [o running] V(o)),
+// 0 when there is no choice. `optimal` maximises over every useful choice; exact evaluation
+// passes the one choice an allocator makes. Time only grows along a path, so the reachable
+// states form a DAG of depth at most D; an explicit stack keeps deep deadlines off the call
+// stack, and one item buffer used as a stack avoids allocation per state.
+//
+// The memo is an open-addressing hash table (absl::flat_hash_map): no node per state, hashes
+// kept beside the keys. Where the deadline and skeleton count allow, states are packed into
+// 16- or 32-byte keys (PackedState), so that a state costs 33 or 49 bytes of table slot
+// instead of the ~140 bytes of a node-based map of full states.
+
+#include <absl/container/flat_hash_map.h>
+#include <absl/hash/hash.h>
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <functional>
+#include <string>
+#include <string_view>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "ontime/mdp/mdp.hpp"
+#include "ontime/util/error.hpp"
+
+namespace ontime::detail {
+
+struct ExpectimaxEntry {
+  double value;
+  int choice;  // the maximising choice, -1 when there was none
+};
+
+// A state in 8 * Words bytes: CT in 16 bits, then refined, spent and execution of each
+// skeleton in 8 bits each. Exact when 2 + 3K <= 8 * Words and every counter stays below 255
+// (D <= 253: spent and execution never exceed D + 1, and 255 is free for markers).
+template <std::size_t Words>
+struct PackedState {
+  std::array<std::uint64_t, Words> words{};
+
+  friend bool operator==(const PackedState& a, const PackedState& b) noexcept {
+    std::uint64_t difference = 0;
+    for (std::size_t i = 0; i < Words; ++i) difference |= a.words[i] ^ b.words[i];
+    return difference == 0;
+  }
+};
+
+// Mixes the words and finishes with MurmurHash3's 64-bit avalanche, inline: the generic
+// absl::Hash of an array calls out of line and showed up as a tenth of the solve time.
+struct PackedStateHash {
+  template <std::size_t Words>
+  std::size_t operator()(const PackedState<Words>& state) const noexcept {
+    std::uint64_t h = 0x9e3779b97f4a7c15ULL;
+    for (std::size_t i = 0; i < Words; ++i) h = (h ^ (h >> 29) ^ state.words[i]) * 0xbf58476d1ce4e5b9ULL;
+    h ^= h >> 33;
+    h *= 0xc4ceb9fe1a85ec53ULL;
+    return static_cast<std::size_t>(h ^ (h >> 33));
+  }
+};
+
+// The fewest 64-bit words a packed state of this MDP needs (2 or 4), or 0 when it cannot be
+// packed.
+inline std::size_t packed_words(const Mdp& mdp) noexcept {
+  if (mdp.deadline() > 253) return 0;
+  const int bytes = 2 + 3 * mdp.skeleton_count();
+  return bytes <= 16 ? 2 : bytes <= 32 ? 4 : 0;
+}
+
+// A whole state in a fixed 82 bytes (at most kMaxExactSkeletons skeletons; unused slots zero):
+// the state the search works on, and its key where the deadline or the skeleton count is too
+// large for a PackedState.
+struct CompactState {
+  std::uint16_t time = 0;
+  std::array<std::uint8_t, kMaxExactSkeletons> refined{};
+  std::array<std::uint16_t, kMaxExactSkeletons> spent{};
+  std::array<std::uint16_t, kMaxExactSkeletons> execution{};
+
+  friend bool operator==(const CompactState&, const CompactState&) = default;
+};
+static_assert(sizeof(CompactState) == 2 + 16 + 32 + 32, "CompactState must have no padding: it is hashed as bytes");
+
+inline CompactState compact(const State& state, int skeleton_count) noexcept {
+  CompactState out;
+  out.time = state.time;
+  for (int k = 0; k < skeleton_count; ++k) {
+    const auto slot = static_cast<std::size_t>(k);
+    out.refined[slot] = state.refined[slot];
+    out.spent[slot] = state.spent[slot];
+    out.execution[slot] = state.execution[slot];
+  }
+  return out;
+}
+
+template <std::size_t Words>
+PackedState<Words> pack(const CompactState& state, int skeleton_count) noexcept {
+  std::array<std::uint8_t, 8 * Words> bytes{};
+  bytes[0] = static_cast<std::uint8_t>(state.time & 0xFF);
+  bytes[1] = static_cast<std::uint8_t>(state.time >> 8);
+  for (int k = 0; k < skeleton_count; ++k) {
+    const auto slot = static_cast<std::size_t>(k);
+    bytes[2 + 3 * slot] = state.refined[slot];
+    bytes[3 + 3 * slot] = static_cast<std::uint8_t>(state.spent[slot]);
+    bytes[4 + 3 * slot] = static_cast<std::uint8_t>(state.execution[slot]);
+  }
+  PackedState<Words> packed;
+  std::memcpy(packed.words.data(), bytes.data(), bytes.size());
+  return packed;
+}
+
+// The state a CompactState holds, written into `out` (sized for `compact`'s skeletons).
+inline void expanded(const CompactState& compact, State& out) noexcept {
+  out.time = compact.time;
+  for (std::size_t k = 0; k < compact.refined.size(); ++k) {
+    out.refined[k] = compact.refined[k];
+    out.spent[k] = compact.spent[k];
+    out.execution[k] = compact.execution[k];
+  }
+}
+
+struct CompactStateHash {
+  std::size_t operator()(const CompactState& state) const noexcept {
+    return absl::Hash<std::string_view>{}(
+        std::string_view(reinterpret_cast<const char*>(&state), sizeof(CompactState)));
+  }
+};
+
+// Above any reachable PT or ET (its low byte, 255, is above them too when packed): the value of
+// a blanked slot.
+inline constexpr std::uint16_t kBlankCounter = 0xFFFF;
+
+// Blanks, in place, the slots of skeletons whose group can no longer succeed (refined 0, spent
+// and execution kBlankCounter): they influence neither the value nor the choices, so states
+// that differ only there are one state to the exact solvers. A blanked state evolves like the
+// original (a blanked skeleton shares no action with a skeleton that can still succeed).
+inline void blank_hopeless(const Mdp& mdp, CompactState& state) noexcept {
+  for (int k = 0; k < mdp.skeleton_count(); ++k) {
+    const int action = mdp.next_action(state, k);
+    if (action >= 0 && mdp.group_can_succeed(state, action)) continue;
+    const auto slot = static_cast<std::size_t>(k);
+    state.refined[slot] = 0;
+    state.spent[slot] = kBlankCounter;
+    state.execution[slot] = kBlankCounter;
+  }
+}
+
+// Throws UsageError when the problem has more skeletons than the exact solvers' keys hold.
+inline void require_exact_size(const Mdp& mdp, const std::string& what) {
+  if (mdp.skeleton_count() > kMaxExactSkeletons) {
+    throw UsageError(what + ": the instance has " + std::to_string(mdp.skeleton_count()) +
+                     " skeletons; exact solving and exact evaluation take at most " +
+                     std::to_string(kMaxExactSkeletons) + " (use a sampled evaluation or an approximate allocator)");
+  }
+}
+
+// The search runs on CompactStates (the Mdp's functions are templates on the state type): a
+// copy is a plain 82-byte copy, with no indirection.
+//
+// Policy provides:
+//   void choices(const CompactState&, std::vector<int>& out) const;  // in increasing preference on ties
+//   Key key(const CompactState&) const;   // states with one key share a value; CompactState or PackedState
+template <class Policy>
+class Expectimax {
+ public:
+  using Key = std::remove_cvref_t<decltype(std::declval<const Policy&>().key(std::declval<const CompactState&>()))>;
+  using Hash = std::conditional_t<std::is_same_v<Key, CompactState>, CompactStateHash, PackedStateHash>;
+  using Memo = absl::flat_hash_map<Key, ExpectimaxEntry, Hash>;
+
+  Expectimax(const Mdp& mdp, Policy policy, std::size_t max_states, double tie_tolerance, std::string what)
+      : mdp_(&mdp),
+        policy_(std::move(policy)),
+        max_states_(max_states),
+        tie_tolerance_(tie_tolerance),
+        what_(std::move(what)) {
+    require_exact_size(mdp, what_);
+  }
+
+  // A condition checked every few thousand states: once it returns true, solve throws Cancelled
+  // (the states solved so far are kept).
+  void set_stop(std::function<bool()> stop) { stop_ = std::move(stop); }
+
+  ExpectimaxEntry solve(const State& start_state) {
+    const CompactState start = compact(start_state, mdp_->skeleton_count());
+    const Key start_key = policy_.key(start);
+    if (const auto found = memo_.find(start_key); found != memo_.end()) return found->second;
+    push(start, start_key);
+    while (!frames_.empty()) {
+      const std::size_t top = frames_.size() - 1;
+      bool descended = false;
+      while (frames_[top].cursor < frames_[top].end) {
+        const Item& item = items_[frames_[top].cursor++];
+        if (item.status == Status::running && !memo_.contains(item.key)) {
+          const CompactState next = item.next;  // push may move the items
+          const Key next_key = item.key;
+          push(next, next_key);
+          descended = true;
+          break;
+        }
+      }
+      if (descended) continue;
+      finish(top);
+    }
+    return memo_.at(start_key);
+  }
+
+  const Memo& memo() const noexcept { return memo_; }
+  Key key_of(const State& state) const { return policy_.key(compact(state, mdp_->skeleton_count())); }
+  const Policy& policy() const noexcept { return policy_; }
+
+  // Memory held by the memo (table slots and their control bytes).
+  std::size_t memo_bytes() const noexcept { return memo_.capacity() * (sizeof(typename Memo::slot_type) + 1); }
+
+ private:
+  struct Item {
+    int choice;
+    Status status;
+    double probability;
+    CompactState next;
+    Key key;  // of `next`, when running
+  };
+  struct Frame {
+    Key key;
+    std::size_t begin, end, cursor;
+  };
+
+  void push(const CompactState& state, const Key& key) {
+    Frame frame{key, items_.size(), 0, items_.size()};
+    choices_.clear();
+    policy_.choices(state, choices_);
+    for (const int choice : choices_) {
+      mdp_->for_each_outcome(state, choice, [&](double probability, Status status, const CompactState& next) {
+        items_.push_back(
+            Item{choice, status, probability, next, status == Status::running ? policy_.key(next) : Key{}});
+      });
+    }
+    frame.end = items_.size();
+    frames_.push_back(frame);
+  }
+
+  void finish(std::size_t top) {
+    const Frame frame = frames_[top];
+    ExpectimaxEntry best{0.0, -1};
+    double best_value = -1.0;
+    for (std::size_t i = frame.begin; i < frame.end;) {
+      const int choice = items_[i].choice;
+      double value = 0;
+      for (; i < frame.end && items_[i].choice == choice; ++i) {
+        const Item& item = items_[i];
+        if (item.status == Status::success) {
+          value += item.probability;
+        } else if (item.status == Status::running) {
+          value += item.probability * memo_.at(item.key).value;
+        }
+      }
+      if (value > best_value + tie_tolerance_) {
+        best_value = value;
+        best = {value, choice};
+      }
+    }
+    if (stop_ && (memo_.size() & (kStopCheckInterval - 1)) == 0 && stop_()) {
+      throw Cancelled(what_ + ": stopped at the caller's request after " + std::to_string(memo_.size()) + " states");
+    }
+    if (memo_.size() >= max_states_) {
+      throw ResourceLimitError(what_ + ": reached the cap of " + std::to_string(max_states_) +
+                               " states (the max-states parameter) before finishing (about " +
+                               std::to_string(memo_bytes() >> 20) + " MiB held, " +
+                               std::to_string((memo_bytes() + memo_bytes() / 2) >> 20) +
+                               " MiB while the table last doubled); raise the cap or use an approximate allocator");
+    }
+    memo_.emplace(frame.key, best);
+    items_.resize(frame.begin);
+    frames_.pop_back();
+  }
+
+  // States between two checks of the stop condition: rare enough to cost nothing, frequent
+  // enough (well under a millisecond of work) to stop promptly.
+  static constexpr std::size_t kStopCheckInterval = 4096;
+
+  const Mdp* mdp_;
+  Policy policy_;
+  std::function<bool()> stop_;
+  std::size_t max_states_;
+  double tie_tolerance_;
+  std::string what_;
+  Memo memo_;
+  std::vector<Frame> frames_;
+  std::vector<Item> items_;
+  std::vector<int> choices_;
+};
+
+}  // namespace ontime::detail

@@ -1,0 +1,91 @@
+#include "ontime/solve/optimal_solver.hpp"
+
+#include <variant>
+#include <vector>
+
+#include "solve/expectimax.hpp"
+
+namespace ontime {
+namespace {
+
+// Choices and state keys of the optimal solver; Words > 0 packs keys into that many 64-bit
+// words (detail::pack), 0 keys by the whole state (detail::compact).
+template <std::size_t Words>
+class OptimalPolicy {
+ public:
+  explicit OptimalPolicy(const Mdp& mdp) : mdp_(&mdp) {}
+
+  void choices(const detail::CompactState& state, std::vector<int>& out) const {
+    for (const int choice : mdp_->useful_choices(state)) out.push_back(choice);
+  }
+
+  // Skeletons in a group that can no longer succeed influence nothing: detail::blank_hopeless
+  // blanks their slots so that states differing only there share one memo entry.
+  auto key(const detail::CompactState& state) const {
+    detail::CompactState key = state;
+    detail::blank_hopeless(*mdp_, key);
+    if constexpr (Words > 0) {
+      return detail::pack<Words>(key, mdp_->skeleton_count());
+    } else {
+      return key;
+    }
+  }
+
+ private:
+  const Mdp* mdp_;
+};
+
+using Search = std::variant<detail::Expectimax<OptimalPolicy<2>>, detail::Expectimax<OptimalPolicy<4>>,
+                            detail::Expectimax<OptimalPolicy<0>>>;
+
+}  // namespace
+
+struct OptimalSolver::Impl {
+  Impl(const Mdp& mdp, std::size_t max_states) : search(make(mdp, max_states)) {}
+
+  static Search make(const Mdp& mdp, std::size_t max_states) {
+    const auto build = [&]<std::size_t Words>() -> Search {
+      return detail::Expectimax<OptimalPolicy<Words>>(mdp, OptimalPolicy<Words>(mdp), max_states,
+                                                      OptimalSolver::kTieTolerance, "optimal");
+    };
+    switch (detail::packed_words(mdp)) {
+      case 2:
+        return build.template operator()<2>();
+      case 4:
+        return build.template operator()<4>();
+      default:
+        return build.template operator()<0>();
+    }
+  }
+
+  Search search;
+};
+
+OptimalSolver::OptimalSolver(const Mdp& mdp, std::size_t max_states)
+    : mdp_(&mdp), max_states_(max_states), impl_(std::make_unique<Impl>(mdp, max_states)) {}
+OptimalSolver::~OptimalSolver() = default;
+void OptimalSolver::set_stop(std::function<bool()> stop) {
+  std::visit([&](auto& search) { search.set_stop(std::move(stop)); }, impl_->search);
+}
+OptimalSolver::OptimalSolver(OptimalSolver&&) noexcept = default;
+OptimalSolver& OptimalSolver::operator=(OptimalSolver&&) noexcept = default;
+
+double OptimalSolver::solve(const State& state) {
+  return std::visit([&state](auto& search) { return search.solve(state).value; }, impl_->search);
+}
+
+std::optional<int> OptimalSolver::best_choice(const State& state) const {
+  return std::visit(
+      [&state](const auto& search) -> std::optional<int> {
+        const auto found = search.memo().find(search.key_of(state));
+        if (found == search.memo().end() || found->second.choice < 0) return std::nullopt;
+        return found->second.choice;
+      },
+      impl_->search);
+}
+
+std::size_t OptimalSolver::states() const noexcept {
+  return std::visit([](const auto& search) { return search.memo().size(); }, impl_->search);
+}
+
+}  // namespace ontime

@@ -1,0 +1,214 @@
+#include "ontime/domains/navigation_generator.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <map>
+#include <set>
+#include <stdexcept>
+
+#include "ontime/domains/navigation.hpp"
+#include "ontime/domains/navigation_collision.hpp"
+#include "ontime/util/input_file.hpp"
+#include "support/paper.hpp"
+
+namespace ontime::domains {
+namespace {
+
+BuildingOptions building(std::uint64_t seed, int rows = 6, int cols = 5) {
+  BuildingOptions options;
+  options.rows = rows;
+  options.cols = cols;
+  options.seed = seed;
+  return options;
+}
+
+// Neighbouring room pairs of a rows x cols grid.
+int neighbour_pairs(int rows, int cols) { return rows * (cols - 1) + (rows - 1) * cols; }
+
+// Rooms reachable from `from` through doors.
+std::size_t reachable(const NavigationWorld& world, const std::string& from) {
+  std::set<std::string> seen{from};
+  std::vector<std::string> frontier{from};
+  while (!frontier.empty()) {
+    const std::string room = frontier.back();
+    frontier.pop_back();
+    for (const Door& door : world.doors) {
+      for (int side = 0; side < 2; ++side) {
+        if (door.rooms[side] == room && seen.insert(door.rooms[1 - side]).second) {
+          frontier.push_back(door.rooms[1 - side]);
+        }
+      }
+    }
+  }
+  return seen.size();
+}
+
+TEST(NavigationGenerator, TheSameSeedWritesTheSameFileAndAnotherSeedAnother) {
+  const std::string first = generate_navigation_world_text(building(1));
+  EXPECT_EQ(generate_navigation_world_text(building(1)), first);
+  EXPECT_NE(generate_navigation_world_text(building(2)), first);
+  BuildingOptions denser = building(1);
+  denser.door_density = 1.0;
+  EXPECT_NE(generate_navigation_world_text(denser), first);
+}
+
+TEST(NavigationGenerator, TheCommittedBuildingIsSeedOneWithTheDefaults) {
+  EXPECT_EQ(generate_navigation_world_text(building(1)),
+            read_input_file(testing::source_path("data/domains/building-6x5.json"), "world"));
+}
+
+TEST(NavigationGenerator, WritesAWorldTheCheckerAcceptsWithTheOfficeSettings) {
+  const NavigationWorld world = parse_navigation_world(generate_navigation_world_text(building(1)), "b.json");
+  const NavigationWorld office = load_navigation_world(testing::source_path("data/domains/navigation.json"));
+  EXPECT_EQ(world.name, "building-6x5");
+  ASSERT_EQ(world.rooms.size(), 30u);
+  for (const Room& room : world.rooms) {
+    EXPECT_DOUBLE_EQ(room.max_x - room.min_x, 4.0);
+    EXPECT_DOUBLE_EQ(room.max_y - room.min_y, 4.0);
+  }
+  // Round(0.8 x 49 neighbour pairs) doors, at least a spanning tree: every room is reachable.
+  EXPECT_EQ(world.doors.size(), static_cast<std::size_t>(std::lround(0.8 * neighbour_pairs(6, 5))));
+  EXPECT_EQ(reachable(world, world.start_room), world.rooms.size());
+  EXPECT_TRUE(world.skeletons.empty());
+  EXPECT_FALSE(world.obstacles.empty());
+  // The deadline grows with the building: 5 steps a move of a shortest path (9 moves here).
+  EXPECT_EQ(world.collection.deadline, 45);
+  EXPECT_EQ(generate_navigation_world(building(1, 2, 3)).collection.deadline, office.collection.deadline);
+  EXPECT_EQ(world.collection.step_seconds, office.collection.step_seconds);
+  EXPECT_EQ(world.collection.checks_per_second, office.collection.checks_per_second);
+  EXPECT_EQ(world.planner.range, office.planner.range);
+  EXPECT_EQ(world.planner.resolution, office.planner.resolution);
+  EXPECT_EQ(world.robot.length, office.robot.length);
+  EXPECT_EQ(world.robot.clearance, office.robot.clearance);
+}
+
+TEST(NavigationGenerator, DoorWidthsVaryFromNarrowToComfortable) {
+  const NavigationWorld world = generate_navigation_world(building(1));
+  const double passable = world.robot.width + 2 * world.robot.clearance;
+  std::size_t narrow = 0, comfortable = 0;
+  for (const Door& door : world.doors) {
+    EXPECT_GT(door.width, passable);
+    if (door.width < 0.9) ++narrow;
+    if (door.width >= 1.0 && door.width <= 1.2) ++comfortable;
+  }
+  EXPECT_EQ(narrow + comfortable, world.doors.size());
+  EXPECT_GT(narrow, 0u);
+  EXPECT_GT(comfortable, world.doors.size() / 2);
+}
+
+TEST(NavigationGenerator, RoomsRangeFromEmptyToCluttered) {
+  const NavigationWorld world = generate_navigation_world(building(1));
+  std::map<std::string, int> pieces;
+  for (const Obstacle& obstacle : world.obstacles) {
+    for (const Room& room : world.rooms) {
+      if (room.contains(obstacle.shape.x, obstacle.shape.y)) ++pieces[room.id];
+    }
+  }
+  std::size_t empty = 0;
+  int most = 0;
+  for (const Room& room : world.rooms) {
+    empty += pieces[room.id] == 0 ? 1 : 0;
+    most = std::max(most, pieces[room.id]);
+  }
+  EXPECT_GT(empty, 0u);
+  EXPECT_GE(most, 4);
+}
+
+// Into both rooms of every door: the robot drives through the door, turns, drives to the room's
+// centre and turns there, collision-free with its clearance, in every generated world.
+TEST(NavigationGenerator, EveryDoorIsPassableFromBothSidesAndEveryRoomCanBeCrossed) {
+  for (const std::uint64_t seed : {1, 2, 3}) {
+    for (const auto& [rows, cols] : {std::pair{6, 5}, std::pair{2, 3}}) {
+      const NavigationWorld world = generate_navigation_world(building(seed, rows, cols));
+      const NavigationCollision collision(world, world.robot.clearance);
+      for (const Door& door : world.doors) {
+        for (const std::string& id : door.rooms) {
+          const std::vector<Pose> route = door_route(world, door, id);
+          ASSERT_GT(route.size(), 2u);
+          EXPECT_DOUBLE_EQ(route.front().x, door.x);
+          EXPECT_DOUBLE_EQ(route.front().y, door.y);
+          // A pose on this side of the door, inside the room.
+          EXPECT_TRUE(world.room(id).contains(route[route.size() / 4].x, route[route.size() / 4].y));
+          for (const Pose& pose : route) {
+            ASSERT_FALSE(collision.collides(pose))
+                << "seed " << seed << ", door " << door.rooms[0] << "-" << door.rooms[1] << " into " << id << " at "
+                << pose.x << ", " << pose.y << ", " << pose.theta;
+          }
+        }
+      }
+    }
+  }
+}
+
+TEST(NavigationGenerator, StartAndGoalAreInOppositeCorners) {
+  for (const auto& [rows, cols] : {std::pair{6, 5}, std::pair{2, 3}, std::pair{1, 2}}) {
+    const NavigationWorld world = generate_navigation_world(building(4, rows, cols));
+    const Room& start = world.room(world.start_room);
+    const Room& goal = world.room(world.goal_room);
+    const double side = start.max_x - start.min_x;
+    const double grid_distance = std::abs(goal.min_x - start.min_x) / side + std::abs(goal.min_y - start.min_y) / side;
+    EXPECT_DOUBLE_EQ(grid_distance, rows - 1 + cols - 1);
+    EXPECT_TRUE(start.contains(world.start.x, world.start.y));
+  }
+}
+
+// Many room paths lead from start to goal, many of them about as short as the shortest.
+TEST(NavigationGenerator, ManyRoomPathsOfSimilarLengthLeadToTheGoal) {
+  for (const std::uint64_t seed : {1, 2, 3, 4}) {
+    const NavigationWorld world = generate_navigation_world(building(seed));
+    const auto paths = world.room_paths(world.start_room, world.goal_room);
+    std::size_t shortest = paths.at(0).size();
+    for (const auto& path : paths) shortest = std::min(shortest, path.size());
+    EXPECT_EQ(shortest, 10u) << "seed " << seed;  // 9 moves: corner to corner of 6 x 5
+    const auto near = std::count_if(paths.begin(), paths.end(),
+                                    [&](const std::vector<std::string>& path) { return path.size() <= shortest + 2; });
+    EXPECT_GT(paths.size(), 100u) << "seed " << seed;
+    EXPECT_GE(near, 20) << "seed " << seed;
+  }
+  // Without extra doors, a spanning tree: exactly one room path.
+  BuildingOptions tree = building(1, 3, 3);
+  tree.door_density = 0;
+  const NavigationWorld world = generate_navigation_world(tree);
+  EXPECT_EQ(world.doors.size(), 8u);
+  EXPECT_EQ(world.room_paths(world.start_room, world.goal_room).size(), 1u);
+  EXPECT_EQ(reachable(world, world.start_room), 9u);
+}
+
+TEST(NavigationGenerator, EveryActionIsEveryDoorInBothDirections) {
+  const NavigationDomain domain(generate_navigation_world(building(2, 2, 3)));
+  const std::vector<StandaloneAction> actions = domain.every_action();
+  const NavigationWorld& world = domain.world();
+  ASSERT_EQ(actions.size(), 2 * world.doors.size());
+  std::set<std::pair<std::string, std::string>> moves;
+  for (const StandaloneAction& action : actions) {
+    const std::vector<std::string> rooms = move_rooms(action.action);
+    ASSERT_EQ(rooms.size(), 2u);
+    moves.emplace(rooms[0], rooms[1]);
+    EXPECT_EQ(action.from_initial_configuration, rooms[0] == world.start_room) << action.action;
+  }
+  for (const Door& door : world.doors) {
+    EXPECT_EQ(moves.count({door.rooms[0], door.rooms[1]}), 1u);
+    EXPECT_EQ(moves.count({door.rooms[1], door.rooms[0]}), 1u);
+  }
+  EXPECT_EQ(moves.size(), actions.size());
+}
+
+TEST(NavigationGenerator, RefusesOptionsOutOfRange) {
+  const auto refused = [](const std::function<void(BuildingOptions&)>& edit) {
+    BuildingOptions options;
+    edit(options);
+    EXPECT_THROW(generate_navigation_world_text(options), std::invalid_argument);
+  };
+  refused([](BuildingOptions& o) { o.rows = 0; });
+  refused([](BuildingOptions& o) { o.cols = kMaxBuildingSide + 1; });
+  refused([](BuildingOptions& o) { o.rows = o.cols = 1; });
+  refused([](BuildingOptions& o) { o.room_size = kMinBuildingRoomSize - 0.5; });
+  refused([](BuildingOptions& o) { o.door_density = 1.5; });
+  refused([](BuildingOptions& o) { o.narrow_door_share = -0.1; });
+}
+
+}  // namespace
+}  // namespace ontime::domains

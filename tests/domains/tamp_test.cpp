@@ -1,0 +1,195 @@
+// The pieces of the TAMP loop over a real planner: room paths streamed in order of length, the
+// streaming planner world's prefix tree of actions, and whole streaming episodes.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "ontime/allocators/allocator_registry.hpp"
+#include "ontime/domains/library_messages.hpp"
+#include "ontime/domains/navigation.hpp"
+#include "ontime/domains/planner_world.hpp"
+#include "ontime/domains/task_planner.hpp"
+#include "ontime/model/instance_io.hpp"
+#include "ontime/run/episode_runner.hpp"
+#include "support/paper.hpp"
+
+namespace ontime::domains {
+namespace {
+
+struct Fixture {
+  NavigationDomain domain{load_navigation_world(testing::source_path("data/domains/navigation.json"))};
+  Problem library{load_problem(testing::source_path("data/instances/navigation.json"))};
+  PlannerWorldOptions options{EffortSettings{EffortUnit::collision_checks, 1200.0}, false, std::nullopt};
+};
+
+const Fixture& fixture() {
+  static const Fixture instance;
+  return instance;
+}
+
+std::vector<std::string> moves_of(const std::vector<std::string>& rooms) {
+  std::vector<std::string> moves;
+  for (std::size_t i = 1; i < rooms.size(); ++i) moves.push_back("move(" + rooms[i - 1] + "," + rooms[i] + ")");
+  return moves;
+}
+
+std::vector<std::vector<std::string>> read_all(TaskPlanner& planner) {
+  std::vector<std::vector<std::string>> paths;
+  while (auto path = planner.next()) paths.push_back(*path);
+  return paths;
+}
+
+TEST(RoomPaths, EverySimplePathOnceInOrderOfLength) {
+  const NavigationWorld& world = fixture().domain.world();
+  const auto planner = room_path_planners(world)();
+  const std::vector<std::vector<std::string>> paths = read_all(*planner);
+  // The same set as the world's own enumeration of simple room paths.
+  std::set<std::vector<std::string>> expected;
+  for (const auto& rooms : world.room_paths(world.start_room, world.goal_room)) expected.insert(moves_of(rooms));
+  EXPECT_EQ(std::set<std::vector<std::string>>(paths.begin(), paths.end()), expected);
+  EXPECT_EQ(paths.size(), expected.size());
+  for (std::size_t k = 1; k < paths.size(); ++k) {
+    EXPECT_LE(room_path_length(world, paths[k - 1]), room_path_length(world, paths[k]) + 1e-9) << "path " << k;
+  }
+  // Started over, and from a second planner of the same factory: the same sequence.
+  planner->restart();
+  EXPECT_EQ(read_all(*planner), paths);
+  const TaskPlannerFactory factory = room_path_planners(world, 2);
+  const auto first = factory();
+  EXPECT_EQ(read_all(*first), std::vector<std::vector<std::string>>(paths.begin(), paths.begin() + 2));
+}
+
+// igraph's warnings reach the program through the library-message sink, never standard error
+// raw. A world changed after it was read (the reader refuses an unreachable goal) makes igraph
+// warn that it cannot reach the goal; the planner then finds no path.
+TEST(RoomPaths, IgraphsWarningsGoThroughTheMessageSink) {
+  NavigationWorld world = fixture().domain.world();
+  std::erase_if(world.doors, [&world](const Door& door) {
+    return door.rooms[0] == world.goal_room || door.rooms[1] == world.goal_room;
+  });
+  std::vector<std::string> messages;
+  set_library_message_sink([&messages](std::string_view library, LibraryMessageLevel level, std::string_view text) {
+    messages.push_back(std::string(library) + (level == LibraryMessageLevel::warning ? " warning: " : " error: ") +
+                       std::string(text));
+  });
+  ::testing::internal::CaptureStderr();
+  const auto planner = room_path_planners(world)();
+  EXPECT_FALSE(planner->next().has_value());
+  const std::string printed = ::testing::internal::GetCapturedStderr();
+  set_library_message_sink(nullptr);
+  EXPECT_EQ(printed, "");
+  ASSERT_EQ(messages.size(), 1U);
+  EXPECT_EQ(messages[0], "igraph warning: Couldn't reach some vertices");
+}
+
+// Hands out the given skeletons in order.
+class ListPlanner final : public TaskPlanner {
+ public:
+  explicit ListPlanner(std::vector<std::vector<std::string>> skeletons) : skeletons_(std::move(skeletons)) {}
+  void restart() override { next_ = 0; }
+  std::optional<std::vector<std::string>> next() override {
+    if (next_ >= skeletons_.size()) return std::nullopt;
+    return skeletons_[next_++];
+  }
+
+ private:
+  std::vector<std::vector<std::string>> skeletons_;
+  std::size_t next_ = 0;
+};
+
+TEST(StreamingPlannerWorld, SkeletonsShareTheirPrefixAndAMoveReachedAnotherWayIsANewAction) {
+  const Fixture& f = fixture();
+  StreamingWorldOptions streaming;
+  streaming.library = &f.library;
+  streaming.seconds_per_skeleton = 0.5;
+  streaming.task_planners = [] {
+    return std::make_unique<ListPlanner>(std::vector<std::vector<std::string>>{
+        {"move(R1,R5)", "move(R5,R6)"}, {"move(R1,R5)", "move(R5,R8)"}, {"move(R1,R2)", "move(R5,R8)"}});
+  };
+  PlannerWorld world(f.domain, streaming, f.options);
+  world.begin_episode(3);
+  const auto first = world.next_skeleton();
+  ASSERT_TRUE(first);
+  EXPECT_EQ(first->action_ids, (std::vector<std::string>{"move(R1,R5)", "move(R5,R6)"}));
+  EXPECT_EQ(first->new_actions.size(), 2u);
+  EXPECT_EQ(first->charged_seconds, 0.5);
+  const auto second = world.next_skeleton();
+  ASSERT_TRUE(second);
+  EXPECT_EQ(second->action_ids, (std::vector<std::string>{"move(R1,R5)", "move(R5,R8)"}));
+  ASSERT_EQ(second->new_actions.size(), 1u);  // the first move is shared
+  const auto third = world.next_skeleton();
+  ASSERT_TRUE(third);
+  EXPECT_EQ(third->action_ids, (std::vector<std::string>{"move(R1,R2)", "move(R5,R8)#2"}));
+  ASSERT_EQ(third->new_actions.size(), 2u);
+  const Action& copy = third->new_actions[1];
+  const Action& original = f.library.action(f.library.find_action("move(R5,R8)"));
+  EXPECT_EQ(copy.id, "move(R5,R8)#2");
+  EXPECT_EQ(copy.planning.mean_finite(), original.planning.mean_finite());
+  EXPECT_EQ(copy.execution.mean_finite(), original.execution.mean_finite());
+  EXPECT_FALSE(world.next_skeleton());
+  // The episode's actions: the prefix tree, each with the domain's action and its parent.
+  ASSERT_EQ(world.actions().size(), 5u);
+  EXPECT_EQ(world.actions()[4].action, "move(R5,R8)");
+  EXPECT_EQ(world.actions()[4].parent, 3);
+  // A new episode starts the tree and the task planner over.
+  world.begin_episode(4);
+  EXPECT_TRUE(world.actions().empty());
+  EXPECT_EQ(world.next_skeleton()->action_ids, first->action_ids);
+}
+
+TEST(StreamingPlannerWorld, AnActionMissingFromTheLibraryIsRefused) {
+  const Fixture& f = fixture();
+  StreamingWorldOptions streaming;
+  streaming.library = &f.library;
+  streaming.task_planners = [] {
+    return std::make_unique<ListPlanner>(std::vector<std::vector<std::string>>{{"move(R1,R6)"}});
+  };
+  PlannerWorld world(f.domain, streaming, f.options);
+  world.begin_episode(1);
+  EXPECT_THROW(world.next_skeleton(), std::invalid_argument);
+}
+
+TEST(StreamingPlannerWorld, WholeEpisodesOnTheRealPlannerAreTheSameForAnyThreadCount) {
+  const Fixture& f = fixture();
+  StreamingWorldOptions streaming;
+  streaming.library = &f.library;
+  streaming.task_planners = room_path_planners(f.domain.world());
+  streaming.seconds_per_skeleton = 0.5;
+  StreamingRun run;
+  run.deadline = 15;
+  run.step_seconds = f.library.step_seconds();
+  run.period = 2;
+  run.max_skeletons = 4;
+  run.make_allocator = [](const Mdp& mdp) { return make_allocator_factory("dp-rerun", mdp)(); };
+  MonteCarloOptions options;
+  options.episodes = 16;
+  options.seed = 2;
+  options.live = LiveRun{};
+  std::vector<int> found(options.episodes, 0);
+  options.on_episode = [&found](std::uint64_t episode, const EpisodeResult& result) {
+    found[episode] = result.skeletons;
+  };
+  options.threads = 1;
+  const MonteCarloResult one =
+      run_streaming_episodes(run, streaming_planner_worlds(f.domain, streaming, f.options), options);
+  const std::vector<int> found_one = found;
+  options.threads = 2;
+  const MonteCarloResult two =
+      run_streaming_episodes(run, streaming_planner_worlds(f.domain, streaming, f.options), options);
+  EXPECT_EQ(one.successes, two.successes);
+  EXPECT_EQ(found, found_one);
+  for (const int skeletons : found) {
+    EXPECT_GE(skeletons, 1);
+    EXPECT_LE(skeletons, 4);
+  }
+  // Each skeleton's 0.5 s of search is charged: at least the first one's in every episode.
+  EXPECT_GE(one.live_mean.outside, 0.5);
+  EXPECT_GT(one.successes, 0u);
+}
+
+}  // namespace
+}  // namespace ontime::domains

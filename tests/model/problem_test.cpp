@@ -1,0 +1,65 @@
+#include "ontime/model/problem.hpp"
+
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+
+#include "ontime/util/error.hpp"
+#include "support/paper.hpp"
+
+namespace ontime {
+namespace {
+
+Action simple(const std::string& id) {
+  return Action{id, Distribution::from_pmf({0.0, 1.0}), Distribution::from_pmf({1.0})};
+}
+
+TEST(Problem, PrefixTreeOfFigureOne) {
+  const Problem problem = testing::paper_instance("figure1");
+  ASSERT_EQ(problem.skeleton_count(), 3);
+  const int d1 = problem.find_action("d1");
+  const int d12 = problem.find_action("d12");
+  const int d3 = problem.find_action("d3");
+  ASSERT_GE(d1, 0);
+  EXPECT_EQ(std::vector<int>(problem.members(d1).begin(), problem.members(d1).end()), (std::vector<int>{0, 1}));
+  EXPECT_EQ(std::vector<int>(problem.members(d12).begin(), problem.members(d12).end()), (std::vector<int>{0}));
+  EXPECT_EQ(problem.position(d1), 0);
+  EXPECT_EQ(problem.position(d12), 1);
+  EXPECT_EQ(problem.parent(d12), d1);
+  EXPECT_EQ(problem.parent(d3), -1);
+  EXPECT_FALSE(problem.completes_a_skeleton(d1));
+  EXPECT_TRUE(problem.completes_a_skeleton(d12));
+  EXPECT_TRUE(problem.completes_a_skeleton(d3));
+}
+
+TEST(Problem, SharingOfInstanceOne) {
+  const Problem problem = testing::paper_instance("instance1");
+  const int shared_first = problem.find_action("a2_1");
+  const int shared_second = problem.find_action("a2_2");
+  EXPECT_EQ(problem.members(shared_first).size(), 3U);
+  EXPECT_EQ(problem.members(shared_second).size(), 2U);
+  EXPECT_EQ(problem.members(problem.find_action("a1_1")).size(), 1U);
+}
+
+TEST(Problem, RejectsBrokenRules) {
+  const auto make = [](std::vector<std::vector<int>> skeletons, Steps deadline = 5) {
+    return Problem("p", deadline, 1.0, {simple("a"), simple("b"), simple("c")}, std::move(skeletons));
+  };
+  EXPECT_NO_THROW(make({{0, 1}, {0, 2}}));
+  EXPECT_NO_THROW(make({{0}, {0, 1}}));              // a skeleton may be a prefix of another
+  EXPECT_THROW(make({{0, 1}, {0, 1}}), UsageError);  // listed twice
+  EXPECT_THROW(make({{0, 1, 0}}), UsageError);       // repeats an action
+  EXPECT_THROW(make({{0, 1}, {2, 1}}), UsageError);  // shared after different prefixes
+  EXPECT_THROW(make({{0, 1}, {1}}), UsageError);     // shared at another position
+  EXPECT_THROW(make({{}}), UsageError);              // empty skeleton
+  EXPECT_THROW(make({{3}}), UsageError);             // unknown action
+  EXPECT_THROW(make({{0}}, 0), UsageError);          // deadline below 1
+  EXPECT_THROW(make({{0}}, Problem::kMaxDeadline + 1), UsageError);
+  EXPECT_THROW(make({}), UsageError);                                                 // no skeleton
+  EXPECT_THROW(Problem("p", 5, 1.0, {simple("a"), simple("a")}, {{0}}), UsageError);  // duplicate id
+  Action zero_planning{"z", Distribution::from_pmf({0.5, 0.5}), Distribution::from_pmf({1.0})};
+  EXPECT_THROW(Problem("p", 5, 1.0, {zero_planning}, {{0}}), UsageError);
+}
+
+}  // namespace
+}  // namespace ontime

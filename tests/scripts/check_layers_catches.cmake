@@ -1,0 +1,22 @@
+# scripts/check-layers.py refuses a tree where a lower layer includes a higher one, naming the file,
+# the line and both layers, and accepts the same tree once the include points downward.
+# -DCHECKER=... -DSCRATCH=...
+file(REMOVE_RECURSE ${SCRATCH})
+file(WRITE ${SCRATCH}/include/ontime/model/problem.hpp "#pragma once\n#include \"ontime/util/error.hpp\"\n#include \"ontime/run/session.hpp\"\n")
+file(WRITE ${SCRATCH}/include/ontime/util/error.hpp "#pragma once\n")
+file(WRITE ${SCRATCH}/src/run/session.cpp "#include \"ontime/model/problem.hpp\"\n#include \"solve/expectimax.hpp\"\n")
+execute_process(COMMAND /usr/bin/python3 ${CHECKER} ${SCRATCH} RESULT_VARIABLE status OUTPUT_VARIABLE out)
+if(NOT status EQUAL 1)
+  message(FATAL_ERROR "an upward include passed the check (exit ${status}): ${out}")
+endif()
+if(NOT out MATCHES "include/ontime/model/problem.hpp:3: layer 'model' includes \"ontime/run/session.hpp\" of layer 'run'")
+  message(FATAL_ERROR "the upward include is not named as expected: ${out}")
+endif()
+if(out MATCHES "session.cpp")
+  message(FATAL_ERROR "downward includes were reported: ${out}")
+endif()
+file(WRITE ${SCRATCH}/include/ontime/model/problem.hpp "#pragma once\n#include \"ontime/util/error.hpp\"\n")
+execute_process(COMMAND /usr/bin/python3 ${CHECKER} ${SCRATCH} RESULT_VARIABLE status OUTPUT_VARIABLE out)
+if(NOT status EQUAL 0)
+  message(FATAL_ERROR "a tree with downward includes only failed the check (exit ${status}): ${out}")
+endif()
