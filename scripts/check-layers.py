@@ -3,7 +3,7 @@
 
 OnTime's layers, lowest first; each knows only those before it:
 
-    util -> model -> mdp -> solve -> allocators -> run -> learn -> domains -> apps, python
+    util -> model -> mdp -> solve -> allocators -> run -> learn -> report -> domains -> apps, python
 
 A file's layer is the folder it lives in: include/ontime/LAYER/ and src/LAYER/ for the core;
 domains/, apps/, python/src/ and bench/ above them. The umbrella header include/ontime/ontime.hpp
@@ -20,7 +20,7 @@ import pathlib
 import re
 import sys
 
-CORE = ["util", "model", "mdp", "solve", "allocators", "run", "learn"]
+CORE = ["util", "model", "mdp", "solve", "allocators", "run", "learn", "report"]
 RANK = {name: rank for rank, name in enumerate(CORE)}
 RANK["umbrella"] = len(CORE)  # ontime.hpp, tests/support: every core layer
 RANK["domains"] = len(CORE) + 1

@@ -11,7 +11,6 @@
 #include "cluster_job.hpp"
 #include "common.hpp"
 #include "data_paths.hpp"
-#include "fit_report.hpp"
 #include "number_options.hpp"
 #include "ontime/domains/collection.hpp"
 #include "ontime/domains/collection_journal.hpp"
@@ -19,6 +18,7 @@
 #include "ontime/learn/fitting.hpp"
 #include "ontime/model/instance_io.hpp"
 #include "ontime/model/ompl_benchmark_log.hpp"
+#include "ontime/report/report.hpp"
 #include "ontime/util/error.hpp"
 #include "ontime/util/input_file.hpp"
 #include "output_paths.hpp"
@@ -198,7 +198,7 @@ void add_collect_command(CLI::App& app) {
       out["resumed_attempts"] = resumed;
       out["log"] = log_path.string();
       out["instance"] = instance_path.string();
-      out["actions"] = fit_report_json(fit);
+      out["actions"] = Json::parse(report::fit_json(fit));
       print_json(out);
       return;
     }
@@ -207,7 +207,7 @@ void add_collect_command(CLI::App& app) {
     if (resumed > 0) fmt::print("Resumed from {}: {} attempts were done before.\n", checkpoint_path.string(), resumed);
     fmt::print("Log: {}. Instance: {} (deadline {} steps of {} s).\n\n", log_path.string(), instance_path.string(),
                deadline, collection.step_seconds);
-    fmt::print("{}", fit_report_markdown(fit));
+    fmt::print("{}", report::fit_markdown(fit));
     fmt::print("\nT: planning steps, X: execution steps (means over the steps within the deadline).\n");
   });
 }

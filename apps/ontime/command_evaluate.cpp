@@ -7,6 +7,7 @@
 #include "memory_limits.hpp"
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/model/instance_io.hpp"
+#include "ontime/report/report.hpp"
 
 namespace ontime::cli {
 
@@ -36,9 +37,9 @@ void add_evaluate_command(CLI::App& app) {
     const Problem problem = load_problem(options->instance);
     const Mdp mdp(problem);
     const ParameterValues parameters = options->allocator.values();
-    options->monte_carlo.check_tree_memory(options->solver, parameters);
+    options->monte_carlo.check_allocator_memory(options->solver, problem, parameters);
     if (options->exact || allocator_registry().find(options->solver).capabilities.has(Capability::optimal)) {
-      check_state_cap_memory(problem, max_states_of(parameters), options->instance);
+      check_exact_work(problem, max_states_of(parameters), options->instance, flag_spelling());
     }
     const AllocatorFactory factory = make_allocator_factory(options->solver, mdp, parameters);
 
@@ -53,40 +54,15 @@ void add_evaluate_command(CLI::App& app) {
       const auto allocator = factory();
       exact = evaluate_exactly(mdp, *allocator, max_states_of(parameters));
     }
-    if (options->json) {
-      Json out;
-      out["solver"] = options->solver;
-      out["parameters"] = parameters_json(allocator_registry().find(options->solver), parameters);
-      out["instance"] = options->instance;
-      out["episodes"] = result.episodes;
-      out["seed"] = options->monte_carlo.seed;
-      out["successes"] = result.successes;
-      out["success_rate"] = result.success_rate;
-      out["ci95"] = result.ci95;
-      if (!options->no_timing) {
-        out["decision_time_us"] = {{"median", result.decision_time.median_us},
-                                   {"p99", result.decision_time.p99_us},
-                                   {"mean", result.decision_time.mean_us},
-                                   {"max", result.decision_time.max_us},
-                                   {"decisions", result.decision_time.decisions}};
-        out["seconds"] = result.seconds;
-      }
-      if (exact) {
-        out["exact_success_probability"] = exact->success_probability;
-        out["exact_states"] = exact->states;
-      }
-      print_json(out);
-      return;
-    }
-    fmt::print("solver          {}\n", options->solver);
-    fmt::print("instance        {} ({}), deadline {}\n", options->instance, problem.name(), problem.deadline());
-    fmt::print("success rate    {:.4f} ± {:.4f}  ({} of {} episodes, seed {})\n", result.success_rate, result.ci95,
-               result.successes, result.episodes, options->monte_carlo.seed);
-    if (exact) fmt::print("exact           {:.6f}  ({} states)\n", exact->success_probability, exact->states);
-    if (options->no_timing) return;
-    fmt::print("decision time   median {:.3f} µs, p99 {:.3f} µs, mean {:.3f} µs, max {:.3f} µs over {} decisions\n",
-               result.decision_time.median_us, result.decision_time.p99_us, result.decision_time.mean_us,
-               result.decision_time.max_us, result.decision_time.decisions);
+    report::Evaluation evaluation{.solver = options->solver,
+                                  .parameters = parameters,
+                                  .instance = options->instance,
+                                  .problem = &problem,
+                                  .seed = options->monte_carlo.seed,
+                                  .result = result,
+                                  .exact = exact,
+                                  .timing = !options->no_timing};
+    fmt::print("{}", options->json ? report::to_json(evaluation) + "\n" : report::to_text(evaluation));
   });
 }
 

@@ -11,12 +11,12 @@
 #include <vector>
 
 #include "common.hpp"
-#include "fit_report.hpp"
 #include "number_options.hpp"
 #include "ontime/learn/fitting.hpp"
 #include "ontime/model/instance_io.hpp"
 #include "ontime/model/ompl_benchmark_log.hpp"
 #include "ontime/model/planner_log.hpp"
+#include "ontime/report/report.hpp"
 #include "ontime/util/error.hpp"
 #include "output_paths.hpp"
 
@@ -149,13 +149,13 @@ void add_fit_command(CLI::App& app) {
       out["deadline"] = options->deadline;
       out["step_seconds"] = options->step_seconds;
       out["laplace"] = options->laplace;
-      out["actions"] = fit_report_json(fit);
+      out["actions"] = Json::parse(report::fit_json(fit));
       print_json(out);
       return;
     }
     fmt::print("Fitted {} from {} records of {}: deadline {} steps of {} s, Laplace alpha {}.\n\n", options->output,
                attempts.size(), logs, options->deadline, options->step_seconds, options->laplace);
-    fmt::print("{}", fit_report_markdown(fit));
+    fmt::print("{}", report::fit_markdown(fit));
     fmt::print("\nT: planning steps, X: execution steps (means over the steps within the deadline).\n");
   });
 }

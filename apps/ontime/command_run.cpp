@@ -114,9 +114,9 @@ void add_run_command(CLI::App& app) {
     const Problem problem = load_problem(instance);
     const Mdp mdp(problem);
     const ParameterValues parameters = options->allocator.values();
-    check_tree_memory(options->solver, parameters, options->episodes, options->threads);
+    check_allocator_memory(options->solver, problem, parameters, options->episodes, options->threads);
     if (options->exact || allocator_registry().find(options->solver).capabilities.has(Capability::optimal)) {
-      check_state_cap_memory(problem, max_states_of(parameters), instance.string());
+      check_exact_work(problem, max_states_of(parameters), instance.string(), flag_spelling());
     }
     const AllocatorFactory factory = make_allocator_factory(options->solver, mdp, parameters);
     domains::PlannerWorldOptions planner;

@@ -37,9 +37,9 @@ struct StudyOptions {
 
 std::string label_of(const std::string& path) { return std::filesystem::path(path).stem().string(); }
 
-double iterations_per_search(const MonteCarloResult& result) {
-  const double searches = result.statistics.find("searches").value_or(0.0);
-  return searches > 0 ? result.statistics.find("iterations").value_or(0.0) / searches : 0.0;
+// The searcher's iterations per search (its declared counters), 0 for a kind that does not search.
+double iterations_per_search(const std::string& searcher, const MonteCarloResult& result) {
+  return ontime::iterations_per_search(allocator_registry().find(searcher), result.statistics).value_or(0.0);
 }
 
 std::vector<double> parse_multipliers(const std::string& text) {
@@ -76,11 +76,10 @@ std::vector<Problem> prepare(const StudyOptions& options, const std::string& kin
   check_outputs(outputs, {options.instances.begin(), options.instances.end()}, MissingFolder::create);
   // Memory the study would need (the searcher's trees; the anytime study's exact optimum).
   const ParameterValues parameters = options.allocator.values();
-  check_tree_memory(options.searcher, parameters, options.episodes, options.threads);
-  if (kind == "anytime") {
-    for (std::size_t i = 0; i < problems.size(); ++i) {
-      check_state_cap_memory(problems[i], max_states_of(parameters), options.instances[i]);
-    }
+  for (std::size_t i = 0; i < problems.size(); ++i) {
+    check_allocator_memory(options.searcher, problems[i], parameters, options.episodes, options.threads);
+    if (kind == "anytime")
+      check_exact_work(problems[i], max_states_of(parameters), options.instances[i], flag_spelling());
   }
   return problems;
 }
@@ -128,7 +127,7 @@ void run_compute_time(const StudyOptions& options) {
                          result->episodes, result->success_rate, result->ci95,
                          result->episode_decision_time.mean_us * 1e-6, result->episode_decision_time.median_us * 1e-6,
                          result->episode_decision_time.p99_us * 1e-6, result->decision_time.mean_us * 1e-6,
-                         iterations_per_search(*result));
+                         iterations_per_search(solver, *result));
     }
   }
   finish(options, "compute-time", csv);
@@ -145,7 +144,8 @@ void run_equal_time(const StudyOptions& options) {
     const EqualTimeStudy study = equal_time_study(mdp, settings_of(options, bar, i, problems.size()));
     csv += fmt::format("{},{},{:.9g},{},{},{},{},{:.6g}\n", label_of(options.instances[i]), options.episodes,
                        study.reference_decision_seconds, study.reference.success_rate, study.reference.ci95,
-                       study.searcher.success_rate, study.searcher.ci95, iterations_per_search(study.searcher));
+                       study.searcher.success_rate, study.searcher.ci95,
+                       iterations_per_search(options.searcher, study.searcher));
   }
   finish(options, "equal-time", csv);
 }
@@ -161,10 +161,11 @@ void run_anytime(const StudyOptions& options) {
     const Mdp mdp(problems[i]);
     const AnytimeStudy study = anytime_study(mdp, multipliers, settings_of(options, bar, i, problems.size()));
     for (const AnytimePoint& point : study.points) {
-      csv += fmt::format("{},{},{},{:.9g},{},{},{:.6g},{:.9g},{},{}\n", label_of(options.instances[i]),
-                         options.episodes, point.log10_multiplier, point.seconds_per_decision,
-                         point.searcher.success_rate, point.searcher.ci95, iterations_per_search(point.searcher),
-                         study.reference_decision_seconds, study.reference.success_rate, study.optimum);
+      csv +=
+          fmt::format("{},{},{},{:.9g},{},{},{:.6g},{:.9g},{},{}\n", label_of(options.instances[i]), options.episodes,
+                      point.log10_multiplier, point.seconds_per_decision, point.searcher.success_rate,
+                      point.searcher.ci95, iterations_per_search(options.searcher, point.searcher),
+                      study.reference_decision_seconds, study.reference.success_rate, study.optimum);
     }
   }
   finish(options, "anytime", csv);

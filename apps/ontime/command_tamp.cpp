@@ -236,20 +236,10 @@ void add_tamp_command(CLI::App& app) {
     if (options->clock == "model") planner.thinking = options->thinking;
 
     MonteCarloOptions episodes;
-    // An anytime allocator given its own budget (--iterations, --time-budget) thinks that much per
-    // decision, charged all the same; otherwise the session gives it decision_share of a slice.
-    const AllocatorKind& kind = allocator_registry().find(solver);
-    const ParameterReader reader(kind, parameters);
-    if (kind.capabilities.has(Capability::anytime) && (reader.given("iterations") || reader.given("time-budget"))) {
-      const double seconds = reader.given("time-budget") ? reader.real("time-budget") : 0.0;
-      if (!reader.given("iterations")) {
-        if (seconds > 0) episodes.decision_budget = DecisionBudget::seconds(seconds);
-      } else if (seconds > 0) {
-        episodes.decision_budget = DecisionBudget::either(reader.integer("iterations"), seconds);
-      } else {
-        episodes.decision_budget = DecisionBudget::iterations(reader.integer("iterations"));
-      }
-    }
+    // An anytime allocator given its own budget (its kind's declared decision budget: e.g.
+    // --iterations, --time-budget) thinks that much per decision, charged all the same; otherwise
+    // the session gives it decision_share of a slice.
+    episodes.decision_budget = allocator_registry().decision_budget(solver, parameters);
     episodes.episodes = options->episodes;
     episodes.seed = options->seed;
     episodes.threads = options->threads;

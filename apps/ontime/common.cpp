@@ -13,6 +13,7 @@
 #include "number_options.hpp"
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/util/error.hpp"
+#include "ontime/util/parallel.hpp"
 
 namespace ontime::cli {
 
@@ -100,21 +101,14 @@ MonteCarloOptions MonteCarloFlags::options() const {
   return options;
 }
 
-void MonteCarloFlags::check_tree_memory(const std::string& solver, const ParameterValues& values) const {
-  cli::check_tree_memory(solver, values, episodes, threads);
+void MonteCarloFlags::check_allocator_memory(const std::string& solver, const Problem& problem,
+                                             const ParameterValues& values) const {
+  cli::check_allocator_memory(solver, problem, values, episodes, threads);
 }
 
-void check_tree_memory(const std::string& solver, const ParameterValues& values, std::uint64_t episodes,
-                       unsigned threads) {
-  const AllocatorKind& kind = allocator_registry().find(solver);
-  const bool has_tree_cap = std::any_of(kind.parameters.begin(), kind.parameters.end(),
-                                        [](const Parameter& parameter) { return parameter.name == "max-tree-mib"; });
-  if (!has_tree_cap) return;
-  const double mib = static_cast<double>(ParameterReader(kind, values).integer("max-tree-mib"));
-  const std::uint64_t workers =
-      std::min<std::uint64_t>(episodes, threads > 0 ? threads : std::max(1U, std::thread::hardware_concurrency()));
-  check_memory_for(fmt::format("--max-tree-mib {} with {} thread{}", mib, workers, workers == 1 ? "" : "s"),
-                   mib * 1024 * 1024 * static_cast<double>(workers));
+void check_allocator_memory(const std::string& solver, const Problem& problem, const ParameterValues& values,
+                            std::uint64_t episodes, unsigned threads) {
+  allocator_registry().check_memory(solver, problem, values, worker_count(episodes, threads), flag_spelling());
 }
 
 CLI::Option* add_solver_option(CLI::App& command, std::string& solver) {

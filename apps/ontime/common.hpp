@@ -60,10 +60,11 @@ struct AllocatorFlags {
 nlohmann::ordered_json parameters_json(const AllocatorKind& kind, const ParameterValues& values);
 
 // Options shared by commands that run Monte Carlo episodes.
-// Refuses (UsageError, exit 2) a search-tree cap (the max-tree-mib parameter of `solver`, if it
-// has one) times the threads that would run it when that exceeds the memory available.
-void check_tree_memory(const std::string& solver, const ParameterValues& values, std::uint64_t episodes,
-                       unsigned threads);
+// Refuses (UsageError, exit 2) what `solver` may hold on `problem` (its declared memory need: a
+// search tree's cap for each thread of the run, the exact solver's table) when that exceeds the
+// memory available; the message names the flag.
+void check_allocator_memory(const std::string& solver, const Problem& problem, const ParameterValues& values,
+                            std::uint64_t episodes, unsigned threads);
 
 struct MonteCarloFlags {
   std::uint64_t episodes = 10'000;
@@ -71,9 +72,8 @@ struct MonteCarloFlags {
   unsigned threads = 0;
   void add_to(CLI::App& command);
   MonteCarloOptions options() const;
-  // Refuses (UsageError, exit 2) a search-tree cap (`max-tree-mib`, if `solver` declares it) that
-  // the threads of the run together could not hold in the memory available.
-  void check_tree_memory(const std::string& solver, const ParameterValues& values) const;
+  // check_allocator_memory for this run's episodes and threads.
+  void check_allocator_memory(const std::string& solver, const Problem& problem, const ParameterValues& values) const;
 };
 
 // Adds the required `--solver NAME` option, its help listing the allocators.

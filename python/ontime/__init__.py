@@ -45,6 +45,7 @@ from ._ontime import (  # noqa: F401  (re-exported)
     read_planner_log,
     run_episodes,
     solve,
+    table,
     train_ppo,
 )
 from . import _ontime
@@ -55,7 +56,7 @@ __all__ = [
     "NEVER", "Action", "Allocator", "Decision", "Distribution", "Error", "InputError", "LiveSession",
     "ManualClock", "Mdp", "Problem",
     "ResourceLimitError", "Session", "State", "Status", "UsageError", "World", "allocators", "evaluate",
-    "fit", "load_problem", "make_allocator", "read_planner_log", "run_episodes", "solve", "train_ppo",
+    "fit", "load_problem", "make_allocator", "read_planner_log", "run_episodes", "solve", "table", "train_ppo",
     "write_planner_log",
 ]
 

@@ -11,6 +11,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -21,6 +22,7 @@
 #include "ontime/mdp/mdp.hpp"
 #include "ontime/mdp/state.hpp"
 #include "ontime/model/problem.hpp"
+#include "ontime/run/evaluation.hpp"
 #include "ontime/util/error.hpp"
 
 namespace ontime::python {
@@ -138,6 +140,15 @@ struct AllocatorHandle {
 ParameterValues parameter_values(const py::kwargs& kwargs);
 // The kind's parameters, defaults filled in, as the command line's JSON reports them.
 py::dict parameters_dict(const std::string& kind, const ParameterValues& values);
+
+// A JSON text of the report module (report/report.hpp) as Python objects (json.loads), so that
+// Python returns what the command line prints.
+py::object json_object(const std::string& text);
+
+// An evaluation's report (report::Evaluation) as a dict: the fields of `ontime evaluate --json`.
+py::dict monte_carlo_dict(const std::string& solver, const ParameterValues& values, const std::string& instance,
+                          const Problem& problem, const MonteCarloResult& result, std::uint64_t seed,
+                          const std::optional<ExactEvaluation>& exact = std::nullopt);
 std::shared_ptr<AllocatorHandle> make_allocator_handle(std::shared_ptr<MdpHandle> mdp, const std::string& name,
                                                        const ParameterValues& values);
 

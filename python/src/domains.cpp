@@ -24,8 +24,6 @@ py::list attempts_list(const std::vector<RefinementAttempt>& attempts);
 std::pair<MonteCarloResult, std::optional<ExactEvaluation>> run_and_evaluate(
     const MdpHandle& mdp, const WorldFactory& worlds, const AllocatorFactory& factory, const MonteCarloOptions& options,
     bool exact, const ParameterValues& values, const py::object& progress);
-py::dict monte_carlo_dict(const std::string& solver, const ParameterValues& values, const std::string& instance,
-                          const MonteCarloResult& result, std::uint64_t seed);
 
 #ifdef ONTIME_PYTHON_DOMAINS
 
@@ -142,7 +140,8 @@ void bind_domains(py::module_& m) {
         const auto [result, exact_result] =
             run_and_evaluate(*mdp, domains::planner_worlds(*domain->loaded.domain, *mdp->problem, planner), factory,
                              options, exact, values, progress);
-        py::dict out = monte_carlo_dict(solver, values, instance_label(problem, *mdp->problem), result, seed);
+        py::dict out =
+            monte_carlo_dict(solver, values, instance_label(problem, *mdp->problem), *mdp->problem, result, seed);
         out["domain"] = domain->name;
         out["independent_starts"] = independent_starts;
         out["refinements_started"] =

@@ -14,6 +14,7 @@
 #include "ontime/model/instance_io.hpp"
 #include "ontime/model/planner_log.hpp"
 #include "ontime/model/skeleton_file.hpp"
+#include "ontime/report/report.hpp"
 #include "ontime/util/error.hpp"
 
 namespace ontime::python {
@@ -286,31 +287,7 @@ void bind_model(py::module_& m) {
       py::arg("deadline"), py::arg("laplace"), py::arg("name"), py::arg("description"));
 
   m.def(
-      "allocators",
-      [] {
-        py::list out;
-        for (const AllocatorKind& kind : allocator_registry().kinds()) {
-          py::dict entry;
-          entry["name"] = kind.name;
-          entry["summary"] = kind.summary;
-          entry["capabilities"] = kind.capabilities.names();
-          py::list parameters;
-          for (const Parameter& parameter : kind.parameters) {
-            py::dict item;
-            item["name"] = parameter.name;
-            item["type"] = std::string(to_string(parameter.type));
-            if (!parameter.default_value.empty()) item["default"] = parameter.default_value;
-            if (std::isfinite(parameter.minimum)) item["minimum"] = parameter.minimum;
-            if (std::isfinite(parameter.maximum)) item["maximum"] = parameter.maximum;
-            if (!parameter.choices.empty()) item["choices"] = parameter.choices;
-            item["help"] = parameter.help;
-            parameters.append(item);
-          }
-          entry["parameters"] = parameters;
-          out.append(entry);
-        }
-        return out;
-      },
+      "allocators", [] { return json_object(report::registry_json(allocator_registry())); },
       "The allocator kinds of the registry with their capabilities and parameters, as `ontime allocators "
       "--json` lists them. Parameters are passed as keyword arguments with '_' for '-' (max_states=...).");
 }

@@ -13,6 +13,7 @@
 
 #include "bindings.hpp"
 #include "ontime/model/instance_io.hpp"
+#include "ontime/report/report.hpp"
 #include "ontime/util/error.hpp"
 
 namespace ontime::python {
@@ -82,12 +83,10 @@ ParameterValues parameter_values(const py::kwargs& kwargs) {
 }
 
 py::dict parameters_dict(const std::string& kind_name, const ParameterValues& values) {
-  const AllocatorKind& kind = allocator_registry().find(kind_name);
-  const ParameterReader reader(kind, values);
-  py::dict out;
-  for (const Parameter& parameter : kind.parameters) out[py::str(parameter.name)] = reader.text(parameter.name);
-  return out;
+  return json_object(report::parameters_json(allocator_registry().find(kind_name), values));
 }
+
+py::object json_object(const std::string& text) { return py::module_::import("json").attr("loads")(text); }
 
 std::shared_ptr<AllocatorHandle> make_allocator_handle(std::shared_ptr<MdpHandle> mdp, const std::string& name,
                                                        const ParameterValues& values) {

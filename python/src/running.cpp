@@ -11,12 +11,15 @@
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/allocators/ppo.hpp"
 #include "ontime/learn/ppo_training.hpp"
+#include "ontime/report/report.hpp"
 #include "ontime/run/episode_runner.hpp"
 #include "ontime/run/evaluation.hpp"
 #include "ontime/run/session.hpp"
 #include "ontime/run/simulator.hpp"
+#include "ontime/run/table.hpp"
 #include "ontime/solve/layered_solver.hpp"
 #include "ontime/util/error.hpp"
+#include "ontime/util/memory.hpp"
 
 namespace ontime::python {
 
@@ -87,16 +90,6 @@ class PythonWorld final : public World {
   py::object world_;
 };
 
-py::dict latency_dict(const LatencySummary& latency) {
-  py::dict out;
-  out["median"] = latency.median_us;
-  out["p99"] = latency.p99_us;
-  out["mean"] = latency.mean_us;
-  out["max"] = latency.max_us;
-  out["decisions"] = latency.decisions;
-  return out;
-}
-
 py::dict statistics_dict(const Statistics& statistics) {
   py::dict out;
   for (const Statistics::Counter& counter : statistics.counters()) out[py::str(counter.name)] = counter.value;
@@ -135,20 +128,16 @@ std::pair<MonteCarloResult, std::optional<ExactEvaluation>> run_and_evaluate(
 }
 
 py::dict monte_carlo_dict(const std::string& solver, const ParameterValues& values, const std::string& instance,
-                          const MonteCarloResult& result, std::uint64_t seed) {
-  py::dict out;
-  out["solver"] = solver;
-  out["parameters"] = parameters_dict(solver, values);
-  out["instance"] = instance;
-  out["episodes"] = result.episodes;
-  out["seed"] = seed;
-  out["successes"] = result.successes;
-  out["success_rate"] = result.success_rate;
-  out["ci95"] = result.ci95;
-  out["decision_time_us"] = latency_dict(result.decision_time);
-  out["seconds"] = result.seconds;
-  out["statistics"] = statistics_dict(result.statistics);
-  return out;
+                          const Problem& problem, const MonteCarloResult& result, std::uint64_t seed,
+                          const std::optional<ExactEvaluation>& exact) {
+  return json_object(report::to_json(report::Evaluation{.solver = solver,
+                                                        .parameters = values,
+                                                        .instance = instance,
+                                                        .problem = &problem,
+                                                        .seed = seed,
+                                                        .result = result,
+                                                        .exact = exact,
+                                                        .timing = true}));
 }
 
 void bind_running(py::module_& m) {
@@ -344,7 +333,8 @@ void bind_running(py::module_& m) {
               result = run_with_hooks(mdp->mdp, worlds, factory, options, stop, counters);
             },
             progress);
-        py::dict out = monte_carlo_dict(solver, values, instance_label(problem, *mdp->problem), result, seed);
+        py::dict out =
+            monte_carlo_dict(solver, values, instance_label(problem, *mdp->problem), *mdp->problem, result, seed);
         out["world_statistics"] = statistics_dict(result.world_statistics);
         return out;
       },
@@ -376,12 +366,8 @@ void bind_running(py::module_& m) {
         options.threads = threads;
         const auto [result, exact_result] =
             run_and_evaluate(*mdp, hidden_worlds(*mdp->problem), *factory, options, exact, values, progress);
-        py::dict out = monte_carlo_dict(solver, values, instance_label(problem, *mdp->problem), result, seed);
-        if (exact_result) {
-          out["exact_success_probability"] = exact_result->success_probability;
-          out["exact_states"] = exact_result->states;
-        }
-        return out;
+        return monte_carlo_dict(solver, values, instance_label(problem, *mdp->problem), *mdp->problem, result, seed,
+                                exact_result);
       },
       py::arg("problem"), py::arg("solver"), py::kw_only(), py::arg("episodes") = 10'000, py::arg("seed") = 1,
       py::arg("threads") = 0, py::arg("exact") = false, py::arg("progress") = py::none(),
@@ -393,73 +379,128 @@ void bind_running(py::module_& m) {
   m.def(
       "solve",
       [](const py::object& problem, Number<std::uint64_t, "max_states", 1> max_states, Threads threads,
-         const std::string& method, Number<double, "tolerance", 0.0, 1.0> tolerance) {
+         const std::string& method, Number<double, "tolerance", 0.0, 1.0> tolerance,
+         Number<std::uint64_t, "max_memory_mib", 0, (std::uint64_t{1} << 40)> max_memory_mib,
+         Number<std::uint64_t, "max_disk_mib", 0, (std::uint64_t{1} << 40)> max_disk_mib, const py::object& scratch) {
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
-        if (max_states == 0) throw UsageError("max_states must be at least 1");
         if (method != "layered" && method != "split") {
           throw UsageError("method must be 'layered' or 'split' (got '" + method + "')");
         }
-        LayeredSolution solution;
-        double seconds = 0;
+        LayeredSolveOptions options;
+        options.max_states = max_states;
+        options.threads = threads;
+        options.tolerance = tolerance;
+        options.split = method == "split" ? SplitMode::always : SplitMode::fallback;
+        if (!scratch.is_none()) options.scratch_directory = py::str(py::module_::import("os").attr("fspath")(scratch));
+        if (max_memory_mib > 0) {
+          check_memory_for("max_memory_mib", static_cast<double>(max_memory_mib) * 1048576.0);
+          options.max_memory_bytes = max_memory_mib << 20;
+        }
+        options.max_disk_bytes = max_disk_mib << 20;
+        // Caps not given: what this machine can give, so that a solve stops with a certified
+        // interval rather than being killed (as the command line does).
+        fill_default_caps(options);
+        report::Solve solve{.instance = instance_label(problem, *mdp->problem),
+                            .problem = mdp->problem.get(),
+                            .mdp = &mdp->mdp,
+                            .method = method,
+                            .tolerance = tolerance};
         run_interruptibly([&](const std::function<bool()>& stop, Progress&) {
           const auto started = std::chrono::steady_clock::now();
-          LayeredSolveOptions options;
-          options.max_states = max_states;
-          options.threads = threads;
           options.stop = stop;
-          options.tolerance = tolerance;
-          options.split = method == "split" ? SplitMode::always : SplitMode::fallback;
-          solution = solve_layered(mdp->mdp, options);
-          seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+          solve.solution = solve_layered(mdp->mdp, options);
+          solve.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
         });
-        const Problem& p = *mdp->problem;
-        const int first = solution.first_choice;
-        py::dict out;
-        out["instance"] = instance_label(problem, p);
-        out["name"] = p.name();
-        out["method"] = method;
-        out["optimal_success_probability"] = solution.exact ? py::object(py::float_(solution.lower)) : py::none();
-        out["lower_bound"] = solution.lower;
-        out["upper_bound"] = solution.upper;
-        out["exact"] = solution.exact;
-        if (solution.frontier_layer >= 0) {
-          out["frontier_layer"] = solution.frontier_layer;
-          out["stopped_by"] = solution.stopped_by;
-        }
-        if (tolerance > 0) {
-          out["tolerance"] = tolerance;
-          out["dropped"] = solution.dropped;
-        }
-        if (!solution.split_kept.empty()) {
-          py::dict split;
-          split["enumerated_skeletons"] = solution.split_kept;
-          split["bounded_start_upper"] = solution.split_weak_upper;
-          split["lower_bound"] = solution.split_lower;
-          split["upper_bound"] = solution.split_upper;
-          split["states"] = solution.split_states;
-          if (solution.split_frontier_layer >= 0) {
-            split["frontier_layer"] = solution.split_frontier_layer;
-            split["stopped_by"] = solution.split_stopped_by;
-          }
-          out["split"] = split;
-        }
-        out["states"] = solution.states;
-        out["seconds"] = seconds;
-        out["first_choice"] = first;
-        out["first_action"] = first >= 0 ? p.action(mdp->mdp.next_action(mdp->mdp.start(), first)).id : "";
-        out["key_bytes"] = solution.key_bytes;
-        out["peak_memory_bytes"] = solution.peak_memory_bytes;
-        out["peak_disk_bytes"] = solution.peak_disk_bytes;
-        return out;
+        return json_object(report::to_json(solve));
       },
       py::arg("problem"), py::arg("max_states") = OptimalSolver::kDefaultMaxStates, py::arg("threads") = 0,
-      py::kw_only(), py::arg("method") = "layered", py::arg("tolerance") = 0.0,
+      py::kw_only(), py::arg("method") = "layered", py::arg("tolerance") = 0.0, py::arg("max_memory_mib") = 0,
+      py::arg("max_disk_mib") = 0, py::arg("scratch") = py::none(),
       "The exact optimal success probability and first choice (the layered solver), as `ontime solve --json` "
-      "reports them; where max_states cuts the whole tree, a certified interval [lower_bound, upper_bound] "
+      "reports them; where a cap cuts the whole tree, a certified interval [lower_bound, upper_bound] "
       "instead (optimal_success_probability None), tightened by a split when the skeletons' first actions "
       "differ. method='split' splits straight away (the strongest first-action subtree enumerated, the others "
       "bounded); tolerance > 0 drops groups whose clairvoyant chance is below it, with their share in the "
-      "interval. The GIL is released; Ctrl-C stops it (KeyboardInterrupt).");
+      "interval. Caps: max_states, max_memory_mib (tables of this process) and max_disk_mib (its scratch files, "
+      "in `scratch`, default the system's temporary folder); 0: 80% of the available memory and 90% of the free "
+      "disk. The GIL is released; Ctrl-C stops it (KeyboardInterrupt).");
+
+  m.def(
+      "table",
+      [](const py::sequence& instances, const std::optional<std::vector<std::string>>& solvers, bool exact,
+         Episodes episodes, Seed seed, Threads threads, const std::string& format, const py::object& progress,
+         const py::kwargs& kwargs) {
+        check_episodes(episodes);
+        if (format != "json" && format != "markdown") {
+          throw UsageError("format must be 'json' or 'markdown' (got '" + format + "')");
+        }
+        TableOptions options;
+        if (solvers) {
+          if (solvers->empty()) throw UsageError("solvers: give at least one allocator");
+          options.solvers = *solvers;
+        }
+        options.exact = exact;
+        options.episodes = episodes;
+        options.seed = seed;
+        options.threads = threads;
+        // A parameter given as a list holds one value per instance (a ppo policy for each);
+        // given once, it applies to every row.
+        const auto count = static_cast<std::size_t>(py::len(instances));
+        std::vector<TableInstance> rows;
+        for (std::size_t i = 0; i < count; ++i) {
+          const py::object source = instances[i];
+          py::kwargs row_parameters;
+          for (const auto& [key, value] : kwargs) {
+            if (py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value)) {
+              const auto values = py::reinterpret_borrow<py::sequence>(value);
+              if (static_cast<std::size_t>(py::len(values)) != count) {
+                throw UsageError("parameter '" + std::string(py::str(key)) + "': " + std::to_string(py::len(values)) +
+                                 " values for " + std::to_string(count) + " instances (give one, or one per instance)");
+              }
+              row_parameters[key] = values[i];
+            } else {
+              row_parameters[key] = value;
+            }
+          }
+          const std::shared_ptr<MdpHandle> mdp = to_mdp(source);
+          const std::string label = instance_label(source, *mdp->problem);
+          const bool is_file = py::isinstance<py::str>(source) || py::hasattr(source, "__fspath__");
+          rows.push_back(
+              {*mdp->problem, label,
+               is_file ? py::str(py::module_::import("pathlib").attr("Path")(source).attr("stem")).cast<std::string>()
+                       : label,
+               parameter_values(row_parameters)});
+        }
+        const ParameterSpelling spelling = [](std::string_view parameter) {
+          std::string name(parameter);
+          for (char& c : name) {
+            if (c == '-') c = '_';
+          }
+          return name;
+        };
+        check_table_request(rows, options, spelling);
+        Table table;
+        run_interruptibly(
+            [&](const std::function<bool()>& stop, Progress& counters) {
+              options.stop = stop;
+              options.progress = [&counters](std::uint64_t done, std::uint64_t total) {
+                counters.total = total;
+                counters.done = done;
+              };
+              table = measure_table(rows, options);
+            },
+            progress);
+        if (format == "markdown") return py::object(py::str(report::to_markdown(table, spelling)));
+        return json_object(report::to_json(table));
+      },
+      py::arg("instances"), py::kw_only(), py::arg("solvers") = py::none(), py::arg("exact") = false,
+      py::arg("episodes") = 10'000, py::arg("seed") = 1, py::arg("threads") = 0, py::arg("format") = "json",
+      py::arg("progress") = py::none(),
+      "Table I's layout, as `ontime table` computes it: one row per instance (a file or a Problem), one column "
+      "per allocator (default: every one that needs nothing beyond the instance), sampled success ± 95% and, "
+      "with exact=True, exact values and the exact optimum (or its certified interval). Parameters as keyword "
+      "arguments; a list gives one value per instance (policy=[...]). format='json' returns the dict of "
+      "`ontime table --json`, 'markdown' the table it prints. The GIL is released; Ctrl-C stops it.");
 
   m.def(
       "train_ppo",

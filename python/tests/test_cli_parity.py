@@ -98,3 +98,46 @@ def test_a_split_and_a_tolerance_give_the_clis_interval(path, cli):
     assert got["split"]["enumerated_skeletons"] == expected["split"]["enumerated_skeletons"]
     assert got["dropped"] == expected["dropped"]
     assert got["lower_bound"] <= optimum + 1e-12 and optimum - 1e-12 <= got["upper_bound"]
+
+
+def test_table_matches_the_cli(cli):
+    # The same computation (run/table.hpp) and the same report: every number but the timings.
+    paths = [str(p) for p in PAPER_INSTANCES[:2]]
+    expected = cli("table", *paths, "--solvers", "dp,greedy,mcts", "--iterations", 40, "--episodes", 400, "--seed", 3,
+                   "--exact", "--json")
+    got = ontime.table(paths, solvers=["dp", "greedy", "mcts"], iterations=40, episodes=400, seed=3, exact=True)
+    assert got["solvers"] == expected["solvers"] == ["dp", "greedy", "mcts"]
+    assert (got["episodes"], got["seed"]) == (400, 3)
+    assert len(got["rows"]) == len(expected["rows"]) == 2
+    for mine, theirs in zip(got["rows"], expected["rows"]):
+        assert mine["instance"] == theirs["instance"] and mine["name"] == theirs["name"]
+        assert mine["optimal_success_probability"] == theirs["optimal_success_probability"]
+        assert mine["optimal_states"] == theirs["optimal_states"]
+        for solver in ("dp", "greedy", "mcts"):
+            for key in ("success_rate", "ci95"):
+                assert mine["solvers"][solver][key] == theirs["solvers"][solver][key], (solver, key)
+        for solver in ("dp", "greedy"):
+            assert mine["solvers"][solver]["exact_success_probability"] == \
+                theirs["solvers"][solver]["exact_success_probability"]
+        assert "exact" not in mine["solvers"]["mcts"]
+    # instance1's exact values (docs/experiments.md): dp 0.9340, greedy 0.9200, optimum 0.9420.
+    first = got["rows"][0]
+    assert round(first["solvers"]["dp"]["exact_success_probability"], 4) == 0.9340
+    assert round(first["solvers"]["greedy"]["exact_success_probability"], 4) == 0.9200
+    assert round(first["optimal_success_probability"], 4) == 0.9420
+
+
+def test_table_takes_problems_one_parameter_per_instance_and_prints_markdown():
+    problems = [ontime.load_problem(p) for p in PAPER_INSTANCES[:2]]
+    text = ontime.table(problems, solvers=["mcts", "dp"], iterations=[20, 30], episodes=50, seed=1, format="markdown")
+    lines = text.splitlines()
+    assert lines[0].startswith("Success probability: mean ± 95% over 50 episodes (seed 1)")
+    assert lines[2].split("|")[1].strip() == "instance" and "mcts" in lines[2] and "dp" in lines[2]
+    # Rows labelled by the problems' own names.
+    assert problems[0].name in lines[4] and problems[1].name in lines[5]
+    with pytest.raises(ontime.UsageError, match="parameter 'iterations': 3 values for 2 instances"):
+        ontime.table(problems, solvers=["mcts"], iterations=[1, 2, 3], episodes=5)
+    with pytest.raises(ontime.UsageError, match="solvers: 'dp' is given twice"):
+        ontime.table(problems, solvers=["dp", "dp"], episodes=5)
+    with pytest.raises(ontime.UsageError, match="unknown solver 'nope'"):
+        ontime.table(problems, solvers=["nope"], episodes=5)

@@ -255,6 +255,48 @@ AllocatorFactory AllocatorRegistry::make_factory(std::string_view name, const Md
   return kind.make(mdp, ParameterReader(kind, values));
 }
 
+DecisionBudget AllocatorRegistry::decision_budget(std::string_view name, const ParameterValues& values) const {
+  const AllocatorKind& kind = find(name);
+  if (!kind.needs.decision_budget) return {};
+  return kind.needs.decision_budget(ParameterReader(kind, values));
+}
+
+double AllocatorRegistry::memory_bytes(std::string_view name, const Problem& problem, const ParameterValues& values,
+                                       std::uint64_t allocators) const {
+  const AllocatorKind& kind = find(name);
+  const MemoryNeed& memory = kind.needs.memory;
+  if (!memory.bytes) return 0;
+  const double each = memory.bytes(problem, ParameterReader(kind, values));
+  return memory.per_allocator ? each * static_cast<double>(std::max<std::uint64_t>(allocators, 1)) : each;
+}
+
+void AllocatorRegistry::check_memory(std::string_view name, const Problem& problem, const ParameterValues& values,
+                                     std::uint64_t allocators, const ParameterSpelling& spelling) const {
+  const AllocatorKind& kind = find(name);
+  const MemoryNeed& memory = kind.needs.memory;
+  if (!memory.bytes) return;
+  const ParameterReader reader(kind, values);
+  std::string what =
+      spell_parameter(spelling, memory.parameter) + " " + std::to_string(reader.integer(memory.parameter));
+  if (memory.per_allocator) {
+    allocators = std::max<std::uint64_t>(allocators, 1);
+    what += " with " + std::to_string(allocators) + (allocators == 1 ? " thread" : " threads");
+  }
+  check_memory_for(what, memory_bytes(name, problem, values, allocators));
+}
+
+bool AllocatorKind::declares_counter(std::string_view counter) const {
+  return std::any_of(needs.counters.begin(), needs.counters.end(),
+                     [&](const CounterDeclaration& declared) { return declared.name == counter; });
+}
+
+std::optional<double> iterations_per_search(const AllocatorKind& kind, const Statistics& statistics) {
+  if (!kind.declares_counter(kSearchesCounter) || !kind.declares_counter(kIterationsCounter)) return std::nullopt;
+  const double searches = statistics.find(kSearchesCounter).value_or(0.0);
+  if (searches <= 0) return std::nullopt;
+  return statistics.find(kIterationsCounter).value_or(0.0) / searches;
+}
+
 void AllocatorRegistry::add(AllocatorKind kind) {
   if (kind.name.empty() || !kind.make) throw UsageError("an allocator kind needs a name and a way to make it");
   if (std::any_of(kinds_.begin(), kinds_.end(), [&](const AllocatorKind& k) { return k.name == kind.name; })) {

@@ -268,8 +268,8 @@ void MctsAllocator::reroot(std::uint32_t new_root) {
 }
 
 void MctsAllocator::collect_statistics(Statistics& statistics) const {
-  statistics.add("searches", static_cast<double>(counters_.searches));
-  statistics.add("iterations", static_cast<double>(counters_.iterations));
+  statistics.add(kSearchesCounter, static_cast<double>(counters_.searches));
+  statistics.add(kIterationsCounter, static_cast<double>(counters_.iterations));
   statistics.add("memory_stops", static_cast<double>(counters_.memory_stops));
   statistics.add("peak_tree_nodes", static_cast<double>(counters_.peak_tree_nodes), Statistics::Merge::max);
   statistics.add("peak_tree_bytes", static_cast<double>(counters_.peak_tree_bytes), Statistics::Merge::max);
@@ -320,7 +320,26 @@ AllocatorKind mcts_kind() {
             }
             MctsAllocator probe(mdp, options);  // checks the options once, before any episode
             return [model = &mdp, options] { return std::make_unique<MctsAllocator>(*model, options); };
-          }};
+          },
+          .needs = {.decision_budget = [](const ParameterReader& parameters) -> DecisionBudget {
+                      // Only what the caller gave: without it, a live session's share of a slice.
+                      const bool iterations = parameters.given("iterations");
+                      const double seconds = parameters.given("time-budget") ? parameters.real("time-budget") : 0.0;
+                      if (!iterations) return seconds > 0 ? DecisionBudget::seconds(seconds) : DecisionBudget{};
+                      return seconds > 0 ? DecisionBudget::either(parameters.integer("iterations"), seconds)
+                                         : DecisionBudget::iterations(parameters.integer("iterations"));
+                    },
+                    .memory = {.parameter = "max-tree-mib",
+                               .bytes =
+                                   [](const Problem&, const ParameterReader& parameters) {
+                                     return static_cast<double>(parameters.integer("max-tree-mib")) * 1024.0 * 1024.0;
+                                   },
+                               .per_allocator = true},
+                    .counters = {{kSearchesCounter, "decisions that ran a search"},
+                                 {kIterationsCounter, "search iterations, summed over the searches"},
+                                 {"memory_stops", "searches stopped by the tree's memory cap"},
+                                 {"peak_tree_nodes", "the most nodes a tree held"},
+                                 {"peak_tree_bytes", "the most bytes a tree held"}}}};
 }
 
 }  // namespace ontime

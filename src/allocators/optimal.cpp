@@ -44,7 +44,13 @@ AllocatorKind optimal_kind() {
             solver->solve(mdp.start());
             std::shared_ptr<const OptimalSolver> solved = std::move(solver);
             return [model = &mdp, solved] { return std::make_unique<OptimalAllocator>(*model, solved); };
-          }};
+          },
+          .needs = {.memory = {.parameter = "max-states",
+                               .bytes =
+                                   [](const Problem& problem, const ParameterReader& parameters) {
+                                     return OptimalSolver::max_bytes(problem, parameters.integer("max-states"));
+                                   },
+                               .per_allocator = false}}};
 }
 
 }  // namespace ontime

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "ontime/allocators/allocator_registry.hpp"
 #include "ontime/util/error.hpp"
 #include "ontime/util/random.hpp"
 #include "ontime/util/statistics.hpp"
@@ -76,7 +77,7 @@ void Session::start_live(const Clock& clock, LiveOptions options) {
 std::uint64_t Session::search_iterations() const {
   Statistics statistics;
   allocator_->collect_statistics(statistics);
-  return static_cast<std::uint64_t>(statistics.find("iterations").value_or(0.0));
+  return static_cast<std::uint64_t>(statistics.find(kIterationsCounter).value_or(0.0));
 }
 
 double Session::step_seconds() const noexcept { return mdp_->problem().step_seconds(); }

@@ -3,6 +3,7 @@
 #include <variant>
 #include <vector>
 
+#include "ontime/util/error.hpp"
 #include "solve/expectimax.hpp"
 
 namespace ontime {
@@ -84,8 +85,27 @@ std::optional<int> OptimalSolver::best_choice(const State& state) const {
       impl_->search);
 }
 
+double OptimalSolver::max_bytes(const Problem& problem, std::size_t max_states) {
+  const double slot_bytes =
+      problem.skeleton_count() <= 4 && problem.deadline() <= 253 ? 33 : (problem.skeleton_count() <= 10 ? 49 : 99);
+  return 3.0 * slot_bytes * static_cast<double>(max_states);
+}
+
 std::size_t OptimalSolver::states() const noexcept {
   return std::visit([](const auto& search) { return search.memo().size(); }, impl_->search);
+}
+
+void check_exact_work(const Problem& problem, std::size_t max_states, const std::string& source,
+                      const ParameterSpelling& spelling) {
+  if (problem.skeleton_count() > kMaxExactSkeletons) {
+    throw InputError(source, "skeletons",
+                     std::to_string(problem.skeleton_count()) +
+                         " skeletons; exact solving and exact evaluation take at most " +
+                         std::to_string(kMaxExactSkeletons) +
+                         " (sampled evaluation and the approximate allocators take any number)");
+  }
+  check_memory_for(spell_parameter(spelling, "max-states") + " " + std::to_string(max_states),
+                   OptimalSolver::max_bytes(problem, max_states));
 }
 
 }  // namespace ontime

@@ -24,7 +24,9 @@
 #include <vector>
 
 #include "ontime/allocators/allocator.hpp"
+#include "ontime/allocators/decision_budget.hpp"
 #include "ontime/mdp/mdp.hpp"
+#include "ontime/util/memory.hpp"
 
 namespace ontime {
 
@@ -123,6 +125,39 @@ class ParameterReader {
   const ParameterValues* values_;
 };
 
+// A counter an allocator reports in collect_statistics.
+struct CounterDeclaration {
+  std::string name;  // "iterations"
+  std::string help;  // what it counts
+};
+
+// The counters that the tools read by meaning: an allocator that searches at each decision
+// reports the searches it ran and their iterations (the modelled clock charges the iterations,
+// studies report iterations per search).
+inline constexpr const char* kSearchesCounter = "searches";
+inline constexpr const char* kIterationsCounter = "iterations";
+
+// The memory one kind of allocator may hold, beyond the instance's own tables.
+struct MemoryNeed {
+  std::string parameter = {};  // the whole-number parameter that caps it: "max-tree-mib", "max-states"
+  // The bytes it may hold at most for `problem` under the given values.
+  std::function<double(const Problem& problem, const ParameterReader& parameters)> bytes = {};
+  // Held by each allocator (one per thread: a search tree), or once by the factory and shared
+  // by every allocator it makes (the exact solver's table).
+  bool per_allocator = true;
+};
+
+// What running a kind needs beyond the instance.
+struct AllocatorNeeds {
+  // The budget of each decision that the given values ask for (an anytime kind's iterations or
+  // seconds); an unset budget when they ask for none, so that the caller's default applies (a
+  // live session gives a share of a slice). Null: the kind takes no budget.
+  std::function<DecisionBudget(const ParameterReader& parameters)> decision_budget = {};
+  // Null `bytes`: the kind holds nothing that grows with its parameters.
+  MemoryNeed memory = {};
+  std::vector<CounterDeclaration> counters = {};
+};
+
 struct AllocatorKind {
   std::string name;     // "dp-rerun"
   std::string summary;  // one line
@@ -132,6 +167,9 @@ struct AllocatorKind {
   // done here, once, and shared by the allocators it makes. Throws UsageError for values that
   // cannot serve (e.g. a policy trained for another instance), ResourceLimitError at a cap.
   std::function<AllocatorFactory(const Mdp& mdp, const ParameterReader& parameters)> make;
+  AllocatorNeeds needs = {};
+
+  bool declares_counter(std::string_view counter) const;
 };
 
 class AllocatorRegistry {
@@ -154,6 +192,20 @@ class AllocatorRegistry {
   // bad value), then makes the factory.
   AllocatorFactory make_factory(std::string_view name, const Mdp& mdp, const ParameterValues& values = {}) const;
 
+  // The budget of each decision that `values` ask of kind `name` (unset when they ask for none,
+  // or when the kind takes no budget). Throws UsageError for a bad value.
+  DecisionBudget decision_budget(std::string_view name, const ParameterValues& values) const;
+
+  // The memory that running kind `name` on `problem` may hold at most with `allocators`
+  // allocators at once (one per thread), in bytes; 0 when it declares none.
+  double memory_bytes(std::string_view name, const Problem& problem, const ParameterValues& values,
+                      std::uint64_t allocators) const;
+  // Throws UsageError "SPELLED VALUE[ with N threads]: would need up to X GiB of memory, Y GiB
+  // available" (util/memory.hpp) when that memory exceeds what this process can have, before
+  // any long work starts.
+  void check_memory(std::string_view name, const Problem& problem, const ParameterValues& values,
+                    std::uint64_t allocators, const ParameterSpelling& spelling = nullptr) const;
+
   // Adds a kind (tests and extensions may add their own). Throws UsageError when the name is
   // taken or a parameter contradicts another kind's declaration of the same name.
   void add(AllocatorKind kind);
@@ -167,6 +219,10 @@ class AllocatorRegistry {
 // The process-wide registry, holding the built-in kinds. Not synchronised: add kinds before
 // using it from several threads.
 AllocatorRegistry& allocator_registry();
+
+// Iterations per search in `statistics` of an allocator of `kind`, when the kind declares both
+// counters (a searcher); nothing otherwise, or when it ran no search.
+std::optional<double> iterations_per_search(const AllocatorKind& kind, const Statistics& statistics);
 
 // Shorthand for allocator_registry().make_factory(...).
 AllocatorFactory make_allocator_factory(std::string_view name, const Mdp& mdp, const ParameterValues& values = {});

@@ -145,4 +145,10 @@ std::vector<int> split_plan(const Mdp& mdp);
 // index.
 LayeredSolution solve_layered(const Mdp& mdp, const LayeredSolveOptions& options = {});
 
+// Fills in the memory and disk caps that are still 0 with what this machine can give, so that a
+// solve stops with a certified interval rather than being killed or filling the disk: 80% of
+// the available memory (util/memory.hpp) divided among the ranks, and 90% of the free space where
+// the scratch files go. The command line and Python solve with these defaults.
+void fill_default_caps(LayeredSolveOptions& options);
+
 }  // namespace ontime

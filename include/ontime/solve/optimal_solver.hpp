@@ -25,8 +25,10 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <string>
 
 #include "ontime/mdp/mdp.hpp"
+#include "ontime/util/memory.hpp"
 
 namespace ontime {
 
@@ -50,6 +52,11 @@ class OptimalSolver {
   // A condition checked every few thousand states while solving: once it returns true, solve
   // throws Cancelled (the states solved so far are kept).
   void set_stop(std::function<bool()> stop);
+  // The most memory a solve of `problem` may hold under a cap of `max_states` states: the slot
+  // per state (33, 49 or 99 bytes, as above), the table's power-of-two growth and the 1.5 while
+  // it grows. Exact evaluation holds the same table.
+  static double max_bytes(const Problem& problem, std::size_t max_states);
+
   // States memoised so far.
   std::size_t states() const noexcept;
   std::size_t max_states() const noexcept { return max_states_; }
@@ -61,5 +68,12 @@ class OptimalSolver {
   std::size_t max_states_;
   std::unique_ptr<Impl> impl_;
 };
+
+// Checks, before exact work on `problem` (read from `source`) starts, that the exact solver and
+// the exact evaluation take it: InputError naming the source when it has more skeletons than
+// kMaxExactSkeletons; UsageError (check_memory_for) when their state cap of `max_states` could
+// need more memory than this process can have.
+void check_exact_work(const Problem& problem, std::size_t max_states, const std::string& source,
+                      const ParameterSpelling& spelling = nullptr);
 
 }  // namespace ontime

@@ -1,0 +1,84 @@
+#pragma once
+// One report of every result: its JSON, for programs (the command line's --json, and the dicts
+// that Python's functions return, which are this JSON read back), and its text, for people (the
+// command line's readable output). The command line prints these and Python parses the same JSON,
+// so the two give the same fields and the same numbers by construction.
+//
+// JSON is two-space indented, without a final newline; every double is written so that reading
+// it back gives the same double. Fields a report leaves out when asked for no timing (seconds,
+// latencies, peak memory) are the ones that depend on the machine, so that the rest can be
+// compared byte for byte.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ontime/allocators/allocator_registry.hpp"
+#include "ontime/learn/fitting.hpp"
+#include "ontime/model/problem.hpp"
+#include "ontime/run/evaluation.hpp"
+#include "ontime/run/table.hpp"
+#include "ontime/solve/layered_solver.hpp"
+
+namespace ontime::report {
+
+// The parameters `kind` declares, given or defaulted, as a JSON object of text values.
+std::string parameters_json(const AllocatorKind& kind, const ParameterValues& values);
+
+// A Monte Carlo evaluation of one allocator, with its exact value when computed.
+struct Evaluation {
+  std::string solver = {};
+  ParameterValues parameters = {};
+  std::string instance = {};  // where the instance came from, as given
+  const Problem* problem = nullptr;
+  std::uint64_t seed = 0;
+  MonteCarloResult result = {};
+  std::optional<ExactEvaluation> exact = {};
+  bool timing = true;  // decision times and run time
+};
+std::string to_json(const Evaluation& evaluation);
+std::string to_text(const Evaluation& evaluation);
+
+// The exact optimum or a certified interval (the layered solver), or the memoised solver's
+// optimum (`memoised`: method "memoised", no layers, no interval).
+struct Solve {
+  std::string instance = {};
+  const Problem* problem = nullptr;
+  const Mdp* mdp = nullptr;
+  std::string method = "layered";
+  LayeredSolution solution = {};
+  bool memoised = false;
+  double tolerance = 0;
+  double seconds = 0;
+  bool timing = true;
+  bool stats = false;  // states (and times) per layer
+};
+std::string to_json(const Solve& solve);
+std::string to_text(const Solve& solve);
+// The policy of the first layers (LayeredSolveOptions::policy_layers): one JSON line per state,
+// its choice and the bounds of its value.
+std::string policy_lines(const Solve& solve);
+
+// Table I's layout (run/table.hpp).
+std::string to_json(const Table& table);
+// A heading line, the Markdown table (one row per instance, the mean decision time of each
+// column last) and, with exact parts, the states and seconds of each.
+// `spelling` names the state cap as the caller writes it ("--max-states").
+std::string to_markdown(const Table& table, const ParameterSpelling& spelling = nullptr);
+
+// The allocator kinds of a registry with their capabilities and parameters: JSON (a list of
+// kinds), and Markdown (a table of kinds, then one of parameters, each named as `spelling` writes
+// it: "--max-states" on the command line).
+std::string registry_json(const AllocatorRegistry& registry);
+std::string registry_markdown(const AllocatorRegistry& registry, const ParameterSpelling& spelling = nullptr);
+
+// What a planner log held about each action and the distributions fitted from it (learn/fitting.hpp).
+std::string fit_json(const FitResult& fit);
+std::string fit_markdown(const FitResult& fit);
+
+// A Markdown table: a header row, the rule below it and the body rows, columns padded to their
+// display width; cells may hold UTF-8 ("±", "µ", "≤").
+std::string markdown_table(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& body);
+
+}  // namespace ontime::report
