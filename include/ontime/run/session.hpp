@@ -175,7 +175,11 @@ class Session {
   Status model_status() const noexcept { return model_status_; }
 
  private:
+  // The live half (src/run/live_session.cpp).
   void start_live(const Clock& clock, LiveOptions options);
+  // choose() and report() on the clock, once what every session checks and records is done.
+  Decision choose_live(const DecisionBudget& budget);
+  Status report_live(int choice, int action, const Observation& observation, double execution_seconds);
   // The search iterations the allocator has run so far (its "iterations" counter; 0 if none).
   std::uint64_t search_iterations() const;
   Status report(const Observation& observation, double execution_seconds);

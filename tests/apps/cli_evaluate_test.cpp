@@ -1,0 +1,220 @@
+// CLI tests of `evaluate`, `table` and `study`: the documented keys, the same bytes for any
+// thread count without timing, one row per instance, exact parts over their cap, instances too
+// large for the exact solver, and memory checked before any work.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "apps/cli_test_support.hpp"
+#include "ontime/allocators/allocator_registry.hpp"
+#include "ontime/model/instance_io.hpp"
+#include "ontime/run/evaluation.hpp"
+#include "support/paper.hpp"
+#include "support/random_instances.hpp"
+
+namespace ontime {
+namespace {
+
+using namespace cli_test;
+
+TEST(Cli, EvaluateWritesTheDocumentedKeys) {
+  const auto result = ontime({"evaluate", paper("instance4"), "--solver", "dp-rerun", "--episodes", "2000", "--seed",
+                              "3", "--threads", "2", "--exact", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const json out = json::parse(result.out);
+  EXPECT_EQ(out["solver"], "dp-rerun");
+  EXPECT_EQ(out["episodes"], 2000);
+  EXPECT_DOUBLE_EQ(out["exact_success_probability"].get<double>(), 0.9);
+  const double rate = out["success_rate"].get<double>();
+  EXPECT_NEAR(rate, 0.9, 4 * std::sqrt(0.09 / 2000));
+  EXPECT_NEAR(out["ci95"].get<double>(), 1.96 * std::sqrt(rate * (1 - rate) / 2000), 1e-12);
+  EXPECT_TRUE(out["decision_time_us"].contains("median"));
+  EXPECT_TRUE(out["decision_time_us"].contains("p99"));
+  EXPECT_GE(out["decision_time_us"]["max"].get<double>(), out["decision_time_us"]["p99"].get<double>());
+  EXPECT_GT(out["decision_time_us"]["max"].get<double>(), 0.0);
+  // Same seed with one thread: the same successes.
+  const auto single = ontime({"evaluate", paper("instance4"), "--solver", "dp-rerun", "--episodes", "2000", "--seed",
+                              "3", "--threads", "1", "--json"});
+  EXPECT_EQ(json::parse(single.out)["successes"], out["successes"]);
+}
+
+// Without the measured times, the output depends only on the inputs: the same bytes for any
+// thread count, with the successes of a timed run.
+TEST(Cli, EvaluateWithoutTimingPrintsTheSameBytesForAnyThreadCount) {
+  const std::vector<std::string> command{"evaluate", paper("instance3"), "--solver", "mcts",   "--iterations",
+                                         "100",      "--episodes",       "300",      "--seed", "5",
+                                         "--json",   "--no-timing"};
+  auto with_threads = [&](const char* threads) {
+    std::vector<std::string> arguments = command;
+    arguments.insert(arguments.end(), {"--threads", threads});
+    return ontime(arguments);
+  };
+  const auto one = with_threads("1");
+  ASSERT_EQ(one.exit_code, 0) << one.err;
+  EXPECT_EQ(with_threads("3").out, one.out);
+  const json out = json::parse(one.out);
+  EXPECT_FALSE(out.contains("decision_time_us"));
+  EXPECT_FALSE(out.contains("seconds"));
+  std::vector<std::string> timed(command.begin(), command.end() - 1);
+  const auto with_timing = ontime(timed);
+  ASSERT_EQ(with_timing.exit_code, 0) << with_timing.err;
+  EXPECT_EQ(json::parse(with_timing.out)["successes"], out["successes"]);
+  EXPECT_TRUE(json::parse(with_timing.out).contains("decision_time_us"));
+}
+
+TEST(Cli, TablePrintsOneRowPerInstanceAndTheOptimum) {
+  const auto result = ontime(
+      {"table", paper("instance2"), paper("instance4"), "--episodes", "500", "--exact", "--solvers", "dp,greedy"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("| instance "), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("| instance2 "), std::string::npos);
+  EXPECT_NE(result.out.find("| instance4 "), std::string::npos);
+  EXPECT_NE(result.out.find("optimum"), std::string::npos);
+  EXPECT_NE(result.out.find("(0.9000)"), std::string::npos);  // dp on instance 4, exact
+  EXPECT_NE(result.out.find("mean decision time"), std::string::npos);
+  const auto as_json = ontime({"table", paper("instance4"), "--episodes", "500", "--exact", "--json"});
+  ASSERT_EQ(as_json.exit_code, 0) << as_json.err;
+  const json out = json::parse(as_json.out);
+  EXPECT_DOUBLE_EQ(out["rows"][0]["optimal_success_probability"].get<double>(), 0.9);
+  EXPECT_DOUBLE_EQ(out["rows"][0]["solvers"]["greedy"]["exact_success_probability"].get<double>(), 0.55);
+}
+
+TEST(Cli, StudiesWriteTheirCsvAndPlot) {
+  const auto directory = scratch("study");
+  const auto anytime = ontime({"study", "anytime", paper("instance4"), paper("instance5"), "--episodes", "30",
+                               "--log10-multipliers", "0,1", "--out", directory.string(), "--threads", "1"});
+  ASSERT_EQ(anytime.exit_code, 0) << anytime.err;
+  EXPECT_EQ(line_count(directory / "anytime.csv"), 1U + 2 * 2);
+  EXPECT_TRUE(std::filesystem::exists(directory / "anytime.png"));
+  EXPECT_NE(anytime.out.find((directory / "anytime.png").string()), std::string::npos);
+  const auto compute = ontime({"study", "compute-time", paper("instance4"), "--episodes", "20", "--iterations", "200",
+                               "--out", directory.string(), "--no-plot"});
+  ASSERT_EQ(compute.exit_code, 0) << compute.err;
+  EXPECT_EQ(line_count(directory / "compute_time.csv"), 1U + 2);
+  EXPECT_FALSE(std::filesystem::exists(directory / "compute_time.png"));
+  const auto bad = ontime({"study", "anytime", paper("instance4"), "--log10-multipliers", "0,x"});
+  EXPECT_EQ(bad.exit_code, 2);
+}
+
+// An instance of 300 skeletons: sampled evaluation by the approximate allocators, and a one-line
+// refusal naming the file and the limit from everything exact, before any work.
+TEST(Cli, ThreeHundredSkeletonsAreEvaluatedAndRefusedByTheExactSolver) {
+  const auto directory = scratch("wide");
+  const std::string path = (directory / "wide.json").string();
+  save_problem(testing::wide_instance(8, 300, 4, 80), path);
+  for (const char* solver : {"dp-rerun", "thompson", "greedy"}) {
+    const auto result =
+        ontime({"evaluate", path, "--solver", solver, "--episodes", "400", "--seed", "2", "--threads", "2", "--json"});
+    ASSERT_EQ(result.exit_code, 0) << solver << ": " << result.err;
+    const json out = json::parse(result.out);
+    EXPECT_EQ(out["episodes"], 400) << solver;
+    EXPECT_GT(out["success_rate"].get<double>(), 0.0) << solver;
+    EXPECT_FALSE(out.contains("exact_success_probability")) << solver;
+  }
+  for (const std::vector<std::string>& command :
+       {std::vector<std::string>{"solve", path},
+        std::vector<std::string>{"evaluate", path, "--solver", "dp", "--exact"},
+        std::vector<std::string>{"table", path, "--solvers", "dp-rerun,optimal", "--episodes", "10"}}) {
+    const auto result = ontime(command);
+    EXPECT_EQ(result.exit_code, 2) << command[0] << ": " << result.err;
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+    EXPECT_NE(result.err.find(path + ": skeletons: 300 skeletons; exact solving and exact evaluation take at most 16"),
+              std::string::npos)
+        << result.err;
+    EXPECT_TRUE(result.out.empty()) << result.out;
+  }
+}
+
+// An exact part beyond --max-states is reported in its cell; the rest of the table stands.
+TEST(Cli, TableReportsAnExactPartOverTheCapInItsCell) {
+  const auto text = ontime({"table", paper("instance1"), "--solvers", "dp,round-robin", "--episodes", "200", "--exact",
+                            "--max-states", "100"});
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("(0.9340)"), std::string::npos) << text.out;       // dp: 48 states
+  EXPECT_NE(text.out.find("(cap reached)"), std::string::npos) << text.out;  // round-robin: 143
+  // The optimum (872 states) past the cap: the whole tree's interval after 49 states (5 layers),
+  // then a split's (skeletons 1-3 enumerated, 58 states), the tighter end of each.
+  EXPECT_NE(text.out.find("optimum over 107 states (certified interval)"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("[0.9360, 0.9939]"), std::string::npos) << text.out;
+  const auto as_json = ontime({"table", paper("instance1"), "--solvers", "dp,round-robin", "--episodes", "200",
+                               "--exact", "--max-states", "100", "--json"});
+  ASSERT_EQ(as_json.exit_code, 0) << as_json.err;
+  const json row = json::parse(as_json.out)["rows"][0];
+  EXPECT_EQ(row["solvers"]["dp"]["exact"]["states"].get<int>(), 48);
+  EXPECT_FALSE(row["solvers"]["dp"]["exact"]["cap_reached"].get<bool>());
+  EXPECT_TRUE(row["solvers"]["round-robin"]["exact"]["cap_reached"].get<bool>());
+  EXPECT_FALSE(row["solvers"]["round-robin"].contains("exact_success_probability"));
+  EXPECT_TRUE(row["optimum"]["cap_reached"].get<bool>());
+  EXPECT_FALSE(row.contains("optimal_success_probability"));
+  EXPECT_LE(row["optimum"]["lower_bound"].get<double>(), 0.942);
+  EXPECT_GE(row["optimum"]["upper_bound"].get<double>(), 0.942);
+  // An exact cell above the layered lower bound (dp-rerun, 0.9400 > 0.9360) raises it: every
+  // policy's exact value is at most the optimum.
+  const auto raised = ontime(
+      {"table", paper("instance1"), "--solvers", "dp,dp-rerun", "--episodes", "200", "--exact", "--max-states", "100"});
+  ASSERT_EQ(raised.exit_code, 0) << raised.err;
+  EXPECT_NE(raised.out.find("[0.9400, 0.9939]"), std::string::npos) << raised.out;
+}
+
+TEST(Cli, TableRefusesEmptyAndRepeatedColumnsAndRepeatedInstances) {
+  const std::string figure1 = paper("figure1");
+  const auto empty = ontime({"table", figure1, "--episodes", "5", "--solvers", "dp,,greedy"});
+  EXPECT_EQ(empty.exit_code, 2);
+  EXPECT_NE(empty.err.find("--solvers: name 2 is empty"), std::string::npos) << empty.err;
+  EXPECT_EQ(ontime({"table", figure1, "--episodes", "5", "--solvers", "dp,"}).exit_code, 2);
+  EXPECT_EQ(ontime({"table", figure1, "--episodes", "5", "--solvers", ""}).exit_code, 2);
+  const auto repeated = ontime({"table", figure1, "--episodes", "5", "--solvers", "dp,greedy,dp"});
+  EXPECT_EQ(repeated.exit_code, 2);
+  EXPECT_NE(repeated.err.find("--solvers: 'dp' is given twice"), std::string::npos) << repeated.err;
+  // The same file under another name is the same instance.
+  const std::string other_name = (std::filesystem::path(figure1).parent_path() / "." / "figure1.json").string();
+  const auto twice = ontime({"table", figure1, other_name, "--episodes", "5", "--solvers", "dp"});
+  EXPECT_EQ(twice.exit_code, 2);
+  EXPECT_NE(twice.err.find("instance given twice (as argument 1 and 2)"), std::string::npos) << twice.err;
+  EXPECT_EQ(ontime({"table", figure1, paper("instance1"), "--episodes", "5", "--solvers", "dp,greedy"}).exit_code, 0);
+}
+
+// "Whichever ends first": a time budget so large that its deadline is out of the clock's range
+// leaves the iteration limit in charge (it must not end every search at once).
+TEST(Cli, AHugeTimeBudgetLeavesTheIterationLimitInCharge) {
+  const Problem problem = testing::paper_instance("instance3");
+  const Mdp mdp(problem);
+  for (const char* seconds : {"1e10", "1e308"}) {
+    const AllocatorFactory factory =
+        make_allocator_factory("mcts", mdp, {{"iterations", "1000"}, {"time-budget", seconds}});
+    MonteCarloOptions monte_carlo;
+    monte_carlo.episodes = 20;
+    monte_carlo.threads = 1;
+    const MonteCarloResult result = run_monte_carlo(mdp, factory, monte_carlo);
+    const double searches = result.statistics.find("searches").value_or(0.0);
+    EXPECT_GT(searches, 0.0) << seconds;
+    EXPECT_EQ(result.statistics.find("iterations").value_or(0.0), searches * 1000) << seconds;
+  }
+}
+
+// The exact parts of evaluate, table and study, and the search trees of a study, are checked
+// against the memory available before any work, as solve's cap is.
+TEST(Cli, ExactPartsAndStudyTreesBeyondTheAvailableMemoryAreRefusedBeforeStarting) {
+  const std::string huge = "1000000000000";  // 10^12 states: terabytes
+  for (const std::vector<std::string>& arguments :
+       {std::vector<std::string>{"evaluate", paper("instance1"), "--solver", "dp", "--exact", "--max-states", huge},
+        std::vector<std::string>{"table", paper("instance1"), "--solvers", "dp", "--exact", "--max-states", huge},
+        std::vector<std::string>{"study", "anytime", paper("instance1"), "--no-plot", "--out",
+                                 scratch("memory_study").string(), "--max-states", huge}}) {
+    const auto result = ontime(arguments);
+    EXPECT_EQ(result.exit_code, 2) << arguments[0] << ": " << result.err;
+    EXPECT_NE(result.err.find("--max-states " + huge + ": would need up to"), std::string::npos) << result.err;
+  }
+  const auto trees = ontime({"study", "compute-time", paper("instance1"), "--no-plot", "--out",
+                             scratch("memory_trees").string(), "--threads", "2", "--max-tree-mib", "16777216"});
+  EXPECT_EQ(trees.exit_code, 2) << trees.err;
+  EXPECT_NE(trees.err.find("--max-tree-mib 16777216 with 2 threads: would need up to"), std::string::npos) << trees.err;
+}
+
+}  // namespace
+}  // namespace ontime

@@ -1,0 +1,229 @@
+// CLI tests of `fit`: planner logs and OMPL benchmark logs fitted back to their instance (through
+// a mapping, an action per log or a library of per-action skeletons), and every bad log, option
+// and Laplace alpha refused in one line.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "apps/cli_test_support.hpp"
+#include "ontime/model/instance_io.hpp"
+#include "support/bad_logs.hpp"
+#include "support/bad_ompl_logs.hpp"
+
+namespace ontime {
+namespace {
+
+using namespace cli_test;
+
+double optimum(const std::string& instance) {
+  const auto result = ontime({"solve", instance, "--json"});
+  EXPECT_EQ(result.exit_code, 0) << result.err;
+  return json::parse(result.out)["optimal_success_probability"].get<double>();
+}
+
+TEST(Cli, SampledLogFitsBackToTheOptimumWithinOneHundredth) {
+  const std::filesystem::path dir = scratch("round-trip");
+  const std::string log = (dir / "instance1.jsonl").string();
+  const std::string fitted = (dir / "fitted.json").string();
+  const auto sampled = ontime({"sample-log", paper("instance1"), "--attempts", "20000", "--seed", "3", "-o", log});
+  ASSERT_EQ(sampled.exit_code, 0) << sampled.err;
+  const auto fit = ontime(
+      {"fit", log, "--step", "1", "--deadline", "14", "--skeletons", paper("instance1"), "-o", fitted, "--json"});
+  ASSERT_EQ(fit.exit_code, 0) << fit.err;
+  const json report = json::parse(fit.out);
+  EXPECT_EQ(report["records"].get<int>(), 9 * 20000);  // instance 1 uses 9 actions
+  EXPECT_EQ(report["actions"].size(), 9u);
+  EXPECT_EQ(report["actions"][0]["attempts"].get<int>(), 20000);
+  EXPECT_NEAR(optimum(fitted), optimum(paper("instance1")), 0.01);
+  // Same seed, same log.
+  const std::string again = (dir / "again.jsonl").string();
+  ASSERT_EQ(ontime({"sample-log", paper("instance1"), "--attempts", "20000", "--seed", "3", "-o", again}).exit_code, 0);
+  EXPECT_EQ(read_file(log), read_file(again));
+}
+
+TEST(Cli, FitRejectsEveryBadLogWithOneLineNamingFileLineAndRule) {
+  const std::filesystem::path dir = scratch("bad-logs");
+  for (const testing::BadInput& bad : testing::kBadLogs) {
+    const std::string path = testing::source_path("tests/data/bad_logs/" + bad.file).string();
+    const std::string output = (dir / "never-written.json").string();
+    const auto result =
+        ontime({"fit", path, "--step", "1", "--deadline", "5", "--skeletons", paper("figure1"), "-o", output});
+    EXPECT_EQ(result.exit_code, 2) << bad.file;
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << bad.file << ": " << result.err;
+    EXPECT_NE(result.err.find(path + ": " + bad.place + ": "), std::string::npos) << result.err;
+    EXPECT_NE(result.err.find(bad.rule), std::string::npos) << result.err;
+    EXPECT_FALSE(std::filesystem::exists(output)) << bad.file;
+  }
+}
+
+TEST(Cli, FitNamesTheSkeletonActionMissingFromTheLog) {
+  const std::filesystem::path dir = scratch("missing-action");
+  const std::string log = (dir / "figure1.jsonl").string();
+  ASSERT_EQ(ontime({"sample-log", paper("figure1"), "--attempts", "10", "-o", log}).exit_code, 0);
+  const auto result = ontime({"fit", log, "--step", "1", "--deadline", "5", "--skeletons", paper("instance1"), "-o",
+                              (dir / "out.json").string()});
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.err.find(paper("instance1") + ": skeletons[0][0]: action 'a1_1' has no record in the log " + log),
+            std::string::npos)
+      << result.err;
+  EXPECT_EQ(
+      ontime({"fit", log, "--step", "0", "--deadline", "5", "--skeletons", paper("figure1"), "-o", "x.json"}).exit_code,
+      2);
+  EXPECT_EQ(
+      ontime({"fit", log, "--step", "1", "--deadline", "0", "--skeletons", paper("figure1"), "-o", "x.json"}).exit_code,
+      2);
+  EXPECT_EQ(ontime({"fit", log, "--step", "1", "--deadline", "5", "--skeletons", paper("figure1"), "-o", "x.json",
+                    "--laplace", "-1"})
+                .exit_code,
+            2);
+}
+
+std::string kitchen_log() { return testing::source_path("tests/data/ompl_logs/kitchen.log").string(); }
+
+TEST(Cli, FitReadsOmplBenchmarkLogsThroughAMappingOrAnActionPerLog) {
+  const std::filesystem::path dir = scratch("ompl-fit");
+  const std::string skeletons = (dir / "skeletons.json").string();
+  std::ofstream(skeletons) << R"json({"skeletons": [["move(R1,R2)", "pick(cup)"]]})json";
+  const std::string mapping = (dir / "mapping.json").string();
+  std::ofstream(mapping) << R"json({"rules": [{"planner": "geometric_RRTConnect", "action": "move(R1,R2)"},
+                                             {"planner": "geometric_RRTstar", "action": "pick(cup)"}]})json";
+  const std::string output = (dir / "kitchen.json").string();
+  const auto mapped =
+      ontime({"fit", "--format", "ompl-benchmark", kitchen_log(), "--speed", "0.5", "--mapping", mapping, "--step",
+              "0.5", "--deadline", "30", "--skeletons", skeletons, "-o", output, "--json"});
+  ASSERT_EQ(mapped.exit_code, 0) << mapped.err;
+  const json report = json::parse(mapped.out);
+  EXPECT_EQ(report["format"], "ompl-benchmark");
+  EXPECT_EQ(report["records"].get<int>(), 6);
+  ASSERT_EQ(report["actions"].size(), 2u);
+  EXPECT_EQ(report["actions"][0]["action"], "move(R1,R2)");
+  EXPECT_EQ(report["actions"][0]["found"].get<int>(), 2);
+  EXPECT_EQ(report["actions"][0]["cut_off"].get<int>(), 1);
+  EXPECT_EQ(report["actions"][1]["action"], "pick(cup)");
+  EXPECT_EQ(report["actions"][1]["found"].get<int>(), 1);
+  EXPECT_EQ(report["actions"][1]["cut_off"].get<int>(), 2);
+  // move(R1,R2): found at 0.125 s (1 step) and 1.75 s (4 steps), cut off at 2 s (4 steps survived).
+  const Problem fitted = load_problem(output);
+  const Distribution& planning = fitted.action(0).planning;
+  EXPECT_DOUBLE_EQ(planning.pmf(1), 1.0 / 3.0);
+  EXPECT_DOUBLE_EQ(planning.pmf(4), 1.0 / 3.0);
+  EXPECT_DOUBLE_EQ(planning.never(), 1.0 / 3.0);
+  // Execution: 3.25 / 0.5 = 6.5 s (13 steps) and 4.5 / 0.5 = 9 s (18 steps).
+  const Distribution& execution = fitted.action(0).execution;
+  EXPECT_DOUBLE_EQ(execution.pmf(13), 0.5);
+  EXPECT_DOUBLE_EQ(execution.pmf(18), 0.5);
+
+  // One action per log: the same log twice, every run of each given to one action.
+  const auto per_log =
+      ontime({"fit",      "--format",    "ompl-benchmark", kitchen_log(), kitchen_log(), "--speed", "1",
+              "--action", "move(R1,R2)", "--action",       "pick(cup)",   "--step",      "0.5",     "--deadline",
+              "30",       "--skeletons", skeletons,        "-o",          output,        "--json"});
+  ASSERT_EQ(per_log.exit_code, 0) << per_log.err;
+  const json per_log_report = json::parse(per_log.out);
+  EXPECT_EQ(per_log_report["records"].get<int>(), 12);
+  EXPECT_EQ(per_log_report["actions"][0]["attempts"].get<int>(), 6);
+  EXPECT_EQ(per_log_report["actions"][0]["found"].get<int>(), 3);
+  EXPECT_EQ(per_log_report["actions"][1]["attempts"].get<int>(), 6);
+}
+
+TEST(Cli, FitRefusesOmplOptionsThatDoNotFit) {
+  const std::filesystem::path dir = scratch("ompl-usage");
+  const std::string output = (dir / "never-written.json").string();
+  const auto fit = [&](std::vector<std::string> extra) {
+    std::vector<std::string> arguments{"fit",         "--step",         "1",  "--deadline", "5",
+                                       "--skeletons", paper("figure1"), "-o", output};
+    arguments.insert(arguments.end(), extra.begin(), extra.end());
+    return ontime(arguments);
+  };
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
+      {{"--format", "ompl-benchmark", kitchen_log()}, "needs --speed"},
+      {{"--format", "ompl-benchmark", kitchen_log(), "--speed", "1", "--action", "a", "--action", "b"},
+       "--action is given 2 times for 1 LOG files"},
+      {{"--format", "ompl-benchmark", kitchen_log(), "--speed", "1", "--action", "a", "--mapping", "m.json"},
+       "either --action (one per LOG) or --mapping"},
+      {{kitchen_log(), "--speed", "1"}, "options of --format ompl-benchmark"},
+      {{kitchen_log(), kitchen_log()}, "--format jsonl reads one LOG"},
+      {{"--format", "ompl-benchmark", kitchen_log(), "--speed", "0"}, "--speed"},
+      {{"--format", "ompl", kitchen_log()}, "--format"},
+  };
+  for (const auto& [extra, message] : cases) {
+    const auto result = fit(extra);
+    EXPECT_EQ(result.exit_code, 2) << message << ": " << result.err;
+    EXPECT_NE(result.err.find(message), std::string::npos) << result.err;
+    EXPECT_FALSE(std::filesystem::exists(output));
+  }
+}
+
+TEST(Cli, FitRejectsEveryBadOmplLogWithOneLineNamingFileLineAndRule) {
+  const std::filesystem::path dir = scratch("bad-ompl-logs");
+  for (const testing::BadInput& bad : testing::kBadOmplLogs) {
+    const std::string path = testing::source_path("tests/data/bad_ompl_logs/" + bad.file).string();
+    const std::string output = (dir / "never-written.json").string();
+    const auto result = ontime({"fit", "--format", "ompl-benchmark", path, "--speed", "1", "--step", "1", "--deadline",
+                                "5", "--skeletons", paper("figure1"), "-o", output});
+    EXPECT_EQ(result.exit_code, 2) << bad.file;
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << bad.file << ": " << result.err;
+    EXPECT_NE(result.err.find(path + ": " + bad.place + ": "), std::string::npos) << result.err;
+    EXPECT_NE(result.err.find(bad.rule), std::string::npos) << result.err;
+    EXPECT_FALSE(std::filesystem::exists(output)) << bad.file;
+  }
+}
+
+// --library fits every action of a log as a skeleton of its own: a library of per-action
+// distributions, e.g. of a collection of every doorway move.
+TEST(Cli, FitWithLibraryGivesOneSkeletonPerActionOfTheLog) {
+  const std::filesystem::path dir = scratch("fit-library");
+  const std::string log = (dir / "instance1.jsonl").string();
+  ASSERT_EQ(ontime({"sample-log", paper("instance1"), "--attempts", "50", "-o", log}).exit_code, 0);
+  const std::string library = (dir / "library.json").string();
+  const auto fit = ontime({"fit", log, "--step", "1", "--deadline", "14", "--library", "-o", library, "--json"});
+  ASSERT_EQ(fit.exit_code, 0) << fit.err;
+  const json instance = json::parse(read_file(library));
+  ASSERT_EQ(instance["actions"].size(), 9u);  // instance 1 uses 9 actions
+  ASSERT_EQ(instance["skeletons"].size(), 9u);
+  std::set<std::string> skeleton_actions;
+  for (const json& skeleton : instance["skeletons"]) {
+    ASSERT_EQ(skeleton.size(), 1u);
+    skeleton_actions.insert(skeleton[0].get<std::string>());
+  }
+  for (const auto& [id, action] : instance["actions"].items()) EXPECT_EQ(skeleton_actions.count(id), 1u) << id;
+  // The same distributions as a fit along the instance's own skeletons.
+  const std::string along = (dir / "along.json").string();
+  ASSERT_EQ(
+      ontime({"fit", log, "--step", "1", "--deadline", "14", "--skeletons", paper("instance1"), "-o", along}).exit_code,
+      0);
+  EXPECT_EQ(instance["actions"], json::parse(read_file(along))["actions"]);
+  // Exactly one of --skeletons and --library.
+  const auto neither = ontime({"fit", log, "--step", "1", "--deadline", "14", "-o", (dir / "x.json").string()});
+  EXPECT_EQ(neither.exit_code, 2);
+  EXPECT_EQ(std::count(neither.err.begin(), neither.err.end(), '\n'), 1) << neither.err;
+  EXPECT_NE(neither.err.find("--skeletons FILE or --library"), std::string::npos) << neither.err;
+  EXPECT_EQ(ontime({"fit", log, "--step", "1", "--deadline", "14", "--library", "--skeletons", paper("instance1"), "-o",
+                    (dir / "x.json").string()})
+                .exit_code,
+            2);
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.json"));
+}
+
+TEST(Cli, ALaplaceAlphaThatSwampsTheLogIsAUsageError) {
+  const auto directory = scratch("laplace");
+  const auto sampled = ontime({"sample-log", paper("figure1"), "-o", (directory / "log.jsonl").string()});
+  ASSERT_EQ(sampled.exit_code, 0) << sampled.err;
+  const auto fitted =
+      ontime({"fit", (directory / "log.jsonl").string(), "--step", "1", "--deadline", "5", "--skeletons",
+              paper("figure1"), "--laplace", "1e308", "-o", (directory / "fit.json").string()});
+  EXPECT_EQ(fitted.exit_code, 2) << fitted.err;
+  EXPECT_NE(fitted.err.find("laplace: the Laplace smoothing alpha must be between 0 and 1e+06"), std::string::npos)
+      << fitted.err;
+  EXPECT_FALSE(std::filesystem::exists(directory / "fit.json"));
+}
+
+}  // namespace
+}  // namespace ontime

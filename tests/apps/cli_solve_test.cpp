@@ -1,0 +1,174 @@
+// CLI tests of `solve` (the optimum, or a certified interval with its layers; the same bytes for
+// any thread count; caps refused before starting; no scratch left behind when stopped or killed)
+// and of `reduce-knapsack`.
+
+#include <gtest/gtest.h>
+
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "apps/cli_test_support.hpp"
+
+namespace ontime {
+namespace {
+
+using namespace cli_test;
+
+TEST(Cli, SolveReportsTheFigureOneOptimum) {
+  const auto result = ontime({"solve", paper("figure1"), "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const json out = json::parse(result.out);
+  EXPECT_DOUBLE_EQ(out["optimal_success_probability"].get<double>(), 0.5625);
+  EXPECT_EQ(out["first_choice"].get<int>(), 0);
+  EXPECT_GT(out["states"].get<int>(), 0);
+  EXPECT_TRUE(out.contains("seconds"));
+}
+
+TEST(Cli, KnapsackReductionWritesASolvableInstance) {
+  const auto directory = scratch("knapsack");
+  const std::string instance = (directory / "example.json").string();
+  const auto reduced =
+      ontime({"reduce-knapsack", testing::source_path("data/knapsack/example.json").string(), "--out", instance});
+  ASSERT_EQ(reduced.exit_code, 0) << reduced.err;
+  const auto solved = ontime({"solve", instance, "--json"});
+  ASSERT_EQ(solved.exit_code, 0) << solved.err;
+  const double epsilon = 1.0 / 2304;
+  EXPECT_NEAR(json::parse(solved.out)["optimal_success_probability"].get<double>(),
+              1 - (1 - 3 * epsilon) * (1 - 4 * epsilon), 1e-15);
+  const auto bad = ontime({"reduce-knapsack", paper("figure1")});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find(paper("figure1") + ": name: unknown key"), std::string::npos) << bad.err;
+}
+
+// A solve stopped by SIGINT, SIGTERM or SIGHUP removes its scratch, says so in one line and dies
+// of the signal; after SIGKILL (nothing can run), the next solve over the folder removes what was
+// left and says so.
+TEST(Cli, AStoppedOrKilledSolveLeavesNoScratchBehind) {
+  const auto folder = scratch("solve-scratch");
+  const std::string navigation = std::string(ONTIME_SOURCE_DIR) + "/data/instances/navigation.json";
+  const std::vector<std::string> solve = {ONTIME_CLI, "solve", navigation, "--scratch", folder.string(), "--quiet"};
+  const auto layer_files_written = [&folder] {
+    std::error_code error;
+    for (const auto& directory : std::filesystem::directory_iterator(folder, error)) {
+      for ([[maybe_unused]] const auto& file : std::filesystem::directory_iterator(directory.path(), error))
+        return true;
+    }
+    return false;
+  };
+  const auto entries = [&folder] {
+    std::vector<std::filesystem::path> found;
+    for (const auto& entry : std::filesystem::directory_iterator(folder)) found.push_back(entry.path());
+    return found;
+  };
+  for (const auto& [signal_number, name] : {std::pair{SIGTERM, "SIGTERM"}, {SIGINT, "SIGINT"}, {SIGHUP, "SIGHUP"}}) {
+    const auto stopped = testing::run_process(solve, layer_files_written, signal_number);
+    EXPECT_EQ(stopped.exit_code, 128 + signal_number) << stopped.err;
+    const std::regex line("ontime: " + std::string(name) + ": stopped; removed the scratch directory " +
+                          folder.string() + "/ontime-layers-[^/\\n]+-rank0-[^/\\n]{6}\n");
+    EXPECT_TRUE(std::regex_match(stopped.err, line)) << stopped.err;
+    EXPECT_TRUE(entries().empty()) << name;
+  }
+  const auto killed = testing::run_process(solve, layer_files_written, SIGKILL);
+  EXPECT_EQ(killed.exit_code, 128 + SIGKILL);
+  const auto left = entries();
+  ASSERT_EQ(left.size(), 1U);
+  const auto next = ontime({"solve", paper("instance1"), "--scratch", folder.string()});
+  ASSERT_EQ(next.exit_code, 0) << next.err;
+  EXPECT_NE(next.err.find("ontime: removed " + left[0].string() + " ("), std::string::npos) << next.err;
+  EXPECT_NE(next.err.find("the scratch of a run on this host whose process is gone"), std::string::npos) << next.err;
+  EXPECT_TRUE(entries().empty());
+}
+
+// A cap the memory cannot hold would end in "out of memory" instead of the cap's clean stop.
+TEST(Cli, CapsBeyondTheAvailableMemoryAreRefusedBeforeStarting) {
+  const auto states =
+      ontime({"solve", paper("figure1"), "--max-states", "18446744073709551615", "--method", "memoised"});
+  EXPECT_EQ(states.exit_code, 2);
+  EXPECT_NE(states.err.find("--max-states 18446744073709551615: would need up to"), std::string::npos) << states.err;
+  const auto tree = ontime({"evaluate", paper("figure1"), "--solver", "mcts", "--max-tree-mib", "16777216",
+                            "--episodes", "5", "--threads", "1"});
+  EXPECT_EQ(tree.exit_code, 2);
+  EXPECT_NE(tree.err.find("--max-tree-mib 16777216 with 1 thread: would need up to 1.64e+04 GiB"), std::string::npos)
+      << tree.err;
+  const auto table = ontime({"table", paper("figure1"), "--solvers", "mcts", "--max-tree-mib", "16777216", "--episodes",
+                             "5", "--threads", "1"});
+  EXPECT_EQ(table.exit_code, 2);
+  EXPECT_EQ(ontime({"solve", paper("figure1"), "--max-states", "1000"}).exit_code, 0);
+  const auto memory = ontime({"solve", paper("figure1"), "--max-memory-mib", "1099511627776"});
+  EXPECT_EQ(memory.exit_code, 2);
+  EXPECT_NE(memory.err.find("--max-memory-mib: would need up to"), std::string::npos) << memory.err;
+}
+
+TEST(Cli, SolveGivesTheOptimumOrACertifiedIntervalWithItsLayers) {
+  const auto exact = ontime({"solve", paper("instance1"), "--json", "--stats"});
+  ASSERT_EQ(exact.exit_code, 0) << exact.err;
+  const json solved = json::parse(exact.out);
+  EXPECT_EQ(solved["optimal_success_probability"].get<double>(), 0.942);
+  EXPECT_EQ(solved["lower_bound"].get<double>(), 0.942);
+  EXPECT_EQ(solved["upper_bound"].get<double>(), 0.942);
+  EXPECT_TRUE(solved["exact"].get<bool>());
+  EXPECT_EQ(solved["states"].get<int>(), 872);
+  int states = 0;
+  for (const json& layer : solved["layers"]) states += layer["states"].get<int>();
+  EXPECT_EQ(states, 872);
+  EXPECT_EQ(solved["layers"][0]["states"].get<int>(), 1);
+
+  const auto capped = ontime({"solve", paper("instance1"), "--json", "--max-states", "100"});
+  ASSERT_EQ(capped.exit_code, 0) << capped.err;
+  const json bounded = json::parse(capped.out);
+  EXPECT_TRUE(bounded["optimal_success_probability"].is_null());
+  EXPECT_FALSE(bounded["exact"].get<bool>());
+  EXPECT_LE(bounded["lower_bound"].get<double>(), 0.942);
+  EXPECT_GE(bounded["upper_bound"].get<double>(), 0.942);
+  // The cap holds for each part: the whole tree, then a split of it (instance1's skeletons begin
+  // with two different actions).
+  EXPECT_LE(bounded["states"].get<int>() - bounded["split"]["states"].get<int>(), 100);
+  EXPECT_LE(bounded["split"]["states"].get<int>(), 100);
+  EXPECT_NE(bounded["stopped_by"].get<std::string>().find("cap of 100 states"), std::string::npos);
+  EXPECT_NE(bounded["split"]["stopped_by"].get<std::string>().find("cap of 100 states"), std::string::npos);
+  EXPECT_EQ(bounded["split"]["enumerated_skeletons"], json({1, 2, 3}));
+  EXPECT_LE(bounded["split"]["lower_bound"].get<double>(), 0.942);
+  EXPECT_GE(bounded["split"]["upper_bound"].get<double>(), 0.942);
+  EXPECT_LE(bounded["upper_bound"].get<double>(), bounded["split"]["upper_bound"].get<double>());
+
+  const auto directory = scratch("solve_policy");
+  const std::string policy = (directory / "policy.jsonl").string();
+  const auto written = ontime({"solve", paper("instance1"), "--policy", policy, "--policy-layers", "2"});
+  ASSERT_EQ(written.exit_code, 0) << written.err;
+  std::ifstream in(policy);
+  std::string line;
+  int lines = 0;
+  while (std::getline(in, line)) {
+    const json entry = json::parse(line);
+    EXPECT_LE(entry["time"].get<int>(), 1);
+    EXPECT_EQ(entry["refined"].size(), 4U);
+    ++lines;
+  }
+  EXPECT_EQ(lines, 1 + solved["layers"][1]["states"].get<int>());
+}
+
+TEST(Cli, SolveNoTimingPrintsTheSameBytesForAnyThreadCount) {
+  const std::vector<std::string> args{"solve",       paper("instance1"), "--json", "--stats",
+                                      "--no-timing", "--max-states",     "300"};
+  auto one = args, two = args;
+  one.insert(one.end(), {"--threads", "1"});
+  two.insert(two.end(), {"--threads", "2"});
+  const auto first = ontime(one);
+  const auto second = ontime(two);
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  EXPECT_EQ(first.out, second.out);
+  const json solved = json::parse(first.out);
+  EXPECT_FALSE(solved.contains("seconds"));
+  EXPECT_FALSE(solved.contains("peak_memory_bytes"));
+  EXPECT_FALSE(solved["layers"][0].contains("forward_seconds"));
+  EXPECT_FALSE(solved["exact"].get<bool>());
+  EXPECT_LT(solved["lower_bound"].get<double>(), solved["upper_bound"].get<double>());
+}
+
+}  // namespace
+}  // namespace ontime
