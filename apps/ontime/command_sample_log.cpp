@@ -33,20 +33,7 @@ void add_sample_log_command(CLI::App& app) {
   command->callback([options] {
     const Problem problem = load_problem(options->instance);
     check_outputs({{"--output", options->output}}, {options->instance});
-    // Streamed: a log of any length is written in constant memory, in pieces of about 1 MiB.
-    AtomicFileWriter writer(options->output);
-    std::string piece;
-    std::uint64_t records = 0;
-    sample_planner_log(problem, options->sampling, [&](const RefinementAttempt& attempt) {
-      piece += planner_log_line(attempt);
-      ++records;
-      if (piece.size() >= (std::size_t{1} << 20)) {
-        writer.write(piece);
-        piece.clear();
-      }
-    });
-    writer.write(piece);
-    writer.commit();
+    const std::uint64_t records = write_sampled_planner_log(problem, options->sampling, options->output);
     fmt::print("Wrote {} records ({} attempts per action, seed {}) to {}.\n", records,
                options->sampling.attempts_per_action, options->sampling.seed, options->output);
   });

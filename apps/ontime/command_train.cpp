@@ -12,6 +12,8 @@
 #include "number_options.hpp"
 #include "ontime/learn/ppo_training.hpp"
 #include "ontime/model/instance_io.hpp"
+#include "ontime/report/report.hpp"
+#include "ontime/run/evaluation.hpp"
 #include "ontime/util/error.hpp"
 #include "ontime/util/output_set.hpp"
 #include "output_paths.hpp"
@@ -45,10 +47,8 @@ void add_train_command(CLI::App& app) {
     const Problem problem = load_problem(options->instance);
     const Mdp mdp(problem);
     const std::filesystem::path policy_path(options->out);
-    std::filesystem::path curve_csv = policy_path;
-    curve_csv.replace_extension(".curve.csv");
-    std::filesystem::path curve_png = policy_path;
-    curve_png.replace_extension(".curve.png");
+    const std::filesystem::path curve_csv = learning_curve_path(policy_path);
+    const std::filesystem::path curve_png = learning_curve_path(policy_path, ".curve.png");
     std::vector<OutputFile> outputs{{"--out", policy_path}, {"--out (learning curve)", curve_csv}};
     if (!options->no_plot) outputs.push_back({"--out (learning curve plot)", curve_png});
     check_outputs(outputs, {options->instance}, MissingFolder::create);
@@ -57,17 +57,11 @@ void add_train_command(CLI::App& app) {
         train_ppo(mdp, options->episodes, options->seed, PpoHyperparameters{},
                   [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); });
 
-    std::string csv = "epoch,episodes,steps,success_rate,mean_episode_length,actor_steps,seconds\n";
-    for (const LearningCurvePoint& point : training.curve) {
-      csv += fmt::format("{},{},{},{},{},{},{:.6f}\n", point.epoch, point.episodes, point.steps, point.success_rate,
-                         point.mean_episode_length, point.actor_steps, point.seconds);
-    }
-    // The three files are one output: all are staged, then renamed together, so that an
-    // interruption leaves the previous set or this one. Without a plot, an older PNG beside the
-    // policy would describe another training: it goes.
+    // The files are one output: all are staged, then renamed together, so that an interruption
+    // leaves the previous set or this one. Without a plot, an older PNG beside the policy would
+    // describe another training: it goes.
     OutputSet files(policy_path.has_parent_path() ? policy_path.parent_path() : std::filesystem::path("."));
-    files.write(policy_path, ppo_policy_to_json(training.policy));
-    const std::filesystem::path staged_csv = files.write(curve_csv, csv);
+    const std::filesystem::path staged_csv = stage_ppo_training(files, training, policy_path);
     if (options->no_plot) {
       files.remove_on_commit(curve_png);
     } else {
@@ -77,35 +71,22 @@ void add_train_command(CLI::App& app) {
     }
     files.commit();
 
-    PpoAllocator trained(mdp, std::make_shared<const PpoPolicy>(training.policy));
+    report::Training trained{.instance = options->instance,
+                             .problem = &problem,
+                             .policy = policy_path.string(),
+                             .files = {policy_path.string(), curve_csv.string()},
+                             .episodes = options->episodes,
+                             .seed = options->seed,
+                             .epochs = training.curve.size(),
+                             .seconds = training.curve.empty() ? 0.0 : training.curve.back().seconds};
+    if (!options->no_plot) trained.files.push_back(curve_png.string());
     // Exact evaluation takes at most kMaxExactSkeletons skeletons; a wider instance trains all
     // the same, without the exact figure.
-    std::optional<ExactEvaluation> exact;
-    if (problem.skeleton_count() <= kMaxExactSkeletons) exact = evaluate_exactly(mdp, trained);
-    const double seconds = training.curve.empty() ? 0.0 : training.curve.back().seconds;
-    if (options->json) {
-      Json out;
-      out["instance"] = options->instance;
-      out["policy"] = policy_path.string();
-      out["learning_curve"] = curve_csv.string();
-      out["episodes"] = options->episodes;
-      out["seed"] = options->seed;
-      out["epochs"] = training.curve.size();
-      out["seconds"] = seconds;
-      out["exact_success_probability"] = exact ? Json(exact->success_probability) : Json(nullptr);
-      print_json(out);
-      return;
+    if (problem.skeleton_count() <= kMaxExactSkeletons) {
+      PpoAllocator greedy(mdp, std::make_shared<const PpoPolicy>(training.policy));
+      trained.exact = evaluate_exactly(mdp, greedy).success_probability;
     }
-    fmt::print("trained ppo on {} ({}): {} episodes in {} epochs, {:.1f} s\n", options->instance, problem.name(),
-               options->episodes, training.curve.size(), seconds);
-    if (exact) {
-      fmt::print("exact success probability of the trained policy (greedy): {:.4f}\n", exact->success_probability);
-    } else {
-      fmt::print("exact success probability of the trained policy: not computed ({} skeletons; at most {})\n",
-                 problem.skeleton_count(), kMaxExactSkeletons);
-    }
-    fmt::print("wrote {}\nwrote {}\n", policy_path.string(), curve_csv.string());
-    if (!options->no_plot) fmt::print("wrote {}\n", curve_png.string());
+    fmt::print("{}", options->json ? report::to_json(trained) + "\n" : report::to_text(trained));
   });
 }
 

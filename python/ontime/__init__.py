@@ -43,8 +43,11 @@ from ._ontime import (  # noqa: F401  (re-exported)
     load_problem,
     make_allocator,
     read_planner_log,
+    reduce_knapsack,
     run_episodes,
+    sample_log,
     solve,
+    study,
     table,
     train_ppo,
 )
@@ -56,7 +59,8 @@ __all__ = [
     "NEVER", "Action", "Allocator", "Decision", "Distribution", "Error", "InputError", "LiveSession",
     "ManualClock", "Mdp", "Problem",
     "ResourceLimitError", "Session", "State", "Status", "UsageError", "World", "allocators", "evaluate",
-    "fit", "load_problem", "make_allocator", "read_planner_log", "run_episodes", "solve", "table", "train_ppo",
+    "fit", "load_problem", "make_allocator", "read_planner_log", "reduce_knapsack", "run_episodes", "sample_log",
+    "solve", "study", "table", "train_ppo",
     "write_planner_log",
 ]
 

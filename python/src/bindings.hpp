@@ -24,6 +24,7 @@
 #include "ontime/model/problem.hpp"
 #include "ontime/run/evaluation.hpp"
 #include "ontime/util/error.hpp"
+#include "ontime/util/memory.hpp"
 
 namespace ontime::python {
 
@@ -144,6 +145,9 @@ py::dict parameters_dict(const std::string& kind, const ParameterValues& values)
 // A JSON text of the report module (report/report.hpp) as Python objects (json.loads), so that
 // Python returns what the command line prints.
 py::object json_object(const std::string& text);
+
+// Parameters as Python writes them (keyword arguments): "max_states".
+ParameterSpelling python_spelling();
 
 // An evaluation's report (report::Evaluation) as a dict: the fields of `ontime evaluate --json`.
 py::dict monte_carlo_dict(const std::string& solver, const ParameterValues& values, const std::string& instance,

@@ -6,15 +6,19 @@
 #include <pybind11/stl.h>
 
 #include <cmath>
+#include <filesystem>
+#include <optional>
 #include <sstream>
 
 #include "bindings.hpp"
 #include "ontime/learn/fitting.hpp"
+#include "ontime/learn/log_sampling.hpp"
 #include "ontime/mdp/state.hpp"
 #include "ontime/model/instance_io.hpp"
 #include "ontime/model/planner_log.hpp"
 #include "ontime/model/skeleton_file.hpp"
 #include "ontime/report/report.hpp"
+#include "ontime/solve/knapsack.hpp"
 #include "ontime/util/error.hpp"
 
 namespace ontime::python {
@@ -171,6 +175,44 @@ void bind_model(py::module_& m) {
         return std::make_shared<Problem>(load_problem(file));
       },
       py::arg("path"), "Reads and validates an instance file (SPEC §5). Raises InputError naming the place and rule.");
+
+  m.def(
+      "reduce_knapsack",
+      [](const py::object& knapsack, const std::optional<std::string>& name) {
+        const bool is_file = py::isinstance<py::str>(knapsack) || py::hasattr(knapsack, "__fspath__");
+        const std::string source =
+            is_file ? std::string(py::str(py::module_::import("os").attr("fspath")(knapsack))) : "<knapsack>";
+        const std::string text =
+            is_file ? std::string() : std::string(py::str(py::module_::import("json").attr("dumps")(knapsack)));
+        const py::gil_scoped_release release;
+        const Knapsack parsed = is_file ? load_knapsack(source) : parse_knapsack(text, source);
+        const std::string problem_name =
+            name ? *name : (is_file ? std::filesystem::path(source).stem().string() : "knapsack-reduction");
+        return std::make_shared<Problem>(reduce_knapsack(parsed, problem_name));
+      },
+      py::arg("knapsack"), py::kw_only(), py::arg("name") = py::none(),
+      "The effort-allocation instance of Theorem 1 for a knapsack problem (a file, or a dict {'capacity': W, "
+      "'items': [{'weight': w, 'value': v}, ...]}), as `ontime reduce-knapsack` writes it; named after the file "
+      "unless `name` is given. Its optimum orders the knapsack's solutions by value (docs/theory.md).");
+
+  m.def(
+      "sample_log",
+      [](const py::object& problem, const py::object& path, Number<std::uint64_t, "attempts", 1> attempts, Seed seed,
+         std::optional<Number<Steps, "cutoff", 1>> cutoff) {
+        const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
+        const std::string file = py::str(py::module_::import("os").attr("fspath")(path));
+        LogSamplingOptions options;
+        options.attempts_per_action = attempts;
+        options.seed = seed;
+        options.cutoff_steps = cutoff ? static_cast<Steps>(*cutoff) : 0;
+        const py::gil_scoped_release release;
+        return write_sampled_planner_log(*mdp->problem, options, file);
+      },
+      py::arg("problem"), py::arg("path"), py::kw_only(), py::arg("attempts") = 1000, py::arg("seed") = 1,
+      py::arg("cutoff") = py::none(),
+      "Draws a planner log from the problem's own distributions and writes it to `path` (JSON Lines), as `ontime "
+      "sample-log` does: `attempts` per action, attempt i of action a from stream i of stream a of `seed`, cut "
+      "off after `cutoff` steps (default: the deadline). Returns the records written.");
 
   py::class_<StateView>(m, "State",
                         "An MDP state (SPEC §2): CT, and per skeleton l_k (actions refined), PT_k (steps on its "

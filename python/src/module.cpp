@@ -86,6 +86,16 @@ py::dict parameters_dict(const std::string& kind_name, const ParameterValues& va
   return json_object(report::parameters_json(allocator_registry().find(kind_name), values));
 }
 
+ParameterSpelling python_spelling() {
+  return [](std::string_view parameter) {
+    std::string name(parameter);
+    for (char& c : name) {
+      if (c == '-') c = '_';
+    }
+    return name;
+  };
+}
+
 py::object json_object(const std::string& text) { return py::module_::import("json").attr("loads")(text); }
 
 std::shared_ptr<AllocatorHandle> make_allocator_handle(std::shared_ptr<MdpHandle> mdp, const std::string& name,

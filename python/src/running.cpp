@@ -4,6 +4,7 @@
 #include <pybind11/stl.h>
 
 #include <chrono>
+#include <filesystem>
 #include <optional>
 #include <stdexcept>
 
@@ -14,6 +15,7 @@
 #include "ontime/report/report.hpp"
 #include "ontime/run/episode_runner.hpp"
 #include "ontime/run/evaluation.hpp"
+#include "ontime/run/experiments.hpp"
 #include "ontime/run/session.hpp"
 #include "ontime/run/simulator.hpp"
 #include "ontime/run/table.hpp"
@@ -471,13 +473,7 @@ void bind_running(py::module_& m) {
                        : label,
                parameter_values(row_parameters)});
         }
-        const ParameterSpelling spelling = [](std::string_view parameter) {
-          std::string name(parameter);
-          for (char& c : name) {
-            if (c == '-') c = '_';
-          }
-          return name;
-        };
+        const ParameterSpelling spelling = python_spelling();
         check_table_request(rows, options, spelling);
         Table table;
         run_interruptibly(
@@ -503,6 +499,57 @@ void bind_running(py::module_& m) {
       "`ontime table --json`, 'markdown' the table it prints. The GIL is released; Ctrl-C stops it.");
 
   m.def(
+      "study",
+      [](const std::string& kind_name, const py::sequence& instances, Episodes episodes, Seed seed, Threads threads,
+         const std::optional<std::string>& searcher, const std::optional<std::string>& reference,
+         const std::optional<std::vector<double>>& log10_multipliers, const py::object& progress,
+         const py::kwargs& kwargs) {
+        const StudyKind kind = study_kind(kind_name);
+        StudySettings settings;
+        settings.episodes = episodes;
+        settings.seed = seed;
+        settings.threads = threads;
+        if (searcher) settings.searcher = *searcher;
+        if (reference) settings.reference = *reference;
+        settings.parameters = parameter_values(kwargs);
+        std::vector<double> multipliers{0, 0.5, 1, 1.5, 2, 2.5, 3, 3.5, 4, 4.5, 5};
+        if (log10_multipliers) {
+          if (kind != StudyKind::anytime) throw UsageError("log10_multipliers is for the anytime study");
+          multipliers = *log10_multipliers;
+        }
+        if (kind != StudyKind::anytime) multipliers.clear();
+        std::vector<StudyInstance> rows;
+        for (const py::handle source : instances) {
+          const auto object = py::reinterpret_borrow<py::object>(source);
+          const std::shared_ptr<MdpHandle> mdp = to_mdp(object);
+          const std::string label = instance_label(object, *mdp->problem);
+          const bool is_file = py::isinstance<py::str>(object) || py::hasattr(object, "__fspath__");
+          rows.push_back({*mdp->problem, label, is_file ? std::filesystem::path(label).stem().string() : label});
+        }
+        check_study_request(kind, rows, settings, python_spelling());
+        StudyRows result;
+        run_interruptibly(
+            [&](const std::function<bool()>& stop, Progress& counters) {
+              settings.progress = [&counters, &stop](std::uint64_t done, std::uint64_t total) {
+                if (stop()) throw Cancelled("the study stopped at the caller's request");
+                counters.total = total;
+                counters.done = done;
+              };
+              result = run_study(kind, rows, settings, multipliers);
+            },
+            progress);
+        return report::study_csv(result, settings);
+      },
+      py::arg("kind"), py::arg("instances"), py::kw_only(), py::arg("episodes") = 1'000, py::arg("seed") = 1,
+      py::arg("threads") = 0, py::arg("searcher") = py::none(), py::arg("reference") = py::none(),
+      py::arg("log10_multipliers") = py::none(), py::arg("progress") = py::none(),
+      "A computation-time study of the paper's Figs. 4-6, as `ontime study KIND` runs it: 'compute-time', "
+      "'equal-time' or 'anytime' (the searcher, mcts, against the reference, dp-rerun, by default), over the "
+      "instances (files or Problems). Returns the CSV the command line writes (python/plot_study.py draws it). "
+      "Times are wall-clock: the success counts of iteration budgets repeat for a seed, those of time budgets do "
+      "not. Parameters as keyword arguments. The GIL is released; Ctrl-C stops it.");
+
+  m.def(
       "train_ppo",
       [](const py::object& problem, const py::object& out, Episodes episodes, Seed seed, const py::object& progress) {
         check_episodes(episodes);
@@ -516,7 +563,13 @@ void bind_running(py::module_& m) {
                 if (stop()) throw Cancelled("training stopped at the caller's request");
                 counters.done = done;
               });
-              save_ppo_policy(training->policy, path);
+              // The policy and its learning curve as one set, as `ontime train --no-plot` writes them
+              // (an older plot beside the policy would describe another training: it goes).
+              const std::filesystem::path policy(path);
+              OutputSet files(policy.has_parent_path() ? policy.parent_path() : std::filesystem::path("."));
+              stage_ppo_training(files, *training, policy);
+              files.remove_on_commit(learning_curve_path(policy, ".curve.png"));
+              files.commit();
             },
             progress);
         py::list curve;
@@ -535,8 +588,9 @@ void bind_running(py::module_& m) {
       },
       py::arg("problem"), py::arg("out"), py::kw_only(), py::arg("episodes") = 10'000, py::arg("seed") = 1,
       py::arg("progress") = py::none(),
-      "Trains the ppo policy on simulated episodes (as `ontime train`), writes it to `out` (atomically, only "
-      "when training finished) and returns the learning curve as a list of dicts. Use it with "
+      "Trains the ppo policy on simulated episodes (as `ontime train`), writes it to `out` with its learning curve "
+      "beside it (OUT.curve.csv; both only when training finished, together) and returns the learning curve as a "
+      "list of dicts. Use it with "
       "make_allocator(problem, 'ppo', policy=out).");
 }
 

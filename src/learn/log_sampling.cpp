@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "ontime/util/atomic_file.hpp"
 #include "ontime/util/error.hpp"
 #include "ontime/util/random.hpp"
 
@@ -66,6 +67,24 @@ void sample_planner_log(const Problem& problem, const LogSamplingOptions& option
       emit(std::move(attempt));
     }
   }
+}
+
+std::uint64_t write_sampled_planner_log(const Problem& problem, const LogSamplingOptions& options,
+                                        const std::filesystem::path& path) {
+  AtomicFileWriter writer(path);
+  std::string piece;
+  std::uint64_t records = 0;
+  sample_planner_log(problem, options, [&](const RefinementAttempt& attempt) {
+    piece += planner_log_line(attempt);
+    ++records;
+    if (piece.size() >= (std::size_t{1} << 20)) {
+      writer.write(piece);
+      piece.clear();
+    }
+  });
+  writer.write(piece);
+  writer.commit();
+  return records;
 }
 
 }  // namespace ontime

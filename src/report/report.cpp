@@ -358,6 +358,87 @@ std::string to_markdown(const Table& table, const ParameterSpelling& spelling) {
   return out;
 }
 
+std::string to_json(const Training& training) {
+  Json out;
+  out["instance"] = training.instance;
+  out["policy"] = training.policy;
+  out["learning_curve"] = training.files.size() > 1 ? training.files[1] : std::string();
+  out["episodes"] = training.episodes;
+  out["seed"] = training.seed;
+  out["epochs"] = training.epochs;
+  out["seconds"] = training.seconds;
+  out["exact_success_probability"] = training.exact ? Json(*training.exact) : Json(nullptr);
+  return dump(out);
+}
+
+std::string to_text(const Training& training) {
+  std::string out = fmt::format("trained ppo on {} ({}): {} episodes in {} epochs, {:.1f} s\n", training.instance,
+                                training.problem->name(), training.episodes, training.epochs, training.seconds);
+  if (training.exact) {
+    out += fmt::format("exact success probability of the trained policy (greedy): {:.4f}\n", *training.exact);
+  } else {
+    out += fmt::format("exact success probability of the trained policy: not computed ({} skeletons; at most {})\n",
+                       training.problem->skeleton_count(), kMaxExactSkeletons);
+  }
+  for (const std::string& file : training.files) out += "wrote " + file + "\n";
+  return out;
+}
+
+std::string study_csv(const StudyRows& rows, const StudySettings& settings) {
+  const AllocatorKind& searcher = allocator_registry().find(settings.searcher);
+  // The searcher's iterations per search (its declared counters), 0 for a kind that does not search.
+  const auto per_search = [](const AllocatorKind& kind, const MonteCarloResult& result) {
+    return iterations_per_search(kind, result.statistics).value_or(0.0);
+  };
+  std::string csv;
+  switch (rows.kind) {
+    case StudyKind::compute_time: {
+      const AllocatorKind& reference = allocator_registry().find(settings.reference);
+      csv =
+          "instance,solver,episodes,success_rate,ci95,mean_episode_seconds,median_episode_seconds,"
+          "p99_episode_seconds,mean_decision_seconds,iterations_per_search\n";
+      for (std::size_t i = 0; i < rows.compute_time.size(); ++i) {
+        const ComputeTimeStudy& study = rows.compute_time[i];
+        for (const auto& [kind, result] :
+             {std::pair{&searcher, &study.searcher}, std::pair{&reference, &study.reference}}) {
+          csv += fmt::format(
+              "{},{},{},{},{},{:.9g},{:.9g},{:.9g},{:.9g},{:.6g}\n", rows.labels[i], kind->name, result->episodes,
+              result->success_rate, result->ci95, result->episode_decision_time.mean_us * 1e-6,
+              result->episode_decision_time.median_us * 1e-6, result->episode_decision_time.p99_us * 1e-6,
+              result->decision_time.mean_us * 1e-6, per_search(*kind, *result));
+        }
+      }
+      break;
+    }
+    case StudyKind::equal_time:
+      csv =
+          "instance,episodes,dp_rerun_decision_seconds,dp_rerun_success_rate,dp_rerun_ci95,mcts_success_rate,"
+          "mcts_ci95,mcts_iterations_per_search\n";
+      for (std::size_t i = 0; i < rows.equal_time.size(); ++i) {
+        const EqualTimeStudy& study = rows.equal_time[i];
+        csv += fmt::format("{},{},{:.9g},{},{},{},{},{:.6g}\n", rows.labels[i], settings.episodes,
+                           study.reference_decision_seconds, study.reference.success_rate, study.reference.ci95,
+                           study.searcher.success_rate, study.searcher.ci95, per_search(searcher, study.searcher));
+      }
+      break;
+    case StudyKind::anytime:
+      csv =
+          "instance,episodes,log10_multiplier,seconds_per_decision,success_rate,ci95,iterations_per_search,"
+          "dp_rerun_decision_seconds,dp_rerun_success_rate,optimum\n";
+      for (std::size_t i = 0; i < rows.anytime.size(); ++i) {
+        const AnytimeStudy& study = rows.anytime[i];
+        for (const AnytimePoint& point : study.points) {
+          csv += fmt::format("{},{},{},{:.9g},{},{},{:.6g},{:.9g},{},{}\n", rows.labels[i], settings.episodes,
+                             point.log10_multiplier, point.seconds_per_decision, point.searcher.success_rate,
+                             point.searcher.ci95, per_search(searcher, point.searcher),
+                             study.reference_decision_seconds, study.reference.success_rate, study.optimum);
+        }
+      }
+      break;
+  }
+  return csv;
+}
+
 std::string registry_json(const AllocatorRegistry& registry) {
   Json out = Json::array();
   for (const AllocatorKind& kind : registry.kinds()) {

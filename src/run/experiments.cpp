@@ -9,6 +9,7 @@
 #include "ontime/run/simulator.hpp"
 #include "ontime/util/byte_packing.hpp"
 #include "ontime/util/error.hpp"
+#include "ontime/util/parallel.hpp"
 #include "ontime/util/random.hpp"
 #include "util/portable_math.hpp"
 
@@ -77,7 +78,7 @@ double optimum_of(const Mdp& mdp, const ParameterValues& values) {
   return OptimalSolver(mdp, max_states_of(values)).solve(mdp.start());
 }
 
-StudyPair make_pair(const Mdp& mdp, const StudySettings& settings) {
+void check_study_kinds(const StudySettings& settings) {
   const AllocatorRegistry& registry = allocator_registry();
   if (!registry.find(settings.searcher).capabilities.has(Capability::anytime)) {
     throw UsageError("the searcher of a study must be an anytime allocator (known: " +
@@ -87,6 +88,11 @@ StudyPair make_pair(const Mdp& mdp, const StudySettings& settings) {
   if (!registry.find(settings.reference).capabilities.has(Capability::stationary)) {
     throw UsageError("the reference of a study must be a stationary allocator, not '" + settings.reference + "'");
   }
+}
+
+StudyPair make_pair(const Mdp& mdp, const StudySettings& settings) {
+  check_study_kinds(settings);
+  const AllocatorRegistry& registry = allocator_registry();
   return {registry.make_factory(settings.searcher, mdp, settings.parameters),
           registry.make_factory(settings.reference, mdp, settings.parameters)};
 }
@@ -168,6 +174,67 @@ AnytimeStudy anytime_study(const Mdp& mdp, const std::vector<double>& log10_mult
     study.points.push_back(std::move(point));
   }
   return study;
+}
+
+StudyKind study_kind(std::string_view name) {
+  if (name == "compute-time") return StudyKind::compute_time;
+  if (name == "equal-time") return StudyKind::equal_time;
+  if (name == "anytime") return StudyKind::anytime;
+  throw UsageError("unknown study '" + std::string(name) + "' (known: compute-time, equal-time, anytime)");
+}
+
+std::string_view to_string(StudyKind kind) noexcept {
+  switch (kind) {
+    case StudyKind::compute_time:
+      return "compute-time";
+    case StudyKind::equal_time:
+      return "equal-time";
+    case StudyKind::anytime:
+      return "anytime";
+  }
+  return "";
+}
+
+void check_study_request(StudyKind kind, const std::vector<StudyInstance>& instances, const StudySettings& settings,
+                         const ParameterSpelling& spelling) {
+  check_study_kinds(settings);
+  if (instances.empty()) throw UsageError("a study needs at least one instance");
+  const std::uint64_t allocators = worker_count(settings.episodes, settings.threads);
+  for (const StudyInstance& instance : instances) {
+    allocator_registry().check_memory(settings.searcher, instance.problem, settings.parameters, allocators, spelling);
+    if (kind == StudyKind::anytime) {
+      check_exact_work(instance.problem, max_states_of(settings.parameters), instance.source, spelling);
+    }
+  }
+}
+
+StudyRows run_study(StudyKind kind, const std::vector<StudyInstance>& instances, const StudySettings& settings,
+                    const std::vector<double>& log10_multipliers) {
+  StudyRows rows;
+  rows.kind = kind;
+  rows.log10_multipliers = log10_multipliers;
+  for (std::size_t i = 0; i < instances.size(); ++i) {
+    rows.labels.push_back(instances[i].label);
+    StudySettings one = settings;
+    if (settings.progress) {
+      one.progress = [&settings, i, count = instances.size()](std::uint64_t done, std::uint64_t total) {
+        settings.progress(i * total + done, count * total);
+      };
+    }
+    const Mdp mdp(instances[i].problem);
+    switch (kind) {
+      case StudyKind::compute_time:
+        rows.compute_time.push_back(compute_time_study(mdp, one));
+        break;
+      case StudyKind::equal_time:
+        rows.equal_time.push_back(equal_time_study(mdp, one));
+        break;
+      case StudyKind::anytime:
+        rows.anytime.push_back(anytime_study(mdp, log10_multipliers, one));
+        break;
+    }
+  }
+  return rows;
 }
 
 }  // namespace ontime

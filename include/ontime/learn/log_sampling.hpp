@@ -3,6 +3,7 @@
 // fitting (fitting.hpp) recovers what produced the data.
 
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <vector>
 
@@ -31,5 +32,12 @@ std::vector<RefinementAttempt> sample_planner_log(const Problem& problem, const 
 // that a log of any length can be written without holding it (constant memory).
 void sample_planner_log(const Problem& problem, const LogSamplingOptions& options,
                         const std::function<void(RefinementAttempt)>& emit);
+
+// The same log written to `path` as JSON Lines (docs/formats.md), streamed in pieces of about
+// 1 MiB, so a log of any length takes constant memory; written atomically (the old file stays
+// until the whole log is there). Returns the records written. `ontime sample-log` and Python's
+// ontime.sample_log call this.
+std::uint64_t write_sampled_planner_log(const Problem& problem, const LogSamplingOptions& options,
+                                        const std::filesystem::path& path);
 
 }  // namespace ontime

@@ -11,11 +11,14 @@
 // until it holds at least `steps_per_epoch` steps. Same seed, same policy, bit for bit.
 
 #include <cstdint>
+#include <filesystem>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "ontime/allocators/ppo.hpp"
 #include "ontime/mdp/mdp.hpp"
+#include "ontime/util/output_set.hpp"
 
 namespace ontime {
 
@@ -38,5 +41,20 @@ struct PpoTraining {
 PpoTraining train_ppo(const Mdp& mdp, std::uint64_t episodes, std::uint64_t seed,
                       const PpoHyperparameters& hyperparameters = {},
                       const std::function<void(std::uint64_t done, std::uint64_t total)>& progress = {});
+
+// The learning curve as CSV: one row per epoch (epoch, episodes, steps, success_rate,
+// mean_episode_length, actor_steps, seconds).
+std::string learning_curve_csv(const std::vector<LearningCurvePoint>& curve);
+
+// Where the learning curve of a policy file goes: POLICY with the extension .curve.csv (and its
+// plot .curve.png).
+std::filesystem::path learning_curve_path(const std::filesystem::path& policy, const char* extension = ".curve.csv");
+
+// Stages a training's files in `files` (util/output_set.hpp: all renamed together at commit, so
+// an interruption leaves the previous set or this one): the policy at `policy` and its learning
+// curve beside it. Returns where the curve CSV is staged (a plot drawn from it goes in the same
+// set). `ontime train` and Python's ontime.train_ppo write through this.
+std::filesystem::path stage_ppo_training(OutputSet& files, const PpoTraining& training,
+                                         const std::filesystem::path& policy);
 
 }  // namespace ontime

@@ -18,6 +18,7 @@
 #include "ontime/learn/fitting.hpp"
 #include "ontime/model/problem.hpp"
 #include "ontime/run/evaluation.hpp"
+#include "ontime/run/experiments.hpp"
 #include "ontime/run/table.hpp"
 #include "ontime/solve/layered_solver.hpp"
 
@@ -66,6 +67,26 @@ std::string to_json(const Table& table);
 // column last) and, with exact parts, the states and seconds of each.
 // `spelling` names the state cap as the caller writes it ("--max-states").
 std::string to_markdown(const Table& table, const ParameterSpelling& spelling = nullptr);
+
+// A ppo training (learn/ppo_training.hpp) and the exact value of the policy it trained (greedy),
+// when the instance is narrow enough for exact evaluation.
+struct Training {
+  std::string instance = {};
+  const Problem* problem = nullptr;
+  std::string policy = {};              // the policy file written
+  std::vector<std::string> files = {};  // every file written, the policy first
+  std::uint64_t episodes = 0, seed = 0;
+  std::size_t epochs = 0;
+  double seconds = 0;
+  std::optional<double> exact = {};
+};
+std::string to_json(const Training& training);
+std::string to_text(const Training& training);
+
+// A study (run/experiments.hpp) as the CSV that python/plot_study.py draws: compute-time, one
+// row per instance and allocator; equal-time, one per instance; anytime, one per instance and
+// multiplier.
+std::string study_csv(const StudyRows& rows, const StudySettings& settings);
 
 // The allocator kinds of a registry with their capabilities and parameters: JSON (a list of
 // kinds), and Markdown (a table of kinds, then one of parameters, each named as `spelling` writes

@@ -14,10 +14,12 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "ontime/allocators/allocator_registry.hpp"
 #include "ontime/run/evaluation.hpp"
+#include "ontime/util/memory.hpp"
 
 namespace ontime {
 
@@ -71,5 +73,37 @@ struct AnytimeStudy {
   std::vector<AnytimePoint> points;
 };
 AnytimeStudy anytime_study(const Mdp& mdp, const std::vector<double>& log10_multipliers, const StudySettings& settings);
+
+// A study over several instances: one of the three above on each, in order.
+enum class StudyKind { compute_time, equal_time, anytime };
+// "compute-time", "equal-time", "anytime"; UsageError for another name.
+StudyKind study_kind(std::string_view name);
+std::string_view to_string(StudyKind kind) noexcept;
+
+struct StudyInstance {
+  Problem problem;
+  std::string source;  // a file, for messages
+  std::string label;   // the instance's column in the CSV
+};
+
+struct StudyRows {
+  StudyKind kind = StudyKind::compute_time;
+  std::vector<std::string> labels;  // one per instance
+  std::vector<ComputeTimeStudy> compute_time;
+  std::vector<EqualTimeStudy> equal_time;
+  std::vector<AnytimeStudy> anytime;
+  std::vector<double> log10_multipliers;  // anytime
+};
+
+// Checks what can be checked before the work: the searcher anytime and the reference stationary
+// (UsageError), the memory the searcher may hold on each instance (the registry's check_memory)
+// and, for the anytime study, the exact optimum's (check_exact_work); `spelling` names the
+// parameters in messages.
+void check_study_request(StudyKind kind, const std::vector<StudyInstance>& instances, const StudySettings& settings,
+                         const ParameterSpelling& spelling = nullptr);
+
+// Runs the study on every instance. `settings.progress` sees the episodes done over all of them.
+StudyRows run_study(StudyKind kind, const std::vector<StudyInstance>& instances, const StudySettings& settings,
+                    const std::vector<double>& log10_multipliers = {});
 
 }  // namespace ontime
