@@ -8,31 +8,12 @@
 
 #include "common.hpp"
 #include "ontime/model/instance_io.hpp"
+#include "ontime/report/report.hpp"
 #include "ontime/util/atomic_file.hpp"
 #include "output_paths.hpp"
 #include "python_runner.hpp"
 
 namespace ontime::cli {
-namespace {
-
-// action,distribution,step,probability: one row per step with positive mass, then "never".
-std::string histogram_csv(const Problem& problem) {
-  std::string csv = "action,distribution,step,probability\n";
-  for (const Action& action : problem.actions()) {
-    const std::string quoted = csv_field(action.id);
-    for (const auto& [kind, distribution] : {std::pair<const char*, const Distribution*>{"planning", &action.planning},
-                                             {"execution", &action.execution}}) {
-      const auto masses = distribution->masses();
-      for (std::size_t t = 0; t < masses.size(); ++t) {
-        if (masses[t] > 0) csv += fmt::format("{},{},{},{:.17g}\n", quoted, kind, t, masses[t]);
-      }
-      csv += fmt::format("{},{},never,{:.17g}\n", quoted, kind, distribution->never());
-    }
-  }
-  return csv;
-}
-
-}  // namespace
 
 void add_plot_command(CLI::App& app) {
   struct Options {
@@ -54,7 +35,7 @@ void add_plot_command(CLI::App& app) {
     std::filesystem::path csv = png;
     csv.replace_extension(".csv");
     check_outputs({{"--output", png}, {"--output (plotted data)", csv}}, {options->instance});
-    write_file_atomically(csv, histogram_csv(problem));
+    write_file_atomically(csv, report::histogram_csv(problem));
     // The name is shortened here already: a command-line argument is limited to 128 KiB.
     const std::string title = fmt::format("{}: deadline {} steps of {} s", shortened_label(problem.name(), 200),
                                           problem.deadline(), problem.step_seconds());

@@ -141,16 +141,6 @@ Json points_json(const std::vector<std::array<double, 2>>& points) {
   return list;
 }
 
-std::string csv_field(std::string_view text) {
-  std::string quoted = "\"";
-  for (const char c : text) {
-    if (c == '"') quoted += '"';
-    quoted += c;
-  }
-  quoted += '"';
-  return quoted;
-}
-
 namespace {
 bool quiet_progress = false;
 }  // namespace

@@ -89,9 +89,6 @@ void print_json(const Json& value);
 // Points of the plane (e.g. of a drawing) as a JSON list of [x, y].
 Json points_json(const std::vector<std::array<double, 2>>& points);
 
-// `text` as one CSV field: in double quotes, inner quotes doubled.
-std::string csv_field(std::string_view text);
-
 // Progress on stderr, on the rank that prints. On a terminal, a bar redrawn in place; otherwise
 // (a log, CI, a pipe) a plain line now and then, at most every progress_line_seconds():
 //   ontime table: 12/35 (34%), 1m12s elapsed, about 2m20s left

@@ -6,6 +6,7 @@
 #include <span>
 #include <vector>
 
+#include "ontime/report/report.hpp"
 #include "python_runner.hpp"
 
 namespace ontime::cli {
@@ -56,9 +57,9 @@ std::string timeline_csv(const Problem& problem, const EpisodeResult& result) {
       "refined,execution_seconds\n";
   for (const LiveStep& step : result.timeline) {
     const std::string action = step.action >= 0 ? problem.action(step.action).id : "";
-    csv += fmt::format("{},{},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{},{:.9f}\n", step.skeleton, csv_field(action),
-                       step.start, step.outside_seconds, step.decision_seconds, step.planning_seconds,
-                       step.overrun_seconds, step.observe_seconds, step.refined ? 1 : 0,
+    csv += fmt::format("{},{},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{},{:.9f}\n", step.skeleton,
+                       report::csv_field(action), step.start, step.outside_seconds, step.decision_seconds,
+                       step.planning_seconds, step.overrun_seconds, step.observe_seconds, step.refined ? 1 : 0,
                        step.refined ? step.execution_seconds : 0.0);
   }
   return csv;

@@ -40,6 +40,7 @@ from ._ontime import (  # noqa: F401  (re-exported)
     UsageError,
     allocators,
     evaluate,
+    histogram_csv,
     load_problem,
     make_allocator,
     read_planner_log,
@@ -59,7 +60,7 @@ __all__ = [
     "NEVER", "Action", "Allocator", "Decision", "Distribution", "Error", "InputError", "LiveSession",
     "ManualClock", "Mdp", "Problem",
     "ResourceLimitError", "Session", "State", "Status", "UsageError", "World", "allocators", "evaluate",
-    "fit", "load_problem", "make_allocator", "read_planner_log", "reduce_knapsack", "run_episodes", "sample_log",
+    "fit", "histogram_csv", "load_problem", "make_allocator", "read_planner_log", "reduce_knapsack", "run_episodes", "sample_log",
     "solve", "study", "table", "train_ppo",
     "write_planner_log",
 ]

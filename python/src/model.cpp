@@ -196,6 +196,12 @@ void bind_model(py::module_& m) {
       "unless `name` is given. Its optimum orders the knapsack's solutions by value (docs/theory.md).");
 
   m.def(
+      "histogram_csv", [](const py::object& problem) { return report::histogram_csv(*to_mdp(problem)->problem); },
+      py::arg("problem"),
+      "Every action's planning and execution PMF as the CSV `ontime plot` writes beside its picture "
+      "(action,distribution,step,probability; 'never' last); python/plot_histograms.py --data CSV draws it.");
+
+  m.def(
       "sample_log",
       [](const py::object& problem, const py::object& path, Number<std::uint64_t, "attempts", 1> attempts, Seed seed,
          std::optional<Number<Steps, "cutoff", 1>> cutoff) {

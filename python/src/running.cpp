@@ -20,6 +20,7 @@
 #include "ontime/run/simulator.hpp"
 #include "ontime/run/table.hpp"
 #include "ontime/solve/layered_solver.hpp"
+#include "ontime/util/atomic_file.hpp"
 #include "ontime/util/error.hpp"
 #include "ontime/util/memory.hpp"
 
@@ -383,7 +384,8 @@ void bind_running(py::module_& m) {
       [](const py::object& problem, Number<std::uint64_t, "max_states", 1> max_states, Threads threads,
          const std::string& method, Number<double, "tolerance", 0.0, 1.0> tolerance,
          Number<std::uint64_t, "max_memory_mib", 0, (std::uint64_t{1} << 40)> max_memory_mib,
-         Number<std::uint64_t, "max_disk_mib", 0, (std::uint64_t{1} << 40)> max_disk_mib, const py::object& scratch) {
+         Number<std::uint64_t, "max_disk_mib", 0, (std::uint64_t{1} << 40)> max_disk_mib, const py::object& scratch,
+         const py::object& policy, Number<int, "policy_layers", 1, 1'000'000> policy_layers) {
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
         if (method != "layered" && method != "split") {
           throw UsageError("method must be 'layered' or 'split' (got '" + method + "')");
@@ -399,6 +401,7 @@ void bind_running(py::module_& m) {
           options.max_memory_bytes = max_memory_mib << 20;
         }
         options.max_disk_bytes = max_disk_mib << 20;
+        if (!policy.is_none()) options.policy_layers = policy_layers;
         // Caps not given: what this machine can give, so that a solve stops with a certified
         // interval rather than being killed (as the command line does).
         fill_default_caps(options);
@@ -413,11 +416,16 @@ void bind_running(py::module_& m) {
           solve.solution = solve_layered(mdp->mdp, options);
           solve.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
         });
+        if (!policy.is_none()) {
+          write_file_atomically(std::string(py::str(py::module_::import("os").attr("fspath")(policy))),
+                                report::policy_lines(solve));
+        }
         return json_object(report::to_json(solve));
       },
       py::arg("problem"), py::arg("max_states") = OptimalSolver::kDefaultMaxStates, py::arg("threads") = 0,
       py::kw_only(), py::arg("method") = "layered", py::arg("tolerance") = 0.0, py::arg("max_memory_mib") = 0,
-      py::arg("max_disk_mib") = 0, py::arg("scratch") = py::none(),
+      py::arg("max_disk_mib") = 0, py::arg("scratch") = py::none(), py::arg("policy") = py::none(),
+      py::arg("policy_layers") = 1,
       "The exact optimal success probability and first choice (the layered solver), as `ontime solve --json` "
       "reports them; where a cap cuts the whole tree, a certified interval [lower_bound, upper_bound] "
       "instead (optimal_success_probability None), tightened by a split when the skeletons' first actions "
@@ -425,7 +433,9 @@ void bind_running(py::module_& m) {
       "bounded); tolerance > 0 drops groups whose clairvoyant chance is below it, with their share in the "
       "interval. Caps: max_states, max_memory_mib (tables of this process) and max_disk_mib (its scratch files, "
       "in `scratch`, default the system's temporary folder); 0: 80% of the available memory and 90% of the free "
-      "disk. The GIL is released; Ctrl-C stops it (KeyboardInterrupt).");
+      "disk. policy=FILE writes the choices of the first `policy_layers` layers as `ontime solve --policy` does "
+      "(JSON Lines: a state, its choice and the bounds of its value). The GIL is released; Ctrl-C stops it "
+      "(KeyboardInterrupt).");
 
   m.def(
       "table",

@@ -79,3 +79,33 @@ def test_studies_give_the_cli_counts(cli, tmp_path):
         ontime.study("nope", [str(instance)])
     with pytest.raises(ontime.UsageError, match="searcher of a study must be an anytime allocator"):
         ontime.study("equal-time", [str(instance)], searcher="dp")
+
+
+def test_histogram_csv_is_the_data_of_the_cli_plot(cli, tmp_path):
+    instance = PAPER_INSTANCES[1]
+    done = cli("plot", instance, "-o", tmp_path / "h.png", expect_json=False)
+    assert done.returncode == 0, done.stderr
+    text = ontime.histogram_csv(str(instance))
+    assert (tmp_path / "h.csv").read_text() == text
+    problem = ontime.load_problem(instance)
+    rows = list(csv.DictReader(io.StringIO(text)))
+    never = [row for row in rows if row["step"] == "never"]
+    assert len(never) == 2 * len(problem.actions)
+    # Each distribution's masses and "never" add up to one.
+    for action in problem.actions:
+        for kind in ("planning", "execution"):
+            total = sum(float(row["probability"]) for row in rows
+                        if row["action"] == action.id and row["distribution"] == kind)
+            assert total == pytest.approx(1.0, abs=1e-12)
+
+
+def test_solve_writes_the_cli_policy(cli, tmp_path):
+    instance = PAPER_INSTANCES[0]
+    cli("solve", instance, "--policy", tmp_path / "cli.jsonl", "--policy-layers", 3, "--json")
+    got = ontime.solve(str(instance), policy=tmp_path / "py.jsonl", policy_layers=3)
+    assert (tmp_path / "py.jsonl").read_bytes() == (tmp_path / "cli.jsonl").read_bytes()
+    lines = [json.loads(line) for line in (tmp_path / "py.jsonl").read_text().splitlines()]
+    assert {line["time"] for line in lines} == {0, 1, 2}
+    start = next(line for line in lines if line["time"] == 0)
+    assert start["choice"] == got["first_choice"]
+    assert start["lower_bound"] == start["upper_bound"] == got["optimal_success_probability"]

@@ -534,6 +534,32 @@ std::string fit_json(const FitResult& fit) {
   return dump(actions);
 }
 
+std::string histogram_csv(const Problem& problem) {
+  std::string csv = "action,distribution,step,probability\n";
+  for (const Action& action : problem.actions()) {
+    const std::string quoted = csv_field(action.id);
+    for (const auto& [kind, distribution] : {std::pair<const char*, const Distribution*>{"planning", &action.planning},
+                                             {"execution", &action.execution}}) {
+      const auto masses = distribution->masses();
+      for (std::size_t t = 0; t < masses.size(); ++t) {
+        if (masses[t] > 0) csv += fmt::format("{},{},{},{:.17g}\n", quoted, kind, t, masses[t]);
+      }
+      csv += fmt::format("{},{},never,{:.17g}\n", quoted, kind, distribution->never());
+    }
+  }
+  return csv;
+}
+
+std::string csv_field(std::string_view text) {
+  std::string quoted = "\"";
+  for (const char c : text) {
+    if (c == '"') quoted += '"';
+    quoted += c;
+  }
+  quoted += '"';
+  return quoted;
+}
+
 std::string markdown_table(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& body) {
   std::vector<std::size_t> widths(header.size(), 0);
   const auto widen = [&widths](const std::vector<std::string>& line) {

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "ontime/allocators/allocator_registry.hpp"
@@ -97,6 +98,13 @@ std::string registry_markdown(const AllocatorRegistry& registry, const Parameter
 // What a planner log held about each action and the distributions fitted from it (learn/fitting.hpp).
 std::string fit_json(const FitResult& fit);
 std::string fit_markdown(const FitResult& fit);
+
+// Every action's planning and execution PMF as CSV (action,distribution,step,probability): one
+// row per step with positive mass, then "never" (python/plot_histograms.py draws it).
+std::string histogram_csv(const Problem& problem);
+
+// A CSV field quoted ("a ""b"""), so that any text stands in one field.
+std::string csv_field(std::string_view text);
 
 // A Markdown table: a header row, the rule below it and the body rows, columns padded to their
 // display width; cells may hold UTF-8 ("±", "µ", "≤").
