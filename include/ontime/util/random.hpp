@@ -40,9 +40,10 @@ constexpr double uniform01(Generator& generator) noexcept {
   return static_cast<double>(generator() >> 11) * 0x1.0p-53;
 }
 
-// The one inverse-CDF draw of the library: an index in [0, count) (count >= 1) where index i
-// has probability `probability(i)` (the probabilities sum to about 1). One uniform draw; when
-// rounding leaves it beyond the summed masses, the last index.
+// An inverse-CDF draw over masses given one by one (a policy's choice, an outcome of the MDP):
+// an index in [0, count) (count >= 1) where index i has probability `probability(i)` (the
+// probabilities sum to about 1). One uniform draw; when rounding leaves it beyond the summed
+// masses, the last index. (A Distribution draws its steps through its own quantile.)
 template <class Probability, class Generator>
 constexpr std::size_t sample_index(std::size_t count, Probability&& probability, Generator& generator) {
   double u = uniform01(generator);
