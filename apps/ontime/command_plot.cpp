@@ -8,6 +8,7 @@
 
 #include "common.hpp"
 #include "ontime/model/instance_io.hpp"
+#include "ontime/report/report.hpp"
 #include "ontime/util/atomic_file.hpp"
 #include "output_paths.hpp"
 #include "python_runner.hpp"
@@ -19,7 +20,7 @@ namespace {
 std::string histogram_csv(const Problem& problem) {
   std::string csv = "action,distribution,step,probability\n";
   for (const Action& action : problem.actions()) {
-    const std::string quoted = csv_field(action.id);
+    const std::string quoted = report::csv_field(action.id);
     for (const auto& [kind, distribution] : {std::pair<const char*, const Distribution*>{"planning", &action.planning},
                                              {"execution", &action.execution}}) {
       const auto masses = distribution->masses();

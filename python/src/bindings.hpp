@@ -24,6 +24,7 @@
 #include "ontime/model/problem.hpp"
 #include "ontime/run/evaluation.hpp"
 #include "ontime/util/error.hpp"
+#include "ontime/util/memory.hpp"
 
 namespace ontime::python {
 
@@ -138,6 +139,8 @@ struct AllocatorHandle {
 
 // Keyword arguments as registry parameter values: `max_states=5` is `max-states` = "5".
 ParameterValues parameter_values(const py::kwargs& kwargs);
+// Parameters as Python writes them in the library's messages: "max_states".
+ParameterSpelling python_spelling();
 // The kind's parameters, defaults filled in, as the command line's JSON reports them.
 py::dict parameters_dict(const std::string& kind, const ParameterValues& values);
 

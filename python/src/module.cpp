@@ -82,6 +82,16 @@ ParameterValues parameter_values(const py::kwargs& kwargs) {
   return values;
 }
 
+ParameterSpelling python_spelling() {
+  return [](std::string_view parameter) {
+    std::string name(parameter);
+    for (char& c : name) {
+      if (c == '-') c = '_';
+    }
+    return name;
+  };
+}
+
 py::dict parameters_dict(const std::string& kind_name, const ParameterValues& values) {
   return json_object(report::parameters_json(allocator_registry().find(kind_name), values));
 }

@@ -108,8 +108,6 @@ void check_episodes(std::uint64_t episodes) {
   if (episodes == 0) throw UsageError("episodes must be at least 1");
 }
 
-}  // namespace
-
 std::pair<MonteCarloResult, std::optional<ExactEvaluation>> run_and_evaluate(
     const MdpHandle& mdp, const WorldFactory& worlds, const AllocatorFactory& factory, const MonteCarloOptions& options,
     bool exact, const ParameterValues& values, const py::object& progress) {
@@ -126,6 +124,8 @@ std::pair<MonteCarloResult, std::optional<ExactEvaluation>> run_and_evaluate(
       progress);
   return {result, exact_result};
 }
+
+}  // namespace
 
 py::dict monte_carlo_dict(const std::string& solver, const ParameterValues& values, const std::string& instance,
                           const Problem& problem, const MonteCarloResult& result, std::uint64_t seed,
@@ -471,13 +471,7 @@ void bind_running(py::module_& m) {
                        : label,
                parameter_values(row_parameters)});
         }
-        const ParameterSpelling spelling = [](std::string_view parameter) {
-          std::string name(parameter);
-          for (char& c : name) {
-            if (c == '-') c = '_';
-          }
-          return name;
-        };
+        const ParameterSpelling spelling = python_spelling();
         check_table_request(rows, options, spelling);
         Table table;
         run_interruptibly(

@@ -475,4 +475,14 @@ std::string markdown_table(const std::vector<std::string>& header, const std::ve
   return out;
 }
 
+std::string csv_field(std::string_view text) {
+  std::string quoted = "\"";
+  for (const char c : text) {
+    if (c == '"') quoted += '"';
+    quoted += c;
+  }
+  quoted += '"';
+  return quoted;
+}
+
 }  // namespace ontime::report

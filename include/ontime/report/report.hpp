@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "ontime/allocators/allocator_registry.hpp"
@@ -80,5 +81,8 @@ std::string fit_markdown(const FitResult& fit);
 // A Markdown table: a header row, the rule below it and the body rows, columns padded to their
 // display width; cells may hold UTF-8 ("±", "µ", "≤").
 std::string markdown_table(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& body);
+
+// `text` as one CSV field: in double quotes, inner quotes doubled.
+std::string csv_field(std::string_view text);
 
 }  // namespace ontime::report
