@@ -2,7 +2,9 @@
 // N times with the real motion planner, writes the planner log and fits the instance. Every
 // finished trial goes to a checkpoint first, so that an interrupted collection can be resumed
 // (--resume) with the same result; the checkpoint is deleted once the outputs are written.
-// With --every-action: every action the domain can refine instead, each on its own.
+// With --every-action: every action the domain can refine instead, each on its own. The
+// collection and the fit are domains::collect_and_fit (collect_and_fit.hpp), the output the
+// domains report's.
 
 #include <fmt/format.h>
 
@@ -11,16 +13,11 @@
 #include "cluster_job.hpp"
 #include "common.hpp"
 #include "data_paths.hpp"
+#include "memory_limits.hpp"
 #include "number_options.hpp"
-#include "ontime/domains/collection.hpp"
-#include "ontime/domains/collection_journal.hpp"
+#include "ontime/domains/collect_and_fit.hpp"
 #include "ontime/domains/registry.hpp"
-#include "ontime/learn/fitting.hpp"
-#include "ontime/model/instance_io.hpp"
-#include "ontime/model/ompl_benchmark_log.hpp"
-#include "ontime/report/report.hpp"
-#include "ontime/util/error.hpp"
-#include "ontime/util/input_file.hpp"
+#include "ontime/domains/report.hpp"
 #include "output_paths.hpp"
 
 namespace ontime::cli {
@@ -30,18 +27,6 @@ namespace {
 std::filesystem::path default_log_file(const std::string& domain, const std::string& format) {
   std::filesystem::path path = collected_log_file(domain);
   return format == "ompl-benchmark" ? path.replace_extension(".log") : path;
-}
-
-OmplLogWriteOptions ompl_log_options(const std::string& domain, const domains::CollectionOptions& collection) {
-  OmplLogWriteOptions options;
-  options.experiment = domain;
-  options.time_limit_seconds = static_cast<double>(collection.budget_steps) * collection.step_seconds;
-  options.seed = collection.seed;
-  options.setup =
-      fmt::format("ontime collect --domain {}: {} trials per action, effort unit {}, step {} s, cut-off {} steps",
-                  domain, collection.trials, domains::effort_unit_name(collection.effort.unit), collection.step_seconds,
-                  collection.budget_steps);
-  return options;
 }
 
 }  // namespace
@@ -112,103 +97,37 @@ void add_collect_command(CLI::App& app) {
     const std::filesystem::path world =
         options->world.empty() ? default_world_file(options->domain) : std::filesystem::path(options->world);
     const domains::LoadedDomain loaded = domains::load_domain(options->domain, world);
-    const domains::CollectionDefaults& defaults = loaded.defaults.collection;
-    const std::filesystem::path log_path = options->log.empty() ? default_log_file(options->domain, options->log_format)
-                                                                : std::filesystem::path(options->log);
-    const std::filesystem::path instance_path =
+    domains::CollectAndFitOptions collect;
+    collect.trials = options->trials;
+    collect.seed = options->seed;
+    collect.threads = options->threads;
+    collect.effort = options->effort;
+    collect.checks_per_second = options->checks_per_second;
+    collect.step_seconds = options->step_seconds;
+    collect.deadline = options->deadline;
+    collect.budget = options->budget;
+    collect.laplace = options->laplace;
+    collect.every_action = options->every_action;
+    collect.log_format = options->log_format;
+    collect.log = options->log.empty() ? default_log_file(options->domain, options->log_format)
+                                       : std::filesystem::path(options->log);
+    collect.instance =
         options->instance.empty() ? collected_instance_file(options->domain) : std::filesystem::path(options->instance);
-
-    domains::CollectionOptions collection;
-    collection.trials = options->trials;
-    collection.seed = options->seed;
-    collection.threads = options->threads;
-    collection.effort.unit = domains::parse_effort_unit(options->effort);
-    collection.effort.checks_per_second =
-        options->checks_per_second > 0 ? options->checks_per_second : defaults.checks_per_second;
-    collection.step_seconds = options->step_seconds > 0 ? options->step_seconds : defaults.step_seconds;
-    const Steps deadline = options->deadline > 0 ? options->deadline : defaults.deadline;
-    collection.budget_steps = options->budget > 0 ? options->budget : deadline;
-    collection.every_action = options->every_action;
-    collection.ranks = job_ranks();
-    const std::filesystem::path checkpoint_path = options->checkpoint.empty()
-                                                      ? std::filesystem::path(log_path.string() + ".checkpoint")
-                                                      : std::filesystem::path(options->checkpoint);
+    collect.checkpoint = options->checkpoint;
+    collect.resume = options->resume;
+    collect.ranks = job_ranks();
     // The checkpoint is read back on --resume, but it is the collection's own file, not an input.
-    check_outputs({{"--log", log_path}, {"--instance", instance_path}, {"--checkpoint", checkpoint_path}}, {world},
-                  MissingFolder::create);
-    // The journal refuses this too; the command's refusal names the option that resumes.
-    if (!options->resume && !domains::CollectionJournal::parts(checkpoint_path).empty()) {
-      throw UsageError(domains::CollectionJournal::parts(checkpoint_path).front().string() +
-                       ": the checkpoint of an unfinished collection is there; resume it (--resume) or delete it");
-    }
-    domains::CollectionJournal journal(checkpoint_path, *loaded.domain, collection, read_input_file(world, "world"),
-                                       options->resume, collection.ranks);
-    collection.journal = &journal;
-    const std::size_t resumed = journal.finished().size();
+    check_outputs(
+        {{"--log", collect.log}, {"--instance", collect.instance}, {"--checkpoint", domains::checkpoint_path(collect)}},
+        {world}, MissingFolder::create);
     ProgressBar bar("collect " + options->domain);
-    collection.progress = [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); };
-    const domains::CollectionResult result = domains::collect(*loaded.domain, collection);
-    if (!is_job_root()) {  // rank 0 writes the outputs, then every rank's checkpoint goes
-      journal.remove();
-      return;
-    }
-
-    if (options->log_format == "ompl-benchmark") {
-      save_ompl_benchmark_log(result.log, log_path, ompl_log_options(options->domain, collection));
-    } else {
-      save_planner_log(result.log, log_path);
-    }
-    FitOptions fit_options;
-    fit_options.step_seconds = collection.step_seconds;
-    fit_options.deadline = deadline;
-    fit_options.laplace = options->laplace;
-    fit_options.name = options->domain;
-    fit_options.description = fmt::format(
-        "Fitted from {} attempts per action of the {} domain ({}): seed {}, effort unit {}{}, step {} s, cut-off {} "
-        "steps",
-        options->trials, options->domain, world.filename().string(), options->seed, options->effort,
-        collection.effort.unit == domains::EffortUnit::collision_checks
-            ? fmt::format(" at {} checks per second", collection.effort.checks_per_second)
-            : std::string(),
-        collection.step_seconds, collection.budget_steps);
-    const SkeletonList skeletons = options->every_action ? single_action_skeletons(result.log, log_path.string())
-                                                         : SkeletonList{world.string(), loaded.domain->skeletons()};
-    const FitResult fit = fit_problem(result.log, log_path.string(), skeletons, fit_options);
-    save_problem(fit.problem, instance_path);
-    journal.remove();
-
-    std::uint64_t found = 0;
-    for (const RefinementAttempt& attempt : result.log) found += attempt.found ? 1 : 0;
-    if (options->json) {
-      Json out;
-      out["domain"] = options->domain;
-      out["world"] = world.string();
-      out["trials"] = options->trials;
-      out["every_action"] = options->every_action;
-      out["seed"] = options->seed;
-      out["effort"] = options->effort;
-      out["step_seconds"] = collection.step_seconds;
-      out["deadline"] = deadline;
-      out["budget_steps"] = collection.budget_steps;
-      out["checks_per_second"] = collection.effort.checks_per_second;
-      out["attempts"] = result.log.size();
-      out["found"] = found;
-      out["collision_checks"] = result.collision_checks;
-      out["seconds"] = result.seconds;
-      out["resumed_attempts"] = resumed;
-      out["log"] = log_path.string();
-      out["instance"] = instance_path.string();
-      out["actions"] = Json::parse(report::fit_json(fit));
-      print_json(out);
-      return;
-    }
-    fmt::print("Collected {} attempts ({} per action, {} found) in {:.1f} s: {} collision checks.\n", result.log.size(),
-               options->trials, found, result.seconds, result.collision_checks);
-    if (resumed > 0) fmt::print("Resumed from {}: {} attempts were done before.\n", checkpoint_path.string(), resumed);
-    fmt::print("Log: {}. Instance: {} (deadline {} steps of {} s).\n\n", log_path.string(), instance_path.string(),
-               deadline, collection.step_seconds);
-    fmt::print("{}", report::fit_markdown(fit));
-    fmt::print("\nT: planning steps, X: execution steps (means over the steps within the deadline).\n");
+    collect.progress = [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); };
+    const domains::CollectAndFitResult result =
+        domains::collect_and_fit(*loaded.domain, loaded.defaults, world, collect, flag_spelling());
+    if (!result.fit) return;  // another rank than the one that writes and prints
+    const domains::report::Collection report{
+        .domain = options->domain, .world = world.string(), .options = &collect, .result = &result};
+    fmt::print("{}", options->json ? domains::report::to_json(report) + "\n" : domains::report::to_text(report));
   });
 }
 

@@ -1,14 +1,14 @@
 // `ontime generate-world --rows R --cols C --seed S -o FILE`: writes a generated navigation world
 // (an office building of R x C rooms, navigation_generator.hpp) as a world file that `collect`,
-// `map` and `run` read with --world. Same options, same seed: the same file.
+// `map` and `run` read with --world. Same options, same seed: the same file. The file and the
+// summary are domains::write_generated_world's and the domains report's.
 
 #include <fmt/format.h>
 
 #include "common.hpp"
 #include "number_options.hpp"
 #include "ontime/domains/navigation_generator.hpp"
-#include "ontime/util/atomic_file.hpp"
-#include "ontime/util/error.hpp"
+#include "ontime/domains/report.hpp"
 #include "output_paths.hpp"
 
 namespace ontime::cli {
@@ -17,6 +17,7 @@ void add_generate_world_command(CLI::App& app) {
   struct Options {
     domains::BuildingOptions building;
     std::string output;
+    bool json = false;
   };
   auto options = std::make_shared<Options>();
   CLI::App* command =
@@ -32,14 +33,11 @@ void add_generate_world_command(CLI::App& app) {
                     "Share of doors that are narrow (0.76-0.86 m; the others 1.0-1.2 m)", 0.0, 1.0);
   add_number_option(*command, "--seed", options->building.seed, "Seed of every random choice");
   command->add_option("--name", options->building.name, "World name (default: building-ROWSxCOLS)");
+  command->add_flag("--json", options->json, "Print JSON");
   command->callback([options] {
-    if (options->building.rows * options->building.cols < 2) throw UsageError("a building needs at least two rooms");
     check_outputs({{"--output", options->output}}, {});
-    const std::string text = domains::generate_navigation_world_text(options->building);
-    write_file_atomically(options->output, text);
-    const domains::NavigationWorld world = domains::parse_navigation_world(text, options->output);
-    fmt::print("Wrote {}: {} rooms, {} doors, {} pieces of furniture; start in {}, goal {}.\n", options->output,
-               world.rooms.size(), world.doors.size(), world.obstacles.size(), world.start_room, world.goal_room);
+    const domains::GeneratedWorld world = domains::write_generated_world(options->building, options->output);
+    fmt::print("{}", options->json ? domains::report::to_json(world) + "\n" : domains::report::to_text(world));
   });
 }
 

@@ -3,30 +3,27 @@
 // allocator expects from the fitted instance. With `--effort wall` (or `--live`) every episode
 // is a live session (session.hpp): the allocator's thinking and the planner's overruns are
 // charged against the deadline in seconds, the planner's time being real (wall) or the nominal
-// seconds of its collision checks (checks).
+// seconds of its collision checks (checks). The episodes are domains::run_planner_episodes
+// (planner_run.hpp), the output the domains report's.
 
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <filesystem>
-#include <span>
 #include <vector>
 
 #include "cluster_job.hpp"
 #include "common.hpp"
 #include "data_paths.hpp"
-#include "live_report.hpp"
 #include "memory_limits.hpp"
 #include "number_options.hpp"
-#include "ontime/allocators/optimal.hpp"
-#include "ontime/domains/planner_world.hpp"
+#include "ontime/domains/planner_run.hpp"
 #include "ontime/domains/registry.hpp"
+#include "ontime/domains/report.hpp"
 #include "ontime/model/instance_io.hpp"
-#include "ontime/run/episode_runner.hpp"
 #include "ontime/util/atomic_file.hpp"
 #include "ontime/util/error.hpp"
 #include "output_paths.hpp"
-#include "python_runner.hpp"
+#include "timeline_plot.hpp"
 
 namespace ontime::cli {
 
@@ -112,101 +109,41 @@ void add_run_command(CLI::App& app) {
     }
     const domains::LoadedDomain loaded = domains::load_domain(options->domain, world);
     const Problem problem = load_problem(instance);
-    const Mdp mdp(problem);
-    const ParameterValues parameters = options->allocator.values();
-    check_allocator_memory(options->solver, problem, parameters, options->episodes, options->threads);
-    if (options->exact || allocator_registry().find(options->solver).capabilities.has(Capability::optimal)) {
-      check_exact_work(problem, max_states_of(parameters), instance.string(), flag_spelling());
-    }
-    const AllocatorFactory factory = make_allocator_factory(options->solver, mdp, parameters);
-    domains::PlannerWorldOptions planner;
-    planner.effort.unit = domains::parse_effort_unit(options->effort);
-    planner.effort.checks_per_second =
-        options->checks_per_second > 0 ? options->checks_per_second : loaded.defaults.collection.checks_per_second;
-    planner.independent_starts = options->independent_starts;
-    MonteCarloOptions episodes;
-    episodes.episodes = options->episodes;
-    episodes.seed = options->seed;
-    episodes.threads = options->threads;
-    episodes.ranks = job_ranks();
-    std::vector<EpisodeResult> results;
-    if (live) {
-      episodes.live = LiveRun{LiveOptions{.decision_share = options->decision_share}, true};
-      results.resize(options->episodes);
-      // Each episode writes its own slot: no two threads touch one.
-      episodes.on_episode = [&results](std::uint64_t episode, const EpisodeResult& result) {
-        results[episode] = result;
-      };
-    }
-    const MonteCarloResult summary =
-        run_episodes(mdp, domains::planner_worlds(*loaded.domain, problem, planner), factory, episodes);
-    const double refinements_started =
-        summary.world_statistics.find("refinements_started").value_or(0.0) / static_cast<double>(summary.episodes);
-    std::optional<ExactEvaluation> exact;
-    if (options->exact) {
-      const auto allocator = factory();
-      exact = evaluate_exactly(mdp, *allocator, max_states_of(parameters));
-    }
+    domains::PlannerRunOptions run;
+    run.solver = options->solver;
+    run.parameters = options->allocator.values();
+    run.episodes = options->episodes;
+    run.seed = options->seed;
+    run.threads = options->threads;
+    run.effort = domains::effort_settings(loaded.defaults, options->effort, options->checks_per_second);
+    run.independent_starts = options->independent_starts;
+    run.exact = options->exact;
+    run.live = options->live;
+    run.decision_share = options->decision_share;
+    run.ranks = job_ranks();
+    domains::check_planner_run_request(problem, instance.string(), run, flag_spelling());
+    const domains::PlannerRun result = domains::run_planner_episodes(*loaded.domain, problem, run);
     if (!timeline_data.empty() && is_job_root()) {  // rank 0 writes
-      const EpisodeResult& shown = results[options->timeline_episode];
-      write_file_atomically(timeline_data, timeline_csv(problem, shown));
+      const EpisodeResult& shown = result.episodes[options->timeline_episode];
+      write_file_atomically(timeline_data, domains::report::timeline_csv(problem, shown));
       if (!options->no_plot) {
-        const std::string title = fmt::format("{} on {}, episode {}: {} at {:.1f} s of {:.1f} s", options->solver,
-                                              options->domain, options->timeline_episode, status_name(shown.status),
-                                              shown.live.elapsed, problem.deadline() * problem.step_seconds());
+        const std::string title =
+            fmt::format("{} on {}, episode {}: {} at {:.1f} s of {:.1f} s", options->solver, options->domain,
+                        options->timeline_episode, domains::report::status_name(shown.status), shown.live.elapsed,
+                        problem.deadline() * problem.step_seconds());
         plot_timeline(problem, shown, timeline_data, timeline_png, title);
       }
     }
-    if (options->json) {
-      Json out;
-      out["domain"] = options->domain;
-      out["instance"] = instance.string();
-      out["solver"] = options->solver;
-      out["parameters"] = parameters_json(allocator_registry().find(options->solver), parameters);
-      out["episodes"] = summary.episodes;
-      out["seed"] = options->seed;
-      out["successes"] = summary.successes;
-      out["success_rate"] = summary.success_rate;
-      out["ci95"] = summary.ci95;
-      out["independent_starts"] = options->independent_starts;
-      out["refinements_started"] = refinements_started;
-      out["seconds"] = summary.seconds;
-      if (exact) out["model_exact_success_probability"] = exact->success_probability;
-      out["effort"] = options->effort;
-      out["live"] = live;
-      if (live) {
-        out["decision_share"] = options->decision_share;
-        out["step_clock_successes"] = summary.model_successes;
-        out["step_clock_undecided"] = summary.model_undecided;
-        add_charges(out, summary.live_mean, "mean_");
-        Json detail = Json::array();
-        for (const EpisodeResult& result : results) detail.push_back(live_json(result));
-        out["episode_results"] = std::move(detail);
-      }
-      print_json(out);
-      return;
-    }
-    fmt::print("solver               {} on the {} domain (model {})\n", options->solver, options->domain,
-               instance.string());
-    fmt::print("real planner         {:.4f} ± {:.4f}  ({} of {} episodes, seed {}, {:.1f} s){}\n", summary.success_rate,
-               summary.ci95, summary.successes, summary.episodes, options->seed, summary.seconds, live ? ", live" : "");
-    if (live) {
-      fmt::print(
-          "same calls, steps    {:.4f}  ({} of {} by the model's step clock; {} undecided when the live episode "
-          "ended)\n",
-          static_cast<double>(summary.model_successes) / static_cast<double>(summary.episodes), summary.model_successes,
-          summary.episodes, summary.model_undecided);
-      fmt::print(
-          "charged per episode  thinking {:.3f} s, planning {:.3f} s (overruns {:.3f} s): {:.3f} s of {:.1f} s\n",
-          summary.live_mean.decision, summary.live_mean.planning, summary.live_mean.overrun, summary.live_mean.elapsed,
-          problem.deadline() * problem.step_seconds());
-    }
+    domains::report::Run report{.domain = options->domain,
+                                .instance = instance.string(),
+                                .problem = &problem,
+                                .options = &run,
+                                .result = &result};
     if (!timeline_data.empty()) {
-      fmt::print("timeline             episode {}: {}{}\n", options->timeline_episode, timeline_data.string(),
-                 options->no_plot ? "" : ", " + timeline_png.string());
+      report.timeline_episode = options->timeline_episode;
+      report.timeline_files = timeline_data.string() + (options->no_plot ? "" : ", " + timeline_png.string());
     }
-    fmt::print("refinements started  {:.2f} per episode\n", refinements_started);
-    if (exact) fmt::print("model, exact         {:.4f}\n", exact->success_probability);
+    fmt::print("{}", options->json ? domains::report::to_json(report) + "\n" : domains::report::to_text(report));
   });
 }
 

@@ -79,13 +79,6 @@ std::size_t AllocatorFlags::max_states() const {
   return max_states_of(values);
 }
 
-nlohmann::ordered_json parameters_json(const AllocatorKind& kind, const ParameterValues& values) {
-  nlohmann::ordered_json out = nlohmann::ordered_json::object();
-  const ParameterReader reader(kind, values);
-  for (const Parameter& parameter : kind.parameters) out[parameter.name] = reader.text(parameter.name);
-  return out;
-}
-
 void MonteCarloFlags::add_to(CLI::App& command) {
   add_number_option(command, "--episodes", episodes, "Simulated episodes per evaluation", std::uint64_t{1});
   add_number_option(command, "--seed", seed, "Seed of the hidden worlds (episode i uses stream i of it)");
@@ -134,12 +127,6 @@ void check_solver_names(const std::vector<std::string>& names) {
 }
 
 void print_json(const Json& value) { fmt::print("{}\n", value.dump(2)); }
-
-Json points_json(const std::vector<std::array<double, 2>>& points) {
-  Json list = Json::array();
-  for (const auto& point : points) list.push_back({point[0], point[1]});
-  return list;
-}
 
 namespace {
 bool quiet_progress = false;

@@ -56,9 +56,6 @@ struct AllocatorFlags {
   std::size_t max_states() const;
 };
 
-// The values of the parameters `kind` declares, given or defaulted, as JSON (text values).
-nlohmann::ordered_json parameters_json(const AllocatorKind& kind, const ParameterValues& values);
-
 // Options shared by commands that run Monte Carlo episodes.
 // Refuses (UsageError, exit 2) what `solver` may hold on `problem` (its declared memory need: a
 // search tree's cap for each thread of the run, the exact solver's table) when that exceeds the
@@ -85,9 +82,6 @@ void check_solver_names(const std::vector<std::string>& names);
 
 // Prints JSON to stdout, two-space indented.
 void print_json(const Json& value);
-
-// Points of the plane (e.g. of a drawing) as a JSON list of [x, y].
-Json points_json(const std::vector<std::array<double, 2>>& points);
 
 // Progress on stderr, on the rank that prints. On a terminal, a bar redrawn in place; otherwise
 // (a log, CI, a pipe) a plain line now and then, at most every progress_line_seconds():

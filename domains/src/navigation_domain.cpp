@@ -9,6 +9,7 @@
 #include "ontime/domains/library_messages.hpp"
 #include "ontime/domains/navigation.hpp"
 #include "ontime/domains/navigation_collision.hpp"
+#include "ontime/domains/task_planner.hpp"
 #include "ontime/util/random.hpp"
 
 namespace ontime::domains {
@@ -104,6 +105,14 @@ std::vector<std::array<double, 2>> NavigationDomain::outline(const Configuration
   const Pose pose = pose_of(configuration);
   const auto corners = Rectangle{pose.x, pose.y, world_.robot.length, world_.robot.width, pose.theta}.corners();
   return {corners.begin(), corners.end()};
+}
+
+std::vector<std::array<double, 2>> NavigationDomain::skeleton_points(const std::vector<std::string>& skeleton) const {
+  return room_path_points(world_, skeleton);
+}
+
+TaskPlannerFactory NavigationDomain::task_planners(int max_skeletons) const {
+  return room_path_planners(world_, max_skeletons);
 }
 
 }  // namespace ontime::domains

@@ -11,6 +11,8 @@
 #include <string>
 
 #include "ontime/domains/navigation_collision.hpp"
+#include "ontime/util/atomic_file.hpp"
+#include "ontime/util/error.hpp"
 #include "ontime/util/random.hpp"
 
 namespace ontime::domains {
@@ -485,6 +487,19 @@ NavigationWorld generate_navigation_world(const BuildingOptions& options) {
   NavigationWorld world = parse_navigation_world(generate_navigation_world_text(options), "generated world");
   world.source = world.name;
   return world;
+}
+
+GeneratedWorld write_generated_world(const BuildingOptions& options, const std::filesystem::path& output) {
+  std::string text;
+  try {
+    text = generate_navigation_world_text(options);
+  } catch (const std::invalid_argument& error) {
+    throw UsageError(error.what());
+  }
+  write_file_atomically(output, text);
+  const NavigationWorld world = parse_navigation_world(text, output.string());
+  return GeneratedWorld{output.string(),        world.name,       world.rooms.size(), world.doors.size(),
+                        world.obstacles.size(), world.start_room, world.goal_room};
 }
 
 std::vector<Pose> door_route(const NavigationWorld& world, const Door& door, std::string_view room_id, double spacing) {

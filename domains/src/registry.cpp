@@ -30,4 +30,11 @@ LoadedDomain load_domain(std::string_view name, const std::filesystem::path& wor
   throw unknown_name_error("domain", name, domain_names());
 }
 
+EffortSettings effort_settings(const DomainDefaults& defaults, std::string_view unit, double checks_per_second) {
+  EffortSettings effort;
+  effort.unit = parse_effort_unit(unit);
+  effort.checks_per_second = checks_per_second > 0 ? checks_per_second : defaults.collection.checks_per_second;
+  return effort;
+}
+
 }  // namespace ontime::domains

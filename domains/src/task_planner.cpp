@@ -174,6 +174,12 @@ TaskPlannerFactory fixed_skeleton_planners(const Domain& domain) {
   return [&domain] { return std::make_unique<FixedSkeletonPlanner>(domain); };
 }
 
+TaskPlannerFactory Domain::task_planners(int /*max_skeletons*/) const { return fixed_skeleton_planners(*this); }
+
+std::vector<std::array<double, 2>> Domain::skeleton_points(const std::vector<std::string>& /*skeleton*/) const {
+  return {};
+}
+
 namespace {
 
 // The door a move goes through: of the doors joining its rooms, the one of least weight.

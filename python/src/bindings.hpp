@@ -139,15 +139,14 @@ struct AllocatorHandle {
 
 // Keyword arguments as registry parameter values: `max_states=5` is `max-states` = "5".
 ParameterValues parameter_values(const py::kwargs& kwargs);
+// Parameters as Python writes them in the library's messages: "max_states".
+ParameterSpelling python_spelling();
 // The kind's parameters, defaults filled in, as the command line's JSON reports them.
 py::dict parameters_dict(const std::string& kind, const ParameterValues& values);
 
 // A JSON text of the report module (report/report.hpp) as Python objects (json.loads), so that
 // Python returns what the command line prints.
 py::object json_object(const std::string& text);
-
-// Parameters as Python writes them (keyword arguments): "max_states".
-ParameterSpelling python_spelling();
 
 // An evaluation's report (report::Evaluation) as a dict: the fields of `ontime evaluate --json`.
 py::dict monte_carlo_dict(const std::string& solver, const ParameterValues& values, const std::string& instance,

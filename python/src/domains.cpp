@@ -1,29 +1,33 @@
 // Bindings of the TAMP domains (OMPL, FCL, KDL): loading a domain, collecting its planner log and
-// running allocators against its real motion planner, as `ontime collect` and `ontime run` do.
-// Built only with the domains library (ONTIME_BUILD_DOMAINS); without it the submodule says so.
+// fitting its instance, running allocators against its real motion planner, the whole TAMP loop,
+// its map and generated worlds — each the library function the command line calls (`ontime
+// collect`, `run`, `tamp`, `map`, `generate-world`), with the command line's defaults, returning
+// the domains report's JSON read back. Built only with the domains library
+// (ONTIME_BUILD_DOMAINS); without it the submodule says so.
 
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
 #include "ontime/model/planner_log.hpp"
-#include "ontime/run/episode_runner.hpp"
-#include "ontime/run/evaluation.hpp"
 
 #ifdef ONTIME_PYTHON_DOMAINS
-#include "ontime/allocators/optimal.hpp"
+#include <filesystem>
+#include <optional>
+
+#include "ontime/domains/collect_and_fit.hpp"
 #include "ontime/domains/collection.hpp"
-#include "ontime/domains/planner_world.hpp"
+#include "ontime/domains/drawing.hpp"
+#include "ontime/domains/navigation_generator.hpp"
+#include "ontime/domains/planner_run.hpp"
 #include "ontime/domains/registry.hpp"
-#include "ontime/run/evaluation.hpp"
+#include "ontime/domains/report.hpp"
+#include "ontime/domains/tamp.hpp"
 #include "ontime/util/error.hpp"
 #endif
 
 namespace ontime::python {
 
 py::list attempts_list(const std::vector<RefinementAttempt>& attempts);
-std::pair<MonteCarloResult, std::optional<ExactEvaluation>> run_and_evaluate(
-    const MdpHandle& mdp, const WorldFactory& worlds, const AllocatorFactory& factory, const MonteCarloOptions& options,
-    bool exact, const ParameterValues& values, const py::object& progress);
 
 #ifdef ONTIME_PYTHON_DOMAINS
 
@@ -35,12 +39,50 @@ struct DomainHandle {
   domains::LoadedDomain loaded;
 };
 
-domains::EffortSettings effort_of(const DomainHandle& domain, const std::string& unit, double checks_per_second) {
-  domains::EffortSettings effort;
-  effort.unit = domains::parse_effort_unit(unit);
-  effort.checks_per_second =
-      checks_per_second > 0 ? checks_per_second : domain.loaded.defaults.collection.checks_per_second;
-  return effort;
+std::string path_text(const py::object& path) { return py::str(py::module_::import("os").attr("fspath")(path)); }
+
+// Progress and Ctrl-C of a long library call: `progress` and `stop` hooks for run_interruptibly.
+struct Hooks {
+  std::function<void(std::uint64_t, std::uint64_t)> progress;
+  std::function<bool()> stop;
+};
+Hooks hooks_of(const std::function<bool()>& stop, Progress& counters) {
+  return {[&counters](std::uint64_t done, std::uint64_t total) {
+            counters.done = done;
+            counters.total = total;
+          },
+          stop};
+}
+
+// The collection's progress also stops it: the collection has no stop hook of its own.
+std::function<void(std::uint64_t, std::uint64_t)> stopping_progress(const std::function<bool()>& stop,
+                                                                    Progress& counters) {
+  return [&stop, &counters](std::uint64_t done, std::uint64_t total) {
+    if (stop()) throw Cancelled("collection stopped at the caller's request");
+    counters.done = done;
+    counters.total = total;
+  };
+}
+
+using ChecksPerSecond = Number<double, "checks_per_second", 0.0>;
+using StepSeconds = Number<double, "step_seconds", 0.0>;
+using BudgetSteps = Number<Steps, "budget_steps", 0>;
+using DecisionShare = Number<double, "decision_share", 0.0, 1e6>;
+
+// What collect and collect_and_fit share: the trials and how they are run.
+domains::CollectAndFitOptions collect_request(std::uint64_t trials, std::uint64_t seed, unsigned threads,
+                                              const std::string& effort, double checks_per_second, double step_seconds,
+                                              Steps budget_steps, bool every_action) {
+  domains::CollectAndFitOptions request;
+  request.trials = trials;
+  request.seed = seed;
+  request.threads = threads;
+  request.effort = effort;
+  request.checks_per_second = checks_per_second;
+  request.step_seconds = step_seconds;
+  request.budget = budget_steps;
+  request.every_action = every_action;
+  return request;
 }
 
 }  // namespace
@@ -72,7 +114,7 @@ void bind_domains(py::module_& m) {
       [](const std::string& name, const py::object& world_file) {
         auto handle = std::make_shared<DomainHandle>();
         handle->name = name;
-        handle->world_file = py::str(py::module_::import("os").attr("fspath")(world_file));
+        handle->world_file = path_text(world_file);
         const py::gil_scoped_release release;
         handle->loaded = domains::load_domain(name, handle->world_file);
         return handle;
@@ -84,26 +126,15 @@ void bind_domains(py::module_& m) {
   m.def(
       "collect",
       [](const std::shared_ptr<DomainHandle>& domain, Number<std::uint64_t, "trials", 1> trials, Seed seed,
-         Threads threads, const std::string& effort, Number<double, "checks_per_second", 0.0> checks_per_second,
-         Number<double, "step_seconds", 0.0> step_seconds, Number<Steps, "budget_steps", 0> budget_steps,
-         const py::object& progress) {
-        if (trials == 0) throw UsageError("trials must be at least 1");
-        domains::CollectionOptions options;
-        options.trials = trials;
-        options.seed = seed;
-        options.threads = threads;
-        options.effort = effort_of(*domain, effort, checks_per_second);
-        const domains::CollectionDefaults& defaults = domain->loaded.defaults.collection;
-        options.step_seconds = step_seconds > 0 ? step_seconds : defaults.step_seconds;
-        options.budget_steps = budget_steps > 0 ? budget_steps : defaults.deadline;
+         Threads threads, const std::string& effort, ChecksPerSecond checks_per_second, StepSeconds step_seconds,
+         BudgetSteps budget_steps, bool every_action, const py::object& progress) {
+        const domains::CollectAndFitOptions request =
+            collect_request(trials, seed, threads, effort, checks_per_second, step_seconds, budget_steps, every_action);
+        domains::CollectionOptions options = domains::collection_options(domain->loaded.defaults, request);
         domains::CollectionResult result;
         run_interruptibly(
             [&](const std::function<bool()>& stop, Progress& counters) {
-              options.progress = [&](std::uint64_t done, std::uint64_t total) {
-                if (stop()) throw Cancelled("collection stopped at the caller's request");
-                counters.done = done;
-                counters.total = total;
-              };
+              options.progress = stopping_progress(stop, counters);
               result = domains::collect(*domain->loaded.domain, options);
             },
             progress);
@@ -111,49 +142,209 @@ void bind_domains(py::module_& m) {
       },
       py::arg("domain"), py::kw_only(), py::arg("trials") = 1000, py::arg("seed") = 1, py::arg("threads") = 0,
       py::arg("effort") = "checks", py::arg("checks_per_second") = 0.0, py::arg("step_seconds") = 0.0,
-      py::arg("budget_steps") = 0, py::arg("progress") = py::none(),
-      "Refines every action of the domain's skeleton tree `trials` times and returns the planner log as "
-      "records (write it with ontime.write_planner_log, fit it with ontime.fit). The same log as `ontime "
-      "collect` for the same seed, whatever `threads` (effort 'checks'). 0 means the world file's setting "
-      "(step_seconds, checks_per_second) or its deadline (budget_steps, the cut-off).");
+      py::arg("budget_steps") = 0, py::arg("every_action") = false, py::arg("progress") = py::none(),
+      "Refines every action of the domain's skeleton tree (every_action=True: every action the domain can "
+      "refine, each on its own) `trials` times and returns the planner log as records (write it with "
+      "ontime.write_planner_log, fit it with ontime.fit). The same log as `ontime collect` for the same seed, "
+      "whatever `threads` (effort 'checks'). 0 means the world file's setting (step_seconds, checks_per_second) "
+      "or its deadline (budget_steps, the cut-off).");
+
+  m.def(
+      "collect_and_fit",
+      [](const std::shared_ptr<DomainHandle>& domain, const py::object& log, const py::object& instance,
+         Number<std::uint64_t, "trials", 1> trials, Seed seed, Threads threads, const std::string& effort,
+         ChecksPerSecond checks_per_second, StepSeconds step_seconds,
+         Number<Steps, "deadline", 0, Problem::kMaxDeadline> deadline, BudgetSteps budget_steps,
+         Number<double, "laplace", 0.0> laplace, bool every_action, const std::string& log_format,
+         const py::object& checkpoint, bool resume, const py::object& progress) {
+        domains::CollectAndFitOptions options =
+            collect_request(trials, seed, threads, effort, checks_per_second, step_seconds, budget_steps, every_action);
+        options.deadline = deadline;
+        options.laplace = laplace;
+        options.log_format = log_format;
+        options.log = path_text(log);
+        options.instance = path_text(instance);
+        if (!checkpoint.is_none()) options.checkpoint = path_text(checkpoint);
+        options.resume = resume;
+        domains::CollectAndFitResult result;
+        run_interruptibly(
+            [&](const std::function<bool()>& stop, Progress& counters) {
+              options.progress = stopping_progress(stop, counters);
+              result = domains::collect_and_fit(*domain->loaded.domain, domain->loaded.defaults, domain->world_file,
+                                                options, python_spelling());
+            },
+            progress);
+        return json_object(domains::report::to_json(domains::report::Collection{
+            .domain = domain->name, .world = domain->world_file, .options = &options, .result = &result}));
+      },
+      py::arg("domain"), py::arg("log"), py::arg("instance"), py::kw_only(), py::arg("trials") = 1000,
+      py::arg("seed") = 1, py::arg("threads") = 0, py::arg("effort") = "checks", py::arg("checks_per_second") = 0.0,
+      py::arg("step_seconds") = 0.0, py::arg("deadline") = 0, py::arg("budget_steps") = 0, py::arg("laplace") = 0.0,
+      py::arg("every_action") = false, py::arg("log_format") = "jsonl", py::arg("checkpoint") = py::none(),
+      py::arg("resume") = false, py::arg("progress") = py::none(),
+      "`ontime collect`: collects as collect() does, writes the planner log to `log` (log_format 'jsonl' or "
+      "'ompl-benchmark'), fits the instance (deadline steps; 0: the world file's) and writes it to `instance`; "
+      "returns the fields of `ontime collect --json`. Finished trials go to `checkpoint` (default: the log's "
+      "path followed by .checkpoint) until the files are written; resume=True continues an interrupted "
+      "collection to the same files.");
 
   m.def(
       "run",
       [](const std::shared_ptr<DomainHandle>& domain, const py::object& problem, const std::string& solver,
-         Episodes episodes, Seed seed, Threads threads, const std::string& effort,
-         Number<double, "checks_per_second", 0.0> checks_per_second, bool independent_starts, bool exact,
-         const py::object& progress, const py::kwargs& kwargs) {
-        if (episodes == 0) throw UsageError("episodes must be at least 1");
+         Episodes episodes, Seed seed, Threads threads, const std::string& effort, ChecksPerSecond checks_per_second,
+         bool independent_starts, bool exact, bool live, DecisionShare decision_share, const py::object& progress,
+         const py::kwargs& kwargs) {
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
-        const ParameterValues values = parameter_values(kwargs);
-        domains::PlannerWorldOptions planner;
-        planner.effort = effort_of(*domain, effort, checks_per_second);
-        planner.independent_starts = independent_starts;
-        const AllocatorFactory factory = [&] {
-          const py::gil_scoped_release release;
-          return make_allocator_factory(solver, mdp->mdp, values);
-        }();
-        MonteCarloOptions options;
+        const std::string instance = instance_label(problem, *mdp->problem);
+        domains::PlannerRunOptions options;
+        options.solver = solver;
+        options.parameters = parameter_values(kwargs);
         options.episodes = episodes;
         options.seed = seed;
         options.threads = threads;
-        const auto [result, exact_result] =
-            run_and_evaluate(*mdp, domains::planner_worlds(*domain->loaded.domain, *mdp->problem, planner), factory,
-                             options, exact, values, progress);
-        py::dict out =
-            monte_carlo_dict(solver, values, instance_label(problem, *mdp->problem), *mdp->problem, result, seed);
-        out["domain"] = domain->name;
-        out["independent_starts"] = independent_starts;
-        out["refinements_started"] =
-            result.world_statistics.find("refinements_started").value_or(0.0) / static_cast<double>(result.episodes);
-        if (exact_result) out["model_exact_success_probability"] = exact_result->success_probability;
-        return out;
+        options.effort = domains::effort_settings(domain->loaded.defaults, effort, checks_per_second);
+        options.independent_starts = independent_starts;
+        options.exact = exact;
+        options.live = live;
+        options.decision_share = decision_share;
+        domains::check_planner_run_request(*mdp->problem, instance, options, python_spelling());
+        domains::PlannerRun result;
+        run_interruptibly(
+            [&](const std::function<bool()>& stop, Progress& counters) {
+              const Hooks hooks = hooks_of(stop, counters);
+              options.progress = hooks.progress;
+              options.stop = hooks.stop;
+              result = domains::run_planner_episodes(*domain->loaded.domain, *mdp->problem, options);
+            },
+            progress);
+        return json_object(domains::report::to_json(domains::report::Run{.domain = domain->name,
+                                                                         .instance = instance,
+                                                                         .problem = mdp->problem.get(),
+                                                                         .options = &options,
+                                                                         .result = &result}));
       },
       py::arg("domain"), py::arg("problem"), py::arg("solver"), py::kw_only(), py::arg("episodes") = 200,
       py::arg("seed") = 1, py::arg("threads") = 0, py::arg("effort") = "checks", py::arg("checks_per_second") = 0.0,
-      py::arg("independent_starts") = false, py::arg("exact") = false, py::arg("progress") = py::none(),
-      "Episodes in which the allocator `solver` (parameters as keyword arguments), with `problem` as its model, "
-      "drives the domain's real motion planner; the fields of `ontime run --json`.");
+      py::arg("independent_starts") = false, py::arg("exact") = false, py::arg("live") = false,
+      py::arg("decision_share") = 0.5, py::arg("progress") = py::none(),
+      "`ontime run`: episodes in which the allocator `solver` (parameters as keyword arguments), with `problem` "
+      "as its model, drives the domain's real motion planner; live=True (always with effort 'wall') charges "
+      "its thinking and the planner's overruns on the clock. Returns the fields of `ontime run --json` (live: "
+      "every episode with its timeline).");
+
+  m.def(
+      "tamp",
+      [](const std::shared_ptr<DomainHandle>& domain, const py::object& library, const std::string& solver,
+         Number<double, "deadline", 1e-9> deadline, Number<std::uint64_t, "episodes", 1> episodes, Seed seed,
+         Threads threads, const std::string& effort, Number<double, "task_seconds", 0.0, 1e6> task_seconds,
+         Number<int, "arrival_period", 1, 10'000> arrival_period,
+         Number<int, "max_skeletons", 1, Problem::kMaxSkeletons> max_skeletons, DecisionShare decision_share,
+         const std::string& clock, std::optional<Number<double, "decision_seconds", 0.0, 1e6>> decision_seconds,
+         std::optional<Number<double, "iteration_seconds", 1e-12, 1e6>> iteration_seconds,
+         std::optional<Number<std::uint64_t, "picture_episode">> picture_episode, const py::object& progress,
+         const py::kwargs& kwargs) {
+        if (clock != "real" && clock != "model") {
+          throw UsageError("clock must be 'real' or 'model' (got '" + clock + "')");
+        }
+        if (clock == "real" && (decision_seconds || iteration_seconds)) {
+          throw UsageError("decision_seconds and iteration_seconds need clock='model'");
+        }
+        const std::shared_ptr<MdpHandle> mdp = to_mdp(library);
+        domains::TampOptions options;
+        options.solver = solver;
+        options.parameters = parameter_values(kwargs);
+        options.deadline = deadline;
+        options.effort = domains::effort_settings(domain->loaded.defaults, effort);
+        options.episodes = episodes;
+        options.seed = seed;
+        options.threads = threads;
+        options.task_seconds = task_seconds;
+        options.arrival_period = arrival_period;
+        options.max_skeletons = max_skeletons;
+        options.decision_share = decision_share;
+        if (clock == "model") {
+          ThinkingModel thinking;
+          if (decision_seconds) thinking.seconds_per_decision = *decision_seconds;
+          if (iteration_seconds) thinking.seconds_per_iteration = *iteration_seconds;
+          options.thinking = thinking;
+        }
+        options.keep_episodes = true;
+        if (picture_episode) options.picture_episode = *picture_episode;
+        options.world_name = std::filesystem::path(domain->world_file).filename().string();
+        options.library_source = instance_label(library, *mdp->problem);
+        domains::TampResult result;
+        run_interruptibly(
+            [&](const std::function<bool()>& stop, Progress& counters) {
+              const Hooks hooks = hooks_of(stop, counters);
+              options.progress = hooks.progress;
+              options.stop = hooks.stop;
+              result = domains::run_tamp(*domain->loaded.domain, *mdp->problem, options, python_spelling());
+            },
+            progress);
+        py::dict out = json_object(domains::report::to_json(domains::report::Tamp{.domain = domain->name,
+                                                                                  .world = domain->world_file,
+                                                                                  .library = options.library_source,
+                                                                                  .options = &options,
+                                                                                  .result = &result}));
+        if (result.picture) out["picture"] = json_object(domains::report::picture_json(*result.picture));
+        return out;
+      },
+      py::arg("domain"), py::arg("library"), py::arg("solver"), py::arg("deadline"), py::kw_only(),
+      py::arg("episodes") = 100, py::arg("seed") = 1, py::arg("threads") = 0, py::arg("effort") = "checks",
+      py::arg("task_seconds") = 0.5, py::arg("arrival_period") = 2, py::arg("max_skeletons") = 16,
+      py::arg("decision_share") = 0.5, py::arg("clock") = "real", py::arg("decision_seconds") = py::none(),
+      py::arg("iteration_seconds") = py::none(), py::arg("picture_episode") = py::none(),
+      py::arg("progress") = py::none(),
+      "`ontime tamp`: the whole TAMP loop on the clock. The domain's task planner streams skeletons (at most "
+      "max_skeletons, each charged task_seconds of search, one every arrival_period steps), the allocator "
+      "`solver` (parameters as keyword arguments) decides which action the real motion planner refines next, "
+      "with the distributions of `library` (a Problem or an instance path whose actions are the domain's). "
+      "`deadline` in seconds. clock='model' charges thinking by decision_seconds and iteration_seconds, so that "
+      "the same seed gives the same episodes on any machine. Returns the fields of `ontime tamp --json`; with "
+      "picture_episode, also 'picture': that episode's drawing (what plot_tamp.py draws) and timeline CSV.");
+
+  m.def(
+      "map_data",
+      [](const std::shared_ptr<DomainHandle>& domain, Seed seed) {
+        domains::MapDrawing drawing;
+        {
+          const py::gil_scoped_release release;
+          drawing = domains::map_drawing(*domain->loaded.domain, domain->loaded.defaults, seed);
+        }
+        return json_object(domains::report::to_json(drawing));
+      },
+      py::arg("domain"), py::kw_only(), py::arg("seed") = 1,
+      "`ontime map`'s drawing: the domain's world and one refined motion per skeleton (stream k of `seed` for "
+      "skeleton k), the JSON the command writes beside its picture (python/plot_map.py draws it).");
+
+  m.def(
+      "generate_world",
+      [](const py::object& output, Number<int, "rows", 1, domains::kMaxBuildingSide> rows,
+         Number<int, "cols", 1, domains::kMaxBuildingSide> cols,
+         Number<double, "room_size", domains::kMinBuildingRoomSize, domains::kMaxBuildingRoomSize> room_size,
+         Number<double, "door_density", 0.0, 1.0> door_density, Number<double, "narrow_doors", 0.0, 1.0> narrow_doors,
+         Seed seed, const std::optional<std::string>& name) {
+        domains::BuildingOptions options;
+        options.rows = rows;
+        options.cols = cols;
+        options.room_size = room_size;
+        options.door_density = door_density;
+        options.narrow_door_share = narrow_doors;
+        options.seed = seed;
+        if (name) options.name = *name;
+        const std::string path = path_text(output);
+        domains::GeneratedWorld world;
+        {
+          const py::gil_scoped_release release;
+          world = domains::write_generated_world(options, path);
+        }
+        return json_object(domains::report::to_json(world));
+      },
+      py::arg("output"), py::kw_only(), py::arg("rows") = 6, py::arg("cols") = 5, py::arg("room_size") = 4.0,
+      py::arg("door_density") = 0.8, py::arg("narrow_doors") = 0.2, py::arg("seed") = 1, py::arg("name") = py::none(),
+      "`ontime generate-world`: writes a generated navigation world (an office building of rows x cols rooms) "
+      "to `output` and returns what it holds (the fields of `ontime generate-world --json`). Same options, same "
+      "seed: the same file.");
 }
 
 #else

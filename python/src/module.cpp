@@ -82,10 +82,6 @@ ParameterValues parameter_values(const py::kwargs& kwargs) {
   return values;
 }
 
-py::dict parameters_dict(const std::string& kind_name, const ParameterValues& values) {
-  return json_object(report::parameters_json(allocator_registry().find(kind_name), values));
-}
-
 ParameterSpelling python_spelling() {
   return [](std::string_view parameter) {
     std::string name(parameter);
@@ -94,6 +90,10 @@ ParameterSpelling python_spelling() {
     }
     return name;
   };
+}
+
+py::dict parameters_dict(const std::string& kind_name, const ParameterValues& values) {
+  return json_object(report::parameters_json(allocator_registry().find(kind_name), values));
 }
 
 py::object json_object(const std::string& text) { return py::module_::import("json").attr("loads")(text); }

@@ -111,8 +111,6 @@ void check_episodes(std::uint64_t episodes) {
   if (episodes == 0) throw UsageError("episodes must be at least 1");
 }
 
-}  // namespace
-
 std::pair<MonteCarloResult, std::optional<ExactEvaluation>> run_and_evaluate(
     const MdpHandle& mdp, const WorldFactory& worlds, const AllocatorFactory& factory, const MonteCarloOptions& options,
     bool exact, const ParameterValues& values, const py::object& progress) {
@@ -129,6 +127,8 @@ std::pair<MonteCarloResult, std::optional<ExactEvaluation>> run_and_evaluate(
       progress);
   return {result, exact_result};
 }
+
+}  // namespace
 
 py::dict monte_carlo_dict(const std::string& solver, const ParameterValues& values, const std::string& instance,
                           const Problem& problem, const MonteCarloResult& result, std::uint64_t seed,

@@ -1,5 +1,8 @@
 // The pieces of the TAMP loop over a real planner: room paths streamed in order of length, the
-// streaming planner world's prefix tree of actions, and whole streaming episodes.
+// streaming planner world's prefix tree of actions, whole streaming episodes, the domain's task
+// planner and skeleton drawing as the Domain interface gives them, and the loop (run_tamp).
+
+#include "ontime/domains/tamp.hpp"
 
 #include <gtest/gtest.h>
 
@@ -12,9 +15,11 @@
 #include "ontime/domains/library_messages.hpp"
 #include "ontime/domains/navigation.hpp"
 #include "ontime/domains/planner_world.hpp"
+#include "ontime/domains/registry.hpp"
 #include "ontime/domains/task_planner.hpp"
 #include "ontime/model/instance_io.hpp"
 #include "ontime/run/episode_runner.hpp"
+#include "ontime/util/error.hpp"
 #include "support/paper.hpp"
 
 namespace ontime::domains {
@@ -189,6 +194,58 @@ TEST(StreamingPlannerWorld, WholeEpisodesOnTheRealPlannerAreTheSameForAnyThreadC
   // Each skeleton's 0.5 s of search is charged: at least the first one's in every episode.
   EXPECT_GE(one.live_mean.outside, 0.5);
   EXPECT_GT(one.successes, 0u);
+}
+
+// Through the Domain interface: navigation streams its room paths in order of length and draws
+// them; a domain without a task planner of its own streams its fixed skeletons and draws none.
+TEST(DomainInterface, TaskPlannersAndSkeletonPointsOfEachDomain) {
+  const Fixture& f = fixture();
+  const Domain& navigation = f.domain;
+  const auto streamed = read_all(*navigation.task_planners(3)());
+  EXPECT_EQ(streamed, read_all(*room_path_planners(f.domain.world(), 3)()));
+  ASSERT_EQ(streamed.size(), 3U);
+  EXPECT_EQ(navigation.skeleton_points(streamed[0]), room_path_points(f.domain.world(), streamed[0]));
+  const LoadedDomain kitchen = load_domain("manipulation", testing::source_path("data/domains/manipulation.json"));
+  EXPECT_EQ(read_all(*kitchen.domain->task_planners(16)()), kitchen.domain->skeletons());
+  EXPECT_TRUE(kitchen.domain->skeleton_points(kitchen.domain->skeletons().front()).empty());
+}
+
+// The loop on the modelled clock: the same episodes for any thread count, every one kept with the
+// skeletons found, and the drawn episode the same as the run's.
+TEST(RunTamp, TheModelledClockGivesTheSameEpisodesForAnyThreadCount) {
+  const Fixture& f = fixture();
+  TampOptions options;
+  options.solver = "dp-rerun";
+  options.deadline = 45;
+  options.effort = EffortSettings{EffortUnit::collision_checks, 1200.0};
+  options.episodes = 4;
+  options.seed = 3;
+  options.max_skeletons = 3;
+  options.thinking = ThinkingModel{};
+  options.keep_episodes = true;
+  options.picture_episode = 2;
+  options.world_name = "navigation.json";
+  options.threads = 1;
+  const TampResult one = run_tamp(f.domain, f.library, options);
+  options.threads = 2;
+  const TampResult two = run_tamp(f.domain, f.library, options);
+  EXPECT_EQ(one.deadline_steps, 15);
+  EXPECT_EQ(one.summary.successes, two.summary.successes);
+  EXPECT_EQ(one.mean_skeletons_found, two.mean_skeletons_found);
+  ASSERT_EQ(one.episodes.size(), 4U);
+  for (std::size_t e = 0; e < one.episodes.size(); ++e) {
+    EXPECT_EQ(one.episodes[e].status, two.episodes[e].status) << e;
+    EXPECT_EQ(one.episodes[e].live.elapsed, two.episodes[e].live.elapsed) << e;
+    EXPECT_GE(one.episodes[e].skeletons, 1);
+  }
+  ASSERT_TRUE(one.picture.has_value());
+  EXPECT_EQ(one.picture->result.status, one.episodes[2].status);
+  EXPECT_EQ(one.picture->result.live.elapsed, one.episodes[2].live.elapsed);
+  EXPECT_EQ(static_cast<int>(one.picture->drawing.skeletons.size()), one.episodes[2].skeletons);
+  for (const EpisodeSkeleton& skeleton : one.picture->drawing.skeletons) EXPECT_GE(skeleton.points.size(), 3U);
+
+  options.deadline = 2;
+  EXPECT_THROW(run_tamp(f.domain, f.library, options), UsageError);
 }
 
 }  // namespace

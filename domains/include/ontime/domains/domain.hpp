@@ -5,14 +5,17 @@
 // A domain names its plan skeletons (sequences of abstract actions) and refines one abstract
 // action at a time: from a start configuration, with all randomness drawn from a seed, in
 // slices of effort that resume the same planner, so that an allocator may interleave actions.
-// It also turns itself and its motions into 2D drawing primitives for the map pictures.
+// It also turns itself and its motions into 2D drawing primitives for the map pictures, and
+// names the task planner that streams its skeletons in the TAMP loop (tamp.hpp).
 //
 // A second domain implements the same two classes (Domain, Refinement); nothing else in the
 // pipeline knows about rooms, arms or OMPL.
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -65,6 +68,21 @@ struct StandaloneAction {
   bool from_initial_configuration = false;
 };
 
+// A task planner streams plan skeletons: a sequence-before-satisfy TAMP system finds skeletons
+// one after another while their actions are being refined (task_planner.hpp has the room-path
+// planner of navigation worlds).
+class TaskPlanner {
+ public:
+  virtual ~TaskPlanner() = default;
+  // Starts over: the next call to next() returns the first skeleton again.
+  virtual void restart() = 0;
+  // The next skeleton, as the domain's action ids, or nullopt when there is none left.
+  virtual std::optional<std::vector<std::string>> next() = 0;
+};
+
+// Makes one task planner per episode runner thread; planners of one factory share their work.
+using TaskPlannerFactory = std::function<std::unique_ptr<TaskPlanner>()>;
+
 class Domain {
  public:
   virtual ~Domain() = default;
@@ -96,6 +114,14 @@ class Domain {
   virtual std::vector<std::array<double, 2>> outline(const Configuration& configuration) const = 0;
   // A short caption of a skeleton for pictures; by default its action ids.
   virtual std::string describe(const std::vector<std::string>& skeleton) const;
+  // A skeleton drawn from above as a polyline (for pictures of a TAMP episode); by default none
+  // (empty). Navigation: the room path through the doors' centres.
+  virtual std::vector<std::array<double, 2>> skeleton_points(const std::vector<std::string>& skeleton) const;
+
+  // The task planner of the TAMP loop, finding at most `max_skeletons` skeletons (at least 1);
+  // the domain must outlive the planners. By default the domain's fixed skeletons in their order;
+  // navigation: room paths in order of length.
+  virtual TaskPlannerFactory task_planners(int max_skeletons) const;
 };
 
 }  // namespace ontime::domains

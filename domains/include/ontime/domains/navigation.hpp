@@ -27,6 +27,10 @@ class NavigationDomain final : public Domain {
   Scene scene() const override;
   std::vector<std::array<double, 2>> trace(const std::vector<Configuration>& motion) const override;
   std::vector<std::array<double, 2>> outline(const Configuration& configuration) const override;
+  // The room path through the doors' centres (room_path_points, task_planner.hpp).
+  std::vector<std::array<double, 2>> skeleton_points(const std::vector<std::string>& skeleton) const override;
+  // Room paths in order of length (room_path_planners, task_planner.hpp).
+  TaskPlannerFactory task_planners(int max_skeletons) const override;
 
   const NavigationWorld& world() const noexcept { return world_; }
 

@@ -17,7 +17,9 @@
 //
 // Same options, same seed: the same file, byte for byte.
 
+#include <cstddef>
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -48,6 +50,19 @@ std::string generate_navigation_world_text(const BuildingOptions& options);
 
 // The same world, read back with the world file's checker (source: the world's name).
 NavigationWorld generate_navigation_world(const BuildingOptions& options);
+
+// What `ontime generate-world` (ontime.domains.generate_world) wrote: the file and what it holds.
+struct GeneratedWorld {
+  std::string output;
+  std::string name;
+  std::size_t rooms = 0, doors = 0, furniture = 0;
+  std::string start_room, goal_room;
+};
+
+// Writes the world file of these options to `output` (atomically: all or nothing) and reads it
+// back with the world file's checker. Throws UsageError (not std::invalid_argument) for options
+// out of range.
+GeneratedWorld write_generated_world(const BuildingOptions& options, const std::filesystem::path& output);
 
 // The route the generator keeps free for `door` and one of its two rooms, `room`: from the door's
 // centre straight into the room (facing across the door) to a pose 0.6 m from the wall, a turn on

@@ -1,5 +1,6 @@
 #pragma once
-// Domains by name, for the command line.
+// Domains by name, for the command line and Python: loading one from its world file, and the
+// settings the world file gives the commands that run it.
 
 #include <filesystem>
 #include <memory>
@@ -8,6 +9,7 @@
 #include <vector>
 
 #include "ontime/domains/domain.hpp"
+#include "ontime/domains/effort.hpp"
 #include "ontime/domains/world_types.hpp"
 
 namespace ontime::domains {
@@ -28,5 +30,9 @@ struct LoadedDomain {
 // Loads the named domain from its world file. Throws ontime::UsageError for an unknown name
 // and ontime::InputError for a bad world file.
 LoadedDomain load_domain(std::string_view name, const std::filesystem::path& world_file);
+
+// The effort settings of a run or a collection: the unit by name ("checks" or "wall"; UsageError
+// otherwise) and `checks_per_second`, or the world file's when it is 0.
+EffortSettings effort_settings(const DomainDefaults& defaults, std::string_view unit, double checks_per_second = 0);
 
 }  // namespace ontime::domains

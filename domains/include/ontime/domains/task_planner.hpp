@@ -1,8 +1,8 @@
 #pragma once
-// Task planners that stream plan skeletons: a sequence-before-satisfy TAMP system finds
-// skeletons one after another while their actions are being refined. A TaskPlanner hands them
-// out in its own order (shortest first, say); a streaming PlannerWorld (planner_world.hpp) turns
-// each into a skeleton arriving in the episode's session.
+// Task planners that stream plan skeletons (TaskPlanner, domain.hpp): a sequence-before-satisfy
+// TAMP system finds skeletons one after another while their actions are being refined. A
+// TaskPlanner hands them out in its own order (shortest first, say); a streaming PlannerWorld
+// (planner_world.hpp) turns each into a skeleton arriving in the episode's session.
 //
 // Room paths (navigation): the k shortest simple paths from the start room to the goal room
 // of the room graph (rooms as vertices, doors as edges weighted by the distance from one room's
@@ -22,18 +22,6 @@
 #include "ontime/domains/navigation_world.hpp"
 
 namespace ontime::domains {
-
-class TaskPlanner {
- public:
-  virtual ~TaskPlanner() = default;
-  // Starts over: the next call to next() returns the first skeleton again.
-  virtual void restart() = 0;
-  // The next skeleton, as the domain's action ids, or nullopt when there is none left.
-  virtual std::optional<std::vector<std::string>> next() = 0;
-};
-
-// Makes one task planner per episode runner thread; planners of one factory share their work.
-using TaskPlannerFactory = std::function<std::unique_ptr<TaskPlanner>()>;
 
 // Room paths of a navigation world in order of length (see above); `longest` caps how many are
 // ever produced. The world must outlive the planners.

@@ -1,0 +1,50 @@
+#include "ontime/domains/planner_run.hpp"
+
+#include "episode_options.hpp"
+#include "ontime/allocators/optimal.hpp"
+#include "ontime/domains/planner_world.hpp"
+#include "ontime/solve/optimal_solver.hpp"
+#include "ontime/util/parallel.hpp"
+
+namespace ontime::domains {
+
+bool is_live(const PlannerRunOptions& options) noexcept {
+  return options.live || options.effort.unit == EffortUnit::wall_clock;
+}
+
+void check_planner_run_request(const Problem& problem, const std::string& source, const PlannerRunOptions& options,
+                               const ParameterSpelling& spelling) {
+  allocator_registry().check_memory(options.solver, problem, options.parameters,
+                                    worker_count(options.episodes, options.threads), spelling);
+  if (options.exact || allocator_registry().find(options.solver).capabilities.has(Capability::optimal)) {
+    check_exact_work(problem, max_states_of(options.parameters), source, spelling);
+  }
+}
+
+PlannerRun run_planner_episodes(const Domain& domain, const Problem& problem, const PlannerRunOptions& options) {
+  const Mdp mdp(problem);
+  const AllocatorFactory factory = make_allocator_factory(options.solver, mdp, options.parameters);
+  PlannerWorldOptions planner;
+  planner.effort = options.effort;
+  planner.independent_starts = options.independent_starts;
+  MonteCarloOptions episodes = detail::monte_carlo_options(options);
+  PlannerRun run;
+  if (is_live(options)) {
+    episodes.live = LiveRun{LiveOptions{.decision_share = options.decision_share}, true};
+    run.episodes.resize(options.episodes);
+    // Each episode writes its own slot: no two threads touch one.
+    episodes.on_episode = [&run](std::uint64_t episode, const EpisodeResult& result) {
+      run.episodes[episode] = result;
+    };
+  }
+  run.summary = run_episodes(mdp, planner_worlds(domain, problem, planner), factory, episodes);
+  run.refinements_started = run.summary.world_statistics.find("refinements_started").value_or(0.0) /
+                            static_cast<double>(run.summary.episodes);
+  if (options.exact) {
+    const auto allocator = factory();
+    run.exact = evaluate_exactly(mdp, *allocator, max_states_of(options.parameters), options.stop);
+  }
+  return run;
+}
+
+}  // namespace ontime::domains

@@ -1,0 +1,120 @@
+"""The domain commands and their Python counterparts are one library function each: for the same
+arguments, ontime.domains.tamp, map_data, generate_world, run and collect_and_fit give what `ontime
+tamp`, `map`, `generate-world`, `run` and `collect` print or write, number for number (all but the
+run's own duration)."""
+
+import json
+
+import pytest
+
+import ontime
+from conftest import SOURCE_DIR
+
+pytestmark = pytest.mark.skipif(not ontime.domains.available, reason="built without the domains")
+
+NAVIGATION = str(SOURCE_DIR / "data" / "domains" / "navigation.json")
+NAVIGATION_MODEL = str(SOURCE_DIR / "data" / "instances" / "navigation.json")
+BUILDING = str(SOURCE_DIR / "data" / "domains" / "building-6x5.json")
+BUILDING_MOVES = str(SOURCE_DIR / "data" / "instances" / "building-6x5-moves.json")
+
+
+def without(result, *keys):
+    return {key: value for key, value in result.items() if key not in keys}
+
+
+def test_tamp_on_the_modelled_clock_matches_the_cli(cli, tmp_path):
+    # A few episodes of the TAMP loop on the 30-room building: with the modelled clock every charge
+    # is the same, whichever process runs them.
+    picture = tmp_path / "episode.png"
+    expected = cli("tamp", "--world", BUILDING, "--library", BUILDING_MOVES, "--deadline", 150, "--solver", "dp-rerun",
+                   "--episodes", 3, "--threads", 2, "--max-skeletons", 3, "--seed", 5, "--clock", "model",
+                   "--picture", picture, "--picture-episode", 1, "--no-plot", "--json")
+    building = ontime.domains.load("navigation", BUILDING)
+    got = ontime.domains.tamp(building, BUILDING_MOVES, "dp-rerun", 150, episodes=3, threads=1, max_skeletons=3,
+                              seed=5, clock="model", picture_episode=1)
+    assert without(got, "seconds", "picture") == without(expected, "seconds")
+    assert got["clock"] == "model" and got["deadline_steps"] == 50 and len(got["episode_results"]) == 3
+    assert got["successes"] >= 1 and got["refinements_started"] > 0
+    assert got["picture"]["episode"] == 1
+    assert got["picture"]["drawing"] == json.loads((tmp_path / "episode.json").read_text())
+    assert got["picture"]["timeline_csv"] == (tmp_path / "episode-timeline.csv").read_text()
+    drawing = got["picture"]["drawing"]
+    assert drawing["skeletons"] and all(len(skeleton["points"]) >= 3 for skeleton in drawing["skeletons"])
+    assert drawing["motions"] and (got["episode_results"][1]["status"] == "success") == any(
+        skeleton["executed"] for skeleton in drawing["skeletons"])
+
+
+def test_tamp_refuses_what_the_cli_refuses():
+    building = ontime.domains.load("navigation", BUILDING)
+    with pytest.raises(ontime.UsageError, match="^deadline 2: 0 steps of 3 s"):
+        ontime.domains.tamp(building, BUILDING_MOVES, "dp-rerun", 2)
+    with pytest.raises(ontime.UsageError, match="clock model needs effort checks"):
+        ontime.domains.tamp(building, BUILDING_MOVES, "dp-rerun", 45, clock="model", effort="wall")
+    with pytest.raises(ontime.UsageError, match="need clock='model'"):
+        ontime.domains.tamp(building, BUILDING_MOVES, "dp-rerun", 45, decision_seconds=0.001)
+    with pytest.raises(ontime.UsageError, match="picture_episode 3: the run has episodes 0 to 2"):
+        ontime.domains.tamp(building, BUILDING_MOVES, "dp-rerun", 45, episodes=3, picture_episode=3)
+    paper = str(SOURCE_DIR / "data" / "instances" / "paper" / "instance1.json")
+    with pytest.raises(ontime.InputError, match=r"instance1.json: actions: no action 'move\(R1,"):
+        ontime.domains.tamp(building, paper, "dp-rerun", 45)
+
+
+def test_map_data_is_the_drawing_the_cli_writes(cli, tmp_path):
+    png = tmp_path / "map.png"
+    done = cli("map", "--domain", "navigation", "--world", NAVIGATION, "--seed", 2, "-o", png, expect_json=False)
+    assert done.returncode == 0, done.stderr
+    got = ontime.domains.map_data(ontime.domains.load("navigation", NAVIGATION), seed=2)
+    assert got == json.loads((tmp_path / "map.json").read_text())
+    assert len(got["paths"]) == 4 and got["title"].endswith("(seed 2)")
+
+
+def test_generate_world_writes_the_clis_file(cli, tmp_path):
+    expected = cli("generate-world", "--rows", 3, "--cols", 4, "--door-density", 1, "--seed", 2, "-o",
+                   tmp_path / "cli.json", "--json")
+    got = ontime.domains.generate_world(tmp_path / "python.json", rows=3, cols=4, door_density=1, seed=2)
+    assert (tmp_path / "python.json").read_bytes() == (tmp_path / "cli.json").read_bytes()
+    assert without(got, "output") == without(expected, "output")
+    assert (got["name"], got["rooms"], got["doors"]) == ("building-3x4", 12, 17)
+    # Without --json, the summary line the report writes as text.
+    text = cli("generate-world", "-o", tmp_path / "default.json", expect_json=False).stdout
+    default = ontime.domains.generate_world(tmp_path / "default-python.json")
+    assert text == (f"Wrote {tmp_path / 'default.json'}: {default['rooms']} rooms, {default['doors']} doors, "
+                    f"{default['furniture']} pieces of furniture; start in {default['start_room']}, goal "
+                    f"{default['goal_room']}.\n")
+    with pytest.raises(ontime.UsageError, match="at least two rooms"):
+        ontime.domains.generate_world(tmp_path / "never.json", rows=1, cols=1)
+    with pytest.raises(ontime.UsageError, match="parameter 'rows'"):
+        ontime.domains.generate_world(tmp_path / "never.json", rows=0)
+    assert not (tmp_path / "never.json").exists()
+
+
+def test_run_matches_the_cli(cli):
+    expected = cli("run", "--domain", "navigation", "--world", NAVIGATION, "--instance", NAVIGATION_MODEL, "--solver",
+                   "dp-rerun", "--episodes", 4, "--threads", 2, "--seed", 3, "--exact", "--json")
+    nav = ontime.domains.load("navigation", NAVIGATION)
+    got = ontime.domains.run(nav, NAVIGATION_MODEL, "dp-rerun", episodes=4, threads=1, seed=3, exact=True)
+    assert without(got, "seconds") == without(expected, "seconds")
+    assert got["live"] is False and "model_exact_success_probability" in got
+    # Live episodes: the same fields, every episode with its timeline.
+    live_expected = cli("run", "--domain", "navigation", "--world", NAVIGATION, "--instance", NAVIGATION_MODEL,
+                        "--solver", "dp-rerun", "--episodes", 2, "--threads", 1, "--live", "--json")
+    live = ontime.domains.run(nav, NAVIGATION_MODEL, "dp-rerun", episodes=2, threads=1, live=True)
+    assert list(live) == list(live_expected)
+    assert len(live["episode_results"]) == 2 and all(episode["timeline"] for episode in live["episode_results"])
+
+
+def test_collect_and_fit_writes_the_clis_files(cli, tmp_path):
+    arguments = dict(trials=2, seed=4, threads=2)
+    expected = cli("collect", "--domain", "navigation", "--world", NAVIGATION, "--trials", 2, "--seed", 4,
+                   "--threads", 2, "--log", tmp_path / "cli.jsonl", "-o", tmp_path / "cli.json", "--json")
+    nav = ontime.domains.load("navigation", NAVIGATION)
+    got = ontime.domains.collect_and_fit(nav, tmp_path / "python.jsonl", tmp_path / "python.json", **arguments)
+    assert without(got, "seconds", "log", "instance") == without(expected, "seconds", "log", "instance")
+    assert (tmp_path / "python.jsonl").read_bytes() == (tmp_path / "cli.jsonl").read_bytes()
+    assert (tmp_path / "python.json").read_bytes() == (tmp_path / "cli.json").read_bytes()
+    assert not (tmp_path / "python.jsonl.checkpoint").exists()
+    # The records collect() returns are the same log.
+    records = ontime.domains.collect(nav, **arguments)
+    assert len(records) == got["attempts"] == expected["attempts"]
+    ontime.write_planner_log(records, tmp_path / "records.jsonl")
+    assert (tmp_path / "records.jsonl").read_bytes() == (tmp_path / "cli.jsonl").read_bytes()
