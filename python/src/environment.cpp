@@ -1,13 +1,18 @@
 // The stepping core of ontime.env.EffortAllocationEnv: one simulated episode at a time in a hidden
 // sampled world (the simulator's HiddenWorld, seeded as the episode runner seeds it), observed as
-// the normalised MDP state the ppo allocator sees. Written in C++ so that a step costs a few
+// the normalised MDP state the ppo allocator sees. Each episode is a Session whose choices the
+// caller makes (Session::decide), carried out against the world as the episode runner carries
+// out its allocators' (Session::carry_out). Written in C++ so that a step costs a few
 // microseconds from Python; the Gymnasium-style API around it is pure Python (env.py).
 
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <optional>
+
 #include "bindings.hpp"
 #include "ontime/allocators/ppo.hpp"
+#include "ontime/run/session.hpp"
 #include "ontime/run/simulator.hpp"
 #include "ontime/util/error.hpp"
 #include "ontime/util/random.hpp"
@@ -23,7 +28,7 @@ class EnvironmentCore {
         world_(*mdp_->problem, 0),
         seed_(seed),
         features_(static_cast<std::size_t>(feature_count(mdp_->mdp.skeleton_count()))),
-        state_(mdp_->mdp.start()) {}
+        start_(mdp_->mdp.start()) {}
 
   int skeleton_count() const { return mdp_->mdp.skeleton_count(); }
   int feature_size() const { return static_cast<int>(features_); }
@@ -36,44 +41,43 @@ class EnvironmentCore {
       episode_ = 0;
     }
     world_.begin_episode(stream_seed(seed_, episode_++));
-    state_ = mdp_->mdp.start();
-    status_ = Status::running;
+    session_.emplace(mdp_->mdp);
     return observation();
   }
 
   py::tuple step(long long action) {
-    if (status_ != Status::running) throw UsageError("the episode is over: call reset() before step()");
+    if (status() != Status::running) throw UsageError("the episode is over: call reset() before step()");
     if (action < 0 || action >= skeleton_count()) {
       throw UsageError("action " + std::to_string(action) + " is not a skeleton index in [0, " +
                        std::to_string(skeleton_count()) + ")");
     }
-    const int choice = static_cast<int>(action);
-    const int next = mdp_->mdp.next_action(state_, choice);
-    const Observation seen =
-        next < 0 ? Observation::not_yet() : world_.step(next, state_.spent[static_cast<std::size_t>(choice)]);
-    status_ = mdp_->mdp.apply(state_, choice, seen);
-    const double reward = status_ == Status::success ? 1.0 : 0.0;
-    return py::make_tuple(observation(), reward, status_ != Status::running, false);
+    session_->decide(static_cast<int>(action));
+    const Status status = session_->carry_out(world_);
+    const double reward = status == Status::success ? 1.0 : 0.0;
+    return py::make_tuple(observation(), reward, status != Status::running, false);
   }
 
   py::array_t<std::int8_t> action_mask() const {
     py::array_t<std::int8_t> mask(skeleton_count());
     auto view = mask.mutable_unchecked<1>();
     for (int k = 0; k < skeleton_count(); ++k) view(k) = 0;
-    if (status_ == Status::running) {
-      for (const int choice : mdp_->mdp.useful_choices(state_)) view(choice) = 1;
+    if (status() == Status::running) {
+      for (const int choice : mdp_->mdp.useful_choices(session_->state())) view(choice) = 1;
     }
     return mask;
   }
 
-  StateView state() const { return {state_, skeleton_count()}; }
-  Status status() const { return status_; }
+  StateView state() const { return {current_state(), skeleton_count()}; }
+  // No episode yet: step() needs a reset() first.
+  Status status() const { return session_ ? session_->status() : Status::failure; }
   std::shared_ptr<MdpHandle> mdp() const { return mdp_; }
 
  private:
+  const State& current_state() const { return session_ ? session_->state() : start_; }
+
   py::array_t<float> observation() const {
     py::array_t<float> out(static_cast<py::ssize_t>(features_));
-    normalised_state(mdp_->mdp, state_, std::span<float>(out.mutable_data(), features_));
+    normalised_state(mdp_->mdp, current_state(), std::span<float>(out.mutable_data(), features_));
     return out;
   }
 
@@ -82,8 +86,8 @@ class EnvironmentCore {
   std::uint64_t seed_;
   std::uint64_t episode_ = 0;
   std::size_t features_;
-  State state_;
-  Status status_ = Status::failure;  // no episode yet: step() needs a reset() first
+  State start_;                     // the state before the first reset()
+  std::optional<Session> session_;  // the episode since the last reset()
 };
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "allocators/detail/ppo_networks.hpp"
+#include "ontime/run/session.hpp"
 #include "ontime/run/simulator.hpp"
 #include "ontime/util/error.hpp"
 #include "ontime/util/random.hpp"
@@ -129,6 +130,7 @@ class PpoTrainer {
         actor_optimiser_(networks_.actor, h.actor_learning_rate),
         critic_optimiser_(networks_.critic, h.critic_learning_rate),
         sampling_(stream_seed(seed, 1)),
+        world_(mdp.problem(), 0),
         features_(inputs_),
         log_probabilities_(static_cast<std::size_t>(count_)),
         valid_(static_cast<std::size_t>(count_)) {}
@@ -138,10 +140,12 @@ class PpoTrainer {
 
   // Plays one episode in the hidden world of `world_seed` with the current actor (choices
   // sampled), appends its steps to the batch with their advantages (GAE) and returns, and
-  // returns how it ended.
+  // returns how it ended. The episode steps through a Session (session.hpp) with the actor's
+  // choices, as the episode runner's allocators step through theirs.
   Status play_episode(std::uint64_t world_seed) {
-    const HiddenWorld world(mdp_.problem(), world_seed);
-    State state = mdp_.start();
+    world_.begin_episode(world_seed);
+    Session session(mdp_);
+    const State& state = session.state();
     const std::size_t first = batch_.steps();
     Status status = Status::running;
     for (int step = 0; step < h_.max_episode_steps && status == Status::running; ++step) {
@@ -164,9 +168,8 @@ class PpoTrainer {
         return portable_exp(log_probabilities_[static_cast<std::size_t>(choices[i])]);
       };
       const int action = choices[sample_index(choices.size(), probability, sampling_)];
-      const int refining = mdp_.next_action(state, action);
-      const Observation observation = world.observe(refining, state.spent[static_cast<std::size_t>(action)]);
-      status = mdp_.apply(state, action, observation);
+      session.decide(action);
+      status = session.carry_out(world_);
 
       batch_.features.insert(batch_.features.end(), features_.data(), features_.data() + inputs_);
       batch_.valid.insert(batch_.valid.end(), valid, valid + count_);
@@ -260,6 +263,7 @@ class PpoTrainer {
   Adam<float> actor_optimiser_;
   Adam<float> critic_optimiser_;
   SplitMix64 sampling_;
+  HiddenWorld world_;  // redrawn for every episode
   Batch batch_;
   Vector features_;
   std::vector<double> log_probabilities_;

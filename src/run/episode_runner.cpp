@@ -82,8 +82,9 @@ void take_next_skeleton(Session& session, Arrivals& arrivals) {
   arrivals.steps_since_last = 0;
 }
 
-// The one loop of every episode: decide, step the world, report, until the session ends (and,
-// in a streaming episode, let skeletons arrive between decisions).
+// The one loop of the runner's episodes: the allocator decides, the session carries the step
+// out in the world (Session::carry_out, the step ppo training and the Python environment take
+// too), until the session ends (and, in a streaming episode, skeletons arrive between decisions).
 EpisodeResult drive(Session& session, World& world, const DecisionBudget& budget, DecisionTimer* timer,
                     const std::optional<LiveRun>& live, Arrivals* arrivals) {
   EpisodeResult result;
@@ -104,12 +105,7 @@ EpisodeResult drive(Session& session, World& world, const DecisionBudget& budget
     }
     if (decision.skeleton < 0) break;  // a live session ran out of time before deciding
     ++result.decisions;
-    if (decision.action < 0) {
-      session.report_not_yet();
-    } else {
-      const Steps spent = session.state().spent[static_cast<std::size_t>(decision.skeleton)];
-      session.report(world.step(decision.action, spent));
-    }
+    session.carry_out(world);
     if (arrivals != nullptr) ++arrivals->steps_since_last;
   }
   result.status = session.status();

@@ -1,12 +1,12 @@
 // The live half of Session (include/ontime/run/session.hpp): a session on a Clock, charged in
-// seconds. The ledger: every decision's, planner call's, observation's and outside time, on a
-// timeline of one entry per step and in totals; CT is ceil(elapsed / step_seconds), an
-// unsuccessful call that overran adds the whole slices it took to PT, and success needs the
-// completed skeleton's execution seconds to fit in the seconds left (a tolerance of 1e-9
-// slices against rounding). An anytime allocator without a budget of its own gets
-// decision_share of a slice, at most the seconds left; on a modelled clock, time budgets are
-// the iterations that fit in them, and the search's iterations are charged. Beside the clock,
-// the model's step clock judges the same planner calls (model_status).
+// seconds. The ledger: every decision's (the allocator's, or the caller's: decide()), planner
+// call's, observation's and outside time, on a timeline of one entry per step and in totals; CT is
+// ceil(elapsed / step_seconds), an unsuccessful call that overran adds the whole slices it took to
+// PT, and success needs the completed skeleton's execution seconds to fit in the seconds left (a
+// tolerance of 1e-9 slices against rounding). An anytime allocator without a budget of its own gets
+// decision_share of a slice, at most the seconds left; on a modelled clock, time budgets are the
+// iterations that fit in them, and the search's iterations are charged. Beside the clock, the
+// model's step clock judges the same planner calls (model_status).
 //
 // Cost: a few clock reads and one timeline entry per step (reserved when the session starts).
 
@@ -118,11 +118,24 @@ Decision Session::choose_live(const DecisionBudget& budget) {
     throw UsageError("allocator '" + std::string(allocator_->name()) + "' chose skeleton " + std::to_string(choice) +
                      ", outside [0, " + std::to_string(mdp_->skeleton_count()) + ")");
   }
+  return record_live_decision(choice, begin, steps_before);
+}
+
+Decision Session::decide_live(int skeleton) {
+  const double begin = clock_->now();
+  const Steps steps_before = state_.time;
+  end_if_out_of_time();
+  if (status_ != Status::running) return Decision{};
+  return record_live_decision(skeleton, begin, steps_before);
+}
+
+Decision Session::record_live_decision(int choice, double begin, Steps steps_before) {
   decided_at_ = clock_->now();
   pending_ = choice;
   LiveStep step;
   step.skeleton = choice;
   step.action = mdp_->next_action(state_, choice);
+  pending_action_ = step.action;
   step.start = begin - started_ + charged_outside_;
   step.outside_seconds = begin - last_report_;
   step.decision_seconds = decided_at_ - begin;
@@ -201,7 +214,7 @@ Status Session::report_live(int choice, int action, const Observation& observati
     status_ = Status::failure;
     ended_at_ = elapsed;
   }
-  allocator_->observe(before_, choice, state_, status_);
+  if (allocator_ != nullptr) allocator_->observe(before_, choice, state_, status_);
   // What the allocator did with the observation (a search moving its tree) is its thinking too.
   last_report_ = clock_->now();
   const double observing = last_report_ - reported;

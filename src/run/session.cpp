@@ -1,8 +1,9 @@
-// Session (include/ontime/run/session.hpp): the MDP state, the allocator asked before every step
-// and the end of the episode, and the skeletons that arrive and leave in a session that owns its
-// problem. A live session's clock, seconds and timeline are in live_session.cpp: where a step
-// differs on the clock (choosing within the seconds left, a report charged in seconds), the
-// member here hands over to its live counterpart.
+// Session (include/ontime/run/session.hpp): the MDP state, the allocator asked (or the caller's
+// choice taken) before every step, the step carried out against a World, the end of the episode,
+// and the skeletons that arrive and leave in a session that owns its problem. A live session's
+// clock, seconds and timeline are in live_session.cpp: where a step differs on the clock (choosing
+// within the seconds left, a report charged in seconds), the member here hands over to its live
+// counterpart.
 
 #include "ontime/run/session.hpp"
 
@@ -32,6 +33,12 @@ Session::Session(const Mdp& mdp, Allocator& allocator, std::uint64_t seed, const
   start_live(clock, options);
 }
 
+// before_ stays empty until a transition needs it (a live report): a caller-decided session that
+// is not live never copies its state.
+Session::Session(const Mdp& mdp) : mdp_(&mdp), allocator_(nullptr), state_(mdp.start()) {}
+
+Session::Session(const Mdp& mdp, const Clock& clock, LiveOptions options) : Session(mdp) { start_live(clock, options); }
+
 Session::Session(Problem problem, AllocatorMaker make_allocator, std::uint64_t seed, const Clock* clock,
                  LiveOptions options)
     : mdp_(nullptr),
@@ -40,16 +47,17 @@ Session::Session(Problem problem, AllocatorMaker make_allocator, std::uint64_t s
       owned_mdp_(std::make_unique<Mdp>(*owned_problem_)),
       make_allocator_(std::move(make_allocator)),
       seed_(seed) {
-  if (!make_allocator_) throw UsageError("a session that owns its problem needs a function making its allocator");
-  owned_allocator_ = make_allocator_(*owned_mdp_);
-  if (!owned_allocator_) throw UsageError("the allocator maker returned no allocator");
+  if (make_allocator_) {
+    owned_allocator_ = make_allocator_(*owned_mdp_);
+    if (!owned_allocator_) throw UsageError("the allocator maker returned no allocator");
+  }
   mdp_ = owned_mdp_.get();
   allocator_ = owned_allocator_.get();
   state_ = mdp_->start();
   before_ = state_;
   action_execution_steps_.assign(static_cast<std::size_t>(owned_problem_->action_count()), -1);
   action_execution_seconds_.assign(static_cast<std::size_t>(owned_problem_->action_count()), -1.0);
-  allocator_->begin_episode(seed);
+  if (allocator_ != nullptr) allocator_->begin_episode(seed);
   if (clock != nullptr) start_live(*clock, options);
 }
 
@@ -60,8 +68,7 @@ bool Session::out_of_skeletons() const { return !more_expected_ && !mdp_->any_ca
 
 void Session::expect_more_skeletons(bool expected) {
   if (owned_problem_ == nullptr) {
-    throw std::logic_error(
-        "expect_more_skeletons needs a session that owns its problem (made with an allocator maker)");
+    throw std::logic_error("expect_more_skeletons needs a session that owns its problem (made from a Problem)");
   }
   more_expected_ = expected;
   if (clock_ != nullptr && model_status_ == Status::running && !expected && !mdp_->any_can_succeed(model_state_)) {
@@ -75,9 +82,21 @@ void Session::expect_more_skeletons(bool expected) {
 
 Decision Session::choose() { return choose(DecisionBudget{}); }
 
+namespace {
+
+// What choose() and decide() check before a decision.
+void check_decidable(Status status, int pending) {
+  if (status != Status::running) throw std::logic_error("the session is over; nothing more to choose");
+  if (pending >= 0) throw std::logic_error("the last decision has not been reported yet");
+}
+
+}  // namespace
+
 Decision Session::choose(const DecisionBudget& budget) {
-  if (status_ != Status::running) throw std::logic_error("the session is over; nothing more to choose");
-  if (pending_ >= 0) throw std::logic_error("the last decision has not been reported yet");
+  check_decidable(status_, pending_);
+  if (allocator_ == nullptr) {
+    throw std::logic_error("choose() needs a session with an allocator; in this one the caller decides (decide())");
+  }
   if (clock_ == nullptr) {
     const int choice = allocator_->choose(state_, budget);
     if (choice < 0 || choice >= mdp_->skeleton_count()) {
@@ -85,9 +104,32 @@ Decision Session::choose(const DecisionBudget& budget) {
                        ", outside [0, " + std::to_string(mdp_->skeleton_count()) + ")");
     }
     pending_ = choice;
-    return Decision{choice, mdp_->next_action(state_, choice)};
+    pending_action_ = mdp_->next_action(state_, choice);
+    return Decision{choice, pending_action_};
   }
   return choose_live(budget);
+}
+
+Decision Session::decide(int skeleton) {
+  check_decidable(status_, pending_);
+  if (allocator_ != nullptr) {
+    throw std::logic_error("decide() needs a session without an allocator; in this one allocator '" +
+                           std::string(allocator_->name()) + "' decides (choose())");
+  }
+  if (skeleton < 0 || skeleton >= mdp_->skeleton_count()) {
+    throw UsageError("skeleton " + std::to_string(skeleton) + " is outside [0, " +
+                     std::to_string(mdp_->skeleton_count()) + ")");
+  }
+  if (clock_ == nullptr) {
+    pending_ = skeleton;
+    pending_action_ = mdp_->next_action(state_, skeleton);
+    return Decision{skeleton, pending_action_};
+  }
+  return decide_live(skeleton);
+}
+
+void Session::throw_without_decision() {
+  throw std::logic_error("carry_out without a decision: call choose() or decide() first");
 }
 
 Status Session::report_not_yet() { return report(Observation::not_yet()); }
@@ -105,12 +147,12 @@ Status Session::report(const Observation& observation) {
 }
 
 Status Session::report(const Observation& observation, double execution_seconds) {
-  if (pending_ < 0) throw std::logic_error("report without a decision: call choose() first");
+  if (pending_ < 0) throw std::logic_error("report without a decision: call choose() or decide() first");
   const int choice = pending_;
-  before_ = state_;
+  const int action = pending_action_;
+  if (allocator_ != nullptr || clock_ != nullptr) before_ = state_;
   const Status model_status = mdp_->apply(state_, choice, observation);
   pending_ = -1;
-  const int action = mdp_->next_action(before_, choice);
   // Only live and owning sessions keep what each action revealed; a plain session (an episode of
   // a Monte Carlo run) does no work for it.
   if (action >= 0 && observation.refined && !action_execution_steps_.empty()) {
@@ -126,7 +168,7 @@ Status Session::report(const Observation& observation, double execution_seconds)
     // Skeletons still to come keep a session going that its present ones cannot save.
     if (status_ == Status::failure && more_expected_ && state_.time < mdp_->deadline()) status_ = Status::running;
     if (status_ == Status::success) solution_ = mdp_->completed_skeleton(state_, choice);
-    allocator_->observe(before_, choice, state_, status_);
+    if (allocator_ != nullptr) allocator_->observe(before_, choice, state_, status_);
     return status_;
   }
   return report_live(choice, action, observation, execution_seconds);
@@ -166,8 +208,11 @@ void Session::change_skeletons(std::vector<Action> actions, std::vector<std::vec
   auto problem = std::make_unique<Problem>(current.name(), current.deadline(), current.step_seconds(),
                                            std::move(actions), std::move(skeletons), current.description());
   auto mdp = std::make_unique<Mdp>(*problem);
-  std::unique_ptr<Allocator> allocator = make_allocator_(*mdp);
-  if (!allocator) throw UsageError("the allocator maker returned no allocator");
+  std::unique_ptr<Allocator> allocator;
+  if (make_allocator_) {
+    allocator = make_allocator_(*mdp);
+    if (!allocator) throw UsageError("the allocator maker returned no allocator");
+  }
   State state = carried_over(state_, *problem);
   State model = clock_ != nullptr ? carried_over(model_state_, *problem) : State{};
 
@@ -180,7 +225,8 @@ void Session::change_skeletons(std::vector<Action> actions, std::vector<std::vec
   before_ = state_;
   action_execution_steps_.resize(static_cast<std::size_t>(owned_problem_->action_count()), -1);
   action_execution_seconds_.resize(static_cast<std::size_t>(owned_problem_->action_count()), -1.0);
-  allocator_->begin_episode(stream_seed(seed_, ++changes_));
+  ++changes_;
+  if (allocator_ != nullptr) allocator_->begin_episode(stream_seed(seed_, changes_));
   if (clock_ != nullptr) {
     model_state_ = std::move(model);
     if (model_status_ == Status::running && !more_expected_ && !mdp_->any_can_succeed(model_state_)) {
@@ -197,7 +243,7 @@ namespace {
 
 void check_changeable(bool owns_problem, int pending, Status status, const char* what) {
   if (!owns_problem) {
-    throw std::logic_error(std::string(what) + " needs a session that owns its problem (made with an allocator maker)");
+    throw std::logic_error(std::string(what) + " needs a session that owns its problem (made from a Problem)");
   }
   if (pending >= 0) throw std::logic_error(std::string(what) + " while a decision awaits its report");
   if (status != Status::running) throw std::logic_error(std::string(what) + " after the session ended");

@@ -16,6 +16,7 @@
 #include "ontime/run/session.hpp"
 #include "ontime/run/simulator.hpp"
 #include "ontime/util/error.hpp"
+#include "ontime/util/random.hpp"
 #include "support/paper.hpp"
 
 namespace ontime {
@@ -230,6 +231,58 @@ TEST(LiveSession, ExactSlicesAndInstantDecisionsGiveTheModelsSuccesses) {
       EXPECT_GT(live.live_mean.planning, 0.0);
     }
   }
+}
+
+// A live session whose choices the caller makes, on exact slices: the transitions of the same
+// choices in a session that is not live, the caller's decisions charged as taking no time.
+TEST(LiveSession, CallerDecisionsOnExactSlicesMakeTheModelsTransitions) {
+  const Problem problem = testing::paper_instance("instance2");
+  const Mdp mdp(problem);
+  int successes = 0;
+  for (std::uint64_t episode = 0; episode < 200; ++episode) {
+    SCOPED_TRACE("episode " + std::to_string(episode));
+    SlicedWorld live_world(problem);
+    HiddenWorld world(problem, 0);
+    live_world.begin_episode(episode);
+    world.begin_episode(episode);
+    Session live(mdp, *live_world.clock());
+    Session model(mdp);
+    EXPECT_TRUE(live.is_live());
+    EXPECT_FALSE(live.has_allocator());
+    SplitMix64 random(episode);
+    while (model.status() == Status::running) {
+      const int choice = static_cast<int>(random() % static_cast<std::uint64_t>(mdp.skeleton_count()));
+      const Decision decision = live.decide(choice);
+      ASSERT_EQ(decision.skeleton, choice);
+      EXPECT_EQ(decision.action, model.decide(choice).action);
+      live.carry_out(live_world);
+      model.carry_out(world);
+      EXPECT_EQ(live.state(), model.state());
+      EXPECT_EQ(live.status(), model.status());
+    }
+    EXPECT_EQ(live.solution(), model.solution());
+    EXPECT_EQ(live.model_status(), model.status());
+    EXPECT_EQ(live.timeline().size(), static_cast<std::size_t>(model.steps_used()));
+    EXPECT_DOUBLE_EQ(live.totals().decision, 0.0);
+    successes += model.status() == Status::success ? 1 : 0;
+  }
+  EXPECT_GT(successes, 0);
+}
+
+TEST(LiveSession, ACallerDecisionAfterTheDeadlinePassedEndsTheSession) {
+  const Problem problem = two_actions(10, 0.5);
+  const Mdp mdp(problem);
+  ManualClock clock;
+  Session session(mdp, clock);
+  EXPECT_THROW(session.choose(), std::logic_error);  // no allocator
+  EXPECT_THROW(session.decide(1), UsageError);       // one skeleton
+  EXPECT_EQ(session.decide(0).action, 0);
+  clock.advance(0.5);
+  EXPECT_EQ(session.report_not_yet(), Status::running);
+  clock.advance(5.0);  // the caller was away past the deadline
+  EXPECT_EQ(session.decide(0).skeleton, -1);
+  EXPECT_EQ(session.status(), Status::failure);
+  EXPECT_THROW(session.decide(0), std::logic_error);
 }
 
 TEST(LiveSession, EpisodesKeepTheirTimelineWhenAsked) {

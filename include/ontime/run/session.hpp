@@ -12,8 +12,17 @@
 //
 // The session keeps the MDP state, asks the allocator before every step, and reports
 // success (with the skeleton to execute) or failure: the deadline passed, or no skeleton can
-// still meet it, so that no more effort is wasted. The episode runner (episode_runner.hpp)
-// drives the same API against a World.
+// still meet it, so that no more effort is wasted.
+//
+// Every episode of the library steps through a session: one place computes a step (the action
+// to refine, the world's answer or an idle step, the transition, the end of the episode). A
+// session made without an allocator takes the caller's choices instead (decide(), checked as
+// choose() checks an allocator's): a learner's environment, or a policy of the caller's own.
+// carry_out(world) carries out the step just decided against a World (world.hpp): one step of
+// effort on its action, or an idle step that never reaches the world (a skeleton with nothing
+// left to refine), then its report. The episode runner (episode_runner.hpp) drives allocators
+// this way, ppo training (ppo_training.hpp) and the Python environment (ontime.env) their
+// learners' choices.
 //
 // A live session (constructed with a Clock) runs on seconds instead of abstract steps. The
 // deadline is D * step_seconds after the session began, and everything the clock sees counts
@@ -31,7 +40,9 @@
 // slice (at most the seconds left). With a manual clock advanced by exactly one slice per call
 // and no time elsewhere, a live session makes exactly the MDP's transitions.
 //
-// The live overhead per step is a few clock reads and one timeline entry (reserved up front).
+// Cost: a step of a session that is not live allocates nothing (the state before a transition
+// is kept in a reused buffer, and only when an allocator observes it or the clock needs it). The
+// live overhead per step is a few clock reads and one timeline entry (reserved up front).
 
 #include <cstdint>
 #include <functional>
@@ -43,6 +54,7 @@
 #include "ontime/allocators/decision_budget.hpp"
 #include "ontime/mdp/mdp.hpp"
 #include "ontime/run/clock.hpp"
+#include "ontime/run/world.hpp"
 
 namespace ontime {
 
@@ -75,7 +87,7 @@ struct LiveTotals {
 };
 
 struct Decision {
-  int skeleton = -1;  // the allocator's choice
+  int skeleton = -1;  // the allocator's (or the caller's) choice
   int action = -1;    // the action to refine now, or -1: the step is spent idle
 };
 
@@ -83,7 +95,7 @@ class Session {
  public:
   // Makes the allocator of a session whose skeletons change: called with the first Mdp and
   // again with every new one (e.g. [&](const Mdp& mdp) { return make_allocator_factory(name,
-  // mdp, values)(); }).
+  // mdp, values)(); }). An empty maker: the caller decides every step (decide()).
   using AllocatorMaker = std::function<std::unique_ptr<Allocator>(const Mdp&)>;
 
   // Calls allocator.begin_episode(seed). The Mdp and the allocator must outlive the session.
@@ -91,6 +103,12 @@ class Session {
   // A live session on `clock` (which must outlive it); its deadline starts now. Throws
   // UsageError for a decision share outside (0, 1e6].
   Session(const Mdp& mdp, Allocator& allocator, std::uint64_t seed, const Clock& clock, LiveOptions options = {});
+  // A session without an allocator: the caller decides every step (decide()). The Mdp must
+  // outlive it.
+  explicit Session(const Mdp& mdp);
+  // The same live on `clock` (which must outlive it); its deadline starts now. Throws UsageError
+  // for a decision share outside (0, 1e6].
+  Session(const Mdp& mdp, const Clock& clock, LiveOptions options = {});
   // A session that owns its problem and its allocator, so that skeletons can arrive and leave
   // while it runs (add_skeleton, retire_skeleton); live on `clock` unless it is null.
   Session(Problem problem, AllocatorMaker make_allocator, std::uint64_t seed, const Clock* clock = nullptr,
@@ -109,7 +127,21 @@ class Session {
   // session ends as a failure and the decision has skeleton -1.
   Decision choose();
   // The same within `budget` (an anytime allocator's budget for this decision; unset: its own).
+  // Both throw std::logic_error for a session without an allocator (use decide()).
   Decision choose(const DecisionBudget& budget);
+  // The caller's choice of the next step: skeleton `skeleton`, in a session without an allocator.
+  // Checked as choose() checks an allocator's: std::logic_error when the session is over, a
+  // decision is still waiting for its report, or the session has an allocator (it decides);
+  // UsageError for a skeleton index out of range. A live session first brings its state up to
+  // the clock, as choose() does (skeleton -1 when it ended meanwhile).
+  Decision decide(int skeleton);
+
+  // Carries out the step just decided in `world`: one step of effort on its action,
+  // world.step(action, effort already spent on it), reported as report() does; an idle step (no
+  // action left to refine) is reported as not yet without asking the world. Returns the status
+  // after the step. Throws std::logic_error without a pending decision, and what the world or
+  // report() throws.
+  Status carry_out(World& world);
 
   // Reports the outcome of the step just decided. Throws std::logic_error without a
   // pending decision, and UsageError for a refinement reported on an idle step or a negative
@@ -161,6 +193,8 @@ class Session {
   Steps steps_used() const noexcept { return state_.time; }
 
   bool is_live() const noexcept { return clock_ != nullptr; }
+  // Whether an allocator decides (choose()) rather than the caller (decide()).
+  bool has_allocator() const noexcept { return allocator_ != nullptr; }
   // Live sessions: D * step_seconds, the seconds gone (frozen when the session ended), the
   // steps so far, and what was charged.
   double step_seconds() const noexcept;
@@ -175,10 +209,14 @@ class Session {
   Status model_status() const noexcept { return model_status_; }
 
  private:
+  [[noreturn]] static void throw_without_decision();
   // The live half (src/run/live_session.cpp).
   void start_live(const Clock& clock, LiveOptions options);
-  // choose() and report() on the clock, once what every session checks and records is done.
+  // choose(), decide() and report() on the clock, once what every session checks and records is
+  // done; record_live_decision keeps a decision made at `begin` on the timeline.
   Decision choose_live(const DecisionBudget& budget);
+  Decision decide_live(int skeleton);
+  Decision record_live_decision(int choice, double begin, Steps steps_before);
   Status report_live(int choice, int action, const Observation& observation, double execution_seconds);
   // The search iterations the allocator has run so far (its "iterations" counter; 0 if none).
   std::uint64_t search_iterations() const;
@@ -192,11 +230,14 @@ class Session {
   State carried_over(const State& old, const Problem& next) const;
 
   const Mdp* mdp_;
-  Allocator* allocator_;
+  Allocator* allocator_;  // null: the caller decides
   State state_;
-  State before_;  // scratch for observe(): reused, so a wide problem's state is not reallocated
+  // The state before the last transition, for the allocator's observe() and the clock: reused,
+  // so that a wide problem's state is not reallocated.
+  State before_;
   Status status_ = Status::running;
-  int pending_ = -1;
+  int pending_ = -1;         // the skeleton decided, awaiting its report
+  int pending_action_ = -1;  // its action (-1: an idle step)
   int solution_ = -1;
 
   // Live and owning sessions: what every action revealed (by action index; actions are only
@@ -227,5 +268,12 @@ class Session {
   std::vector<LiveStep> timeline_;
   LiveTotals totals_;
 };
+
+// Inline, so that the runner's loop pays for no more than the calls it would make itself.
+inline Status Session::carry_out(World& world) {
+  if (pending_ < 0) throw_without_decision();
+  if (pending_action_ < 0) return report_not_yet();  // an idle step: nothing to ask the world
+  return report(world.step(pending_action_, state_.spent[static_cast<std::size_t>(pending_)]));
+}
 
 }  // namespace ontime
