@@ -34,23 +34,46 @@ class RecordingTimer final : public DecisionTimer {
   std::int64_t episode_total = 0;
 };
 
+// A live run's charges (LiveTotals, field for field) summed in whole nanoseconds, so that the
+// sums do not depend on how episodes fell to threads or ranks.
+struct LiveNanoseconds {
+  std::int64_t decision = 0, planning = 0, overrun = 0, outside = 0, elapsed = 0;
+
+  void add(const LiveTotals& episode) noexcept {
+    decision += std::llround(episode.decision * 1e9);
+    planning += std::llround(episode.planning * 1e9);
+    overrun += std::llround(episode.overrun * 1e9);
+    outside += std::llround(episode.outside * 1e9);
+    elapsed += std::llround(episode.elapsed * 1e9);
+  }
+  void add(const LiveNanoseconds& other) noexcept {
+    decision += other.decision;
+    planning += other.planning;
+    overrun += other.overrun;
+    outside += other.outside;
+    elapsed += other.elapsed;
+  }
+  // The mean of `episodes` episodes, in seconds.
+  LiveTotals mean(std::uint64_t episodes) const noexcept {
+    const double scale = 1e-9 / static_cast<double>(episodes);
+    return {.decision = static_cast<double>(decision) * scale,
+            .planning = static_cast<double>(planning) * scale,
+            .overrun = static_cast<double>(overrun) * scale,
+            .outside = static_cast<double>(outside) * scale,
+            .elapsed = static_cast<double>(elapsed) * scale};
+  }
+};
+
 // What one thread of run_episodes keeps until the threads' results are merged.
 struct ThreadRun {
   std::unique_ptr<Allocator> allocator;
   std::unique_ptr<World> world;
   RecordingTimer timer;
   std::uint64_t successes = 0;
-  // Live runs: charges summed over this thread's episodes in whole nanoseconds, so that the
-  // sums do not depend on how episodes fell to threads.
-  std::array<std::int64_t, 5> live_nanoseconds{};
+  LiveNanoseconds live_nanoseconds;  // live runs: this thread's episodes' charges
   std::uint64_t model_successes = 0;
   std::uint64_t model_undecided = 0;
 };
-
-void add_totals(std::array<std::int64_t, 5>& sum, const LiveTotals& episode) noexcept {
-  const double parts[] = {episode.decision, episode.planning, episode.overrun, episode.outside, episode.elapsed};
-  for (std::size_t i = 0; i < sum.size(); ++i) sum[i] += std::llround(parts[i] * 1e9);
-}
 
 }  // namespace
 
@@ -226,7 +249,7 @@ struct RankPart {
   std::uint64_t successes = 0;
   std::uint64_t model_successes = 0;
   std::uint64_t model_undecided = 0;
-  std::array<std::int64_t, 5> live_nanoseconds{};
+  LiveNanoseconds live_nanoseconds;
   LatencyHistogram decisions;
   LatencyHistogram episode_totals;
   Statistics statistics;
@@ -236,7 +259,7 @@ struct RankPart {
     successes += other.successes;
     model_successes += other.model_successes;
     model_undecided += other.model_undecided;
-    for (std::size_t i = 0; i < live_nanoseconds.size(); ++i) live_nanoseconds[i] += other.live_nanoseconds[i];
+    live_nanoseconds.add(other.live_nanoseconds);
     decisions.merge(other.decisions);
     episode_totals.merge(other.episode_totals);
     statistics.merge(other.statistics);
@@ -312,7 +335,7 @@ void merge_ranks(const Ranks& ranks, RankPart& part, const std::string& episodes
     other.successes = unpacker.get<std::uint64_t>();
     other.model_successes = unpacker.get<std::uint64_t>();
     other.model_undecided = unpacker.get<std::uint64_t>();
-    other.live_nanoseconds = unpacker.get<std::array<std::int64_t, 5>>();
+    other.live_nanoseconds = unpacker.get<LiveNanoseconds>();
     other.decisions = unpacker.get<LatencyHistogram>();
     other.episode_totals = unpacker.get<LatencyHistogram>();
     other.statistics = unpack_statistics(unpacker);
@@ -361,7 +384,7 @@ MonteCarloResult run_many(const WorldFactory& worlds, const AllocatorFactory* al
         const EpisodeResult result = run_one(run, stream_seed(options.seed, episode));
         if (result.status == Status::success) ++run.successes;
         if (options.live) {
-          add_totals(run.live_nanoseconds, result.live);
+          run.live_nanoseconds.add(result.live);
           if (result.model_status == Status::success) ++run.model_successes;
           if (result.model_status == Status::running) ++run.model_undecided;
         }
@@ -391,7 +414,7 @@ MonteCarloResult run_many(const WorldFactory& worlds, const AllocatorFactory* al
     part.episode_totals.merge(run.timer.episodes);
     if (run.allocator) run.allocator->collect_statistics(part.statistics);
     if (run.world) run.world->collect_statistics(part.world_statistics);
-    for (std::size_t i = 0; i < part.live_nanoseconds.size(); ++i) part.live_nanoseconds[i] += run.live_nanoseconds[i];
+    part.live_nanoseconds.add(run.live_nanoseconds);
     part.model_successes += run.model_successes;
     part.model_undecided += run.model_undecided;
   }
@@ -404,13 +427,7 @@ MonteCarloResult run_many(const WorldFactory& worlds, const AllocatorFactory* al
   result.world_statistics = std::move(part.world_statistics);
   result.model_successes = part.model_successes;
   result.model_undecided = part.model_undecided;
-  if (options.episodes > 0) {
-    const double scale = 1e-9 / static_cast<double>(options.episodes);
-    const auto& sums = part.live_nanoseconds;
-    result.live_mean = {static_cast<double>(sums[0]) * scale, static_cast<double>(sums[1]) * scale,
-                        static_cast<double>(sums[2]) * scale, static_cast<double>(sums[3]) * scale,
-                        static_cast<double>(sums[4]) * scale};
-  }
+  if (options.episodes > 0) result.live_mean = part.live_nanoseconds.mean(options.episodes);
   result.success_rate =
       options.episodes == 0 ? 0.0 : static_cast<double>(result.successes) / static_cast<double>(options.episodes);
   result.ci95 = ci95_half_width(result.success_rate, options.episodes);
