@@ -16,13 +16,17 @@
 #include <string>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 #include "ontime/allocators/allocator.hpp"
 #include "ontime/allocators/allocator_registry.hpp"
 #include "ontime/mdp/mdp.hpp"
 #include "ontime/mdp/state.hpp"
+#include "ontime/model/planner_log.hpp"
 #include "ontime/model/problem.hpp"
+#include "ontime/run/episode_runner.hpp"
 #include "ontime/run/evaluation.hpp"
+#include "ontime/run/world.hpp"
 #include "ontime/util/error.hpp"
 #include "ontime/util/memory.hpp"
 
@@ -167,11 +171,33 @@ struct Progress {
 void run_interruptibly(const std::function<void(const std::function<bool()>& stop, Progress& progress)>& work,
                        const py::object& progress_callback = py::none());
 
+// The bindings, one file per layer of the library (python/src/LAYER.cpp; live.cpp and
+// environment.cpp are the run layer's live sessions and Gymnasium-style environment).
 void bind_model(py::module_& m);
-void bind_running(py::module_& m);
-void bind_environment(py::module_& m);
+void bind_mdp(py::module_& m);
+void bind_solve(py::module_& m);
+void bind_allocators(py::module_& m);
+void bind_run(py::module_& m);
 void bind_live(py::module_& m);
+void bind_environment(py::module_& m);
+void bind_learn(py::module_& m);
+void bind_report(py::module_& m);
 void bind_domains(py::module_& m);
+
+// Helpers the layers' bindings share.
+// A decision budget from Python's keyword arguments (neither: unset, the allocator's own).
+DecisionBudget budget_of(std::optional<Iterations> iterations, std::optional<Seconds> seconds);
+// Counters as a dict, by name.
+py::dict statistics_dict(const Statistics& statistics);
+// UsageError for zero episodes.
+void check_episodes(std::uint64_t episodes);
+// Planner-log records as a list of dicts (the keys of docs/formats.md).
+py::list attempts_list(const std::vector<RefinementAttempt>& attempts);
+// Episodes in `worlds` and, when `exact`, the exact evaluation of the allocator (Ctrl-C stops
+// both), with `progress(done, total)` called now and then.
+std::pair<MonteCarloResult, std::optional<ExactEvaluation>> run_and_evaluate(
+    const MdpHandle& mdp, const WorldFactory& worlds, const AllocatorFactory& factory, const MonteCarloOptions& options,
+    bool exact, const ParameterValues& values, const py::object& progress);
 
 }  // namespace ontime::python
 

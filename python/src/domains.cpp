@@ -27,8 +27,6 @@
 
 namespace ontime::python {
 
-py::list attempts_list(const std::vector<RefinementAttempt>& attempts);
-
 #ifdef ONTIME_PYTHON_DOMAINS
 
 namespace {

@@ -1,24 +1,16 @@
-// Bindings of the model layer: distributions, problems, the MDP and its states, planner logs and
-// fitting, and the allocator registry's description of itself.
+// Bindings of the model layer: distributions, actions, problems and their instance files, and
+// planner logs (read, parsed and written by the library's own readers and writer).
 
 #include <pybind11/numpy.h>
 #include <pybind11/operators.h>
 #include <pybind11/stl.h>
 
 #include <cmath>
-#include <filesystem>
-#include <optional>
 #include <sstream>
 
 #include "bindings.hpp"
-#include "ontime/learn/fitting.hpp"
-#include "ontime/learn/log_sampling.hpp"
-#include "ontime/mdp/state.hpp"
 #include "ontime/model/instance_io.hpp"
 #include "ontime/model/planner_log.hpp"
-#include "ontime/model/skeleton_file.hpp"
-#include "ontime/report/report.hpp"
-#include "ontime/solve/knapsack.hpp"
 #include "ontime/util/error.hpp"
 
 namespace ontime::python {
@@ -31,13 +23,6 @@ std::vector<double> to_vector(const py::array_t<double, py::array::c_style | py:
 }
 
 py::object step_or_none(Steps step) { return step == kNever ? py::none() : py::object(py::int_(step)); }
-
-template <class Array>
-py::list first(const Array& values, int count) {
-  py::list out;
-  for (int k = 0; k < count; ++k) out.append(values[static_cast<std::size_t>(k)]);
-  return out;
-}
 
 py::dict attempt_dict(const RefinementAttempt& attempt) {
   py::dict out;
@@ -176,116 +161,13 @@ void bind_model(py::module_& m) {
       },
       py::arg("path"), "Reads and validates an instance file (SPEC §5). Raises InputError naming the place and rule.");
 
-  m.def(
-      "reduce_knapsack",
-      [](const py::object& knapsack, const std::optional<std::string>& name) {
-        const bool is_file = py::isinstance<py::str>(knapsack) || py::hasattr(knapsack, "__fspath__");
-        const std::string source =
-            is_file ? std::string(py::str(py::module_::import("os").attr("fspath")(knapsack))) : "<knapsack>";
-        const std::string text =
-            is_file ? std::string() : std::string(py::str(py::module_::import("json").attr("dumps")(knapsack)));
-        const py::gil_scoped_release release;
-        const Knapsack parsed = is_file ? load_knapsack(source) : parse_knapsack(text, source);
-        const std::string problem_name =
-            name ? *name : (is_file ? std::filesystem::path(source).stem().string() : "knapsack-reduction");
-        return std::make_shared<Problem>(reduce_knapsack(parsed, problem_name));
-      },
-      py::arg("knapsack"), py::kw_only(), py::arg("name") = py::none(),
-      "The effort-allocation instance of Theorem 1 for a knapsack problem (a file, or a dict {'capacity': W, "
-      "'items': [{'weight': w, 'value': v}, ...]}), as `ontime reduce-knapsack` writes it; named after the file "
-      "unless `name` is given. Its optimum orders the knapsack's solutions by value (docs/theory.md).");
-
-  m.def(
-      "histogram_csv", [](const py::object& problem) { return report::histogram_csv(*to_mdp(problem)->problem); },
-      py::arg("problem"),
-      "Every action's planning and execution PMF as the CSV `ontime plot` writes beside its picture "
-      "(action,distribution,step,probability; 'never' last); python/plot_histograms.py --data CSV draws it.");
-
-  m.def(
-      "sample_log",
-      [](const py::object& problem, const py::object& path, Number<std::uint64_t, "attempts", 1> attempts, Seed seed,
-         std::optional<Number<Steps, "cutoff", 1>> cutoff) {
-        const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
-        const std::string file = py::str(py::module_::import("os").attr("fspath")(path));
-        LogSamplingOptions options;
-        options.attempts_per_action = attempts;
-        options.seed = seed;
-        options.cutoff_steps = cutoff ? static_cast<Steps>(*cutoff) : 0;
-        const py::gil_scoped_release release;
-        return write_sampled_planner_log(*mdp->problem, options, file);
-      },
-      py::arg("problem"), py::arg("path"), py::kw_only(), py::arg("attempts") = 1000, py::arg("seed") = 1,
-      py::arg("cutoff") = py::none(),
-      "Draws a planner log from the problem's own distributions and writes it to `path` (JSON Lines), as `ontime "
-      "sample-log` does: `attempts` per action, attempt i of action a from stream i of stream a of `seed`, cut "
-      "off after `cutoff` steps (default: the deadline). Returns the records written.");
-
-  py::class_<StateView>(m, "State",
-                        "An MDP state (SPEC §2): CT, and per skeleton l_k (actions refined), PT_k (steps on its "
-                        "current action) and ET_k (execution steps of its refined actions, saturated at D + 1).")
-      .def_property_readonly(
-          "time", [](const StateView& s) { return s.state.time; }, "CT: steps of effort used.")
-      .def_property_readonly(
-          "refined", [](const StateView& s) { return first(s.state.refined, s.skeletons); }, "l_k for each skeleton.")
-      .def_property_readonly(
-          "spent", [](const StateView& s) { return first(s.state.spent, s.skeletons); }, "PT_k for each skeleton.")
-      .def_property_readonly(
-          "execution", [](const StateView& s) { return first(s.state.execution, s.skeletons); },
-          "ET_k for each skeleton.")
-      .def("__eq__", [](const StateView& a, const StateView& b) { return a.state == b.state; })
-      .def("__hash__",
-           [](const StateView& s) {
-             return py::hash(py::make_tuple(s.state.time, first(s.state.refined, s.skeletons),
-                                            first(s.state.spent, s.skeletons), first(s.state.execution, s.skeletons))
-                                 .attr("__str__")());
-           })
-      .def("__repr__", [](const StateView& s) {
-        return "ontime.State(time=" + std::to_string(s.state.time) +
-               ", refined=" + std::string(py::str(first(s.state.refined, s.skeletons))) +
-               ", spent=" + std::string(py::str(first(s.state.spent, s.skeletons))) +
-               ", execution=" + std::string(py::str(first(s.state.execution, s.skeletons))) + ")";
-      });
-
-  py::class_<MdpHandle, std::shared_ptr<MdpHandle>>(
-      m, "Mdp", "The effort-allocation MDP of a problem (SPEC §2), with its precomputed tables.")
-      .def(py::init([](std::shared_ptr<Problem> problem) { return std::make_shared<MdpHandle>(std::move(problem)); }),
-           py::arg("problem"))
-      .def_property_readonly("problem", [](const MdpHandle& h) { return std::const_pointer_cast<Problem>(h.problem); })
-      .def_property_readonly("skeleton_count", [](const MdpHandle& h) { return h.mdp.skeleton_count(); })
-      .def_property_readonly("deadline", [](const MdpHandle& h) { return h.mdp.deadline(); })
-      .def(
-          "start",
-          [](const MdpHandle& h) {
-            return StateView{h.mdp.start(), h.mdp.skeleton_count()};
-          },
-          "The start state.")
-      .def(
-          "next_action",
-          [](const MdpHandle& h, const StateView& s, Number<int, "skeleton", 0> k) {
-            return h.mdp.next_action(s.state, k);
-          },
-          py::arg("state"), py::arg("skeleton"), "The action skeleton k refines next, or -1 when it is fully refined.")
-      .def(
-          "useful_choices",
-          [](const MdpHandle& h, const StateView& s) {
-            std::vector<int> out;
-            for (const int choice : h.mdp.useful_choices(s.state)) out.push_back(choice);
-            return out;
-          },
-          py::arg("state"), "The choices worth considering (one per group sharing a next action), ascending.")
-      .def(
-          "can_succeed",
-          [](const MdpHandle& h, const StateView& s, Number<int, "skeleton", 0> k) {
-            return h.mdp.can_succeed(s.state, k);
-          },
-          py::arg("state"), py::arg("skeleton"), "Whether skeleton k can still meet the deadline from this state.");
-
   // Planner logs and fitting. Records given from Python are read as JSON Lines text by the
   // library's own reader, so they obey, and are reported against, the same rules as a log file.
   m.def(
       "_parse_planner_log",
       [](const std::string& text, const std::string& source) { return attempts_list(parse_planner_log(text, source)); },
       py::arg("text"), py::arg("source"));
+
   m.def(
       "read_planner_log",
       [](const py::object& path) {
@@ -300,6 +182,7 @@ void bind_model(py::module_& m) {
       py::arg("path"),
       "Reads a planner log (JSON Lines, docs/formats.md) as a list of dicts with the keys action, "
       "planning_seconds, found, execution_seconds (when found) and trial / collision_checks (when recorded).");
+
   m.def(
       "_save_planner_log",
       [](const std::string& text, const std::string& source, const std::string& path) {
@@ -308,36 +191,6 @@ void bind_model(py::module_& m) {
         save_planner_log(attempts, path);
       },
       py::arg("text"), py::arg("source"), py::arg("path"));
-  m.def(
-      "_fit",
-      [](const std::string& log, bool log_is_path, const std::string& skeleton_data, bool skeletons_are_path,
-         Number<double, "step", 0.0> step, Number<Steps, "deadline", 1> deadline,
-         Number<double, "laplace", 0.0> laplace, const std::string& name, const std::string& description) {
-        const std::string log_source = log_is_path ? log : "<records>";
-        const std::vector<RefinementAttempt> attempts =
-            log_is_path ? load_planner_log(log) : parse_planner_log(log, log_source);
-        const SkeletonList skeletons =
-            skeletons_are_path ? load_skeleton_file(skeleton_data) : parse_skeleton_file(skeleton_data, "<skeletons>");
-        FitOptions options;
-        options.step_seconds = step;
-        options.deadline = deadline;
-        options.laplace = laplace;
-        options.name = name;
-        options.description = description;
-        if (!(step > 0) || !std::isfinite(step)) throw UsageError("step must be a positive number of seconds");
-        if (deadline < 1 || deadline > Problem::kMaxDeadline) {
-          throw UsageError("deadline must be in [1, " + std::to_string(Problem::kMaxDeadline) + "] steps");
-        }
-        const py::gil_scoped_release release;
-        return std::make_shared<Problem>(fit_problem(attempts, log_source, skeletons, options).problem);
-      },
-      py::arg("log"), py::arg("log_is_path"), py::arg("skeleton_data"), py::arg("skeletons_are_path"), py::arg("step"),
-      py::arg("deadline"), py::arg("laplace"), py::arg("name"), py::arg("description"));
-
-  m.def(
-      "allocators", [] { return json_object(report::registry_json(allocator_registry())); },
-      "The allocator kinds of the registry with their capabilities and parameters, as `ontime allocators "
-      "--json` lists them. Parameters are passed as keyword arguments with '_' for '-' (max_states=...).");
 }
 
 }  // namespace ontime::python

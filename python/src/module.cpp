@@ -224,9 +224,14 @@ PYBIND11_MODULE(_ontime, m) {
   py::register_exception_translator(&translate_errors);
   m.attr("NEVER") = ontime::kNever;
   bind_model(m);
-  bind_running(m);
-  bind_environment(m);
+  bind_mdp(m);
+  bind_solve(m);
+  bind_allocators(m);
+  bind_run(m);
   bind_live(m);
+  bind_environment(m);
+  bind_learn(m);
+  bind_report(m);
   py::module_ domains = m.def_submodule("domains", "OnTime's TAMP domains (OMPL, FCL, KDL), when built.");
   bind_domains(domains);
 }

@@ -1,17 +1,15 @@
-// Bindings of allocators, sessions, worlds written in Python, and the long computations (solve,
-// evaluate, episodes, training), all on the library's one episode runner.
+// Bindings of the run layer: sessions a caller's planner drives, worlds written in Python, and the
+// long computations on the library's one episode runner (episodes, evaluation, Table I, studies).
 
 #include <pybind11/stl.h>
 
-#include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <optional>
 #include <stdexcept>
 
 #include "bindings.hpp"
 #include "ontime/allocators/optimal.hpp"
-#include "ontime/allocators/ppo.hpp"
-#include "ontime/learn/ppo_training.hpp"
 #include "ontime/report/report.hpp"
 #include "ontime/run/episode_runner.hpp"
 #include "ontime/run/evaluation.hpp"
@@ -19,21 +17,11 @@
 #include "ontime/run/session.hpp"
 #include "ontime/run/simulator.hpp"
 #include "ontime/run/table.hpp"
-#include "ontime/solve/layered_solver.hpp"
-#include "ontime/util/atomic_file.hpp"
 #include "ontime/util/error.hpp"
-#include "ontime/util/memory.hpp"
 
 namespace ontime::python {
 
 namespace {
-
-DecisionBudget budget_of(std::optional<Iterations> iterations, std::optional<Seconds> seconds) {
-  if (iterations && seconds) return DecisionBudget::either(*iterations, *seconds);
-  if (iterations) return DecisionBudget::iterations(*iterations);
-  if (seconds) return DecisionBudget::seconds(*seconds);
-  return {};
-}
 
 struct SessionHandle {
   SessionHandle(std::shared_ptr<AllocatorHandle> handle, std::uint64_t seed_value, DecisionBudget default_budget)
@@ -93,12 +81,6 @@ class PythonWorld final : public World {
   py::object world_;
 };
 
-py::dict statistics_dict(const Statistics& statistics) {
-  py::dict out;
-  for (const Statistics::Counter& counter : statistics.counters()) out[py::str(counter.name)] = counter.value;
-  return out;
-}
-
 MonteCarloResult run_with_hooks(const Mdp& mdp, const WorldFactory& worlds, const AllocatorFactory& factory,
                                 MonteCarloOptions options, const std::function<bool()>& stop, Progress& progress) {
   progress.total = options.episodes;
@@ -106,6 +88,8 @@ MonteCarloResult run_with_hooks(const Mdp& mdp, const WorldFactory& worlds, cons
   options.progress = [&progress](std::uint64_t done, std::uint64_t) { progress.done = done; };
   return run_episodes(mdp, worlds, factory, options);
 }
+
+}  // namespace
 
 void check_episodes(std::uint64_t episodes) {
   if (episodes == 0) throw UsageError("episodes must be at least 1");
@@ -128,8 +112,6 @@ std::pair<MonteCarloResult, std::optional<ExactEvaluation>> run_and_evaluate(
   return {result, exact_result};
 }
 
-}  // namespace
-
 py::dict monte_carlo_dict(const std::string& solver, const ParameterValues& values, const std::string& instance,
                           const Problem& problem, const MonteCarloResult& result, std::uint64_t seed,
                           const std::optional<ExactEvaluation>& exact) {
@@ -143,63 +125,7 @@ py::dict monte_carlo_dict(const std::string& solver, const ParameterValues& valu
                                                         .timing = true}));
 }
 
-void bind_running(py::module_& m) {
-  py::enum_<Status>(m, "Status", "Where an episode or session stands.")
-      .value("running", Status::running)
-      .value("success", Status::success)
-      .value("failure", Status::failure);
-
-  py::class_<AllocatorHandle, std::shared_ptr<AllocatorHandle>>(
-      m, "Allocator",
-      "An effort allocator of the registry, made by ontime.make_allocator. One allocator serves one session "
-      "at a time; episode runs make their own per thread from the same kind and parameters.")
-      .def_property_readonly(
-          "name", [](const AllocatorHandle& h) { return h.name; }, "The registry name of its kind.")
-      .def_property_readonly(
-          "parameters", [](const AllocatorHandle& h) { return parameters_dict(h.name, h.values); },
-          "Its parameters, defaults filled in (registry names, text values).")
-      .def_property_readonly(
-          "capabilities",
-          [](const AllocatorHandle& h) { return allocator_registry().find(h.name).capabilities.names(); })
-      .def_property_readonly("mdp", [](const AllocatorHandle& h) { return h.mdp; })
-      .def_property_readonly(
-          "is_stationary", [](const AllocatorHandle& h) { return h.allocator->is_stationary(); },
-          "True when its choice is a function of the state alone (exact evaluation applies).")
-      .def(
-          "begin_episode", [](AllocatorHandle& h, Seed seed) { h.allocator->begin_episode(seed); }, py::arg("seed"),
-          "Starts a new episode; `seed` seeds its randomness.")
-      .def(
-          "choose",
-          [](AllocatorHandle& h, const StateView& state, std::optional<Iterations> iterations,
-             std::optional<Seconds> seconds) {
-            const DecisionBudget budget = budget_of(iterations, seconds);
-            const py::gil_scoped_release release;
-            return h.allocator->choose(state.state, budget);
-          },
-          py::arg("state"), py::kw_only(), py::arg("iterations") = py::none(), py::arg("seconds") = py::none(),
-          "The skeleton to spend the next step on in `state`, within the budget given (anytime allocators; "
-          "unset: the allocator's own).")
-      .def(
-          "statistics",
-          [](const AllocatorHandle& h) {
-            Statistics statistics;
-            h.allocator->collect_statistics(statistics);
-            return statistics_dict(statistics);
-          },
-          "Its counters (e.g. mcts iterations) since it was made.")
-      .def("__repr__", [](const AllocatorHandle& h) { return "ontime.Allocator('" + h.name + "')"; });
-
-  m.def(
-      "make_allocator",
-      [](const py::object& mdp, const std::string& name, const py::kwargs& kwargs) {
-        return make_allocator_handle(to_mdp(mdp), name, parameter_values(kwargs));
-      },
-      py::arg("mdp"), py::arg("name"),
-      "Makes the allocator `name` of the registry for an Mdp (or a Problem, or an instance path), with its "
-      "parameters as keyword arguments, '_' for '-': make_allocator(mdp, 'mcts', iterations=2000). "
-      "ontime.allocators() lists the kinds and their parameters. Raises UsageError for an unknown name or a "
-      "bad value.");
-
+void bind_run(py::module_& m) {
   py::class_<DecisionView>(m, "Decision", "An allocator's decision: which skeleton, which action to refine now.")
       .def_readonly("skeleton", &DecisionView::skeleton, "The skeleton chosen (0-based).")
       .def_readonly("action", &DecisionView::action,
@@ -380,64 +306,6 @@ void bind_running(py::module_& m) {
       "as keyword arguments. The GIL is released; Ctrl-C stops it (KeyboardInterrupt).");
 
   m.def(
-      "solve",
-      [](const py::object& problem, Number<std::uint64_t, "max_states", 1> max_states, Threads threads,
-         const std::string& method, Number<double, "tolerance", 0.0, 1.0> tolerance,
-         Number<std::uint64_t, "max_memory_mib", 0, (std::uint64_t{1} << 40)> max_memory_mib,
-         Number<std::uint64_t, "max_disk_mib", 0, (std::uint64_t{1} << 40)> max_disk_mib, const py::object& scratch,
-         const py::object& policy, Number<int, "policy_layers", 1, 1'000'000> policy_layers) {
-        const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
-        if (method != "layered" && method != "split") {
-          throw UsageError("method must be 'layered' or 'split' (got '" + method + "')");
-        }
-        LayeredSolveOptions options;
-        options.max_states = max_states;
-        options.threads = threads;
-        options.tolerance = tolerance;
-        options.split = method == "split" ? SplitMode::always : SplitMode::fallback;
-        if (!scratch.is_none()) options.scratch_directory = py::str(py::module_::import("os").attr("fspath")(scratch));
-        if (max_memory_mib > 0) {
-          check_memory_for("max_memory_mib", static_cast<double>(max_memory_mib) * 1048576.0);
-          options.max_memory_bytes = max_memory_mib << 20;
-        }
-        options.max_disk_bytes = max_disk_mib << 20;
-        if (!policy.is_none()) options.policy_layers = policy_layers;
-        // Caps not given: what this machine can give, so that a solve stops with a certified
-        // interval rather than being killed (as the command line does).
-        fill_default_caps(options);
-        report::Solve solve{.instance = instance_label(problem, *mdp->problem),
-                            .problem = mdp->problem.get(),
-                            .mdp = &mdp->mdp,
-                            .method = method,
-                            .tolerance = tolerance};
-        run_interruptibly([&](const std::function<bool()>& stop, Progress&) {
-          const auto started = std::chrono::steady_clock::now();
-          options.stop = stop;
-          solve.solution = solve_layered(mdp->mdp, options);
-          solve.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-        });
-        if (!policy.is_none()) {
-          write_file_atomically(std::string(py::str(py::module_::import("os").attr("fspath")(policy))),
-                                report::policy_lines(solve));
-        }
-        return json_object(report::to_json(solve));
-      },
-      py::arg("problem"), py::arg("max_states") = OptimalSolver::kDefaultMaxStates, py::arg("threads") = 0,
-      py::kw_only(), py::arg("method") = "layered", py::arg("tolerance") = 0.0, py::arg("max_memory_mib") = 0,
-      py::arg("max_disk_mib") = 0, py::arg("scratch") = py::none(), py::arg("policy") = py::none(),
-      py::arg("policy_layers") = 1,
-      "The exact optimal success probability and first choice (the layered solver), as `ontime solve --json` "
-      "reports them; where a cap cuts the whole tree, a certified interval [lower_bound, upper_bound] "
-      "instead (optimal_success_probability None), tightened by a split when the skeletons' first actions "
-      "differ. method='split' splits straight away (the strongest first-action subtree enumerated, the others "
-      "bounded); tolerance > 0 drops groups whose clairvoyant chance is below it, with their share in the "
-      "interval. Caps: max_states, max_memory_mib (tables of this process) and max_disk_mib (its scratch files, "
-      "in `scratch`, default the system's temporary folder); 0: 80% of the available memory and 90% of the free "
-      "disk. policy=FILE writes the choices of the first `policy_layers` layers as `ontime solve --policy` does "
-      "(JSON Lines: a state, its choice and the bounds of its value). The GIL is released; Ctrl-C stops it "
-      "(KeyboardInterrupt).");
-
-  m.def(
       "table",
       [](const py::sequence& instances, const std::optional<std::vector<std::string>>& solvers, bool exact,
          Episodes episodes, Seed seed, Threads threads, const std::string& format, const py::object& progress,
@@ -558,50 +426,6 @@ void bind_running(py::module_& m) {
       "instances (files or Problems). Returns the CSV the command line writes (python/plot_study.py draws it). "
       "Times are wall-clock: the success counts of iteration budgets repeat for a seed, those of time budgets do "
       "not. Parameters as keyword arguments. The GIL is released; Ctrl-C stops it.");
-
-  m.def(
-      "train_ppo",
-      [](const py::object& problem, const py::object& out, Episodes episodes, Seed seed, const py::object& progress) {
-        check_episodes(episodes);
-        const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
-        const std::string path = py::str(py::module_::import("os").attr("fspath")(out));
-        std::optional<PpoTraining> training;
-        run_interruptibly(
-            [&](const std::function<bool()>& stop, Progress& counters) {
-              counters.total = episodes;
-              training = train_ppo(mdp->mdp, episodes, seed, {}, [&](std::uint64_t done, std::uint64_t) {
-                if (stop()) throw Cancelled("training stopped at the caller's request");
-                counters.done = done;
-              });
-              // The policy and its learning curve as one set, as `ontime train --no-plot` writes them
-              // (an older plot beside the policy would describe another training: it goes).
-              const std::filesystem::path policy(path);
-              OutputSet files(policy.has_parent_path() ? policy.parent_path() : std::filesystem::path("."));
-              stage_ppo_training(files, *training, policy);
-              files.remove_on_commit(learning_curve_path(policy, ".curve.png"));
-              files.commit();
-            },
-            progress);
-        py::list curve;
-        for (const LearningCurvePoint& point : training->curve) {
-          py::dict row;
-          row["epoch"] = point.epoch;
-          row["episodes"] = point.episodes;
-          row["steps"] = point.steps;
-          row["success_rate"] = point.success_rate;
-          row["mean_episode_length"] = point.mean_episode_length;
-          row["actor_steps"] = point.actor_steps;
-          row["seconds"] = point.seconds;
-          curve.append(row);
-        }
-        return curve;
-      },
-      py::arg("problem"), py::arg("out"), py::kw_only(), py::arg("episodes") = 10'000, py::arg("seed") = 1,
-      py::arg("progress") = py::none(),
-      "Trains the ppo policy on simulated episodes (as `ontime train`), writes it to `out` with its learning curve "
-      "beside it (OUT.curve.csv; both only when training finished, together) and returns the learning curve as a "
-      "list of dicts. Use it with "
-      "make_allocator(problem, 'ppo', policy=out).");
 }
 
 }  // namespace ontime::python

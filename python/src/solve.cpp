@@ -1,0 +1,100 @@
+// Bindings of the solve layer: the exact optimum or its certified interval (the layered solver,
+// with the command line's caps and report), and the knapsack reduction of Theorem 1.
+
+#include <pybind11/stl.h>
+
+#include <chrono>
+#include <filesystem>
+#include <optional>
+
+#include "bindings.hpp"
+#include "ontime/report/report.hpp"
+#include "ontime/solve/knapsack.hpp"
+#include "ontime/solve/layered_solver.hpp"
+#include "ontime/solve/optimal_solver.hpp"
+#include "ontime/util/atomic_file.hpp"
+#include "ontime/util/error.hpp"
+#include "ontime/util/memory.hpp"
+
+namespace ontime::python {
+
+void bind_solve(py::module_& m) {
+  m.def(
+      "reduce_knapsack",
+      [](const py::object& knapsack, const std::optional<std::string>& name) {
+        const bool is_file = py::isinstance<py::str>(knapsack) || py::hasattr(knapsack, "__fspath__");
+        const std::string source =
+            is_file ? std::string(py::str(py::module_::import("os").attr("fspath")(knapsack))) : "<knapsack>";
+        const std::string text =
+            is_file ? std::string() : std::string(py::str(py::module_::import("json").attr("dumps")(knapsack)));
+        const py::gil_scoped_release release;
+        const Knapsack parsed = is_file ? load_knapsack(source) : parse_knapsack(text, source);
+        const std::string problem_name =
+            name ? *name : (is_file ? std::filesystem::path(source).stem().string() : "knapsack-reduction");
+        return std::make_shared<Problem>(reduce_knapsack(parsed, problem_name));
+      },
+      py::arg("knapsack"), py::kw_only(), py::arg("name") = py::none(),
+      "The effort-allocation instance of Theorem 1 for a knapsack problem (a file, or a dict {'capacity': W, "
+      "'items': [{'weight': w, 'value': v}, ...]}), as `ontime reduce-knapsack` writes it; named after the file "
+      "unless `name` is given. Its optimum orders the knapsack's solutions by value (docs/theory.md).");
+
+  m.def(
+      "solve",
+      [](const py::object& problem, Number<std::uint64_t, "max_states", 1> max_states, Threads threads,
+         const std::string& method, Number<double, "tolerance", 0.0, 1.0> tolerance,
+         Number<std::uint64_t, "max_memory_mib", 0, (std::uint64_t{1} << 40)> max_memory_mib,
+         Number<std::uint64_t, "max_disk_mib", 0, (std::uint64_t{1} << 40)> max_disk_mib, const py::object& scratch,
+         const py::object& policy, Number<int, "policy_layers", 1, 1'000'000> policy_layers) {
+        const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
+        if (method != "layered" && method != "split") {
+          throw UsageError("method must be 'layered' or 'split' (got '" + method + "')");
+        }
+        LayeredSolveOptions options;
+        options.max_states = max_states;
+        options.threads = threads;
+        options.tolerance = tolerance;
+        options.split = method == "split" ? SplitMode::always : SplitMode::fallback;
+        if (!scratch.is_none()) options.scratch_directory = py::str(py::module_::import("os").attr("fspath")(scratch));
+        if (max_memory_mib > 0) {
+          check_memory_for("max_memory_mib", static_cast<double>(max_memory_mib) * 1048576.0);
+          options.max_memory_bytes = max_memory_mib << 20;
+        }
+        options.max_disk_bytes = max_disk_mib << 20;
+        if (!policy.is_none()) options.policy_layers = policy_layers;
+        // Caps not given: what this machine can give, so that a solve stops with a certified
+        // interval rather than being killed (as the command line does).
+        fill_default_caps(options);
+        report::Solve solve{.instance = instance_label(problem, *mdp->problem),
+                            .problem = mdp->problem.get(),
+                            .mdp = &mdp->mdp,
+                            .method = method,
+                            .tolerance = tolerance};
+        run_interruptibly([&](const std::function<bool()>& stop, Progress&) {
+          const auto started = std::chrono::steady_clock::now();
+          options.stop = stop;
+          solve.solution = solve_layered(mdp->mdp, options);
+          solve.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+        });
+        if (!policy.is_none()) {
+          write_file_atomically(std::string(py::str(py::module_::import("os").attr("fspath")(policy))),
+                                report::policy_lines(solve));
+        }
+        return json_object(report::to_json(solve));
+      },
+      py::arg("problem"), py::arg("max_states") = OptimalSolver::kDefaultMaxStates, py::arg("threads") = 0,
+      py::kw_only(), py::arg("method") = "layered", py::arg("tolerance") = 0.0, py::arg("max_memory_mib") = 0,
+      py::arg("max_disk_mib") = 0, py::arg("scratch") = py::none(), py::arg("policy") = py::none(),
+      py::arg("policy_layers") = 1,
+      "The exact optimal success probability and first choice (the layered solver), as `ontime solve --json` "
+      "reports them; where a cap cuts the whole tree, a certified interval [lower_bound, upper_bound] "
+      "instead (optimal_success_probability None), tightened by a split when the skeletons' first actions "
+      "differ. method='split' splits straight away (the strongest first-action subtree enumerated, the others "
+      "bounded); tolerance > 0 drops groups whose clairvoyant chance is below it, with their share in the "
+      "interval. Caps: max_states, max_memory_mib (tables of this process) and max_disk_mib (its scratch files, "
+      "in `scratch`, default the system's temporary folder); 0: 80% of the available memory and 90% of the free "
+      "disk. policy=FILE writes the choices of the first `policy_layers` layers as `ontime solve --policy` does "
+      "(JSON Lines: a state, its choice and the bounds of its value). The GIL is released; Ctrl-C stops it "
+      "(KeyboardInterrupt).");
+}
+
+}  // namespace ontime::python
