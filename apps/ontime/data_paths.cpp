@@ -2,13 +2,17 @@
 
 #include <cstdlib>
 
+#include "install_paths.hpp"
+
 namespace ontime::cli {
 
 std::filesystem::path data_directory() {
   if (const char* override_dir = std::getenv("ONTIME_DATA_DIR")) return override_dir;
+  const std::filesystem::path installed = beside_executable(ONTIME_DATA_FROM_BINDIR);
   std::error_code error;
+  if (std::filesystem::is_directory(installed, error)) return installed;
   if (std::filesystem::is_directory(ONTIME_DATA_SOURCE_DIR, error)) return ONTIME_DATA_SOURCE_DIR;
-  return ONTIME_DATA_INSTALL_DIR;
+  return installed;
 }
 
 std::filesystem::path default_world_file(const std::string& domain) {

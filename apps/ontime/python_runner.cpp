@@ -16,6 +16,7 @@
 #include <iterator>
 #include <stdexcept>
 
+#include "install_paths.hpp"
 #include "ontime/util/atomic_file.hpp"
 #include "ontime/util/error.hpp"
 
@@ -115,9 +116,11 @@ std::string last_line(std::string_view text) {
 
 std::string python_script_directory() {
   if (const char* override_dir = std::getenv("ONTIME_PYTHON_DIR")) return override_dir;
+  const std::filesystem::path installed = beside_executable(ONTIME_PYTHON_FROM_BINDIR);
   std::error_code error;
+  if (std::filesystem::is_directory(installed, error)) return installed.string();
   if (std::filesystem::is_directory(ONTIME_PYTHON_SOURCE_DIR, error)) return ONTIME_PYTHON_SOURCE_DIR;
-  return ONTIME_PYTHON_INSTALL_DIR;
+  return installed.string();
 }
 
 std::string shortened_label(std::string_view text, std::size_t max_characters) {
