@@ -79,7 +79,7 @@ Json episode_drawing(const domains::Domain& domain, const domains::PlannerWorld&
     const domains::Refinement* refinement = world.refinement(a);
     if (refinement == nullptr || refinement->status() != domains::RefinementStatus::found) continue;
     drawing["motions"].push_back({{"action", problem.action(a).id},
-                                  {"executed", plan.count(a) > 0},
+                                  {"executed", plan.contains(a)},
                                   {"points", points_json(domain.trace(refinement->motion()))}});
   }
   return drawing;
@@ -327,9 +327,9 @@ void add_tamp_command(CLI::App& app) {
       out["seconds"] = summary.seconds;
       add_charges(out, summary.live_mean, "mean_");
       Json detail = Json::array();
-      for (std::size_t e = 0; e < results.size(); ++e) {
-        Json episode = live_json(results[e]);
-        episode["skeletons_found"] = results[e].skeletons;
+      for (const auto& result : results) {
+        Json episode = live_json(result);
+        episode["skeletons_found"] = result.skeletons;
         detail.push_back(std::move(episode));
       }
       out["episode_results"] = std::move(detail);

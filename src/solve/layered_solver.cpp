@@ -265,8 +265,8 @@ enum class Cut : std::uint8_t { none = 0, stop, states, memory, disk };
 // layer and the file.
 class ScratchFile {
  public:
-  ScratchFile(std::filesystem::path path, int layer, const char* mode) : path_(std::move(path)), layer_(layer) {
-    file_ = std::fopen(path_.c_str(), mode);
+  ScratchFile(std::filesystem::path path, int layer, const char* mode)
+      : path_(std::move(path)), layer_(layer), file_(std::fopen(path_.c_str(), mode)) {
     if (file_ == nullptr) fail("cannot open");
   }
   ~ScratchFile() {
@@ -1026,7 +1026,7 @@ class LayeredSearch {
       const auto started = Clock::now();
       std::vector<Key> keys;
       if (t == top_) {
-        keys = std::move(top_keys);
+        keys = std::exchange(top_keys, {});
       } else {
         keys = read_file<Key>(t, "keys", records_[static_cast<std::size_t>(t)].states);
       }
@@ -1153,7 +1153,7 @@ class LayeredSearch {
 
     void begin(bool flagged) {
       const WeakCluster* weak = search->weak_;
-      const auto next_t = static_cast<std::size_t>(t + 1);
+      const auto next_t = static_cast<std::size_t>(t) + 1;
       ended = weak != nullptr && !flagged ? Bounds{weak->lower[next_t], weak->upper[next_t]} : Bounds{};
       any = false;
       best_lower = -1.0;
@@ -1382,7 +1382,7 @@ class LayeredSearch {
   }
 
   std::string describe(Cut cut, int t) const {
-    const std::string at =
+    std::string at =
         "the forward pass stopped at layer " + std::to_string(t) + " (" + std::to_string(solution_.states) + " states)";
     switch (cut) {
       case Cut::stop:
