@@ -27,7 +27,7 @@ if installed; then fail "a package ontime is installed already (apt-get remove o
 [ -f "$build/CMakeCache.txt" ] || fail "$build is not a configured build tree (run scripts/build.sh)"
 cmake --build "$build" --parallel "$(nproc)"
 rm -f "$build"/ontime_*.deb
-(cd "$build" && cpack -G DEB > cpack.log) || { cat "$build/cpack.log" >&2; fail "cpack failed"; }
+(cd "$build" && cpack -G DEB > cpack.log 2>&1) || { cat "$build/cpack.log" >&2; fail "cpack failed"; }
 debs=("$build"/ontime_*.deb)
 [ ${#debs[@]} -eq 1 ] && [ -f "${debs[0]}" ] || fail "cpack made no single ontime_*.deb in $build"
 deb=$(realpath "${debs[0]}")
