@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# Configures and builds OnTime (Release) in build/. Extra arguments go to the configure step.
+# Configures and builds OnTime (Release) in build/: the `release` preset of CMakePresets.json.
+# Extra arguments go to the configure step.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-generator=()
-if command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
-if [ -f build/CMakeCache.txt ]; then generator=(); fi
-cmake -S . -B build "${generator[@]}" -DCMAKE_BUILD_TYPE=Release "$@"
-cmake --build build --parallel "$(nproc)"
+# Ninja when it is installed (CMake reads CMAKE_GENERATOR only for a new build folder; an existing
+# one keeps its generator).
+if [ -z "${CMAKE_GENERATOR:-}" ] && command -v ninja >/dev/null 2>&1; then export CMAKE_GENERATOR=Ninja; fi
+cmake --preset release "$@"
+cmake --build --preset release --parallel "$(nproc)"

@@ -14,7 +14,11 @@ packages=(
   libboost-serialization-dev libboost-filesystem-dev libboost-system-dev
   python3 python3-matplotlib python3-numpy
   python3-dev pybind11-dev python3-pybind11 python3-pytest
-  clang libclang-rt-14-dev clang-format
+  # pip install of the Python package (pyproject.toml, setup.py) and its check in a venv.
+  python3-pip python3-setuptools python3-wheel python3-venv
+  clang libclang-rt-14-dev clang-format clang-tidy
+  # The Debian package (CPack's DEB generator: dpkg-shlibdeps, file).
+  dpkg-dev file
   # MPI for the split commands; a single-node SLURM cluster for their check (scripts/cluster/).
   # (libpmix-dev must be there before slurmd first starts, or `srun --mpi=pmix` hangs: slurmd
   # is only ever started by scripts/cluster/slurm-up.sh, after this.)

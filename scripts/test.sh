@@ -1,41 +1,42 @@
 #!/usr/bin/env bash
 # Sets up the machine, checks the C++ formatting (clang-format, .clang-format), builds OnTime
 # with warnings as errors and runs every test (the C++ suites, then the Python package's pytest suite, then the
-# MPI and SLURM check of scripts/cluster/check.sh); then the core
-# alone without OMPL, FCL and KDL (build-core/: build, tests, install, consumer); then builds
-# the suite again with AddressSanitizer and UndefinedBehaviorSanitizer (build-sanitize/) and
-# runs it there too (warnings are checked by the first build; GCC warns falsely inside the
-# standard library when it is instrumented).
+# MPI and SLURM check of scripts/cluster/check.sh); then clang-tidy over OnTime's sources
+# (.clang-tidy), the Python package installed by pip and the Debian package built, installed and
+# removed (both from build/); then the core alone without OMPL, FCL and KDL (build-core/: build,
+# tests, install, consumer); then builds the suite again with AddressSanitizer and
+# UndefinedBehaviorSanitizer (build-sanitize/) and runs it there too (warnings are checked by the
+# first build; GCC warns falsely inside the standard library when it is instrumented).
+# Each build folder is a preset of CMakePresets.json (release, core, sanitize).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/setup.sh
 ./scripts/check-format.sh
+# Ninja when it is installed (CMake reads CMAKE_GENERATOR only for a new build folder).
+if [ -z "${CMAKE_GENERATOR:-}" ] && command -v ninja >/dev/null 2>&1; then export CMAKE_GENERATOR=Ninja; fi
 ./scripts/build.sh -DONTIME_WARNINGS_AS_ERRORS=ON
-ctest --test-dir build --parallel "$(nproc)" --output-on-failure --label-exclude python
+ctest --preset release --parallel "$(nproc)" --label-exclude python
 # The Python package's pytest suite, verbose so that its closing line shows.
-ctest --test-dir build --label-regex python --output-on-failure --verbose
+ctest --preset release --label-regex python --verbose
 # Split over MPI ranks (mpirun, and srun on a single-node SLURM cluster brought up for it): the
 # same files as one process, byte for byte, and no work lost when a rank dies.
 ./scripts/cluster/check.sh build/ontime
+# Static analysis: no finding of .clang-tidy's checks in src/, include/, apps/, domains/ (python/src/: see the script).
+./scripts/clang-tidy.sh build
+# Installing: pip install --no-build-isolation . (reusing build/), then the .deb of cpack.
+./scripts/check-pip-install.sh build
+./scripts/check-package.sh build
 
 # The core without the domains: configured with OMPL, FCL and KDL hidden from find_package, it
 # builds, passes its tests, installs, and an outside project builds against the install (the
 # install_and_consume test, core component only, with Eigen hidden from the consumer).
-generator=()
-if command -v ninja >/dev/null 2>&1 && [ ! -f build-core/CMakeCache.txt ]; then generator=(-G Ninja); fi
-# (--no-warn-unused-cli: that nothing reads the CMAKE_DISABLE_FIND_PACKAGE_ variables is the point.)
-cmake -S . -B build-core "${generator[@]}" --no-warn-unused-cli -DCMAKE_BUILD_TYPE=Release -DONTIME_WARNINGS_AS_ERRORS=ON \
-  -DONTIME_BUILD_DOMAINS=OFF -DONTIME_BUILD_BENCHMARKS=OFF -DONTIME_PYTHON=OFF \
-  -DCMAKE_DISABLE_FIND_PACKAGE_ompl=ON -DCMAKE_DISABLE_FIND_PACKAGE_fcl=ON -DCMAKE_DISABLE_FIND_PACKAGE_orocos_kdl=ON
-cmake --build build-core --parallel "$(nproc)"
-ctest --test-dir build-core --parallel "$(nproc)" --output-on-failure
+cmake --preset core -DONTIME_WARNINGS_AS_ERRORS=ON
+cmake --build --preset core --parallel "$(nproc)"
+ctest --preset core --parallel "$(nproc)"
 
-generator=()
-if command -v ninja >/dev/null 2>&1 && [ ! -f build-sanitize/CMakeCache.txt ]; then generator=(-G Ninja); fi
-# (No Python package: an instrumented extension cannot be loaded by the uninstrumented interpreter.)
-cmake -S . -B build-sanitize "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DONTIME_SANITIZE=ON \
-  -DONTIME_BUILD_BENCHMARKS=OFF -DONTIME_PYTHON=OFF
-cmake --build build-sanitize --parallel "$(nproc)"
-# The install test builds an uninstrumented consumer against the library: not meaningful here.
-ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  ctest --test-dir build-sanitize --parallel "$(nproc)" --output-on-failure --label-exclude integration
+# (No Python package: an instrumented extension cannot be loaded by the uninstrumented
+# interpreter. The install test, which builds an uninstrumented consumer against the library, is
+# left out by the preset; it sets ASAN_OPTIONS and UBSAN_OPTIONS.)
+cmake --preset sanitize
+cmake --build --preset sanitize --parallel "$(nproc)"
+ctest --preset sanitize --parallel "$(nproc)"

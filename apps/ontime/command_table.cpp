@@ -6,7 +6,6 @@
 #include <fmt/format.h>
 
 #include <filesystem>
-#include <ranges>
 #include <string_view>
 
 #include "common.hpp"
@@ -36,9 +35,14 @@ void add_table_command(CLI::App& app) {
           "--solvers",
           [options](const std::string& text) {
             options->solvers.clear();
-            for (const auto part : std::views::split(std::string_view(text), ',')) {
-              options->solvers.emplace_back(part.begin(), part.end());
+            if (text.empty()) return;
+            // (A loop rather than std::views::split, which clang 14 cannot parse in libstdc++ 12.)
+            std::string_view rest(text);
+            for (std::size_t comma = rest.find(','); comma != std::string_view::npos; comma = rest.find(',')) {
+              options->solvers.emplace_back(rest.substr(0, comma));
+              rest.remove_prefix(comma + 1);
             }
+            options->solvers.emplace_back(rest);
           },
           "Comma-separated allocators, one column each")
       ->default_str(fmt::format("{}", fmt::join(options->solvers, ",")));

@@ -91,6 +91,8 @@ class ProgressBar {
  public:
   explicit ProgressBar(std::string label);
   ~ProgressBar();
+  ProgressBar(const ProgressBar&) = delete;
+  ProgressBar& operator=(const ProgressBar&) = delete;
   void update(std::uint64_t done, std::uint64_t total);
   // For work whose total is not known in advance: the label and `text` on one line, redrawn.
   void status(std::string_view text);

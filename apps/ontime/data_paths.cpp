@@ -2,13 +2,17 @@
 
 #include <cstdlib>
 
+#include "install_paths.hpp"
+
 namespace ontime::cli {
 
 std::filesystem::path data_directory() {
   if (const char* override_dir = std::getenv("ONTIME_DATA_DIR")) return override_dir;
+  std::filesystem::path installed = beside_executable(ONTIME_DATA_FROM_BINDIR);
   std::error_code error;
+  if (std::filesystem::is_directory(installed, error)) return installed;
   if (std::filesystem::is_directory(ONTIME_DATA_SOURCE_DIR, error)) return ONTIME_DATA_SOURCE_DIR;
-  return ONTIME_DATA_INSTALL_DIR;
+  return installed;
 }
 
 std::filesystem::path default_world_file(const std::string& domain) {
@@ -24,7 +28,7 @@ std::filesystem::path collected_instance_file(const std::string& domain) {
 }
 
 std::filesystem::path default_model_file(const std::string& domain) {
-  const std::filesystem::path collected = collected_instance_file(domain);
+  std::filesystem::path collected = collected_instance_file(domain);
   std::error_code error;
   if (std::filesystem::is_regular_file(collected, error)) return collected;
   return data_directory() / "instances" / (domain + ".json");

@@ -12,8 +12,8 @@
 
 namespace ontime::cli {
 
-// $ONTIME_DATA_DIR, else the source tree's data/ when running from a build tree, else the
-// installed share/ontime/data.
+// $ONTIME_DATA_DIR, else share/ontime/data installed beside this executable (../share/ontime/data
+// from its bin/), else the source tree's data/ (running from a build tree).
 std::filesystem::path data_directory();
 
 // The world file of a domain: data_directory()/domains/NAME.json.

@@ -16,6 +16,7 @@
 #include <iterator>
 #include <stdexcept>
 
+#include "install_paths.hpp"
 #include "ontime/util/atomic_file.hpp"
 #include "ontime/util/error.hpp"
 
@@ -29,7 +30,8 @@ constexpr std::array<int, 3> kForwardedSignals{SIGINT, SIGTERM, SIGHUP};
 // it exists) and the first forwarded signal received (0 for none).
 std::atomic<pid_t> script_process_group{0};
 std::atomic<int> received_signal{0};
-static_assert(std::atomic<pid_t>::is_always_lock_free && std::atomic<int>::is_always_lock_free);
+static_assert(std::atomic<pid_t>::is_always_lock_free);
+static_assert(std::atomic<int>::is_always_lock_free);
 
 extern "C" void forward_signal(int signal_number) {
   int none = 0;
@@ -115,9 +117,11 @@ std::string last_line(std::string_view text) {
 
 std::string python_script_directory() {
   if (const char* override_dir = std::getenv("ONTIME_PYTHON_DIR")) return override_dir;
+  const std::filesystem::path installed = beside_executable(ONTIME_PYTHON_FROM_BINDIR);
   std::error_code error;
+  if (std::filesystem::is_directory(installed, error)) return installed.string();
   if (std::filesystem::is_directory(ONTIME_PYTHON_SOURCE_DIR, error)) return ONTIME_PYTHON_SOURCE_DIR;
-  return ONTIME_PYTHON_INSTALL_DIR;
+  return installed.string();
 }
 
 std::string shortened_label(std::string_view text, std::size_t max_characters) {
@@ -151,6 +155,7 @@ void run_python_script(const std::string& script, const std::filesystem::path& o
   command.insert(command.end(), script_arguments.begin(), script_arguments.end());
   // Everything the child needs is prepared before fork: only async-signal-safe calls follow.
   std::vector<char*> argv;
+  argv.reserve(command.size() + 1);
   for (std::string& argument : command) argv.push_back(argument.data());
   argv.push_back(nullptr);
   const std::string exec_failure = "cannot run " + interpreter + "\n";
@@ -192,7 +197,7 @@ void run_python_script(const std::string& script, const std::filesystem::path& o
     if (const int early = received_signal.load(); early != 0) ::kill(-child, early);
     ::close(error_pipe[1]);
     // Only the end of the output is kept: its last line is the script's message.
-    constexpr std::size_t kKeptBytes = 64 * 1024;
+    constexpr std::size_t kKeptBytes = std::size_t{64} * 1024;
     std::array<char, 4096> buffer{};
     for (;;) {
       const ssize_t n = ::read(error_pipe[0], buffer.data(), buffer.size());

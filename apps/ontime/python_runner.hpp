@@ -18,8 +18,8 @@
 
 namespace ontime::cli {
 
-// The directory holding the scripts: $ONTIME_PYTHON_DIR, else the source tree's python/ when
-// running from a build tree, else the installed share/ontime/python.
+// The directory holding the scripts: $ONTIME_PYTHON_DIR, else share/ontime/python installed
+// beside this executable, else the source tree's python/ (running from a build tree).
 std::string python_script_directory();
 
 // The exit status by which a script says its input data was bad (sysexits' EX_DATAERR); any

@@ -105,7 +105,7 @@ std::vector<TreeAction> skeleton_tree(const std::vector<std::vector<std::string>
     for (const auto& skeleton : skeletons) {
       if (position >= skeleton.size()) continue;
       const std::string& action = skeleton[position];
-      if (index_of.count(action) != 0) continue;
+      if (index_of.contains(action)) continue;
       const int parent = position == 0 ? -1 : index_of.at(skeleton[position - 1]);
       index_of.emplace(action, static_cast<int>(tree.size()));
       tree.push_back(TreeAction{action, parent});

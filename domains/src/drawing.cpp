@@ -62,7 +62,7 @@ EpisodeDrawing episode_drawing(const Domain& domain, const PlannerWorld& world, 
   for (int a = 0; a < problem.action_count(); ++a) {
     const Refinement* refinement = world.refinement(a);
     if (refinement == nullptr || refinement->status() != RefinementStatus::found) continue;
-    drawing.motions.push_back({problem.action(a).id, plan.count(a) > 0, domain.trace(refinement->motion())});
+    drawing.motions.push_back({problem.action(a).id, plan.contains(a), domain.trace(refinement->motion())});
   }
   return drawing;
 }

@@ -52,6 +52,12 @@ bool overlap(const Object& a, const Object& b) {
   return fcl::collide(&a, &b, request, result) > 0;
 }
 
+// Moves a shape to `transform` and updates its bounding box.
+void place(Object& object, const Transform& transform) {
+  object.setTransform(transform);
+  object.computeAABB();
+}
+
 }  // namespace
 
 Transform object_transform(const ObjectPose& pose) {
@@ -102,11 +108,6 @@ struct ManipulationCollision::Impl {
   Transform base_offset, torso_offset, upper_arm_offset, forearm_offset, palm_offset, left_offset, right_offset;
   Transform grasp = Transform::Identity();
 
-  void place(Object& object, const Transform& transform) const {
-    object.setTransform(transform);
-    object.computeAABB();
-  }
-
   bool hits_world(Object* object) const {
     fcl::DefaultCollisionData<double> data;
     manager.collide(object, &data, fcl::DefaultCollisionFunction<double>);
@@ -123,7 +124,7 @@ ManipulationCollision::ManipulationCollision(const ManipulationWorld& world, con
   impl.arm = &arm;
   impl.grasp = grasp;
   const auto add_static = [&impl](std::unique_ptr<Object> object, const Transform& transform) {
-    impl.place(*object, transform);
+    place(*object, transform);
     impl.manager.registerObject(object.get());
     impl.statics.push_back(std::move(object));
   };
@@ -187,19 +188,19 @@ bool ManipulationCollision::collides(const Pose& base, const ArmJoints& arm) con
   const ArmFrames frames = impl.arm->frames(arm);
   // The gripper first: it is the part that reaches among the objects.
   const Transform wrist = torso * frames[6];
-  impl.place(*impl.palm, wrist * impl.palm_offset);
-  impl.place(*impl.left_finger, wrist * impl.left_offset);
-  impl.place(*impl.right_finger, wrist * impl.right_offset);
-  impl.place(*impl.forearm, torso * frames[4] * impl.forearm_offset);
-  if (impl.held) impl.place(*impl.held, torso * frames[kArmJointCount] * impl.grasp);
+  place(*impl.palm, wrist * impl.palm_offset);
+  place(*impl.left_finger, wrist * impl.left_offset);
+  place(*impl.right_finger, wrist * impl.right_offset);
+  place(*impl.forearm, torso * frames[4] * impl.forearm_offset);
+  if (impl.held) place(*impl.held, torso * frames[kArmJointCount] * impl.grasp);
   for (Object* part :
        {impl.left_finger.get(), impl.right_finger.get(), impl.palm.get(), impl.held.get(), impl.forearm.get()}) {
     if (part != nullptr && impl.hits_world(part)) return true;
   }
-  impl.place(*impl.upper_arm, torso * frames[2] * impl.upper_arm_offset);
-  impl.place(*impl.shoulder, torso * frames[0]);
-  impl.place(*impl.torso, body * impl.torso_offset);
-  impl.place(*impl.base, body * impl.base_offset);
+  place(*impl.upper_arm, torso * frames[2] * impl.upper_arm_offset);
+  place(*impl.shoulder, torso * frames[0]);
+  place(*impl.torso, body * impl.torso_offset);
+  place(*impl.base, body * impl.base_offset);
   for (Object* part : {impl.upper_arm.get(), impl.shoulder.get(), impl.torso.get(), impl.base.get()}) {
     if (impl.hits_world(part)) return true;
   }
@@ -217,7 +218,7 @@ bool ManipulationCollision::collides(const Pose& base, const ArmJoints& arm) con
 bool ManipulationCollision::held_object_collides(const ObjectPose& pose) const {
   Impl& impl = *impl_;
   if (!impl.held) throw std::logic_error("no object is held");
-  impl.place(*impl.held, object_transform(pose));
+  place(*impl.held, object_transform(pose));
   return impl.hits_world(impl.held.get());
 }
 
@@ -229,7 +230,7 @@ void ManipulationCollision::set_grasp(const Transform& grasp) {
 void ManipulationCollision::set_object_pose(std::size_t object, const ObjectPose& pose) {
   Object* standing = impl_->standing.at(object);
   if (standing == nullptr) throw std::logic_error("the held object does not stand anywhere");
-  impl_->place(*standing, object_transform(pose));
+  place(*standing, object_transform(pose));
   impl_->manager.update(standing);
 }
 

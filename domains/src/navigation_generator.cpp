@@ -211,7 +211,7 @@ class Generator {
  private:
   int room_count() const { return options_.rows * options_.cols; }
   Cell cell(int room) const { return Cell{room / options_.cols, room % options_.cols}; }
-  std::string room_id(int room) const {
+  static std::string room_id(int room) {
     std::string id = "R";
     id += std::to_string(room + 1);
     return id;
@@ -290,7 +290,7 @@ class Generator {
   }
 
   // The side pose of a door in `room` (one of its two rooms) and the direction into the room.
-  Point side_point(const DoorPlan& door, int room) const {
+  static Point side_point(const DoorPlan& door, int room) {
     const double sign = room == door.b ? 1.0 : -1.0;
     return door.vertical ? Point{door.x + sign * kSideDistance, door.y} : Point{door.x, door.y + sign * kSideDistance};
   }

@@ -144,7 +144,7 @@ class WorldReader : detail::WorldFields {
   }
 
   std::string room_id(const Json& value, const std::string& path, const NavigationWorld& world) const {
-    const std::string id = string_at(value, path);
+    std::string id = string_at(value, path);
     if (world.room_index(id) < 0) fail(path, "unknown room '" + id + "' (not a key of 'rooms')");
     return id;
   }
@@ -275,7 +275,7 @@ class WorldReader : detail::WorldFields {
           fail(place, "'" + skeleton[l] + "' is not move(FROM,TO) between rooms of this world");
         }
         if (rooms[0] != at) fail(place, "'" + skeleton[l] + "' starts in " + rooms[0] + " but the robot is in " + at);
-        if (joined.count({rooms[0], rooms[1]}) == 0) fail(place, "no door joins " + rooms[0] + " and " + rooms[1]);
+        if (!joined.contains({rooms[0], rooms[1]})) fail(place, "no door joins " + rooms[0] + " and " + rooms[1]);
         at = rooms[1];
       }
       if (at != world.goal_room) {

@@ -141,6 +141,8 @@ ArmFrames Pr2Arm::frames(const ArmJoints& joints) const {
 
 Transform Pr2Arm::tool(const ArmJoints& joints) const { return frames(joints)[kArmJointCount]; }
 
+// (A member though it reads only the PR2's constants: whether this arm may reach.)
+// NOLINTNEXTLINE(readability-convert-member-functions-to-static)
 bool Pr2Arm::may_reach(const Transform& target) const noexcept {
   // The wrist (flex and roll joints) lies 0.18 m behind the tool frame, and at most
   // 0.1 + 0.4 + 0.321 m from the shoulder pan joint.

@@ -25,7 +25,7 @@ double door_weight(const NavigationWorld& world, const Door& door) {
 
 // igraph's containers, freed on every path out.
 struct Graph {
-  igraph_t graph;
+  igraph_t graph{};
   explicit Graph(const igraph_vector_int_t& edges, igraph_integer_t vertices) {
     if (igraph_create(&graph, &edges, vertices, IGRAPH_UNDIRECTED) != IGRAPH_SUCCESS) {
       throw std::runtime_error("igraph could not build the room graph");
@@ -37,7 +37,7 @@ struct Graph {
 };
 
 struct IntVector {
-  igraph_vector_int_t vector;
+  igraph_vector_int_t vector{};
   explicit IntVector(igraph_integer_t size) {
     if (igraph_vector_int_init(&vector, size) != IGRAPH_SUCCESS) throw std::bad_alloc();
   }
@@ -47,7 +47,7 @@ struct IntVector {
 };
 
 struct RealVector {
-  igraph_vector_t vector;
+  igraph_vector_t vector{};
   explicit RealVector(igraph_integer_t size) {
     if (igraph_vector_init(&vector, size) != IGRAPH_SUCCESS) throw std::bad_alloc();
   }
@@ -57,7 +57,7 @@ struct RealVector {
 };
 
 struct PathList {
-  igraph_vector_int_list_t list;
+  igraph_vector_int_list_t list{};
   PathList() {
     if (igraph_vector_int_list_init(&list, 0) != IGRAPH_SUCCESS) throw std::bad_alloc();
   }

@@ -247,6 +247,7 @@ AllocatorFactory AllocatorRegistry::make_factory(std::string_view name, const Md
         std::find_if(declared.begin(), declared.end(), [&](const Parameter& p) { return p.name == given; });
     if (parameter == declared.end()) {
       std::vector<std::string> known;
+      known.reserve(declared.size());
       for (const Parameter& p : declared) known.push_back(p.name);
       throw unknown_name_error("allocator parameter", given, known);
     }

@@ -111,7 +111,7 @@ std::uint32_t MctsAllocator::select_edge(const DecisionNode& node) const {
 
 double MctsAllocator::rollout(State& state) {
   for (;;) {
-    int choice;
+    int choice = -1;
     if (rollout_policy_) {
       choice = rollout_policy_->choose(state);
     } else {

@@ -17,7 +17,7 @@ void normalised_state(const Mdp& mdp, const State& state, std::span<float> out) 
   out[0] = static_cast<float>(state.time) / deadline;
   for (int k = 0; k < count; ++k) {
     const auto slot = static_cast<std::size_t>(k);
-    const auto base = static_cast<std::size_t>(3 * k);
+    const auto base = 3 * slot;
     out[base + 1] = static_cast<float>(state.refined[slot]) / static_cast<float>(problem.skeleton_length(k));
     out[base + 2] = static_cast<float>(state.spent[slot]) / deadline;
     out[base + 3] = static_cast<float>(state.execution[slot]) / deadline;

@@ -84,7 +84,7 @@ Distribution estimate_planning(const PlanningSample& sample, Steps deadline, dou
   double survival = 1.0;
   for (Steps t = 1; t <= deadline; ++t) {
     const auto slot = static_cast<std::size_t>(t);
-    const double categories_left = static_cast<double>(deadline - t + 2);  // t..D and "never"
+    const auto categories_left = static_cast<double>(deadline - t + 2);  // t..D and "never"
     const double denominator = at_risk + laplace * categories_left;
     const double hazard = denominator > 0 ? (found_at[slot] + laplace) / denominator : 0.0;
     masses[slot] = survival * hazard;
@@ -137,9 +137,9 @@ FitResult fit_problem(std::span<const RefinementAttempt> attempts, std::string_v
   std::map<std::string, int> index_of;
   std::vector<std::vector<int>> skeleton_indices;
   std::vector<ActionFit> fits;
-  for (std::size_t k = 0; k < skeletons.skeletons.size(); ++k) {
+  for (const auto& skeleton : skeletons.skeletons) {
     std::vector<int>& indices = skeleton_indices.emplace_back();
-    for (const std::string& id : skeletons.skeletons[k]) {
+    for (const std::string& id : skeleton) {
       const auto [entry, fresh] = index_of.try_emplace(id, static_cast<int>(fits.size()));
       if (fresh) fits.push_back(ActionFit{id, 0, 0, 0});
       indices.push_back(entry->second);

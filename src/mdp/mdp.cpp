@@ -92,7 +92,7 @@ void Mdp::reject_choice(int choice) const {
                    ")");
 }
 
-void Mdp::reject_idle_refinement(int choice) const {
+void Mdp::reject_idle_refinement(int choice) {
   throw UsageError("skeleton " + std::to_string(choice) + " has nothing left to refine; its step was idle");
 }
 

@@ -93,7 +93,7 @@ Distribution Distribution::conditioned(Steps spent) const {
   const double remaining = survival(spent);
   if (spent < 0 || remaining <= 0.0) return Distribution{};
   std::vector<double> masses;
-  const std::size_t first = static_cast<std::size_t>(spent);
+  const auto first = static_cast<std::size_t>(spent);
   if (masses_.size() > first) {
     masses.assign(masses_.begin() + static_cast<std::ptrdiff_t>(first), masses_.end());
     masses[0] = 0.0;  // T - spent >= 1 given T > spent

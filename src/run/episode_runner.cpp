@@ -227,7 +227,8 @@ LatencySummary LatencyHistogram::summary() const {
   summary.decisions = count_;
   if (count_ == 0) return summary;
   const auto at = [&](double quantile) {
-    const auto rank = static_cast<std::uint64_t>(quantile * static_cast<double>(count_ - 1) + 0.5);
+    // Rounded half up (the value is never negative).
+    const auto rank = static_cast<std::uint64_t>(std::floor(quantile * static_cast<double>(count_ - 1) + 0.5));
     std::uint64_t below = 0;
     for (std::size_t bucket = 0; bucket < kBuckets; ++bucket) {
       below += counts_[bucket];

@@ -269,6 +269,7 @@ int Session::add_skeleton(const std::vector<std::string>& action_ids, std::vecto
     path.push_back(index);
   }
   std::vector<std::vector<int>> skeletons;
+  skeletons.reserve(static_cast<std::size_t>(current.skeleton_count()) + 1);
   for (int k = 0; k < current.skeleton_count(); ++k)
     skeletons.emplace_back(current.skeleton(k).begin(), current.skeleton(k).end());
   skeletons.push_back(std::move(path));

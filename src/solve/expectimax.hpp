@@ -216,9 +216,9 @@ class Expectimax {
 
  private:
   struct Item {
-    int choice;
-    Status status;
-    double probability;
+    int choice = -1;
+    Status status = Status::running;
+    double probability = 0.0;
     CompactState next;
     Key key;  // of `next`, when running
   };

@@ -81,8 +81,8 @@ Knapsack load_knapsack(const std::filesystem::path& path) {
 double reduction_epsilon(const Knapsack& knapsack) {
   std::int64_t largest = 0;
   for (const KnapsackItem& item : knapsack.items) largest = std::max(largest, item.value);
-  const double h = static_cast<double>(largest);
-  const double m = static_cast<double>(knapsack.items.size());
+  const auto h = static_cast<double>(largest);
+  const auto m = static_cast<double>(knapsack.items.size());
   return 1.0 / (h * h * m * m * m);
 }
 

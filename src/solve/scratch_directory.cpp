@@ -43,7 +43,7 @@ std::string host_name() {
 // with the signals blocked, read by the handler ----
 struct Slot {
   std::atomic<bool> used{false};
-  char path[kMaxPath];
+  char path[kMaxPath]{};
 };
 Slot slots[kSlots];
 std::mutex registry;

@@ -36,10 +36,10 @@ if(WITH_DOMAINS)
     message(FATAL_ERROR "domains consumer answered '${out}${err}' (exit ${status}), expected 'skeletons 4'")
   endif()
   message(STATUS "domains consumer built against the installed package: ${out}")
-  # The installed ontime finds the installed world file and instance (data directory given as
-  # the install prefix's, since the build tree's data/ would be found first otherwise).
+  # The installed ontime finds the world file and instance installed beside it (not the source
+  # tree's data/, though that exists here), whatever the prefix.
   set(data "${SCRATCH_DIR}/prefix/share/ontime/data")
-  execute_process(COMMAND "${CMAKE_COMMAND}" -E env "ONTIME_DATA_DIR=${data}"
+  execute_process(COMMAND "${CMAKE_COMMAND}" -E env --unset=ONTIME_DATA_DIR
     "${SCRATCH_DIR}/prefix/bin/ontime" run --domain navigation --solver dp --episodes 1 --threads 1 --json
     WORKING_DIRECTORY "${SCRATCH_DIR}" RESULT_VARIABLE status OUTPUT_VARIABLE out ERROR_VARIABLE err)
   string(FIND "${out}" "\"instance\": \"${data}/instances/navigation.json\"" at)

@@ -83,6 +83,8 @@ class PpoAllocator final : public Allocator {
   // skeletons or deadline.
   PpoAllocator(const Mdp& mdp, std::shared_ptr<const PpoPolicy> policy);
   ~PpoAllocator() override;
+  PpoAllocator(const PpoAllocator&) = delete;
+  PpoAllocator& operator=(const PpoAllocator&) = delete;
 
   std::string_view name() const noexcept override { return "ppo"; }
   int choose(const State& state) override;

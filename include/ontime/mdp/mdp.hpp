@@ -175,7 +175,7 @@ class Mdp {
  private:
   // The UsageErrors of apply (out of line: the templates stay free of message building).
   [[noreturn]] void reject_choice(int choice) const;
-  [[noreturn]] void reject_idle_refinement(int choice) const;
+  [[noreturn]] static void reject_idle_refinement(int choice);
   [[noreturn]] static void reject_execution(Steps execution);
 
   std::uint16_t saturate_execution(std::int64_t steps) const noexcept {

@@ -24,7 +24,7 @@ struct KnapsackItem {
 };
 
 struct Knapsack {
-  std::int64_t capacity;
+  std::int64_t capacity = 0;
   std::vector<KnapsackItem> items;
 };
 

@@ -39,6 +39,8 @@ class OptimalSolver {
 
   explicit OptimalSolver(const Mdp& mdp, std::size_t max_states = kDefaultMaxStates);
   ~OptimalSolver();
+  OptimalSolver(const OptimalSolver&) = delete;
+  OptimalSolver& operator=(const OptimalSolver&) = delete;
   OptimalSolver(OptimalSolver&&) noexcept;
   OptimalSolver& operator=(OptimalSolver&&) noexcept;
 
@@ -58,7 +60,7 @@ class OptimalSolver {
   static double max_bytes(const Problem& problem, std::size_t max_states);
 
   // States memoised so far.
-  std::size_t states() const noexcept;
+  std::size_t states() const noexcept;  // NOLINT(bugprone-exception-escape): see its definition
   std::size_t max_states() const noexcept { return max_states_; }
   const Mdp& mdp() const noexcept { return *mdp_; }
 

@@ -49,7 +49,7 @@ class ByteUnpacker {
   template <class T>
   T get() {
     static_assert(std::is_trivially_copyable_v<T>);
-    T value;
+    T value{};
     std::memcpy(&value, take(sizeof(T)), sizeof(T));
     return value;
   }

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 #include "util/portable_math.hpp"
 
@@ -36,7 +37,7 @@ void ordered_product(const Lhs& lhs, const Rhs& rhs, Dst& dst) {
 }  // namespace
 
 template <class Scalar>
-Mlp<Scalar>::Mlp(const std::vector<int>& sizes, SplitMix64& generator) : sizes_(sizes) {
+Mlp<Scalar>::Mlp(std::vector<int> sizes, SplitMix64& generator) : sizes_(std::move(sizes)) {
   if (sizes_.size() < 2) throw std::invalid_argument("a network needs at least an input and an output layer");
   for (const int size : sizes_) {
     if (size < 1) throw std::invalid_argument("layer sizes must be positive");

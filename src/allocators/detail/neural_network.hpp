@@ -27,7 +27,7 @@ class Mlp {
   Mlp() = default;
   // sizes = {inputs, hidden..., outputs}. Weights and biases drawn uniformly from
   // [-1/sqrt(fan_in), 1/sqrt(fan_in)] with the given generator.
-  Mlp(const std::vector<int>& sizes, SplitMix64& generator);
+  Mlp(std::vector<int> sizes, SplitMix64& generator);
 
   const std::vector<int>& sizes() const noexcept { return sizes_; }
   int inputs() const noexcept { return sizes_.front(); }

@@ -29,7 +29,7 @@ void LayeredSearch<W>::backward(std::vector<Key> top_keys) {
     const auto started = Clock::now();
     std::vector<Key> keys;
     if (t == top_) {
-      keys = std::move(top_keys);
+      keys = std::exchange(top_keys, {});
     } else {
       keys = read_keys(t, records_[static_cast<std::size_t>(t)].states);
     }
@@ -81,7 +81,7 @@ struct LayeredSearch<W>::StateValue {
 
   void begin(bool flagged) {
     const WeakCluster* weak = search->weak_;
-    const auto next_t = static_cast<std::size_t>(t + 1);
+    const auto next_t = static_cast<std::size_t>(t) + 1;
     ended = weak != nullptr && !flagged ? Bounds{weak->lower[next_t], weak->upper[next_t]} : Bounds{};
     any = false;
     best_lower = -1.0;
@@ -200,12 +200,12 @@ void LayeredSearch<W>::keep_policy(const std::vector<Key>& keys, const std::vect
 }
 
 // The members defined here, for every key width search_layers dispatches to (search.hpp).
-#define ONTIME_INSTANTIATE_BACKWARD_PASS(W)                                                                        \
-  template void LayeredSearch<W>::backward(std::vector<PackedState<W>>);                                           \
-  template void LayeredSearch<W>::value_layer(const std::vector<PackedState<W>>&, int, const std::vector<Bounds>&, \
-                                              std::vector<Bounds>&, std::vector<int>&);                            \
-  template void LayeredSearch<W>::keep_policy(const std::vector<PackedState<W>>&, const std::vector<Bounds>&,      \
-                                              const std::vector<int>&, int);
+#define ONTIME_INSTANTIATE_BACKWARD_PASS(W)                                                                            \
+  template void LayeredSearch<(W)>::backward(std::vector<PackedState<(W)>>);                                           \
+  template void LayeredSearch<(W)>::value_layer(const std::vector<PackedState<(W)>>&, int, const std::vector<Bounds>&, \
+                                                std::vector<Bounds>&, std::vector<int>&);                              \
+  template void LayeredSearch<(W)>::keep_policy(const std::vector<PackedState<(W)>>&, const std::vector<Bounds>&,      \
+                                                const std::vector<int>&, int);
 ONTIME_LAYERED_KEY_WIDTHS(ONTIME_INSTANTIATE_BACKWARD_PASS)
 #undef ONTIME_INSTANTIATE_BACKWARD_PASS
 

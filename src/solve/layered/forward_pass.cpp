@@ -317,9 +317,9 @@ Cut LayeredSearch<W>::expand(const std::vector<Key>& current, int t, std::vector
 }
 
 // The members defined here, for every key width search_layers dispatches to (search.hpp).
-#define ONTIME_INSTANTIATE_FORWARD_PASS(W)                                                     \
-  template std::vector<PackedState<W>> LayeredSearch<W>::forward(std::vector<PackedState<W>>); \
-  template Cut LayeredSearch<W>::expand(const std::vector<PackedState<W>>&, int, std::vector<PackedState<W>>&);
+#define ONTIME_INSTANTIATE_FORWARD_PASS(W)                                                           \
+  template std::vector<PackedState<(W)>> LayeredSearch<(W)>::forward(std::vector<PackedState<(W)>>); \
+  template Cut LayeredSearch<(W)>::expand(const std::vector<PackedState<(W)>>&, int, std::vector<PackedState<(W)>>&);
 ONTIME_LAYERED_KEY_WIDTHS(ONTIME_INSTANTIATE_FORWARD_PASS)
 #undef ONTIME_INSTANTIATE_FORWARD_PASS
 

@@ -61,7 +61,7 @@ void LayeredSearch<W>::value_frontier(const std::vector<Key>& keys, int t, std::
 
 template <std::size_t W>
 std::string LayeredSearch<W>::describe(Cut cut, int t) const {
-  const std::string at =
+  std::string at =
       "the forward pass stopped at layer " + std::to_string(t) + " (" + std::to_string(solution_.states) + " states)";
   switch (cut) {
     case Cut::stop:
@@ -81,10 +81,10 @@ std::string LayeredSearch<W>::describe(Cut cut, int t) const {
 }
 
 // The members defined here, for every key width search_layers dispatches to (search.hpp).
-#define ONTIME_INSTANTIATE_FRONTIER(W)                                                                          \
-  template void LayeredSearch<W>::value_frontier(const std::vector<PackedState<W>>&, int, std::vector<Bounds>&, \
-                                                 std::vector<int>&);                                            \
-  template std::string LayeredSearch<W>::describe(Cut, int) const;
+#define ONTIME_INSTANTIATE_FRONTIER(W)                                                                              \
+  template void LayeredSearch<(W)>::value_frontier(const std::vector<PackedState<(W)>>&, int, std::vector<Bounds>&, \
+                                                   std::vector<int>&);                                              \
+  template std::string LayeredSearch<(W)>::describe(Cut, int) const;
 ONTIME_LAYERED_KEY_WIDTHS(ONTIME_INSTANTIATE_FRONTIER)
 #undef ONTIME_INSTANTIATE_FRONTIER
 

@@ -21,8 +21,7 @@
 namespace ontime::layered {
 
 ScratchFile::ScratchFile(std::filesystem::path path, int layer, const char* mode)
-    : path_(std::move(path)), layer_(layer) {
-  file_ = std::fopen(path_.c_str(), mode);
+    : path_(std::move(path)), layer_(layer), file_(std::fopen(path_.c_str(), mode)) {
   if (file_ == nullptr) fail("cannot open");
 }
 
@@ -70,10 +69,10 @@ void LayeredSearch<W>::remove_layer_files(int t) {
 }
 
 // The members defined here, for every key width search_layers dispatches to (search.hpp).
-#define ONTIME_INSTANTIATE_STORAGE(W)                                                  \
-  template void LayeredSearch<W>::write_keys(int, const std::vector<PackedState<W>>&); \
-  template std::vector<PackedState<W>> LayeredSearch<W>::read_keys(int, std::size_t);  \
-  template void LayeredSearch<W>::remove_layer_files(int);
+#define ONTIME_INSTANTIATE_STORAGE(W)                                                      \
+  template void LayeredSearch<(W)>::write_keys(int, const std::vector<PackedState<(W)>>&); \
+  template std::vector<PackedState<(W)>> LayeredSearch<(W)>::read_keys(int, std::size_t);  \
+  template void LayeredSearch<(W)>::remove_layer_files(int);
 ONTIME_LAYERED_KEY_WIDTHS(ONTIME_INSTANTIATE_STORAGE)
 #undef ONTIME_INSTANTIATE_STORAGE
 
