@@ -4,7 +4,7 @@
 # MPI and SLURM check of scripts/cluster/check.sh); then clang-tidy over OnTime's sources
 # (.clang-tidy), the Python package installed by pip and the Debian package built, installed and
 # removed (both from build/); then the core alone without OMPL, FCL and KDL (build-core/: build,
-# tests, install, consumer); then builds the suite again with AddressSanitizer and
+# the tool's refusals, install, consumer); then builds the suite again with AddressSanitizer and
 # UndefinedBehaviorSanitizer (build-sanitize/) and runs it there too (warnings are checked by the
 # first build; GCC warns falsely inside the standard library when it is instrumented).
 # Each build folder is a preset of CMakePresets.json (release, core, sanitize).
@@ -27,12 +27,15 @@ ctest --preset release --label-regex python --verbose
 ./scripts/check-pip-install.sh build
 ./scripts/check-package.sh build
 
-# The core without the domains: configured with OMPL, FCL and KDL hidden from find_package, it
-# builds, passes its tests, installs, and an outside project builds against the install (the
-# install_and_consume test, core component only, with Eigen hidden from the consumer).
+# The core without the domains: configured with OMPL, FCL and KDL hidden from find_package, the
+# library and the tool build, the tool refuses the domain commands, the install works and an
+# outside project builds against it (install_and_consume, core component only, with Eigen hidden
+# from the consumer). Its unit tests are those of build/ (and of build-sanitize/ below), the same
+# sources with the same flags: they are not built a third time.
 cmake --preset core -DONTIME_WARNINGS_AS_ERRORS=ON
-cmake --build --preset core --parallel "$(nproc)"
-ctest --preset core --parallel "$(nproc)"
+cmake --build --preset core --parallel "$(nproc)" --target ontime ontime_cli
+ctest --preset core --parallel "$(nproc)" \
+  --tests-regex '^(install_and_consume|cli_refuses_domain_commands_without_the_domains|layers_.*)$'
 
 # (No Python package: an instrumented extension cannot be loaded by the uninstrumented
 # interpreter. The install test, which builds an uninstrumented consumer against the library, is
