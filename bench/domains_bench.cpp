@@ -16,6 +16,9 @@
 #include "ontime/domains/manipulation_collision.hpp"
 #include "ontime/domains/navigation.hpp"
 #include "ontime/domains/navigation_collision.hpp"
+#include "ontime/domains/navigation_features.hpp"
+#include "ontime/domains/predict.hpp"
+#include "ontime/domains/registry.hpp"
 #include "ontime/domains/task_planner.hpp"
 #include "ontime/util/random.hpp"
 
@@ -145,5 +148,34 @@ void BM_RoomPathsBuilding(benchmark::State& bench) {
   }
 }
 BENCHMARK(BM_RoomPathsBuilding)->Arg(1)->Arg(16)->Arg(64)->Unit(benchmark::kMicrosecond);
+
+// `ontime predict` on the 30-room building: features and a hazard model's PMFs for its 78 doorway
+// moves (issue target: 10 ms). The model is fitted once, on drawn rows (its cost per prediction
+// does not depend on what it learned): 11 features, horizon 45.
+void BM_PredictBuilding(benchmark::State& bench) {
+  const std::string world = std::string(ONTIME_SOURCE_DIR) + "/data/domains/building-6x5.json";
+  const ontime::domains::LoadedDomain building = ontime::domains::load_domain("navigation", world);
+  ontime::ConditionalData data;
+  data.step_seconds = building.defaults.collection.step_seconds;
+  data.feature_count = ontime::domains::navigation_feature_names().size();
+  ontime::SplitMix64 random(1);
+  for (int i = 0; i < 2000; ++i) {
+    for (std::size_t f = 0; f < data.feature_count; ++f) data.features.push_back(ontime::uniform01(random));
+    data.found.push_back(ontime::uniform01(random) < 0.8 ? 1 : 0);
+    data.planning.push_back(1 + static_cast<ontime::Steps>(44 * ontime::uniform01(random)));
+    data.execution_seconds.push_back(data.found.back() != 0 ? 3 + 10 * ontime::uniform01(random) : 0.0);
+    data.worlds.emplace_back("drawn");
+    data.actions.emplace_back("a");
+  }
+  ontime::ConditionalFitOptions options;
+  options.feature_names = ontime::domains::navigation_feature_names();
+  options.horizon = 45;
+  const auto model = ontime::fit_conditional_model(data, options);
+  for (auto _ : bench) {
+    benchmark::DoNotOptimize(ontime::domains::predict_instance(*building.domain, building.defaults, *model,
+                                                               ontime::domains::PredictOptions{}));
+  }
+}
+BENCHMARK(BM_PredictBuilding)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

@@ -1,5 +1,5 @@
 // The whole `ontime` command line: every command registered on one CLI::App. The domain
-// commands (collect, map, run, generate-world) exist only in the domains build
+// commands (collect, map, run, tamp, generate-world, predict) exist only in the domains build
 // (ONTIME_BUILD_DOMAINS, which needs OMPL, FCL and KDL); without it they are listed and refused.
 
 #include <fmt/core.h>
@@ -84,8 +84,9 @@ std::unique_ptr<CLI::App> make_app() {
   add_run_command(*app);
   add_tamp_command(*app);
   add_generate_world_command(*app);
+  add_predict_command(*app);
 #else
-  for (const char* name : {"collect", "map", "run", "tamp", "generate-world"})
+  for (const char* name : {"collect", "map", "run", "tamp", "generate-world", "predict"})
     add_unavailable_domain_command(*app, name);
 #endif
   add_allocators_command(*app);

@@ -50,6 +50,7 @@ void add_collect_command(CLI::App& app) {
     double laplace = 0;
     bool resume = false;
     bool every_action = false;
+    bool features = false;
     bool json = false;
   };
   auto options = std::make_shared<Options>();
@@ -92,6 +93,9 @@ void add_collect_command(CLI::App& app) {
   command->add_flag("--every-action", options->every_action,
                     "Refine every action of the domain on its own (navigation: every doorway move, both ways) "
                     "instead of the skeletons' actions; the instance gets one skeleton per action");
+  command->add_flag("--features", options->features,
+                    "Every log record carries the world (the world file's name) and the action's feature vector "
+                    "there, for conditional time models (docs/learning.md)");
   command->add_flag("--json", options->json, "Print JSON");
   command->callback([options] {
     const std::filesystem::path world =
@@ -108,6 +112,7 @@ void add_collect_command(CLI::App& app) {
     collect.budget = options->budget;
     collect.laplace = options->laplace;
     collect.every_action = options->every_action;
+    collect.features = options->features;
     collect.log_format = options->log_format;
     collect.log = options->log.empty() ? default_log_file(options->domain, options->log_format)
                                        : std::filesystem::path(options->log);

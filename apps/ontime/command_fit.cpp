@@ -3,6 +3,10 @@
 // The log is JSON Lines, or (--format ompl-benchmark) one or more OMPL benchmark logs. With
 // --library instead of --skeletons: every action of the logs, one skeleton each (a library of
 // per-action distributions, e.g. of `collect --every-action`).
+//
+// `ontime fit LOG... --conditional KIND --step S --output MODEL`: a conditional time model
+// (learn/conditional_model.hpp) from logs whose records carry features (`collect --features`,
+// one log per world or one for many), for `ontime predict`.
 
 #include <fmt/format.h>
 
@@ -12,13 +16,19 @@
 
 #include "common.hpp"
 #include "number_options.hpp"
+#include "ontime/learn/conditional_model.hpp"
 #include "ontime/learn/fitting.hpp"
 #include "ontime/model/instance_io.hpp"
 #include "ontime/model/ompl_benchmark_log.hpp"
 #include "ontime/model/planner_log.hpp"
+#include "ontime/report/conditional_report.hpp"
 #include "ontime/report/report.hpp"
+#include "ontime/util/atomic_file.hpp"
 #include "ontime/util/error.hpp"
 #include "output_paths.hpp"
+#if ONTIME_WITH_DOMAINS
+#include "ontime/domains/registry.hpp"
+#endif
 
 namespace ontime::cli {
 namespace {
@@ -70,6 +80,43 @@ std::vector<RefinementAttempt> load_logs(const LogOptions& options) {
   return attempts;
 }
 
+struct ConditionalOptions {
+  std::string kind;
+  std::string domain;
+  Steps horizon = 0;
+  double ridge = ConditionalFitOptions{}.ridge;
+  int bins = 0;
+};
+
+// fit --conditional: every LOG is JSON Lines with features; the model file is written atomically.
+void fit_conditional(const LogOptions& log, const ConditionalOptions& conditional, double step_seconds,
+                     const std::string& output, bool json) {
+  if (log.format != "jsonl") throw UsageError("--conditional reads JSON Lines logs (--format jsonl)");
+  ConditionalFitOptions options;
+  options.kind = conditional.kind;
+  options.horizon = conditional.horizon;
+  options.ridge = conditional.ridge;
+  options.bins = conditional.bins;
+  if (!conditional.domain.empty()) {
+#if ONTIME_WITH_DOMAINS
+    options.feature_names = domains::domain_feature_names(conditional.domain);
+#else
+    throw UsageError("--domain needs the domains build (this ontime was built with ONTIME_BUILD_DOMAINS=OFF)");
+#endif
+  }
+  std::vector<std::filesystem::path> inputs(log.logs.begin(), log.logs.end());
+  check_outputs({{"--output", output}}, inputs);
+  const ConditionalData data =
+      load_conditional_data(std::vector<std::filesystem::path>(log.logs.begin(), log.logs.end()), step_seconds);
+  const std::unique_ptr<ConditionalTimeModel> model = fit_conditional_model(data, options);
+  write_file_atomically(output, model->to_json());
+  if (json) {
+    print_json(Json::parse(report::conditional_fit_json(*model, data, output)));
+    return;
+  }
+  fmt::print("{}", report::conditional_fit_text(*model, data, output));
+}
+
 }  // namespace
 
 void add_fit_command(CLI::App& app) {
@@ -84,6 +131,7 @@ void add_fit_command(CLI::App& app) {
     double laplace = 0;
     bool library = false;
     bool json = false;
+    ConditionalOptions conditional;
   };
   auto options = std::make_shared<Options>();
   CLI::App* command = app.add_subcommand("fit", "Learn an instance's time distributions from a planner log");
@@ -104,9 +152,8 @@ void add_fit_command(CLI::App& app) {
                     std::numeric_limits<double>::max(), false)
       ->required();
   add_number_option(*command, "--deadline", options->deadline,
-                    "Deadline D in steps; planning or execution beyond it is \"never\"", Steps{1},
-                    Problem::kMaxDeadline, false)
-      ->required();
+                    "Deadline D in steps; planning or execution beyond it is \"never\" (not with --conditional)",
+                    Steps{1}, Problem::kMaxDeadline, false);
   CLI::Option* skeletons_option = command->add_option(
       "--skeletons", options->skeletons,
       "JSON file whose 'skeletons' member lists the plan skeletons (an instance or world file will do)");
@@ -118,8 +165,30 @@ void add_fit_command(CLI::App& app) {
   add_number_option(*command, "--laplace", options->laplace, "Laplace (add-alpha) smoothing of the estimates", 0.0);
   command->add_option("--name", options->name, "Instance name (default: the output file's stem)");
   command->add_option("--description", options->description, "Instance description");
+  command->add_option("--conditional", options->conditional.kind,
+                      "Fit a conditional time model of this kind (pooled, hazard) from logs with features, and "
+                      "write it to --output instead of an instance");
+  command->add_option("--domain", options->conditional.domain,
+                      "--conditional: the domain whose feature names the records carry (e.g. navigation)");
+  add_number_option(*command, "--horizon", options->conditional.horizon,
+                    "--conditional: steps predicted (0: the longest planning time of the logs)", Steps{0},
+                    Problem::kMaxDeadline);
+  add_number_option(*command, "--ridge", options->conditional.ridge,
+                    "--conditional hazard: L2 penalty on the feature weights", 0.0);
+  add_number_option(*command, "--bins", options->conditional.bins,
+                    "--conditional hazard: baseline hazard levels (0: one per step)", 0, Problem::kMaxDeadline);
   command->add_flag("--json", options->json, "Print JSON");
   command->callback([options] {
+    if (!options->conditional.kind.empty()) {
+      if (options->deadline != 0 || options->library || !options->skeletons.empty() || options->laplace != 0) {
+        throw UsageError(
+            "--conditional writes a model, not an instance: no --deadline, --skeletons, --library or "
+            "--laplace");
+      }
+      fit_conditional(options->log, options->conditional, options->step_seconds, options->output, options->json);
+      return;
+    }
+    if (options->deadline == 0) throw UsageError("--deadline is required (or --conditional KIND)");
     check_log_options(options->log);
     if (options->skeletons.empty() && !options->library) throw UsageError("give --skeletons FILE or --library");
     std::vector<std::filesystem::path> inputs(options->log.logs.begin(), options->log.logs.end());

@@ -31,6 +31,22 @@ void add_generate_world_command(CLI::App& app) {
                     "Share of neighbouring rooms joined by a door (at least a spanning tree)", 0.0, 1.0);
   add_number_option(*command, "--narrow-doors", options->building.narrow_door_share,
                     "Share of doors that are narrow (0.76-0.86 m; the others 1.0-1.2 m)", 0.0, 1.0);
+  auto& b = options->building;
+  add_number_option(*command, "--narrow-min", b.narrow_width_min, "Narrowest narrow door (m)",
+                    domains::kMinBuildingDoorWidth, domains::kMaxBuildingDoorWidth);
+  add_number_option(*command, "--narrow-max", b.narrow_width_max, "Widest narrow door (m)",
+                    domains::kMinBuildingDoorWidth, domains::kMaxBuildingDoorWidth);
+  add_number_option(*command, "--wide-min", b.wide_width_min, "Narrowest other door (m)",
+                    domains::kMinBuildingDoorWidth, domains::kMaxBuildingDoorWidth);
+  add_number_option(*command, "--wide-max", b.wide_width_max, "Widest other door (m)", domains::kMinBuildingDoorWidth,
+                    domains::kMaxBuildingDoorWidth);
+  add_number_option(*command, "--empty-rooms", b.empty_room_share, "Share of rooms left empty", 0.0, 1.0);
+  add_number_option(*command, "--cluttered-rooms", b.cluttered_room_share,
+                    "Share of rooms cluttered with boxes (the rest are furnished against the walls)", 0.0, 1.0);
+  add_number_option(*command, "--min-boxes", b.min_boxes, "Fewest boxes in a cluttered room", 0,
+                    domains::kMaxBuildingBoxes);
+  add_number_option(*command, "--max-boxes", b.max_boxes, "Most boxes in a cluttered room", 0,
+                    domains::kMaxBuildingBoxes);
   add_number_option(*command, "--seed", options->building.seed, "Seed of every random choice");
   command->add_option("--name", options->building.name, "World name (default: building-ROWSxCOLS)");
   command->add_flag("--json", options->json, "Print JSON");

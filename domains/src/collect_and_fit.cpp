@@ -34,6 +34,7 @@ CollectionOptions collection_options(const DomainDefaults& defaults, const Colle
   collection.step_seconds = options.step_seconds > 0 ? options.step_seconds : defaults.collection.step_seconds;
   collection.budget_steps = options.budget > 0 ? options.budget : collection_deadline(defaults, options);
   collection.every_action = options.every_action;
+  collection.features = options.features;
   collection.ranks = options.ranks;
   return collection;
 }
@@ -53,8 +54,12 @@ CollectAndFitResult collect_and_fit(const Domain& domain, const DomainDefaults& 
     static const std::string kFormats[] = {"jsonl", "ompl-benchmark"};
     throw unknown_name_error("log format", options.log_format, kFormats);
   }
+  if (options.features && options.log_format != "jsonl") {
+    throw UsageError("feature vectors are written only to a jsonl log (OMPL's benchmark format has no place for them)");
+  }
   CollectAndFitResult out;
   out.collection = collection_options(defaults, options);
+  out.collection.world_name = world.stem().string();
   out.deadline = collection_deadline(defaults, options);
   out.checkpoint = checkpoint_path(options);
   // The journal refuses this too; this refusal names the parameter that resumes.

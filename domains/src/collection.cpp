@@ -137,6 +137,18 @@ CollectionResult collect(const Domain& domain, const CollectionOptions& options)
   check_options(options);
   const auto started = std::chrono::steady_clock::now();
   const std::vector<TreeAction> tree = collection_actions(domain, options);
+  // The feature vectors first, so that a world without what the extractor needs stops the
+  // collection before any trial.
+  std::vector<std::vector<double>> features(options.features ? tree.size() : 0);
+  const std::string world_name =
+      !options.features ? std::string() : (options.world_name.empty() ? domain.scene().title : options.world_name);
+  for (std::size_t a = 0; a < features.size(); ++a) {
+    try {
+      features[a] = domain.action_features(tree[a].action);
+    } catch (const std::invalid_argument& error) {
+      throw UsageError(std::string("cannot record features: ") + error.what());
+    }
+  }
   const std::uint64_t total = options.trials * tree.size();
   std::uint64_t finished = 0;
   std::mutex progress_mutex;
@@ -222,9 +234,13 @@ CollectionResult collect(const Domain& domain, const CollectionOptions& options)
 
   CollectionResult result;
   result.log.reserve(total);
-  for (std::vector<Outcome>& trials : outcomes) {
-    for (Outcome& outcome : trials) {
+  for (std::size_t a = 0; a < outcomes.size(); ++a) {
+    for (Outcome& outcome : outcomes[a]) {
       result.collision_checks += outcome.attempt.collision_checks.value_or(0);
+      if (options.features) {
+        outcome.attempt.world = world_name;
+        outcome.attempt.features = features[a];
+      }
       result.log.push_back(std::move(outcome.attempt));
     }
   }

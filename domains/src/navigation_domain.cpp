@@ -9,6 +9,7 @@
 #include "ontime/domains/library_messages.hpp"
 #include "ontime/domains/navigation.hpp"
 #include "ontime/domains/navigation_collision.hpp"
+#include "ontime/domains/navigation_features.hpp"
 #include "ontime/domains/task_planner.hpp"
 #include "ontime/util/random.hpp"
 
@@ -65,6 +66,12 @@ std::vector<StandaloneAction> NavigationDomain::every_action() const {
     }
   }
   return actions;
+}
+
+const std::vector<std::string>& NavigationDomain::feature_names() const { return navigation_feature_names(); }
+
+std::vector<double> NavigationDomain::action_features(const std::string& action) const {
+  return navigation_action_features(world_, action);
 }
 
 double NavigationDomain::execution_seconds(const std::vector<Pose>& poses) const {

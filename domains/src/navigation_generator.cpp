@@ -30,11 +30,10 @@ constexpr double kClearance = 0.02;
 constexpr double kPassable = kRobotSide + 2 * kClearance;
 constexpr Steps kOfficeDeadline = 22;
 
-// Door widths: narrow ones a few centimetres wider than the robot with its clearance (the office
-// floor's narrow doors are 0.78 m and 0.84 m), comfortable ones 1.0–1.2 m.
-constexpr double kNarrowLow = 0.76, kNarrowHigh = 0.86;
-constexpr double kWideLow = 1.0, kWideHigh = 1.2;
-static_assert(kNarrowLow > kPassable, "every door must let the robot pass");
+// Door widths (BuildingOptions): by default narrow ones a few centimetres wider than the robot
+// with its clearance (the office floor's narrow doors are 0.78 m and 0.84 m), comfortable ones
+// 1.0–1.2 m.
+static_assert(kMinBuildingDoorWidth > kPassable, "every door must let the robot pass");
 
 // The clear zones. The side pose of a door is kSideDistance from the wall's centre line: far
 // enough for the padded footprint (half-diagonal 0.50 m) to turn on the spot clear of the wall
@@ -197,9 +196,31 @@ class Generator {
     if (!(options.narrow_door_share >= 0 && options.narrow_door_share <= 1)) {
       throw std::invalid_argument("the share of narrow doors must be between 0 and 1");
     }
+    check_widths("narrow", options.narrow_width_min, options.narrow_width_max);
+    check_widths("wide", options.wide_width_min, options.wide_width_max);
+    if (!(options.empty_room_share >= 0 && options.empty_room_share <= 1)) {
+      throw std::invalid_argument("the share of empty rooms must be between 0 and 1");
+    }
+    if (!(options.cluttered_room_share >= 0 && options.cluttered_room_share <= 1)) {
+      throw std::invalid_argument("the share of cluttered rooms must be between 0 and 1");
+    }
+    if (options.empty_room_share + options.cluttered_room_share > 1) {
+      throw std::invalid_argument("the shares of empty and cluttered rooms must sum to at most 1");
+    }
+    if (options.min_boxes < 0 || options.max_boxes > kMaxBuildingBoxes || options.min_boxes > options.max_boxes) {
+      throw std::invalid_argument("the boxes of a cluttered room must be a range within 0.." +
+                                  std::to_string(kMaxBuildingBoxes));
+    }
     size_ = centimetres(options.room_size);
     name_ = options.name.empty() ? "building-" + std::to_string(options.rows) + "x" + std::to_string(options.cols)
                                  : options.name;
+  }
+
+  static void check_widths(const std::string& kind, double low, double high) {
+    if (!(low >= kMinBuildingDoorWidth && high <= kMaxBuildingDoorWidth && low <= high)) {
+      throw std::invalid_argument("the " + kind + " doors' widths must be a range within " +
+                                  number(kMinBuildingDoorWidth) + ".." + number(kMaxBuildingDoorWidth) + " m");
+    }
   }
 
   std::string text() {
@@ -274,8 +295,8 @@ class Generator {
       door.b = pairs[p][1];
       door.vertical = door.b == door.a + 1;  // side by side in x: the shared edge runs along y
       door.narrow = uniform01(random) < options_.narrow_door_share;
-      door.width =
-          centimetres(door.narrow ? uniform(random, kNarrowLow, kNarrowHigh) : uniform(random, kWideLow, kWideHigh));
+      door.width = centimetres(door.narrow ? uniform(random, options_.narrow_width_min, options_.narrow_width_max)
+                                           : uniform(random, options_.wide_width_min, options_.wide_width_max));
       const double reach = std::max(0.0, size_ / 2 - kDoorEndMargin);
       const double offset = centimetres(uniform(random, -reach, reach));
       if (door.vertical) {
@@ -324,16 +345,16 @@ class Generator {
     return true;
   }
 
-  // Empty (a quarter of the rooms), furnished against the walls (two fifths) or cluttered with
-  // turned boxes (the rest).
+  // Empty (by default a quarter of the rooms), furnished against the walls (two fifths) or
+  // cluttered with turned boxes (the rest).
   void furnish(int room) {
     SplitMix64 random(stream_seed(stream_seed(options_.seed, 2), static_cast<std::uint64_t>(room)));
     const std::vector<ClearZone> zones = clear_zones(room);
     std::vector<Piece> placed;
     const double kind = uniform01(random);
-    if (kind < 0.25) return;
+    if (kind < options_.empty_room_share) return;
     const double inner = kWallThickness / 2 + kWallGap;
-    if (kind < 0.65) {
+    if (kind < 1 - options_.cluttered_room_share) {
       struct Furniture {
         const char* name;
         double length, width;
@@ -370,7 +391,8 @@ class Generator {
         }
       }
     } else {
-      const std::size_t count = 4 + below(random, 4);
+      const auto fewest = static_cast<std::size_t>(options_.min_boxes);
+      const std::size_t count = fewest + below(random, static_cast<std::size_t>(options_.max_boxes) - fewest + 1);
       for (std::size_t k = 0; k < count; ++k) {
         for (int attempt = 0; attempt < kPlacementTries; ++attempt) {
           const Rectangle shape{centimetres(uniform(random, low_x(room), high_x(room))),
@@ -392,6 +414,23 @@ class Generator {
     return std::max<Steps>(kOfficeDeadline, 5 * static_cast<Steps>(options_.rows + options_.cols - 2));
   }
 
+  // The door widths and furniture when they are not the defaults (the default building's text
+  // is unchanged by their existence).
+  std::string family_text() const {
+    const BuildingOptions defaults;
+    const BuildingOptions& o = options_;
+    if (o.narrow_width_min == defaults.narrow_width_min && o.narrow_width_max == defaults.narrow_width_max &&
+        o.wide_width_min == defaults.wide_width_min && o.wide_width_max == defaults.wide_width_max &&
+        o.empty_room_share == defaults.empty_room_share && o.cluttered_room_share == defaults.cluttered_room_share &&
+        o.min_boxes == defaults.min_boxes && o.max_boxes == defaults.max_boxes) {
+      return "";
+    }
+    return " Narrow doors " + number(o.narrow_width_min) + "-" + number(o.narrow_width_max) + " m, others " +
+           number(o.wide_width_min) + "-" + number(o.wide_width_max) + " m; empty-room share " +
+           number(o.empty_room_share) + ", cluttered-room share " + number(o.cluttered_room_share) + " (" +
+           std::to_string(o.min_boxes) + "-" + std::to_string(o.max_boxes) + " boxes).";
+  }
+
   std::string write() const {
     const int goal = room_count() - 1;
     std::size_t narrow = 0;
@@ -403,7 +442,7 @@ class Generator {
         number(options_.narrow_door_share) + "): " + std::to_string(doors_.size()) + " doors (" +
         std::to_string(narrow) + " narrow), " + std::to_string(furniture_.size()) + " pieces of furniture; start in " +
         room_id(0) + " (bottom left), goal " + room_id(goal) +
-        " (top right). No skeletons: collect every doorway move on its own.";
+        " (top right). No skeletons: collect every doorway move on its own." + family_text();
     const Point start = centre(0);
     std::string out = "{\n";
     out += "  \"name\": " + json_string(name_) + ",\n";

@@ -1,7 +1,10 @@
 #include "ontime/domains/registry.hpp"
 
+#include <stdexcept>
+
 #include "ontime/domains/manipulation.hpp"
 #include "ontime/domains/navigation.hpp"
+#include "ontime/domains/navigation_features.hpp"
 #include "ontime/util/error.hpp"
 
 namespace ontime::domains {
@@ -14,7 +17,22 @@ std::string Domain::describe(const std::vector<std::string>& skeleton) const {
 
 std::vector<StandaloneAction> Domain::every_action() const { return {}; }
 
+const std::vector<std::string>& Domain::feature_names() const {
+  static const std::vector<std::string> none;
+  return none;
+}
+
+std::vector<double> Domain::action_features(const std::string& /*action*/) const {
+  throw std::invalid_argument("the " + name() + " domain has no features for conditional time models");
+}
+
 std::vector<std::string> domain_names() { return {"navigation", "manipulation"}; }
+
+std::vector<std::string> domain_feature_names(std::string_view name) {
+  if (name == "navigation") return navigation_feature_names();
+  if (name == "manipulation") throw UsageError("the manipulation domain has no features for conditional time models");
+  throw unknown_name_error("domain", name, domain_names());
+}
 
 LoadedDomain load_domain(std::string_view name, const std::filesystem::path& world_file) {
   if (name == "navigation") {

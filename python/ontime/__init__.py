@@ -25,6 +25,7 @@ from ._ontime import (  # noqa: F401  (re-exported)
     NEVER,
     Action,
     Allocator,
+    ConditionalTimeModel,
     Decision,
     Distribution,
     Error,
@@ -32,6 +33,7 @@ from ._ontime import (  # noqa: F401  (re-exported)
     LiveSession,
     ManualClock,
     Mdp,
+    PlanningPosterior,
     Problem,
     ResourceLimitError,
     Session,
@@ -39,8 +41,10 @@ from ._ontime import (  # noqa: F401  (re-exported)
     Status,
     UsageError,
     allocators,
+    conditional_model_kinds,
     evaluate,
     histogram_csv,
+    load_conditional_model,
     load_problem,
     make_allocator,
     read_planner_log,
@@ -57,10 +61,10 @@ from . import _ontime
 __version__ = "0.1.0"
 
 __all__ = [
-    "NEVER", "Action", "Allocator", "Decision", "Distribution", "Error", "InputError", "LiveSession",
-    "ManualClock", "Mdp", "Problem",
-    "ResourceLimitError", "Session", "State", "Status", "UsageError", "World", "allocators", "evaluate",
-    "fit", "histogram_csv", "load_problem", "make_allocator", "read_planner_log", "reduce_knapsack", "run_episodes", "sample_log",
+    "NEVER", "Action", "Allocator", "ConditionalTimeModel", "Decision", "Distribution", "Error", "InputError", "LiveSession",
+    "ManualClock", "Mdp", "PlanningPosterior", "Problem",
+    "ResourceLimitError", "Session", "State", "Status", "UsageError", "World", "allocators", "conditional_model_kinds",
+    "evaluate", "fit", "fit_conditional", "histogram_csv", "load_conditional_model", "load_problem", "make_allocator", "read_planner_log", "reduce_knapsack", "run_episodes", "sample_log",
     "solve", "study", "table", "train_ppo",
     "write_planner_log",
 ]
@@ -205,6 +209,33 @@ def fit(records_or_path: Union[PathLike, Iterable[Mapping[str, Any]]], *, step: 
                      else json.dumps({"skeletons": [list(s) for s in skeletons]}))
     return _ontime._fit(log, log_is_path, skeleton_data, skeletons_is_path, float(step), int(deadline),
                         float(laplace), name, description)
+
+
+def fit_conditional(records_or_paths: Union[PathLike, Sequence[PathLike], Iterable[Mapping[str, Any]]], *,
+                    step: float, kind: str = "hazard", domain: Optional[str] = None,
+                    feature_names: Optional[Sequence[str]] = None, horizon: int = 0, ridge: float = 1e-3,
+                    bins: int = 0) -> "ConditionalTimeModel":
+    """A conditional time model (docs/learning.md), as `ontime fit --conditional KIND` fits it: from one or
+    more planner logs (paths), or from records (dicts), whose every record carries `features` (`collect
+    --features`). Times in steps of `step` seconds; `horizon` steps predicted (0: the longest planning time
+    of the data). Feature names: the domain's (`domain="navigation"`), or `feature_names`, or f1, f2, ....
+    kind "pooled" ignores the features (Kaplan-Meier over every record); "hazard" is the discrete-time
+    hazard model with a cure fraction (`ridge`, `bins`: conditional_model_kinds())."""
+    if domain is not None and feature_names is not None:
+        raise UsageError("give domain or feature_names, not both")
+    names = list(feature_names) if feature_names is not None else []
+    if domain is not None:
+        from . import domains as _domains_module
+        if not _domains_module.available:
+            raise UsageError("domain= needs the domains build (ONTIME_BUILD_DOMAINS)")
+        names = list(_domains_module.feature_names(domain))
+    if isinstance(records_or_paths, (str, os.PathLike)):
+        logs, are_paths = [os.fspath(records_or_paths)], True
+    else:
+        items = list(records_or_paths)
+        are_paths = bool(items) and all(isinstance(item, (str, os.PathLike)) for item in items)
+        logs = [os.fspath(item) for item in items] if are_paths else [_records_text(items)]
+    return _ontime._fit_conditional(logs, are_paths, float(step), kind, names, int(horizon), float(ridge), int(bins))
 
 
 from . import env  # noqa: E402,F401  (ontime.env.EffortAllocationEnv)

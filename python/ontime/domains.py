@@ -19,9 +19,10 @@ available: bool = bool(_domains.available)
 
 if available:
     from ._ontime.domains import (  # noqa: F401
-        Domain, collect, collect_and_fit, generate_world, load, map_data, names, run, tamp)
-    __all__ = ["Domain", "available", "collect", "collect_and_fit", "generate_world", "load", "map_data", "names",
-               "run", "tamp"]
+        Domain, collect, collect_and_fit, feature_names, features, generate_world, load, map_data, names, predict,
+        run, tamp)
+    __all__ = ["Domain", "available", "collect", "collect_and_fit", "feature_names", "features", "generate_world",
+               "load", "map_data", "names", "predict", "run", "tamp"]
 else:
     __all__ = ["available"]
 

@@ -5,6 +5,7 @@
 // the domains report's JSON read back. Built only with the domains library
 // (ONTIME_BUILD_DOMAINS); without it the submodule says so.
 
+#include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
@@ -19,6 +20,7 @@
 #include "ontime/domains/drawing.hpp"
 #include "ontime/domains/navigation_generator.hpp"
 #include "ontime/domains/planner_run.hpp"
+#include "ontime/domains/predict.hpp"
 #include "ontime/domains/registry.hpp"
 #include "ontime/domains/report.hpp"
 #include "ontime/domains/tamp.hpp"
@@ -70,7 +72,7 @@ using DecisionShare = Number<double, "decision_share", 0.0, 1e6>;
 // What collect and collect_and_fit share: the trials and how they are run.
 domains::CollectAndFitOptions collect_request(std::uint64_t trials, std::uint64_t seed, unsigned threads,
                                               const std::string& effort, double checks_per_second, double step_seconds,
-                                              Steps budget_steps, bool every_action) {
+                                              Steps budget_steps, bool every_action, bool features) {
   domains::CollectAndFitOptions request;
   request.trials = trials;
   request.seed = seed;
@@ -80,6 +82,7 @@ domains::CollectAndFitOptions collect_request(std::uint64_t trials, std::uint64_
   request.step_seconds = step_seconds;
   request.budget = budget_steps;
   request.every_action = every_action;
+  request.features = features;
   return request;
 }
 
@@ -125,10 +128,11 @@ void bind_domains(py::module_& m) {
       "collect",
       [](const std::shared_ptr<DomainHandle>& domain, Number<std::uint64_t, "trials", 1> trials, Seed seed,
          Threads threads, const std::string& effort, ChecksPerSecond checks_per_second, StepSeconds step_seconds,
-         BudgetSteps budget_steps, bool every_action, const py::object& progress) {
-        const domains::CollectAndFitOptions request =
-            collect_request(trials, seed, threads, effort, checks_per_second, step_seconds, budget_steps, every_action);
+         BudgetSteps budget_steps, bool every_action, bool features, const py::object& progress) {
+        const domains::CollectAndFitOptions request = collect_request(
+            trials, seed, threads, effort, checks_per_second, step_seconds, budget_steps, every_action, features);
         domains::CollectionOptions options = domains::collection_options(domain->loaded.defaults, request);
+        options.world_name = std::filesystem::path(domain->world_file).stem().string();
         domains::CollectionResult result;
         run_interruptibly(
             [&](const std::function<bool()>& stop, Progress& counters) {
@@ -140,9 +144,11 @@ void bind_domains(py::module_& m) {
       },
       py::arg("domain"), py::kw_only(), py::arg("trials") = 1000, py::arg("seed") = 1, py::arg("threads") = 0,
       py::arg("effort") = "checks", py::arg("checks_per_second") = 0.0, py::arg("step_seconds") = 0.0,
-      py::arg("budget_steps") = 0, py::arg("every_action") = false, py::arg("progress") = py::none(),
+      py::arg("budget_steps") = 0, py::arg("every_action") = false, py::arg("features") = false,
+      py::arg("progress") = py::none(),
       "Refines every action of the domain's skeleton tree (every_action=True: every action the domain can "
-      "refine, each on its own) `trials` times and returns the planner log as records (write it with "
+      "refine, each on its own; features=True: every record carries the world and the action's feature vector) "
+      "`trials` times and returns the planner log as records (write it with "
       "ontime.write_planner_log, fit it with ontime.fit). The same log as `ontime collect` for the same seed, "
       "whatever `threads` (effort 'checks'). 0 means the world file's setting (step_seconds, checks_per_second) "
       "or its deadline (budget_steps, the cut-off).");
@@ -153,10 +159,10 @@ void bind_domains(py::module_& m) {
          Number<std::uint64_t, "trials", 1> trials, Seed seed, Threads threads, const std::string& effort,
          ChecksPerSecond checks_per_second, StepSeconds step_seconds,
          Number<Steps, "deadline", 0, Problem::kMaxDeadline> deadline, BudgetSteps budget_steps,
-         Number<double, "laplace", 0.0> laplace, bool every_action, const std::string& log_format,
+         Number<double, "laplace", 0.0> laplace, bool every_action, bool features, const std::string& log_format,
          const py::object& checkpoint, bool resume, const py::object& progress) {
-        domains::CollectAndFitOptions options =
-            collect_request(trials, seed, threads, effort, checks_per_second, step_seconds, budget_steps, every_action);
+        domains::CollectAndFitOptions options = collect_request(trials, seed, threads, effort, checks_per_second,
+                                                                step_seconds, budget_steps, every_action, features);
         options.deadline = deadline;
         options.laplace = laplace;
         options.log_format = log_format;
@@ -178,8 +184,8 @@ void bind_domains(py::module_& m) {
       py::arg("domain"), py::arg("log"), py::arg("instance"), py::kw_only(), py::arg("trials") = 1000,
       py::arg("seed") = 1, py::arg("threads") = 0, py::arg("effort") = "checks", py::arg("checks_per_second") = 0.0,
       py::arg("step_seconds") = 0.0, py::arg("deadline") = 0, py::arg("budget_steps") = 0, py::arg("laplace") = 0.0,
-      py::arg("every_action") = false, py::arg("log_format") = "jsonl", py::arg("checkpoint") = py::none(),
-      py::arg("resume") = false, py::arg("progress") = py::none(),
+      py::arg("every_action") = false, py::arg("features") = false, py::arg("log_format") = "jsonl",
+      py::arg("checkpoint") = py::none(), py::arg("resume") = false, py::arg("progress") = py::none(),
       "`ontime collect`: collects as collect() does, writes the planner log to `log` (log_format 'jsonl' or "
       "'ompl-benchmark'), fits the instance (deadline steps; 0: the world file's) and writes it to `instance`; "
       "returns the fields of `ontime collect --json`. Finished trials go to `checkpoint` (default: the log's "
@@ -316,18 +322,69 @@ void bind_domains(py::module_& m) {
       "skeleton k), the JSON the command writes beside its picture (python/plot_map.py draws it).");
 
   m.def(
+      "feature_names", [](const std::string& name) { return domains::domain_feature_names(name); }, py::arg("name"),
+      "The names of a domain's action features (what `fit --conditional --domain NAME` records).");
+
+  m.def(
+      "features",
+      [](const std::shared_ptr<DomainHandle>& domain, const std::string& action) {
+        std::vector<double> values;
+        try {
+          values = domain->loaded.domain->action_features(action);
+        } catch (const std::invalid_argument& error) {
+          throw UsageError(error.what());
+        }
+        return py::array_t<double>(static_cast<py::ssize_t>(values.size()), values.data());
+      },
+      py::arg("domain"), py::arg("action"),
+      "The action's feature vector in the domain's world (numpy), in the order of feature_names(domain.name).");
+
+  m.def(
+      "predict",
+      [](const std::shared_ptr<DomainHandle>& domain, const std::shared_ptr<ConditionalTimeModel>& model,
+         Number<Steps, "deadline", 0, Problem::kMaxDeadline> deadline, bool library, const std::string& name) {
+        domains::PredictOptions options;
+        options.deadline = deadline;
+        options.library = library;
+        options.name = name;
+        return std::make_shared<Problem>(
+            domains::predict_instance(*domain->loaded.domain, domain->loaded.defaults, *model, options));
+      },
+      py::arg("domain"), py::arg("model"), py::kw_only(), py::arg("deadline") = 0, py::arg("library") = false,
+      py::arg("name") = "",
+      "`ontime predict`: the instance of the domain's world with every action's distributions predicted by the "
+      "conditional time model (the world's skeletons, or every action on its own with library=True or a world "
+      "without skeletons); deadline 0: the world file's.");
+
+  m.def(
       "generate_world",
       [](const py::object& output, Number<int, "rows", 1, domains::kMaxBuildingSide> rows,
          Number<int, "cols", 1, domains::kMaxBuildingSide> cols,
          Number<double, "room_size", domains::kMinBuildingRoomSize, domains::kMaxBuildingRoomSize> room_size,
          Number<double, "door_density", 0.0, 1.0> door_density, Number<double, "narrow_doors", 0.0, 1.0> narrow_doors,
-         Seed seed, const std::optional<std::string>& name) {
+         Number<double, "narrow_min", domains::kMinBuildingDoorWidth, domains::kMaxBuildingDoorWidth> narrow_min,
+         Number<double, "narrow_max", domains::kMinBuildingDoorWidth, domains::kMaxBuildingDoorWidth> narrow_max,
+         Number<double, "wide_min", domains::kMinBuildingDoorWidth, domains::kMaxBuildingDoorWidth> wide_min,
+         Number<double, "wide_max", domains::kMinBuildingDoorWidth, domains::kMaxBuildingDoorWidth> wide_max,
+         Number<double, "empty_rooms", 0.0, 1.0> empty_rooms,
+         Number<double, "cluttered_rooms", 0.0, 1.0> cluttered_rooms,
+         Number<int, "min_boxes", 0, domains::kMaxBuildingBoxes> min_boxes,
+         Number<int, "max_boxes", 0, domains::kMaxBuildingBoxes> max_boxes, Seed seed,
+         const std::optional<std::string>& name) {
         domains::BuildingOptions options;
         options.rows = rows;
         options.cols = cols;
         options.room_size = room_size;
         options.door_density = door_density;
         options.narrow_door_share = narrow_doors;
+        options.narrow_width_min = narrow_min;
+        options.narrow_width_max = narrow_max;
+        options.wide_width_min = wide_min;
+        options.wide_width_max = wide_max;
+        options.empty_room_share = empty_rooms;
+        options.cluttered_room_share = cluttered_rooms;
+        options.min_boxes = min_boxes;
+        options.max_boxes = max_boxes;
         options.seed = seed;
         if (name) options.name = *name;
         const std::string path = path_text(output);
@@ -339,7 +396,15 @@ void bind_domains(py::module_& m) {
         return json_object(domains::report::to_json(world));
       },
       py::arg("output"), py::kw_only(), py::arg("rows") = 6, py::arg("cols") = 5, py::arg("room_size") = 4.0,
-      py::arg("door_density") = 0.8, py::arg("narrow_doors") = 0.2, py::arg("seed") = 1, py::arg("name") = py::none(),
+      py::arg("door_density") = 0.8, py::arg("narrow_doors") = 0.2,
+      py::arg("narrow_min") = domains::BuildingOptions{}.narrow_width_min,
+      py::arg("narrow_max") = domains::BuildingOptions{}.narrow_width_max,
+      py::arg("wide_min") = domains::BuildingOptions{}.wide_width_min,
+      py::arg("wide_max") = domains::BuildingOptions{}.wide_width_max,
+      py::arg("empty_rooms") = domains::BuildingOptions{}.empty_room_share,
+      py::arg("cluttered_rooms") = domains::BuildingOptions{}.cluttered_room_share,
+      py::arg("min_boxes") = domains::BuildingOptions{}.min_boxes,
+      py::arg("max_boxes") = domains::BuildingOptions{}.max_boxes, py::arg("seed") = 1, py::arg("name") = py::none(),
       "`ontime generate-world`: writes a generated navigation world (an office building of rows x cols rooms) "
       "to `output` and returns what it holds (the fields of `ontime generate-world --json`). Same options, same "
       "seed: the same file.");

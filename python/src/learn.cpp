@@ -1,6 +1,7 @@
-// Bindings of the learn layer: fitting an instance from a planner log, drawing a log from an
-// instance, and training the ppo policy.
+// Bindings of the learn layer: fitting an instance from a planner log, conditional time models,
+// drawing a log from an instance, and training the ppo policy.
 
+#include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
 #include <cmath>
@@ -8,17 +9,130 @@
 #include <optional>
 
 #include "bindings.hpp"
+#include "ontime/learn/conditional_model.hpp"
 #include "ontime/learn/fitting.hpp"
 #include "ontime/learn/log_sampling.hpp"
+#include "ontime/learn/online_update.hpp"
 #include "ontime/learn/ppo_training.hpp"
 #include "ontime/model/planner_log.hpp"
 #include "ontime/model/skeleton_file.hpp"
+#include "ontime/util/atomic_file.hpp"
 #include "ontime/util/error.hpp"
 #include "ontime/util/output_set.hpp"
 
 namespace ontime::python {
 
+namespace {
+
+using Model = std::shared_ptr<ConditionalTimeModel>;
+using FeatureArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+py::tuple predicted_tuple(const PredictedTimes& times) { return py::make_tuple(times.planning, times.execution); }
+
+void bind_conditional(py::module_& m) {
+  py::class_<ConditionalTimeModel, Model>(
+      m, "ConditionalTimeModel",
+      "A conditional time model (docs/learning.md): an action's planning and execution distributions predicted "
+      "from its feature vector. Made by fit_conditional or load_conditional_model.")
+      .def_property_readonly("kind", &ConditionalTimeModel::kind)
+      .def_property_readonly("feature_names", &ConditionalTimeModel::feature_names)
+      .def_property_readonly("step_seconds", &ConditionalTimeModel::step_seconds)
+      .def_property_readonly("horizon", &ConditionalTimeModel::horizon)
+      .def_property_readonly("training_rows", &ConditionalTimeModel::training_rows)
+      .def_property_readonly("training_worlds", &ConditionalTimeModel::training_worlds)
+      .def(
+          "predict",
+          [](const ConditionalTimeModel& model, const FeatureArray& features) -> py::object {
+            if (features.ndim() == 1)
+              return predicted_tuple(model.predict({features.data(), static_cast<std::size_t>(features.size())}));
+            if (features.ndim() != 2) throw UsageError("features are one vector or a 2-D array of one row per action");
+            py::list rows;
+            const auto columns = static_cast<std::size_t>(features.shape(1));
+            for (py::ssize_t r = 0; r < features.shape(0); ++r) {
+              rows.append(predicted_tuple(model.predict({features.data(r, 0), columns})));
+            }
+            return rows;
+          },
+          py::arg("features"),
+          "(planning, execution) Distributions for one feature vector, or a list of them for a 2-D array (one row "
+          "per action). Raises UsageError for the wrong number of features or a value that is not finite.")
+      .def("to_json", &ConditionalTimeModel::to_json, "The model file's text.")
+      .def(
+          "save",
+          [](const ConditionalTimeModel& model, const py::object& path) {
+            write_file_atomically(std::string(py::str(py::module_::import("os").attr("fspath")(path))),
+                                  model.to_json());
+          },
+          py::arg("path"), "Writes the model file (atomically).");
+
+  m.def(
+      "_fit_conditional",
+      [](const std::vector<std::string>& logs, bool are_paths, Number<double, "step", 0.0> step,
+         const std::string& kind, const std::vector<std::string>& feature_names,
+         Number<Steps, "horizon", 0, Problem::kMaxDeadline> horizon, Number<double, "ridge", 0.0> ridge,
+         Number<int, "bins", 0, Problem::kMaxDeadline> bins) {
+        ConditionalFitOptions options;
+        options.kind = kind;
+        options.feature_names = feature_names;
+        options.horizon = horizon;
+        options.ridge = ridge;
+        options.bins = bins;
+        const py::gil_scoped_release release;
+        const ConditionalData data =
+            are_paths ? load_conditional_data(std::vector<std::filesystem::path>(logs.begin(), logs.end()), step)
+                      : conditional_data(parse_planner_log(logs.at(0), "<records>"), step, "<records>");
+        return Model(fit_conditional_model(data, options));
+      },
+      py::arg("logs"), py::arg("are_paths"), py::arg("step"), py::arg("kind"), py::arg("feature_names"),
+      py::arg("horizon"), py::arg("ridge"), py::arg("bins"));
+
+  py::class_<PlanningPosterior>(
+      m, "PlanningPosterior",
+      "The online update of one action's planning distribution (docs/learning.md): a prior Distribution worth "
+      "`strength` attempts, updated by every attempt found or cut off; mean() is the posterior to plan with.")
+      .def(py::init(
+               [](const Distribution& prior, Number<Steps, "horizon", 1, Distribution::kMaxStep> horizon,
+                  Number<double, "strength", 0.0> strength) { return PlanningPosterior(prior, horizon, strength); }),
+           py::arg("prior"), py::arg("horizon"), py::arg("strength"))
+      .def("observe_found", &PlanningPosterior::observe_found, py::arg("steps"), "A motion found after `steps` steps.")
+      .def("observe_cut_off", &PlanningPosterior::observe_cut_off, py::arg("steps"),
+           "An attempt cut off after `steps` steps without a motion.")
+      .def("mean", &PlanningPosterior::mean, "The posterior mean Distribution (over 1..horizon, the rest never).")
+      .def("predictive_found", &PlanningPosterior::predictive_found, py::arg("steps"))
+      .def("predictive_cut_off", &PlanningPosterior::predictive_cut_off, py::arg("steps"))
+      .def_property_readonly("observations", &PlanningPosterior::observations)
+      .def_property_readonly("strength", &PlanningPosterior::strength)
+      .def_property_readonly("horizon", &PlanningPosterior::horizon);
+
+  m.def(
+      "load_conditional_model",
+      [](const py::object& path) {
+        return Model(load_conditional_model(std::string(py::str(py::module_::import("os").attr("fspath")(path)))));
+      },
+      py::arg("path"), "Reads a model file (`ontime fit --conditional`); InputError names the place and rule.");
+
+  m.def(
+      "conditional_model_kinds",
+      [] {
+        py::list kinds;
+        for (const ConditionalModelKind& kind : conditional_model_kinds()) {
+          py::list parameters;
+          for (const ConditionalParameter& p : kind.parameters) {
+            parameters.append(py::dict(py::arg("name") = p.name, py::arg("default") = p.default_value,
+                                       py::arg("meaning") = p.meaning));
+          }
+          kinds.append(py::dict(py::arg("name") = kind.name, py::arg("description") = kind.description,
+                                py::arg("parameters") = parameters));
+        }
+        return kinds;
+      },
+      "The kinds of conditional time model with their declared parameters.");
+}
+
+}  // namespace
+
 void bind_learn(py::module_& m) {
+  bind_conditional(m);
   m.def(
       "_fit",
       [](const std::string& log, bool log_is_path, const std::string& skeleton_data, bool skeletons_are_path,

@@ -32,6 +32,8 @@ py::dict attempt_dict(const RefinementAttempt& attempt) {
   if (attempt.found) out["execution_seconds"] = attempt.execution_seconds;
   if (attempt.trial) out["trial"] = *attempt.trial;
   if (attempt.collision_checks) out["collision_checks"] = *attempt.collision_checks;
+  if (attempt.world) out["world"] = *attempt.world;
+  if (!attempt.features.empty()) out["features"] = py::cast(attempt.features);
   return out;
 }
 
@@ -181,7 +183,8 @@ void bind_model(py::module_& m) {
       },
       py::arg("path"),
       "Reads a planner log (JSON Lines, docs/formats.md) as a list of dicts with the keys action, "
-      "planning_seconds, found, execution_seconds (when found) and trial / collision_checks (when recorded).");
+      "planning_seconds, found, execution_seconds (when found) and trial / collision_checks / world / features "
+      "(when recorded).");
 
   m.def(
       "_save_planner_log",

@@ -35,10 +35,10 @@ class LineReader {
       fail("", "a record must be a JSON object (got " + detail::describe_json_type(record) + ")");
     for (const auto& [key, value] : record.items()) {
       if (key != "action" && key != "planning_seconds" && key != "found" && key != "execution_seconds" &&
-          key != "trial" && key != "collision_checks") {
+          key != "trial" && key != "collision_checks" && key != "world" && key != "features") {
         fail(key,
              "unknown key (expected 'action', 'planning_seconds', 'found', 'execution_seconds', 'trial', "
-             "'collision_checks')");
+             "'collision_checks', 'world', 'features')");
       }
     }
     RefinementAttempt attempt;
@@ -61,6 +61,27 @@ class LineReader {
     if (record.contains("trial")) attempt.trial = count(record["trial"], "trial");
     if (record.contains("collision_checks"))
       attempt.collision_checks = count(record["collision_checks"], "collision_checks");
+    if (record.contains("world")) {
+      const Json& world = record["world"];
+      if (!world.is_string() || world.get<std::string>().empty()) {
+        fail("world", "must be a non-empty string naming the world (got " + world.dump() + ")");
+      }
+      attempt.world = world.get<std::string>();
+    }
+    if (record.contains("features")) {
+      const Json& features = record["features"];
+      if (!features.is_array() || features.empty()) {
+        fail("features", "must be a non-empty array of numbers (got " + detail::describe_json_type(features) + ")");
+      }
+      attempt.features.reserve(features.size());
+      for (std::size_t i = 0; i < features.size(); ++i) {
+        const Json& value = features[i];
+        if (!value.is_number() || !std::isfinite(value.get<double>())) {
+          fail(detail::json_index("features", i), "must be a finite number (got " + value.dump() + ")");
+        }
+        attempt.features.push_back(value.get<double>());
+      }
+    }
     return attempt;
   }
 
@@ -104,6 +125,7 @@ std::vector<RefinementAttempt> parse_planner_log(std::string_view text, std::str
   std::vector<RefinementAttempt> attempts;
   std::size_t line = 0;
   std::size_t begin = 0;
+  std::size_t feature_count = 0;
   while (begin < text.size()) {
     std::size_t end = text.find('\n', begin);
     if (end == std::string_view::npos) end = text.size();
@@ -112,6 +134,16 @@ std::vector<RefinementAttempt> parse_planner_log(std::string_view text, std::str
     begin = end + 1;
     if (content.find_first_not_of(" \t\r") == std::string_view::npos) continue;  // blank line
     attempts.push_back(LineReader(name, line).read(content));
+    // Feature vectors are the same length throughout a log (one domain's extractor).
+    const std::vector<double>& features = attempts.back().features;
+    if (!features.empty()) {
+      if (feature_count == 0) feature_count = features.size();
+      if (features.size() != feature_count) {
+        throw InputError(name, "line " + std::to_string(line) + ": features",
+                         "has " + std::to_string(features.size()) + " numbers, but earlier records have " +
+                             std::to_string(feature_count));
+      }
+    }
   }
   if (attempts.empty()) throw InputError(name, "file", "the log holds no records (one JSON object per line)");
   return attempts;
@@ -129,6 +161,8 @@ std::string planner_log_line(const RefinementAttempt& attempt) {
   record["found"] = attempt.found;
   if (attempt.found) record["execution_seconds"] = attempt.execution_seconds;
   if (attempt.collision_checks) record["collision_checks"] = *attempt.collision_checks;
+  if (attempt.world) record["world"] = *attempt.world;
+  if (!attempt.features.empty()) record["features"] = attempt.features;
   return record.dump() + "\n";
 }
 

@@ -1,5 +1,5 @@
 #pragma once
-// Internal: the elementary functions (exp, log, pow) that learning and search use, with the same
+// Internal: the elementary functions (exp, log, pow, log1p, erfc) that learning and search use, with the same
 // bits on every x86-64 (and every other) CPU.
 //
 // Why not std::exp and friends: glibc picks among several builds of exp, log and pow at run time
@@ -20,5 +20,8 @@ namespace ontime {
 inline double portable_exp(double x) noexcept { return Sleef_cinz_expd1_u10purec(x); }
 inline double portable_log(double x) noexcept { return Sleef_cinz_logd1_u10purec(x); }
 inline double portable_pow(double x, double y) noexcept { return Sleef_cinz_powd1_u10purec(x, y); }
+inline double portable_log1p(double x) noexcept { return Sleef_cinz_log1pd1_u10purec(x); }
+// (At most 1.5 ulp.)
+inline double portable_erfc(double x) noexcept { return Sleef_cinz_erfcd1_u15purec(x); }
 
 }  // namespace ontime

@@ -309,6 +309,33 @@ TEST(Collection, AWorldWithoutSkeletonsNeedsEveryAction) {
   EXPECT_THROW(collect(kitchen(), settings), UsageError);
 }
 
+// With features, every record names its world and carries its action's feature vector there;
+// the times are those of the collection without them. A domain without features refuses before
+// any trial.
+TEST(Collection, FeaturesNameTheWorldAndDescribeEachAction) {
+  CollectionOptions plain = options(2, 6, 2);
+  plain.every_action = true;
+  CollectionOptions described = plain;
+  described.features = true;
+  described.world_name = "building-s6";
+  const std::vector<RefinementAttempt> without = collect(small_building(), plain).log;
+  const std::vector<RefinementAttempt> with = collect(small_building(), described).log;
+  ASSERT_EQ(with.size(), without.size());
+  for (std::size_t i = 0; i < with.size(); ++i) {
+    EXPECT_EQ(with[i].world, "building-s6");
+    EXPECT_EQ(with[i].features, small_building().action_features(with[i].action)) << with[i].action;
+    EXPECT_EQ(with[i].features.size(), small_building().feature_names().size());
+    RefinementAttempt stripped = with[i];
+    stripped.world.reset();
+    stripped.features.clear();
+    EXPECT_EQ(stripped, without[i]);
+  }
+  CollectionOptions kitchen_features = kitchen_options(1, 1, 1, 1);
+  kitchen_features.features = true;
+  kitchen_features.progress = [](std::uint64_t, std::uint64_t) { FAIL() << "a trial ran"; };
+  EXPECT_THROW(collect(kitchen(), kitchen_features), UsageError);
+}
+
 TEST(CollectionJournal, AnEveryActionCollectionResumesToTheSameLog) {
   CollectionOptions settings = options(2, 6, 2);
   settings.every_action = true;

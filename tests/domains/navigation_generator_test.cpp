@@ -208,6 +208,79 @@ TEST(NavigationGenerator, RefusesOptionsOutOfRange) {
   refused([](BuildingOptions& o) { o.room_size = kMinBuildingRoomSize - 0.5; });
   refused([](BuildingOptions& o) { o.door_density = 1.5; });
   refused([](BuildingOptions& o) { o.narrow_door_share = -0.1; });
+  refused([](BuildingOptions& o) { o.narrow_width_min = 0.70; });  // the robot with its clearance: 0.708 m
+  refused([](BuildingOptions& o) { o.wide_width_max = kMaxBuildingDoorWidth + 0.01; });
+  refused([](BuildingOptions& o) { o.wide_width_min = 1.3; });  // above its maximum, 1.2
+  refused([](BuildingOptions& o) { o.empty_room_share = -0.1; });
+  refused([](BuildingOptions& o) { o.cluttered_room_share = 1.1; });
+  refused([](BuildingOptions& o) { o.empty_room_share = o.cluttered_room_share = 0.6; });
+  refused([](BuildingOptions& o) { o.min_boxes = 8; });  // above max_boxes, 7
+  refused([](BuildingOptions& o) { o.max_boxes = kMaxBuildingBoxes + 1; });
+  refused([](BuildingOptions& o) { o.min_boxes = -1; });
+}
+
+// The family options: every door's width within its kind's range, rooms all empty or all
+// cluttered with the boxes asked for, and the world still passable through every door.
+TEST(NavigationGenerator, FamilyOptionsSetDoorWidthsAndClutter) {
+  BuildingOptions narrow = building(4, 3, 3);
+  narrow.narrow_door_share = 1;
+  narrow.narrow_width_min = 0.72;
+  narrow.narrow_width_max = 0.74;
+  narrow.empty_room_share = 1;
+  narrow.cluttered_room_share = 0;
+  const NavigationWorld bare = generate_navigation_world(narrow);
+  ASSERT_FALSE(bare.doors.empty());
+  for (const Door& door : bare.doors) {
+    EXPECT_GE(door.width, 0.72);
+    EXPECT_LE(door.width, 0.74);
+  }
+  EXPECT_TRUE(bare.obstacles.empty());
+  EXPECT_NE(bare.description.find("Narrow doors 0.72-0.74 m"), std::string::npos) << bare.description;
+
+  BuildingOptions wide = building(4, 3, 3);
+  wide.narrow_door_share = 0;
+  wide.wide_width_min = 1.6;
+  wide.wide_width_max = 1.8;
+  wide.empty_room_share = 0;
+  wide.cluttered_room_share = 1;
+  wide.min_boxes = wide.max_boxes = 9;
+  const NavigationWorld cluttered = generate_navigation_world(wide);
+  for (const Door& door : cluttered.doors) {
+    EXPECT_GE(door.width, 1.6);
+    EXPECT_LE(door.width, 1.8);
+  }
+  // Boxes by room; a box that finds no place in 200 tries is left out, so a room of 4 m holds
+  // fewer than nine, but more boxes asked give more boxes placed.
+  const auto boxes_by_room = [](const NavigationWorld& world) {
+    std::map<std::string, int> boxes;
+    for (const Obstacle& obstacle : world.obstacles) {
+      EXPECT_NE(obstacle.name.find(" box "), std::string::npos) << obstacle.name;
+      for (const Room& room : world.rooms) {
+        if (room.contains(obstacle.shape.x, obstacle.shape.y)) ++boxes[room.id];
+      }
+    }
+    return boxes;
+  };
+  BuildingOptions few = wide;
+  few.min_boxes = few.max_boxes = 2;
+  std::map<std::string, int> many_boxes = boxes_by_room(cluttered),
+                             few_boxes = boxes_by_room(generate_navigation_world(few));
+  int many_total = 0, few_total = 0;
+  for (const Room& room : cluttered.rooms) {
+    EXPECT_GE(many_boxes[room.id], 1) << room.id;
+    EXPECT_LE(many_boxes[room.id], 9) << room.id;
+    EXPECT_GE(few_boxes[room.id], 1) << room.id;
+    EXPECT_LE(few_boxes[room.id], 2) << room.id;
+    many_total += many_boxes[room.id];
+    few_total += few_boxes[room.id];
+  }
+  EXPECT_GT(many_total, few_total + static_cast<int>(cluttered.rooms.size()));
+  const NavigationCollision collision(cluttered, cluttered.robot.clearance);
+  for (const Door& door : cluttered.doors) {
+    for (const std::string& id : door.rooms) {
+      for (const Pose& pose : door_route(cluttered, door, id)) ASSERT_FALSE(collision.collides(pose));
+    }
+  }
 }
 
 }  // namespace

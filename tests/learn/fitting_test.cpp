@@ -195,11 +195,11 @@ SkeletonList skeletons(std::vector<std::vector<std::string>> list) {
 
 TEST(Fitting, FitsAProblemForTheSkeletons) {
   const std::vector<RefinementAttempt> log{
-      {"a", 0.4, true, 1.5, std::nullopt, std::nullopt},   // 1 step, executes in 2
-      {"a", 1.6, true, 0.0, std::nullopt, std::nullopt},   // 2 steps, executes in 0
-      {"a", 3.0, false, 0.0, std::nullopt, std::nullopt},  // cut off after 3 steps
-      {"b", 0.9, true, 9.0, std::nullopt, std::nullopt},   // executes in 9 > D: never
-      {"unused", 1.0, true, 1.0, std::nullopt, std::nullopt},
+      {"a", 0.4, true, 1.5, std::nullopt, std::nullopt, std::nullopt, {}},   // 1 step, executes in 2
+      {"a", 1.6, true, 0.0, std::nullopt, std::nullopt, std::nullopt, {}},   // 2 steps, executes in 0
+      {"a", 3.0, false, 0.0, std::nullopt, std::nullopt, std::nullopt, {}},  // cut off after 3 steps
+      {"b", 0.9, true, 9.0, std::nullopt, std::nullopt, std::nullopt, {}},   // executes in 9 > D: never
+      {"unused", 1.0, true, 1.0, std::nullopt, std::nullopt, std::nullopt, {}},
   };
   FitOptions options;
   options.step_seconds = 1.0;
@@ -228,7 +228,7 @@ TEST(Fitting, FitsAProblemForTheSkeletons) {
 }
 
 TEST(Fitting, NamesTheSkeletonWhoseActionTheLogLacks) {
-  const std::vector<RefinementAttempt> log{{"a", 0.4, true, 1.5, std::nullopt, std::nullopt}};
+  const std::vector<RefinementAttempt> log{{"a", 0.4, true, 1.5, std::nullopt, std::nullopt, std::nullopt, {}}};
   FitOptions options;
   options.deadline = 3;
   try {

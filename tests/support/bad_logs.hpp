@@ -25,6 +25,11 @@ inline const std::array kBadLogs{
     BadInput{"trial_negative.jsonl", "line 1: trial", "whole number >= 0"},
     BadInput{"checks_fraction.jsonl", "line 1: collision_checks", "whole number >= 0"},
     BadInput{"empty.jsonl", "file", "no records"},
+    BadInput{"features_not_number.jsonl", "line 1: features[1]", "must be a finite number"},
+    BadInput{"features_overflow.jsonl", "line 1, column 76", "number overflow"},
+    BadInput{"features_empty.jsonl", "line 1: features", "non-empty array of numbers"},
+    BadInput{"features_length.jsonl", "line 2: features", "has 1 numbers, but earlier records have 2"},
+    BadInput{"world_empty.jsonl", "line 1: world", "non-empty string naming the world"},
 };
 
 }  // namespace ontime::testing

@@ -7,6 +7,9 @@
 //   {"action": "move(R1,R5)", "planning_seconds": 1.62, "found": true, "execution_seconds": 5.3}
 //   {"action": "move(R5,R8)", "planning_seconds": 44.0, "found": false}
 //
+// Records may also name their world and carry the action's feature vector there (a corpus
+// across worlds for conditional time models): "world": "building-s7", "features": [0.92, ...].
+//
 // `found: false` means the attempt was cut off after `planning_seconds` of effort without a
 // motion (right-censored: its planning time is known only to exceed that). Reading checks
 // every rule and raises InputError naming the file, the line (and key) and the rule.
@@ -28,6 +31,11 @@ struct RefinementAttempt {
   double execution_seconds = 0;                   // time to execute the motion; only when found
   std::optional<std::uint64_t> trial;             // optional: the collection trial it belongs to
   std::optional<std::uint64_t> collision_checks;  // optional: deterministic effort, if counted
+  // Optional, for conditional time models (docs/formats.md): the world the attempt was made in
+  // and the action's feature vector there (finite numbers, the same length in every record of
+  // a log that has them).
+  std::optional<std::string> world;
+  std::vector<double> features;
 
   friend bool operator==(const RefinementAttempt&, const RefinementAttempt&) = default;
 };

@@ -37,6 +37,9 @@ struct CollectAndFitOptions {
   Steps budget = 0;               // cut-off of an attempt in steps; 0: the deadline
   double laplace = 0;             // smoothing of the fit
   bool every_action = false;
+  // Records carry the world (the world file's name without its extension) and the action's
+  // feature vector there (CollectionOptions::features).
+  bool features = false;
   std::string log_format = "jsonl";  // or "ompl-benchmark"
   std::filesystem::path log;
   std::filesystem::path instance;

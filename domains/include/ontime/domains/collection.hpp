@@ -67,6 +67,10 @@ struct CollectionOptions {
   // Collect every action of the domain on its own (every_action_list) instead of the actions of
   // its skeleton tree.
   bool every_action = false;
+  // Every record carries the world's name (Domain::name) and the action's feature vector there
+  // (Domain::action_features): a log of a corpus across worlds for conditional time models.
+  bool features = false;
+  std::string world_name;  // the name records carry with `features`; empty: the domain's scene title
   // Called with the number of attempts done and the total (from one thread at a time).
   std::function<void(std::uint64_t done, std::uint64_t total)> progress;
   // When set: trials it holds are taken from it instead of being run again, and every trial

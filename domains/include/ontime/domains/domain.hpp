@@ -107,6 +107,14 @@ class Domain {
   // move per door and direction). Empty when the domain cannot list them (the default).
   virtual std::vector<StandaloneAction> every_action() const;
 
+  // What a conditional time model sees of an action in this world (docs/learning.md,
+  // "Features"): a vector of feature_names().size() numbers from the world's geometry alone, the
+  // same length for every action and world of the domain. Throws std::invalid_argument for an
+  // action the world does not have. A domain without features (the default) has no names and
+  // throws std::invalid_argument.
+  virtual const std::vector<std::string>& feature_names() const;
+  virtual std::vector<double> action_features(const std::string& action) const;
+
   // The world, and a motion as a polyline of the robot's reference point (seen from above).
   virtual Scene scene() const = 0;
   virtual std::vector<std::array<double, 2>> trace(const std::vector<Configuration>& motion) const = 0;

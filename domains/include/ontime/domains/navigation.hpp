@@ -24,6 +24,8 @@ class NavigationDomain final : public Domain {
   // move(A,B) and move(B,A) for every pair of rooms a door joins, in the order of the doors; the
   // moves out of the start room start at the start pose.
   std::vector<StandaloneAction> every_action() const override;
+  const std::vector<std::string>& feature_names() const override;
+  std::vector<double> action_features(const std::string& action) const override;
   Scene scene() const override;
   std::vector<std::array<double, 2>> trace(const std::vector<Configuration>& motion) const override;
   std::vector<std::array<double, 2>> outline(const Configuration& configuration) const override;

@@ -34,6 +34,16 @@ struct BuildingOptions {
   double room_size = 4.0;          // metres, every room square; at least kMinBuildingRoomSize
   double door_density = 0.8;       // share of neighbour pairs joined by a door (at least a spanning tree)
   double narrow_door_share = 0.2;  // share of doors that are narrow
+  // Door widths in metres, drawn uniformly in [min, max]: narrow ones a few centimetres wider
+  // than the robot with its clearance (slow to refine), the others comfortable. Every width is
+  // above kMinBuildingDoorWidth and at most kMaxBuildingDoorWidth.
+  double narrow_width_min = 0.76, narrow_width_max = 0.86;
+  double wide_width_min = 1.0, wide_width_max = 1.2;
+  // Rooms by furniture: a share left empty, a share cluttered with boxes (min_boxes to max_boxes
+  // of them), the rest furnished against the walls. The shares sum to at most 1.
+  double empty_room_share = 0.25;
+  double cluttered_room_share = 0.35;
+  int min_boxes = 4, max_boxes = 7;
   std::uint64_t seed = 1;
   std::string name;  // default: building-ROWSxCOLS
 };
@@ -42,10 +52,16 @@ struct BuildingOptions {
 inline constexpr double kMinBuildingRoomSize = 3.0;
 inline constexpr double kMaxBuildingRoomSize = 20.0;
 inline constexpr int kMaxBuildingSide = 50;
+// A door is wider than the robot's footprint with its clearance (0.708 m) and at most twice the
+// margin kept from the ends of its edge (so it fits in the smallest room).
+inline constexpr double kMinBuildingDoorWidth = 0.71;
+inline constexpr double kMaxBuildingDoorWidth = 2.0;
+inline constexpr int kMaxBuildingBoxes = 20;
 
 // The world file's text. Throws std::invalid_argument for options out of range (rows or cols
 // below 1 or above kMaxBuildingSide, a single room, a room size out of range, shares outside
-// [0, 1]).
+// [0, 1] or room shares summing above 1, door widths out of range or a minimum above its maximum,
+// box counts outside 0..kMaxBuildingBoxes or a minimum above the maximum).
 std::string generate_navigation_world_text(const BuildingOptions& options);
 
 // The same world, read back with the world file's checker (source: the world's name).

@@ -17,6 +17,11 @@ namespace ontime::domains {
 // Names of the domains that can be loaded: "navigation", "manipulation".
 std::vector<std::string> domain_names();
 
+// The names of the named domain's action features (Domain::feature_names, without a world), the
+// names a conditional time model of its worlds is fitted with. UsageError for an unknown domain
+// or one without features.
+std::vector<std::string> domain_feature_names(std::string_view name);
+
 // Settings a domain's world file carries besides the world itself.
 struct DomainDefaults {
   CollectionDefaults collection;

@@ -1,0 +1,49 @@
+#include "ontime/domains/predict.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "ontime/util/error.hpp"
+
+namespace ontime::domains {
+
+Problem predict_instance(const Domain& domain, const DomainDefaults& defaults, const ConditionalTimeModel& model,
+                         const PredictOptions& options) {
+  if (domain.feature_names().empty()) {
+    throw UsageError("the " + domain.name() + " domain has no features for conditional time models");
+  }
+  if (model.feature_names() != domain.feature_names()) {
+    std::string names;
+    for (const std::string& name : model.feature_names()) names += (names.empty() ? "" : ", ") + name;
+    throw UsageError("the model was fitted on other features (" + names + ") than the " + domain.name() +
+                     " domain's; fit it with --domain " + domain.name());
+  }
+  // (A relative slack: the step is written as a decimal in both files.)
+  if (std::abs(model.step_seconds() - defaults.collection.step_seconds) > 1e-9 * defaults.collection.step_seconds) {
+    throw UsageError("the model's step is " + std::to_string(model.step_seconds()) + " s, the world's " +
+                     std::to_string(defaults.collection.step_seconds) + " s");
+  }
+  std::vector<std::vector<std::string>> skeletons;
+  std::vector<std::string> ids;
+  if (!options.library && !domain.skeletons().empty()) {
+    skeletons = domain.skeletons();
+    for (const auto& skeleton : skeletons) ids.insert(ids.end(), skeleton.begin(), skeleton.end());
+  } else {
+    for (const StandaloneAction& action : domain.every_action()) ids.push_back(action.action);
+  }
+  std::vector<ActionFeatures> actions;
+  actions.reserve(ids.size());
+  for (const std::string& id : ids) {
+    try {
+      actions.push_back({id, domain.action_features(id)});
+    } catch (const std::invalid_argument& error) {
+      throw UsageError(error.what());
+    }
+  }
+  const Steps deadline = options.deadline > 0 ? options.deadline : defaults.collection.deadline;
+  return predict_problem(model, actions, skeletons, deadline,
+                         options.name.empty() ? domain.scene().title : options.name,
+                         "Predicted by a " + model.kind() + " conditional time model from the world's geometry");
+}
+
+}  // namespace ontime::domains

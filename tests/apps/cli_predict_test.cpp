@@ -1,0 +1,133 @@
+// CLI tests of conditional time models: worlds of a family collected with --features, a model
+// fitted over them with `fit --conditional`, and `predict` writing the instance of a world none
+// of them is (the domains build only).
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "apps/cli_test_support.hpp"
+
+namespace ontime {
+namespace {
+
+using namespace cli_test;
+
+// Three small buildings with many narrow doors, collected with features; seeds 1-3 train, seed 4
+// is predicted.
+struct Corpus {
+  std::filesystem::path dir;
+  std::vector<std::string> logs;
+  std::string unseen;
+};
+
+// Each test makes its own (CTest runs tests as processes side by side).
+Corpus corpus(const std::string& folder) {
+  Corpus c;
+  c.dir = scratch(folder);
+  {
+    for (const std::string seed : {"1", "2", "3", "4"}) {
+      const std::string world = (c.dir / ("w" + seed + ".json")).string();
+      EXPECT_EQ(
+          ontime({"generate-world", "--rows", "2", "--cols", "3", "--narrow-doors", "0.5", "--seed", seed, "-o", world})
+              .exit_code,
+          0);
+      if (seed == "4") {
+        c.unseen = world;
+        continue;
+      }
+      const std::string log = (c.dir / ("w" + seed + ".jsonl")).string();
+      const auto collected =
+          ontime({"collect", "--domain", "navigation", "--world", world, "--every-action", "--features", "--trials",
+                  "6", "--threads", "2", "--log", log, "-o", (c.dir / ("w" + seed + ".instance.json")).string()});
+      EXPECT_EQ(collected.exit_code, 0) << collected.err;
+      c.logs.push_back(log);
+    }
+  }
+  return c;
+}
+
+TEST(Cli, PredictWritesTheInstanceOfAnUnseenWorld) {
+  const Corpus c = corpus("predict");
+  const json record = json::parse(read_file(c.logs[0]).substr(0, read_file(c.logs[0]).find('\n')));
+  EXPECT_EQ(record["world"], "w1");
+  EXPECT_EQ(record["features"].size(), 11u);
+  const std::string model = (c.dir / "hazard.json").string();
+  std::vector<std::string> fit{"fit"};
+  fit.insert(fit.end(), c.logs.begin(), c.logs.end());
+  for (const std::string arg : {"--conditional", "hazard", "--domain", "navigation", "--step", "3", "-o"}) {
+    fit.push_back(arg);
+  }
+  fit.push_back(model);
+  fit.push_back("--json");
+  const auto fitted = ontime(fit);
+  ASSERT_EQ(fitted.exit_code, 0) << fitted.err;
+  const json summary = json::parse(fitted.out);
+  EXPECT_EQ(summary["worlds"].get<int>(), 3);
+  EXPECT_EQ(summary["feature_names"][0], "door_width");
+  EXPECT_EQ(json::parse(read_file(model))["version"].get<int>(), 1);
+
+  const std::string instance = (c.dir / "w4.predicted.json").string();
+  const auto predicted =
+      ontime({"predict", "--domain", "navigation", "--world", c.unseen, "--model", model, "-o", instance, "--json"});
+  ASSERT_EQ(predicted.exit_code, 0) << predicted.err;
+  const json out = json::parse(predicted.out);
+  const json problem = json::parse(read_file(instance));
+  // Every doorway move of the unseen building, both ways, one skeleton each; its deadline.
+  const json world = json::parse(read_file(c.unseen));
+  EXPECT_EQ(out["actions"].get<std::size_t>(), 2 * world["doors"].size());
+  EXPECT_EQ(out["skeletons"], out["actions"]);
+  EXPECT_EQ(problem["deadline"], world["collection"]["deadline"]);
+  // Features matter: the move through the unseen building's narrowest door is predicted slower to
+  // plan than the move through its widest.
+  std::string narrow, wide;
+  double narrowest = 10, widest = 0;
+  for (const json& door : world["doors"]) {
+    const std::string move =
+        "move(" + door["rooms"][0].get<std::string>() + "," + door["rooms"][1].get<std::string>() + ")";
+    if (door["width"].get<double>() < narrowest) narrowest = door["width"].get<double>(), narrow = move;
+    if (door["width"].get<double>() > widest) widest = door["width"].get<double>(), wide = move;
+  }
+  ASSERT_LT(narrowest, 0.9);
+  ASSERT_GT(widest, 1.0);
+  const auto found_by = [&](const std::string& action, int steps) {
+    double mass = 0;
+    for (const auto& [step, p] : problem["actions"][action]["planning"]["pmf"].items()) {
+      if (std::stoi(step) <= steps) mass += p.get<double>();
+    }
+    return mass;
+  };
+  EXPECT_LT(found_by(narrow, 3), found_by(wide, 3)) << narrow << " against " << wide;
+  // The same model and world write the same file.
+  const std::string again = (c.dir / "w4.again.json").string();
+  ASSERT_EQ(ontime({"predict", "--domain", "navigation", "--world", c.unseen, "--model", model, "-o", again}).exit_code,
+            0);
+  EXPECT_EQ(read_file(again), read_file(instance));
+}
+
+TEST(Cli, PredictRefusesAModelOfOtherFeaturesAndWritesNothing) {
+  const Corpus c = corpus("predict-refused");
+  const std::string unnamed = (c.dir / "unnamed.json").string();
+  ASSERT_EQ(ontime({"fit", c.logs[0], "--conditional", "pooled", "--step", "3", "-o", unnamed}).exit_code, 0);
+  const std::string instance = (c.dir / "refused.json").string();
+  const auto refused =
+      ontime({"predict", "--domain", "navigation", "--world", c.unseen, "--model", unnamed, "-o", instance});
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_NE(refused.err.find("fitted on other features"), std::string::npos) << refused.err;
+  EXPECT_FALSE(std::filesystem::exists(instance));
+  // A log without features, and --deadline with --conditional, are refused before any fit.
+  const auto plain = ontime({"fit", testing::source_path("data/logs/navigation.jsonl").string(), "--conditional",
+                             "hazard", "--step", "3", "-o", (c.dir / "plain.json").string()});
+  EXPECT_EQ(plain.exit_code, 2);
+  EXPECT_NE(plain.err.find("record 1: has no 'features'"), std::string::npos) << plain.err;
+  EXPECT_EQ(ontime({"fit", c.logs[0], "--conditional", "hazard", "--step", "3", "--deadline", "4", "-o",
+                    (c.dir / "x.json").string()})
+                .exit_code,
+            2);
+  EXPECT_FALSE(std::filesystem::exists(c.dir / "plain.json"));
+}
+
+}  // namespace
+}  // namespace ontime
