@@ -65,7 +65,10 @@ TEST(Cli, ProgressLinesInALogAndNoneWhenQuiet) {
   logged.insert(logged.end(), train.begin(), train.end());
   const auto result = testing::run_process(logged);
   ASSERT_EQ(result.exit_code, 0) << result.err;
-  const std::regex line(R"(ontime train ppo: (\d+)/3000 \((\d+)%\), \d+s elapsed, about \d+s left)");
+  // Durations as the bar writes them: 42s, 1m07s, 1h21m (a slow build, e.g. under the sanitizers,
+  // passes a minute).
+  const std::regex line(
+      R"(ontime train ppo: (\d+)/3000 \((\d+)%\), \d+[hms](\d+[ms])? elapsed, about \d+[hms](\d+[ms])? left)");
   std::istringstream err(result.err);
   std::vector<std::uint64_t> done;
   for (std::string text; std::getline(err, text);) {
