@@ -3,17 +3,22 @@
 
 #include <fmt/format.h>
 
+#include <optional>
+
 #include "common.hpp"
 #include "memory_limits.hpp"
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/model/instance_io.hpp"
+#include "ontime/model/problem.hpp"
 #include "ontime/report/report.hpp"
+#include "ontime/util/error.hpp"
 
 namespace ontime::cli {
 
 void add_evaluate_command(CLI::App& app) {
   struct Options {
     std::string instance;
+    std::string belief;
     std::string solver;
     bool exact = false;
     bool json = false;
@@ -25,6 +30,9 @@ void add_evaluate_command(CLI::App& app) {
   CLI::App* command = app.add_subcommand("evaluate", "Success rate of one allocator over simulated episodes");
   command->add_option("INSTANCE", options->instance, "Instance file (JSON, SPEC §5)")->required();
   add_solver_option(*command, options->solver);
+  command->add_option("--belief", options->belief,
+                      "Instance the allocator plans with (a prediction, a pooled fit): its distributions for "
+                      "INSTANCE's actions, matched by id; the episodes and the exact value are drawn from INSTANCE");
   command->add_flag("--exact", options->exact, "Also compute the exact success probability (no sampling)");
   command->add_flag("--json", options->json, "Print JSON");
   command->add_flag("--no-timing", options->no_timing,
@@ -36,12 +44,23 @@ void add_evaluate_command(CLI::App& app) {
     check_solver_names({options->solver});
     const Problem problem = load_problem(options->instance);
     const Mdp mdp(problem);
+    // The allocator's own instance: INSTANCE's skeletons with the belief's distributions.
+    std::optional<Problem> planned;
+    if (!options->belief.empty()) {
+      const Problem belief = load_problem(options->belief);
+      try {
+        planned.emplace(with_distributions_of(problem, belief));
+      } catch (const UsageError& error) {
+        throw UsageError(options->belief + ": " + error.what() + " (--belief against " + options->instance + ")");
+      }
+    }
+    const Mdp planned_mdp(planned ? *planned : problem);
     const ParameterValues parameters = options->allocator.values();
     options->monte_carlo.check_allocator_memory(options->solver, problem, parameters);
     if (options->exact || allocator_registry().find(options->solver).capabilities.has(Capability::optimal)) {
       check_exact_work(problem, max_states_of(parameters), options->instance, flag_spelling());
     }
-    const AllocatorFactory factory = make_allocator_factory(options->solver, mdp, parameters);
+    const AllocatorFactory factory = make_allocator_factory(options->solver, planned_mdp, parameters);
 
     MonteCarloOptions monte_carlo = options->monte_carlo.options();
     monte_carlo.time_decisions = !options->no_timing;
@@ -58,6 +77,7 @@ void add_evaluate_command(CLI::App& app) {
                                   .parameters = parameters,
                                   .instance = options->instance,
                                   .problem = &problem,
+                                  .belief = options->belief,
                                   .seed = options->monte_carlo.seed,
                                   .result = result,
                                   .exact = exact,

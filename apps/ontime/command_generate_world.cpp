@@ -47,6 +47,10 @@ void add_generate_world_command(CLI::App& app) {
                     domains::kMaxBuildingBoxes);
   add_number_option(*command, "--max-boxes", b.max_boxes, "Most boxes in a cluttered room", 0,
                     domains::kMaxBuildingBoxes);
+  add_number_option(*command, "--skeletons", b.skeletons,
+                    "Skeletons written into the world: its task planner's shortest room paths from the start to "
+                    "the goal room (0: none)",
+                    0, domains::kMaxBuildingSkeletons);
   add_number_option(*command, "--seed", options->building.seed, "Seed of every random choice");
   command->add_option("--name", options->building.name, "World name (default: building-ROWSxCOLS)");
   command->add_flag("--json", options->json, "Print JSON");

@@ -33,6 +33,7 @@ void add_plot_command(CLI::App& app);
 void add_collect_command(CLI::App& app);
 void add_map_command(CLI::App& app);
 void add_predict_command(CLI::App& app);
+void add_score_command(CLI::App& app);
 void add_generate_world_command(CLI::App& app);
 void add_run_command(CLI::App& app);
 void add_tamp_command(CLI::App& app);

@@ -5,12 +5,18 @@
 #include <charconv>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <memory>
 #include <numbers>
 #include <numeric>
+#include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "ontime/domains/navigation_collision.hpp"
+#include "ontime/domains/task_planner.hpp"
 #include "ontime/util/atomic_file.hpp"
 #include "ontime/util/error.hpp"
 #include "ontime/util/random.hpp"
@@ -226,8 +232,11 @@ class Generator {
   std::string text() {
     plan_doors();
     for (int room = 0; room < room_count(); ++room) furnish(room);
-    return write();
+    return write({});
   }
+
+  // The same building with these skeletons (room paths of its task planner).
+  std::string text_with(const std::vector<std::vector<std::string>>& skeletons) const { return write(skeletons); }
 
  private:
   int room_count() const { return options_.rows * options_.cols; }
@@ -431,7 +440,7 @@ class Generator {
            std::to_string(o.min_boxes) + "-" + std::to_string(o.max_boxes) + " boxes).";
   }
 
-  std::string write() const {
+  std::string write(const std::vector<std::vector<std::string>>& skeletons) const {
     const int goal = room_count() - 1;
     std::size_t narrow = 0;
     for (const DoorPlan& door : doors_) narrow += door.narrow ? 1 : 0;
@@ -441,8 +450,10 @@ class Generator {
         ", door density " + number(options_.door_density) + ", narrow-door share " +
         number(options_.narrow_door_share) + "): " + std::to_string(doors_.size()) + " doors (" +
         std::to_string(narrow) + " narrow), " + std::to_string(furniture_.size()) + " pieces of furniture; start in " +
-        room_id(0) + " (bottom left), goal " + room_id(goal) +
-        " (top right). No skeletons: collect every doorway move on its own." + family_text();
+        room_id(0) + " (bottom left), goal " + room_id(goal) + " (top right). " +
+        (skeletons.empty() ? std::string("No skeletons: collect every doorway move on its own.")
+                           : "Skeletons: the " + std::to_string(skeletons.size()) + " shortest room paths.") +
+        family_text();
     const Point start = centre(0);
     std::string out = "{\n";
     out += "  \"name\": " + json_string(name_) + ",\n";
@@ -475,7 +486,19 @@ class Generator {
              ", \"center\": " + pair_text(shape.x, shape.y) + ", \"size\": " + pair_text(shape.length, shape.width) +
              ", \"angle\": " + number(shape.angle) + "}";
     }
-    out += furniture_.empty() ? "]\n}\n" : "\n  ]\n}\n";
+    out += furniture_.empty() ? "]" : "\n  ]";
+    if (!skeletons.empty()) {
+      out += ",\n  \"skeletons\": [";
+      for (std::size_t k = 0; k < skeletons.size(); ++k) {
+        out += std::string(k == 0 ? "\n" : ",\n") + "    [";
+        for (std::size_t l = 0; l < skeletons[k].size(); ++l) {
+          out += (l == 0 ? "" : ", ") + json_string(skeletons[k][l]);
+        }
+        out += "]";
+      }
+      out += "\n  ]";
+    }
+    out += "\n}\n";
     return out;
   }
 
@@ -505,7 +528,11 @@ void turn(std::vector<Pose>& route, const Point& at, double theta) {
 }  // namespace
 
 std::string generate_navigation_world_text(const BuildingOptions& options) {
-  std::string text = Generator(options).text();
+  if (options.skeletons < 0 || options.skeletons > kMaxBuildingSkeletons) {
+    throw std::invalid_argument("the skeletons must be between 0 and " + std::to_string(kMaxBuildingSkeletons));
+  }
+  Generator generator(options);
+  std::string text = generator.text();
   // The world as read back must keep every promise: each door's routes free of collisions.
   const NavigationWorld world = parse_navigation_world(text, "generated world");
   const NavigationCollision collision(world, world.robot.clearance);
@@ -518,6 +545,32 @@ std::string generate_navigation_world_text(const BuildingOptions& options) {
         }
       }
     }
+  }
+  if (options.skeletons > 0) {
+    const std::unique_ptr<TaskPlanner> planner = room_path_planners(world, options.skeletons)();
+    std::vector<std::vector<std::string>> skeletons;
+    // An instance's actions form a prefix tree (SPEC §1): a move reached after other moves than
+    // before is a node of its own, named as the streaming TAMP loop names it (planner_world.hpp):
+    // the move's id followed by "#2", "#3", ...
+    std::map<std::pair<std::string, std::string>, std::string> node_of;  // (parent node, move) -> node
+    std::set<std::string> taken;
+    for (int k = 0; k < options.skeletons; ++k) {
+      std::optional<std::vector<std::string>> path = planner->next();
+      if (!path) break;  // a small building has fewer simple paths
+      std::vector<std::string> skeleton;
+      std::string parent;
+      for (const std::string& move : *path) {
+        auto [node, added] = node_of.try_emplace({parent, move}, move);
+        if (added) {
+          for (int copy = 2; taken.contains(node->second); ++copy) node->second = move + "#" + std::to_string(copy);
+          taken.insert(node->second);
+        }
+        skeleton.push_back(node->second);
+        parent = node->second;
+      }
+      skeletons.push_back(std::move(skeleton));
+    }
+    text = generator.text_with(skeletons);
   }
   return text;
 }

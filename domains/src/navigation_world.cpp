@@ -406,7 +406,7 @@ std::vector<std::vector<std::string>> NavigationWorld::room_paths(std::string_vi
 }
 
 std::vector<std::string> move_rooms(std::string_view action) {
-  static const std::regex pattern(R"(move\(([^(), ]+),([^(), ]+)\))");
+  static const std::regex pattern(R"(move\(([^(), ]+),([^(), ]+)\)(#[1-9][0-9]*)?)");
   std::cmatch match;
   if (!std::regex_match(action.begin(), action.end(), match, pattern)) return {};
   return {match[1].str(), match[2].str()};

@@ -51,6 +51,7 @@ from ._ontime import (  # noqa: F401  (re-exported)
     reduce_knapsack,
     run_episodes,
     sample_log,
+    score,
     solve,
     study,
     table,
@@ -64,7 +65,7 @@ __all__ = [
     "NEVER", "Action", "Allocator", "ConditionalTimeModel", "Decision", "Distribution", "Error", "InputError", "LiveSession",
     "ManualClock", "Mdp", "PlanningPosterior", "Problem",
     "ResourceLimitError", "Session", "State", "Status", "UsageError", "World", "allocators", "conditional_model_kinds",
-    "evaluate", "fit", "fit_conditional", "histogram_csv", "load_conditional_model", "load_problem", "make_allocator", "read_planner_log", "reduce_knapsack", "run_episodes", "sample_log",
+    "evaluate", "fit", "fit_conditional", "histogram_csv", "load_conditional_model", "load_problem", "make_allocator", "read_planner_log", "reduce_knapsack", "run_episodes", "sample_log", "score",
     "solve", "study", "table", "train_ppo",
     "write_planner_log",
 ]

@@ -369,7 +369,8 @@ void bind_domains(py::module_& m) {
          Number<double, "empty_rooms", 0.0, 1.0> empty_rooms,
          Number<double, "cluttered_rooms", 0.0, 1.0> cluttered_rooms,
          Number<int, "min_boxes", 0, domains::kMaxBuildingBoxes> min_boxes,
-         Number<int, "max_boxes", 0, domains::kMaxBuildingBoxes> max_boxes, Seed seed,
+         Number<int, "max_boxes", 0, domains::kMaxBuildingBoxes> max_boxes,
+         Number<int, "skeletons", 0, domains::kMaxBuildingSkeletons> skeletons, Seed seed,
          const std::optional<std::string>& name) {
         domains::BuildingOptions options;
         options.rows = rows;
@@ -385,6 +386,7 @@ void bind_domains(py::module_& m) {
         options.cluttered_room_share = cluttered_rooms;
         options.min_boxes = min_boxes;
         options.max_boxes = max_boxes;
+        options.skeletons = skeletons;
         options.seed = seed;
         if (name) options.name = *name;
         const std::string path = path_text(output);
@@ -404,7 +406,8 @@ void bind_domains(py::module_& m) {
       py::arg("empty_rooms") = domains::BuildingOptions{}.empty_room_share,
       py::arg("cluttered_rooms") = domains::BuildingOptions{}.cluttered_room_share,
       py::arg("min_boxes") = domains::BuildingOptions{}.min_boxes,
-      py::arg("max_boxes") = domains::BuildingOptions{}.max_boxes, py::arg("seed") = 1, py::arg("name") = py::none(),
+      py::arg("max_boxes") = domains::BuildingOptions{}.max_boxes, py::arg("skeletons") = 0, py::arg("seed") = 1,
+      py::arg("name") = py::none(),
       "`ontime generate-world`: writes a generated navigation world (an office building of rows x cols rooms) "
       "to `output` and returns what it holds (the fields of `ontime generate-world --json`). Same options, same "
       "seed: the same file.");

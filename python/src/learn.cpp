@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "bindings.hpp"
+#include "ontime/learn/attempt_scores.hpp"
 #include "ontime/learn/conditional_model.hpp"
 #include "ontime/learn/fitting.hpp"
 #include "ontime/learn/log_sampling.hpp"
@@ -16,6 +17,7 @@
 #include "ontime/learn/ppo_training.hpp"
 #include "ontime/model/planner_log.hpp"
 #include "ontime/model/skeleton_file.hpp"
+#include "ontime/report/conditional_report.hpp"
 #include "ontime/util/atomic_file.hpp"
 #include "ontime/util/error.hpp"
 #include "ontime/util/output_set.hpp"
@@ -158,6 +160,38 @@ void bind_learn(py::module_& m) {
       },
       py::arg("log"), py::arg("log_is_path"), py::arg("skeleton_data"), py::arg("skeletons_are_path"), py::arg("step"),
       py::arg("deadline"), py::arg("laplace"), py::arg("name"), py::arg("description"));
+
+  m.def(
+      "score",
+      [](const py::object& problem, const std::vector<py::object>& logs, Number<Steps, "horizon", 0> horizon,
+         double floor, bool skip_unknown) {
+        const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
+        if (logs.empty()) throw UsageError("logs: give at least one planner log");
+        std::vector<std::string> paths;
+        for (const py::object& log : logs) paths.emplace_back(py::str(py::module_::import("os").attr("fspath")(log)));
+        report::ScoreReport report{.instance = instance_label(problem, *mdp->problem),
+                                   .logs = paths,
+                                   .problem = mdp->problem.get(),
+                                   .options = {.horizon = horizon, .floor = floor, .skip_unknown = skip_unknown},
+                                   .scores = {}};
+        {
+          const py::gil_scoped_release release;
+          std::vector<RefinementAttempt> attempts;
+          for (const std::string& path : paths) {
+            std::vector<RefinementAttempt> records = load_planner_log(path);
+            attempts.insert(attempts.end(), std::make_move_iterator(records.begin()),
+                            std::make_move_iterator(records.end()));
+          }
+          report.scores =
+              score_attempts(attempts, *mdp->problem, paths.size() == 1 ? paths.front() : "the logs", report.options);
+        }
+        return json_object(report::attempt_scores_json(report));
+      },
+      py::arg("problem"), py::arg("logs"), py::kw_only(), py::arg("horizon") = 0, py::arg("floor") = 1e-6,
+      py::arg("skip_unknown") = false,
+      "`ontime score`: how well the problem's distributions explain the attempts of planner logs (paths): the "
+      "censoring-aware planning log score, the integrated Brier score and the execution log score, as the "
+      "command's --json fields (docs/learning.md).");
 
   m.def(
       "sample_log",

@@ -280,14 +280,20 @@ void bind_run(py::module_& m) {
   m.def(
       "evaluate",
       [](const py::object& problem, const std::string& solver, Episodes episodes, Seed seed, Threads threads,
-         bool exact, const py::object& progress, const py::kwargs& kwargs) {
+         bool exact, const py::object& belief, const py::object& progress, const py::kwargs& kwargs) {
         check_episodes(episodes);
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
+        // The allocator's own instance: the problem's skeletons with the belief's distributions.
+        std::shared_ptr<MdpHandle> planned = mdp;
+        if (!belief.is_none()) {
+          planned = std::make_shared<MdpHandle>(
+              std::make_shared<const Problem>(with_distributions_of(*mdp->problem, *to_mdp(belief)->problem)));
+        }
         const ParameterValues values = parameter_values(kwargs);
         std::optional<AllocatorFactory> factory;
         {
           const py::gil_scoped_release release;
-          factory = make_allocator_factory(solver, mdp->mdp, values);
+          factory = make_allocator_factory(solver, planned->mdp, values);
         }
         MonteCarloOptions options;
         options.episodes = episodes;
@@ -295,15 +301,21 @@ void bind_run(py::module_& m) {
         options.threads = threads;
         const auto [result, exact_result] =
             run_and_evaluate(*mdp, hidden_worlds(*mdp->problem), *factory, options, exact, values, progress);
-        return monte_carlo_dict(solver, values, instance_label(problem, *mdp->problem), *mdp->problem, result, seed,
-                                exact_result);
+        py::dict out = monte_carlo_dict(solver, values, instance_label(problem, *mdp->problem), *mdp->problem, result,
+                                        seed, exact_result);
+        if (!belief.is_none()) out["belief"] = instance_label(belief, *planned->problem);
+        return out;
       },
       py::arg("problem"), py::arg("solver"), py::kw_only(), py::arg("episodes") = 10'000, py::arg("seed") = 1,
-      py::arg("threads") = 0, py::arg("exact") = false, py::arg("progress") = py::none(),
+      py::arg("threads") = 0, py::arg("exact") = false, py::arg("belief") = py::none(),
+      py::arg("progress") = py::none(),
       "Success rate of an allocator over simulated episodes (hidden sampled worlds), as `ontime evaluate "
       "--json` reports it: the same fields and, for the same seed, the same counts whatever `threads`. "
-      "exact=True adds the exact success probability (stationary allocators). Parameters of the allocator "
-      "as keyword arguments. The GIL is released; Ctrl-C stops it (KeyboardInterrupt).");
+      "exact=True adds the exact success probability (stationary allocators). `belief` (an instance, its "
+      "path or a Problem): the allocator plans with its distributions for the problem's actions (matched by "
+      "id) while the episodes and the exact value are drawn from `problem` (`ontime evaluate --belief`). "
+      "Parameters of the allocator as keyword arguments. The GIL is released; Ctrl-C stops it "
+      "(KeyboardInterrupt).");
 
   m.def(
       "table",

@@ -83,4 +83,29 @@ int Problem::find_action(std::string_view id) const noexcept {
   return -1;
 }
 
+Problem with_distributions_of(const Problem& structure, const Problem& distributions) {
+  if (distributions.deadline() != structure.deadline()) {
+    reject("the deadlines differ (" + std::to_string(distributions.deadline()) + " and " +
+           std::to_string(structure.deadline()) + " steps)");
+  }
+  // (A relative slack: steps are written as decimals in instance files.)
+  if (std::abs(distributions.step_seconds() - structure.step_seconds()) > 1e-9 * structure.step_seconds()) {
+    reject("the steps differ (" + std::to_string(distributions.step_seconds()) + " s and " +
+           std::to_string(structure.step_seconds()) + " s)");
+  }
+  std::vector<Action> actions(structure.actions().begin(), structure.actions().end());
+  for (Action& action : actions) {
+    const int source = distributions.find_action(action.id);
+    if (source < 0) reject("no distributions for the action " + action.id);
+    action.planning = distributions.action(source).planning;
+    action.execution = distributions.action(source).execution;
+  }
+  std::vector<std::vector<int>> skeletons;
+  for (int k = 0; k < structure.skeleton_count(); ++k) {
+    skeletons.emplace_back(structure.skeleton(k).begin(), structure.skeleton(k).end());
+  }
+  return {structure.name(),   structure.deadline(), structure.step_seconds(),
+          std::move(actions), std::move(skeletons), structure.description()};
+}
+
 }  // namespace ontime

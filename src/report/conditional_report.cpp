@@ -50,4 +50,47 @@ std::string conditional_fit_text(const ConditionalTimeModel& model, const Condit
   return text;
 }
 
+namespace {
+
+Steps horizon_of(const ScoreReport& report) {
+  return report.options.horizon > 0 ? report.options.horizon : report.problem->deadline();
+}
+
+}  // namespace
+
+std::string attempt_scores_json(const ScoreReport& report) {
+  const AttemptScores& scores = report.scores;
+  Json out = Json::object();
+  out["instance"] = report.instance;
+  out["logs"] = std::vector<std::string>(report.logs.begin(), report.logs.end());
+  out["horizon"] = horizon_of(report);
+  out["attempts"] = scores.attempts;
+  out["found"] = scores.found;
+  out["censored"] = scores.censored;
+  out["skipped"] = scores.skipped;
+  out["planning_nll"] = scores.planning_nll;
+  out["integrated_brier"] = scores.integrated_brier;
+  out["executions"] = scores.executions;
+  out["execution_nll"] = scores.execution_nll;
+  out["floored"] = scores.floored;
+  out["floor"] = report.options.floor;
+  return out.dump();
+}
+
+std::string attempt_scores_text(const ScoreReport& report) {
+  const AttemptScores& scores = report.scores;
+  std::string out = fmt::format("instance          {} ({}), deadline {}, horizon {} steps\n", report.instance,
+                                report.problem->name(), report.problem->deadline(), horizon_of(report));
+  out += fmt::format("attempts          {} ({} found within the horizon, {} censored; {} skipped)\n", scores.attempts,
+                     scores.found, scores.censored, scores.skipped);
+  out += fmt::format("planning NLL      {:.4f} nats per attempt\n", scores.planning_nll);
+  out += fmt::format("integrated Brier  {:.4f}\n", scores.integrated_brier);
+  out += fmt::format("execution NLL     {:.4f} nats per found attempt ({})\n", scores.execution_nll, scores.executions);
+  if (scores.floored > 0) {
+    out += fmt::format("floored           {} outcomes the instance gives less than {:g}, scored at it\n",
+                       scores.floored, report.options.floor);
+  }
+  return out;
+}
+
 }  // namespace ontime::report

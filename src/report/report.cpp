@@ -90,6 +90,7 @@ std::string to_json(const Evaluation& evaluation) {
   out["solver"] = evaluation.solver;
   out["parameters"] = parameters_object(allocator_registry().find(evaluation.solver), evaluation.parameters);
   out["instance"] = evaluation.instance;
+  if (!evaluation.belief.empty()) out["belief"] = evaluation.belief;
   out["episodes"] = result.episodes;
   out["seed"] = evaluation.seed;
   out["successes"] = result.successes;
@@ -112,6 +113,7 @@ std::string to_text(const Evaluation& evaluation) {
   std::string out = fmt::format("solver          {}\n", evaluation.solver);
   out += fmt::format("instance        {} ({}), deadline {}\n", evaluation.instance, evaluation.problem->name(),
                      evaluation.problem->deadline());
+  if (!evaluation.belief.empty()) out += fmt::format("planned with    {}\n", evaluation.belief);
   out += fmt::format("success rate    {:.4f} ± {:.4f}  ({} of {} episodes, seed {})\n", result.success_rate,
                      result.ci95, result.successes, result.episodes, evaluation.seed);
   if (evaluation.exact) {

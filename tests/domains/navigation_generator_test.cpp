@@ -196,6 +196,42 @@ TEST(NavigationGenerator, EveryActionIsEveryDoorInBothDirections) {
   EXPECT_EQ(moves.size(), actions.size());
 }
 
+// Skeletons: the task planner's shortest room paths, a move reached after other moves named
+// "#2" (an instance's actions form a prefix tree), the world still its checker's.
+TEST(NavigationGenerator, SkeletonsAreTheShortestRoomPathsAsAPrefixTree) {
+  BuildingOptions options = building(5, 3, 3);
+  options.narrow_door_share = 0.5;
+  const std::string plain = generate_navigation_world_text(options);
+  options.skeletons = 6;
+  const NavigationWorld world = generate_navigation_world(options);
+  EXPECT_EQ(generate_navigation_world_text(options), generate_navigation_world_text(options));
+  // The same building: only the description and the skeletons differ.
+  const NavigationWorld without = parse_navigation_world(plain, "plain");
+  EXPECT_TRUE(without.skeletons.empty());
+  EXPECT_EQ(world.doors.size(), without.doors.size());
+  EXPECT_EQ(world.obstacles.size(), without.obstacles.size());
+
+  const auto paths = world.room_paths(world.start_room, world.goal_room);
+  ASSERT_EQ(world.skeletons.size(), std::min<std::size_t>(6, paths.size()));
+  std::set<std::vector<std::string>> room_paths(paths.begin(), paths.end());
+  std::map<std::string, std::vector<std::string>> prefix_of;
+  std::size_t renamed = 0;
+  for (const std::vector<std::string>& skeleton : world.skeletons) {
+    std::vector<std::string> rooms{world.start_room};
+    for (std::size_t l = 0; l < skeleton.size(); ++l) {
+      rooms.push_back(move_rooms(skeleton[l]).at(1));
+      const std::vector<std::string> prefix(skeleton.begin(), skeleton.begin() + static_cast<std::ptrdiff_t>(l));
+      const auto [seen, added] = prefix_of.emplace(skeleton[l], prefix);
+      EXPECT_EQ(seen->second, prefix) << skeleton[l] << " after other actions";
+      renamed += skeleton[l].find('#') != std::string::npos && added ? 1 : 0;
+    }
+    EXPECT_TRUE(room_paths.contains(rooms));
+  }
+  EXPECT_EQ(world.skeletons.front().front(), "move(R1,R4)");
+  EXPECT_GE(renamed, 1u);  // move(R8,R9) ends two paths after different moves
+  EXPECT_EQ(world.skeletons[2].back(), "move(R8,R9)#2");
+}
+
 TEST(NavigationGenerator, RefusesOptionsOutOfRange) {
   const auto refused = [](const std::function<void(BuildingOptions&)>& edit) {
     BuildingOptions options;
@@ -217,6 +253,8 @@ TEST(NavigationGenerator, RefusesOptionsOutOfRange) {
   refused([](BuildingOptions& o) { o.min_boxes = 8; });  // above max_boxes, 7
   refused([](BuildingOptions& o) { o.max_boxes = kMaxBuildingBoxes + 1; });
   refused([](BuildingOptions& o) { o.min_boxes = -1; });
+  refused([](BuildingOptions& o) { o.skeletons = -1; });
+  refused([](BuildingOptions& o) { o.skeletons = kMaxBuildingSkeletons + 1; });
 }
 
 // The family options: every door's width within its kind's range, rooms all empty or all

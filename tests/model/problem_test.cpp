@@ -61,5 +61,33 @@ TEST(Problem, RejectsBrokenRules) {
   EXPECT_THROW(Problem("p", 5, 1.0, {zero_planning}, {{0}}), UsageError);
 }
 
+TEST(Problem, DistributionsOfAnotherInstanceByActionId) {
+  const Problem structure("truth", 5, 0.5, {simple("a"), simple("b")}, {{0, 1}, {0}}, "the world's");
+  // The belief lists the actions in the other order, with other distributions, and an action
+  // the structure does not use.
+  const Action belief_b{"b", Distribution::from_pmf({0.0, 0.25, 0.75}), Distribution::from_pmf({0.0, 1.0})};
+  const Action belief_a{"a", Distribution::from_pmf({0.0, 0.0, 0.5}), Distribution::from_pmf({1.0})};
+  const Problem belief("belief", 5, 0.5, {belief_b, simple("c"), belief_a}, {{0}, {1}, {2}});
+  const Problem planned = with_distributions_of(structure, belief);
+  EXPECT_EQ(planned.name(), "truth");
+  EXPECT_EQ(planned.description(), "the world's");
+  ASSERT_EQ(planned.action_count(), 2);
+  EXPECT_EQ(planned.action(0).id, "a");
+  EXPECT_EQ(planned.action(0).planning.pmf(2), 0.5);
+  EXPECT_EQ(planned.action(0).planning.never(), 0.5);
+  EXPECT_EQ(planned.action(1).planning.pmf(1), 0.25);
+  EXPECT_EQ(planned.action(1).execution.pmf(1), 1.0);
+  ASSERT_EQ(planned.skeleton_count(), 2);
+  EXPECT_EQ(planned.action_at(0, 1), 1);
+  EXPECT_EQ(planned.action_at(1, 0), 0);
+
+  const Problem lacking("belief", 5, 0.5, {belief_b}, {{0}});
+  EXPECT_THROW(with_distributions_of(structure, lacking), UsageError);
+  const Problem later("belief", 6, 0.5, {belief_b, belief_a}, {{0}, {1}});
+  EXPECT_THROW(with_distributions_of(structure, later), UsageError);
+  const Problem coarser("belief", 5, 1.0, {belief_b, belief_a}, {{0}, {1}});
+  EXPECT_THROW(with_distributions_of(structure, coarser), UsageError);
+}
+
 }  // namespace
 }  // namespace ontime

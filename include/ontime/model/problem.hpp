@@ -75,4 +75,11 @@ class Problem {
   std::vector<char> completes_;
 };
 
+// `structure` (its name, skeletons, deadline and step) with every action's distributions taken
+// from the action of the same id in `distributions`: the instance an allocator plans with when
+// its beliefs differ from the world's (a prediction, a pooled fit, a posterior), in the state
+// layout of `structure`, so that its decisions can be scored in the true instance. Throws
+// UsageError naming the first action `distributions` lacks, or a deadline or step that differs.
+Problem with_distributions_of(const Problem& structure, const Problem& distributions);
+
 }  // namespace ontime

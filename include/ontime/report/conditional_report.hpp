@@ -6,6 +6,7 @@
 #include <span>
 #include <string>
 
+#include "ontime/learn/attempt_scores.hpp"
 #include "ontime/learn/conditional_model.hpp"
 
 namespace ontime::report {
@@ -16,5 +17,19 @@ std::string conditional_fit_json(const ConditionalTimeModel& model, const Condit
                                  const std::string& output);
 std::string conditional_fit_text(const ConditionalTimeModel& model, const ConditionalData& data,
                                  const std::string& output);
+
+// What `ontime score` prints: the instance scored (as given), its deadline and the horizon, the
+// attempts (found, censored, skipped) and the three scores of attempt_scores.hpp. JSON members:
+// instance, logs, horizon, attempts, found, censored, skipped, planning_nll, integrated_brier,
+// executions, execution_nll, floored, floor.
+struct ScoreReport {
+  std::string instance;
+  std::span<const std::string> logs;
+  const Problem* problem = nullptr;
+  AttemptScoreOptions options;
+  AttemptScores scores;
+};
+std::string attempt_scores_json(const ScoreReport& report);
+std::string attempt_scores_text(const ScoreReport& report);
 
 }  // namespace ontime::report

@@ -34,6 +34,7 @@ struct Evaluation {
   ParameterValues parameters = {};
   std::string instance = {};  // where the instance came from, as given
   const Problem* problem = nullptr;
+  std::string belief = {};  // the instance the allocator planned with, when not `instance`
   std::uint64_t seed = 0;
   MonteCarloResult result = {};
   std::optional<ExactEvaluation> exact = {};

@@ -44,6 +44,13 @@ struct BuildingOptions {
   double empty_room_share = 0.25;
   double cluttered_room_share = 0.35;
   int min_boxes = 4, max_boxes = 7;
+  // Skeletons written into the file: the first `skeletons` room paths of the task planner (the
+  // shortest simple paths from the start room to the goal room, task_planner.hpp), so that the
+  // world has an instance of its own (collect, predict, solve); fewer when the building has fewer.
+  // A move reached after other moves than in an earlier path is an action of its own, its id
+  // followed by "#2", "#3", ... (as the streaming TAMP loop names it). 0: none, every doorway
+  // move is left to collect on its own or to a task planner. At most kMaxBuildingSkeletons.
+  int skeletons = 0;
   std::uint64_t seed = 1;
   std::string name;  // default: building-ROWSxCOLS
 };
@@ -57,6 +64,7 @@ inline constexpr int kMaxBuildingSide = 50;
 inline constexpr double kMinBuildingDoorWidth = 0.71;
 inline constexpr double kMaxBuildingDoorWidth = 2.0;
 inline constexpr int kMaxBuildingBoxes = 20;
+inline constexpr int kMaxBuildingSkeletons = 64;
 
 // The world file's text. Throws std::invalid_argument for options out of range (rows or cols
 // below 1 or above kMaxBuildingSide, a single room, a room size out of range, shares outside

@@ -74,7 +74,9 @@ struct NavigationWorld {
   std::vector<std::vector<std::string>> room_paths(std::string_view from, std::string_view to) const;
 };
 
-// "move(R1,R5)" -> {"R1", "R5"}; an empty result when the id has another form.
+// "move(R1,R5)" -> {"R1", "R5"}; an empty result when the id has another form. A suffix "#n"
+// (n >= 1), "move(R1,R5)#2", names the same move as a node of its own in a skeletons' prefix
+// tree (reached after other moves, see navigation_generator.hpp): the same rooms.
 std::vector<std::string> move_rooms(std::string_view action);
 
 // Reads and checks a world file. Throws ontime::InputError naming the file, the JSON path

@@ -1,0 +1,115 @@
+// CLI tests of `score` (an instance's log and Brier scores on a planner log) and of `evaluate
+// --belief` (an allocator planning with other distributions, scored in the true instance).
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "apps/cli_test_support.hpp"
+#include "ontime/allocators/dp_rerun.hpp"
+#include "ontime/model/instance_io.hpp"
+#include "ontime/run/evaluation.hpp"
+#include "support/paper.hpp"
+
+namespace ontime {
+namespace {
+
+using namespace cli_test;
+using json = nlohmann::json;
+
+void write_text(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+TEST(Cli, ScorePrintsTheLogAndBrierScoresOfAnInstance) {
+  const auto folder = scratch("score");
+  // One action: found at step 1 with 0.6, at 2 with 0.2, never with 0.2; executes in 0 or 1 step.
+  const Action action{"a", Distribution::from_pmf({0.0, 0.6, 0.2}), Distribution::from_pmf({0.5, 0.5})};
+  save_problem(Problem("one", 3, 1.0, {action}, {{0}}), folder / "one.json");
+  write_text(folder / "log.jsonl",
+             "{\"action\": \"a\", \"planning_seconds\": 1, \"found\": true, \"execution_seconds\": 1}\n"
+             "{\"action\": \"a\", \"planning_seconds\": 2, \"found\": true, \"execution_seconds\": 0}\n"
+             "{\"action\": \"a\", \"planning_seconds\": 1.5, \"found\": false}\n"
+             "{\"action\": \"a\", \"planning_seconds\": 5, \"found\": true, \"execution_seconds\": 0.5}\n");
+  const auto result = ontime({"score", (folder / "one.json").string(), (folder / "log.jsonl").string(), "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const json out = json::parse(result.out);
+  EXPECT_EQ(out["attempts"], 4);
+  EXPECT_EQ(out["found"], 2);
+  EXPECT_EQ(out["censored"], 2);
+  EXPECT_EQ(out["horizon"], 3);
+  EXPECT_NEAR(out["planning_nll"].get<double>(), -(std::log(0.6) + std::log(0.2) + std::log(0.4) + std::log(0.2)) / 4,
+              1e-15);
+  EXPECT_NEAR(out["integrated_brier"].get<double>(), 0.28, 1e-15);  // tests/learn/attempt_scores_test.cpp
+  EXPECT_NEAR(out["execution_nll"].get<double>(), std::log(2.0), 1e-15);
+
+  // An attempt of an action the instance lacks: refused, or skipped when asked.
+  write_text(folder / "other.jsonl", "{\"action\": \"b\", \"planning_seconds\": 1, \"found\": false}\n");
+  const auto refused = ontime(
+      {"score", (folder / "one.json").string(), (folder / "log.jsonl").string(), (folder / "other.jsonl").string()});
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_NE(refused.err.find("no action b"), std::string::npos) << refused.err;
+  const auto skipped = ontime({"score", (folder / "one.json").string(), (folder / "log.jsonl").string(),
+                               (folder / "other.jsonl").string(), "--skip-unknown", "--json"});
+  ASSERT_EQ(skipped.exit_code, 0) << skipped.err;
+  EXPECT_EQ(json::parse(skipped.out)["skipped"], 1);
+  EXPECT_EQ(
+      ontime({"score", (folder / "one.json").string(), (folder / "log.jsonl").string(), "--horizon", "4"}).exit_code,
+      2);  // beyond the deadline
+}
+
+TEST(Cli, EvaluateWithABeliefPlansWithItAndScoresInTheInstance) {
+  const auto folder = scratch("evaluate_belief");
+  const Problem truth = testing::paper_instance("instance4");
+  // The belief swaps the planning times of the two skeletons' first actions.
+  std::vector<Action> actions(truth.actions().begin(), truth.actions().end());
+  const int first = truth.find_action("a1_1");
+  const int second = truth.find_action("a2_1");
+  ASSERT_GE(first, 0);
+  ASSERT_GE(second, 0);
+  std::swap(actions[static_cast<std::size_t>(first)].planning, actions[static_cast<std::size_t>(second)].planning);
+  std::vector<std::vector<int>> skeletons;
+  for (int k = 0; k < truth.skeleton_count(); ++k) {
+    skeletons.emplace_back(truth.skeleton(k).begin(), truth.skeleton(k).end());
+  }
+  const Problem belief("belief", truth.deadline(), truth.step_seconds(), actions, skeletons);
+  save_problem(belief, folder / "belief.json");
+
+  const auto plain = ontime({"evaluate", paper("instance4"), "--solver", "dp-rerun", "--exact", "--episodes", "500",
+                             "--no-timing", "--json"});
+  const auto believing = ontime({"evaluate", paper("instance4"), "--belief", (folder / "belief.json").string(),
+                                 "--solver", "dp-rerun", "--exact", "--episodes", "500", "--no-timing", "--json"});
+  ASSERT_EQ(believing.exit_code, 0) << believing.err;
+  const json out = json::parse(believing.out);
+  EXPECT_EQ(out["belief"], (folder / "belief.json").string());
+  // The exact value of dp-rerun deciding with the belief, in the true instance.
+  const Mdp truth_mdp(truth);
+  const Problem planned = with_distributions_of(truth, belief);
+  const Mdp planned_mdp(planned);
+  DpRerunAllocator allocator(planned_mdp);
+  const double expected = evaluate_exactly(truth_mdp, allocator).success_probability;
+  EXPECT_EQ(out["exact_success_probability"].get<double>(), expected);
+  EXPECT_LT(expected, json::parse(plain.out)["exact_success_probability"].get<double>());
+
+  // The instance itself as the belief: the same numbers as without one.
+  const auto same = ontime({"evaluate", paper("instance4"), "--belief", paper("instance4"), "--solver", "dp-rerun",
+                            "--exact", "--episodes", "500", "--no-timing", "--json"});
+  json same_out = json::parse(same.out);
+  same_out.erase("belief");
+  EXPECT_EQ(same_out, json::parse(plain.out));
+
+  // A belief without one of the instance's actions: exit 2 naming the belief.
+  save_problem(Problem("lacking", truth.deadline(), truth.step_seconds(), {truth.action(0)}, {{0}}),
+               folder / "lacking.json");
+  const auto lacking = ontime({"evaluate", paper("instance4"), "--belief", (folder / "lacking.json").string(),
+                               "--solver", "dp-rerun", "--episodes", "10"});
+  EXPECT_EQ(lacking.exit_code, 2);
+  EXPECT_NE(lacking.err.find("lacking.json: no distributions for the action"), std::string::npos) << lacking.err;
+}
+
+}  // namespace
+}  // namespace ontime
