@@ -36,7 +36,7 @@ list(JOIN depends ", " CPACK_DEBIAN_PACKAGE_DEPENDS)
 # `ontime plot` and the other drawing commands run the plotting scripts with matplotlib; building
 # against the library (find_package(ontime)) needs the development packages its CMake package
 # looks for (Eigen, OMPL, FCL and KDL only for the domains component).
-set(recommends python3-matplotlib libfmt-dev libabsl-dev libsleef-dev pkg-config)
+set(recommends python3-matplotlib libfmt-dev libabsl-dev libsleef-dev libxgboost-dev pkg-config)
 if(ONTIME_BUILD_DOMAINS)
   list(APPEND recommends libeigen3-dev libompl-dev libfcl-dev liborocos-kdl-dev)
 endif()

@@ -8,8 +8,8 @@ packages=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev nlohmann-json3-dev libcli11-dev libfmt-dev libabsl-dev
   # SLEEF's deterministic elementary functions (src/util/portable_math.hpp); NLopt (L-BFGS for the
-  # conditional time models).
-  libsleef-dev libnlopt-dev
+  # conditional time models); XGBoost's C API (the boosted conditional time model).
+  libsleef-dev libnlopt-dev libxgboost-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libompl-dev libfcl-dev liborocos-kdl-dev libigraph-dev
   libboost-serialization-dev libboost-filesystem-dev libboost-system-dev

@@ -86,6 +86,12 @@ struct ConditionalOptions {
   Steps horizon = 0;
   double ridge = ConditionalFitOptions{}.ridge;
   int bins = 0;
+  int trees = ConditionalFitOptions{}.trees;
+  int depth = ConditionalFitOptions{}.depth;
+  double learning_rate = ConditionalFitOptions{}.learning_rate;
+  double min_child_weight = ConditionalFitOptions{}.min_child_weight;
+  std::string aft_distribution = ConditionalFitOptions{}.aft_distribution;
+  double aft_scale = ConditionalFitOptions{}.aft_scale;
 };
 
 // fit --conditional: every LOG is JSON Lines with features; the model file is written atomically.
@@ -97,6 +103,12 @@ void fit_conditional(const LogOptions& log, const ConditionalOptions& conditiona
   options.horizon = conditional.horizon;
   options.ridge = conditional.ridge;
   options.bins = conditional.bins;
+  options.trees = conditional.trees;
+  options.depth = conditional.depth;
+  options.learning_rate = conditional.learning_rate;
+  options.min_child_weight = conditional.min_child_weight;
+  options.aft_distribution = conditional.aft_distribution;
+  options.aft_scale = conditional.aft_scale;
   if (!conditional.domain.empty()) {
 #if ONTIME_WITH_DOMAINS
     options.feature_names = domains::domain_feature_names(conditional.domain);
@@ -165,9 +177,11 @@ void add_fit_command(CLI::App& app) {
   add_number_option(*command, "--laplace", options->laplace, "Laplace (add-alpha) smoothing of the estimates", 0.0);
   command->add_option("--name", options->name, "Instance name (default: the output file's stem)");
   command->add_option("--description", options->description, "Instance description");
+  std::string kinds;
+  for (const ConditionalModelKind& kind : conditional_model_kinds()) kinds += (kinds.empty() ? "" : ", ") + kind.name;
   command->add_option("--conditional", options->conditional.kind,
-                      "Fit a conditional time model of this kind (pooled, hazard) from logs with features, and "
-                      "write it to --output instead of an instance");
+                      "Fit a conditional time model of this kind (" + kinds +
+                          ") from logs with features, and write it to --output instead of an instance");
   command->add_option("--domain", options->conditional.domain,
                       "--conditional: the domain whose feature names the records carry (e.g. navigation)");
   add_number_option(*command, "--horizon", options->conditional.horizon,
@@ -177,6 +191,22 @@ void add_fit_command(CLI::App& app) {
                     "--conditional hazard: L2 penalty on the feature weights", 0.0);
   add_number_option(*command, "--bins", options->conditional.bins,
                     "--conditional hazard: baseline hazard levels (0: one per step)", 0, Problem::kMaxDeadline);
+  add_number_option(*command, "--trees", options->conditional.trees,
+                    "--conditional boosted: boosting rounds (the trees of each booster)", 1, 10000);
+  add_number_option(*command, "--depth", options->conditional.depth, "--conditional boosted: a tree's largest depth", 1,
+                    16);
+  add_number_option(*command, "--learning-rate", options->conditional.learning_rate,
+                    "--conditional boosted: the shrinkage of each tree (XGBoost's eta)", kPositive, 1.0);
+  add_number_option(*command, "--min-child-weight", options->conditional.min_child_weight,
+                    "--conditional boosted: the least hessian sum of a leaf", 0.0);
+  command
+      ->add_option("--aft-distribution", options->conditional.aft_distribution,
+                   "--conditional boosted: the law of log(planning time) of an attempt that finds (extreme: "
+                   "Weibull times)")
+      ->check(CLI::IsMember({"normal", "logistic", "extreme"}))
+      ->capture_default_str();
+  add_number_option(*command, "--aft-scale", options->conditional.aft_scale,
+                    "--conditional boosted: the scale of that law", kPositive, 100.0);
   command->add_flag("--json", options->json, "Print JSON");
   command->callback([options] {
     if (!options->conditional.kind.empty()) {

@@ -215,13 +215,17 @@ def fit(records_or_path: Union[PathLike, Iterable[Mapping[str, Any]]], *, step: 
 def fit_conditional(records_or_paths: Union[PathLike, Sequence[PathLike], Iterable[Mapping[str, Any]]], *,
                     step: float, kind: str = "hazard", domain: Optional[str] = None,
                     feature_names: Optional[Sequence[str]] = None, horizon: int = 0, ridge: float = 1e-3,
-                    bins: int = 0) -> "ConditionalTimeModel":
+                    bins: int = 0, trees: int = 100, depth: int = 3, learning_rate: float = 0.3,
+                    min_child_weight: float = 1.0, aft_distribution: str = "normal",
+                    aft_scale: float = 1.0) -> "ConditionalTimeModel":
     """A conditional time model (docs/learning.md), as `ontime fit --conditional KIND` fits it: from one or
     more planner logs (paths), or from records (dicts), whose every record carries `features` (`collect
     --features`). Times in steps of `step` seconds; `horizon` steps predicted (0: the longest planning time
     of the data). Feature names: the domain's (`domain="navigation"`), or `feature_names`, or f1, f2, ....
     kind "pooled" ignores the features (Kaplan-Meier over every record); "hazard" is the discrete-time
-    hazard model with a cure fraction (`ridge`, `bins`: conditional_model_kinds())."""
+    hazard model with a cure fraction (`ridge`, `bins`); "boosted" is XGBoost's gradient-boosted trees, a
+    cure fraction and an accelerated failure time fitted together to the censored times (`trees`, `depth`,
+    `learning_rate`, `min_child_weight`, `aft_distribution`, `aft_scale`): conditional_model_kinds()."""
     if domain is not None and feature_names is not None:
         raise UsageError("give domain or feature_names, not both")
     names = list(feature_names) if feature_names is not None else []
@@ -236,7 +240,9 @@ def fit_conditional(records_or_paths: Union[PathLike, Sequence[PathLike], Iterab
         items = list(records_or_paths)
         are_paths = bool(items) and all(isinstance(item, (str, os.PathLike)) for item in items)
         logs = [os.fspath(item) for item in items] if are_paths else [_records_text(items)]
-    return _ontime._fit_conditional(logs, are_paths, float(step), kind, names, int(horizon), float(ridge), int(bins))
+    return _ontime._fit_conditional(logs, are_paths, float(step), kind, names, int(horizon), float(ridge), int(bins),
+                                    int(trees), int(depth), float(learning_rate), float(min_child_weight),
+                                    str(aft_distribution), float(aft_scale))
 
 
 from . import env  # noqa: E402,F401  (ontime.env.EffortAllocationEnv)

@@ -48,10 +48,12 @@ void bind_conditional(py::module_& m) {
             if (features.ndim() == 1)
               return predicted_tuple(model.predict({features.data(), static_cast<std::size_t>(features.size())}));
             if (features.ndim() != 2) throw UsageError("features are one vector or a 2-D array of one row per action");
-            py::list rows;
+            // One batch (a boosted model answers it in one XGBoost call per booster).
+            const auto count = static_cast<std::size_t>(features.shape(0));
             const auto columns = static_cast<std::size_t>(features.shape(1));
-            for (py::ssize_t r = 0; r < features.shape(0); ++r) {
-              rows.append(predicted_tuple(model.predict({features.data(r, 0), columns})));
+            py::list rows;
+            for (const PredictedTimes& times : model.predict_rows({features.data(), count * columns}, count)) {
+              rows.append(predicted_tuple(times));
             }
             return rows;
           },
@@ -72,13 +74,22 @@ void bind_conditional(py::module_& m) {
       [](const std::vector<std::string>& logs, bool are_paths, Number<double, "step", 0.0> step,
          const std::string& kind, const std::vector<std::string>& feature_names,
          Number<Steps, "horizon", 0, Problem::kMaxDeadline> horizon, Number<double, "ridge", 0.0> ridge,
-         Number<int, "bins", 0, Problem::kMaxDeadline> bins) {
+         Number<int, "bins", 0, Problem::kMaxDeadline> bins, Number<int, "trees", 1, 10000> trees,
+         Number<int, "depth", 1, 16> depth, Number<double, "learning_rate", 0.0, 1.0> learning_rate,
+         Number<double, "min_child_weight", 0.0> min_child_weight, const std::string& aft_distribution,
+         Number<double, "aft_scale", 0.0, 100.0> aft_scale) {
         ConditionalFitOptions options;
         options.kind = kind;
         options.feature_names = feature_names;
         options.horizon = horizon;
         options.ridge = ridge;
         options.bins = bins;
+        options.trees = trees;
+        options.depth = depth;
+        options.learning_rate = learning_rate;
+        options.min_child_weight = min_child_weight;
+        options.aft_distribution = aft_distribution;
+        options.aft_scale = aft_scale;
         const py::gil_scoped_release release;
         const ConditionalData data =
             are_paths ? load_conditional_data(std::vector<std::filesystem::path>(logs.begin(), logs.end()), step)
@@ -86,7 +97,8 @@ void bind_conditional(py::module_& m) {
         return Model(fit_conditional_model(data, options));
       },
       py::arg("logs"), py::arg("are_paths"), py::arg("step"), py::arg("kind"), py::arg("feature_names"),
-      py::arg("horizon"), py::arg("ridge"), py::arg("bins"));
+      py::arg("horizon"), py::arg("ridge"), py::arg("bins"), py::arg("trees"), py::arg("depth"),
+      py::arg("learning_rate"), py::arg("min_child_weight"), py::arg("aft_distribution"), py::arg("aft_scale"));
 
   py::class_<PlanningPosterior>(
       m, "PlanningPosterior",

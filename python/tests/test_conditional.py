@@ -91,7 +91,51 @@ def test_bad_features_and_models_are_refused(corpus, tmp_path):
     bad.write_text(model.to_json().replace('"version": 1', '"version": 9'))
     with pytest.raises(ontime.InputError, match="version"):
         ontime.load_conditional_model(bad)
-    assert [kind["name"] for kind in ontime.conditional_model_kinds()] == ["pooled", "hazard"]
+    assert [kind["name"] for kind in ontime.conditional_model_kinds()] == ["pooled", "hazard", "boosted"]
+
+
+BOOSTED = {"trees": 20, "depth": 2, "learning_rate": 0.5, "min_child_weight": 2.0, "aft_distribution": "extreme",
+           "aft_scale": 0.8}
+
+
+def test_boosted_fits_the_clis_file_and_predicts_its_instance(corpus, cli):
+    folder, logs, unseen = corpus
+    model_file = folder / "boosted-model.json"
+    flags = [item for key, value in BOOSTED.items() for item in ("--" + key.replace("_", "-"), value)]
+    summary = cli("fit", *logs, "--conditional", "boosted", "--domain", "navigation", "--step", 3, *flags,
+                  "-o", model_file, "--json")
+    model = ontime.fit_conditional(logs, step=3.0, kind="boosted", domain="navigation", **BOOSTED)
+    assert model.to_json() == model_file.read_text()
+    assert model.kind == "boosted"
+    parameters = json.loads(model.to_json())["parameters"]
+    assert {key: parameters[key] for key in BOOSTED} == BOOSTED
+    # The summary leaves XGBoost's trees in the file.
+    assert set(summary["parameters"]) == set(parameters) - {"never_booster", "planning_booster", "execution_booster"}
+
+    instance_file = folder / "boosted-predicted.json"
+    cli("predict", "--domain", "navigation", "--world", unseen, "--model", model_file, "-o", instance_file, "--json")
+    problem = ontime.domains.predict(ontime.domains.load("navigation", unseen), ontime.load_conditional_model(model_file))
+    python_file = folder / "boosted-python-predicted.json"
+    problem.save(python_file)
+    assert json.loads(python_file.read_text()) == json.loads(instance_file.read_text())
+
+    # One row at a time or a 2-D array: the same distributions.
+    building = ontime.domains.load("navigation", unseen)
+    rows = np.array([ontime.domains.features(building, f"move({a},{b})") for a, b in (("R1", "R2"), ("R2", "R1"))])
+    planning, execution = model.predict(rows[1])
+    assert list(model.predict(rows)[1][0].pmf) == list(planning.pmf)
+    assert abs(planning.pmf.sum() + planning.never - 1) < 1e-9
+    assert abs(execution.pmf.sum() + execution.never - 1) < 1e-9
+
+
+def test_boosted_settings_out_of_range_are_refused(corpus):
+    _, logs, _ = corpus
+    for bad, rule in ((dict(aft_distribution="weibull"), "normal, logistic or extreme"), (dict(trees=0), "trees"),
+                      (dict(learning_rate=0.0), "learning_rate"), (dict(aft_scale=-1.0), "aft_scale")):
+        with pytest.raises(ontime.UsageError, match=rule):
+            ontime.fit_conditional(logs, step=3.0, kind="boosted", **bad)
+    names = [p["name"] for p in ontime.conditional_model_kinds()[2]["parameters"]]
+    assert names == list(BOOSTED)
 
 
 def test_the_online_update_follows_the_beta_stacy_algebra():

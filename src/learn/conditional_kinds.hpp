@@ -25,6 +25,7 @@ class ParameterReader {
  public:
   ParameterReader(const ModelJson& parameters, std::string source)
       : parameters_(parameters), source_(std::move(source)) {}
+  std::string text(const std::string& key) const;
   double real(const std::string& key) const;
   std::vector<double> reals(const std::string& key, std::size_t size) const;  // size 0: any length >= 1
   std::vector<int> whole_numbers(const std::string& key) const;
@@ -38,5 +39,6 @@ class ParameterReader {
 
 std::unique_ptr<ConditionalTimeModel> read_pooled_model(const ParameterReader& reader, ModelHeader header);
 std::unique_ptr<ConditionalTimeModel> read_hazard_model(const ParameterReader& reader, ModelHeader header);
+std::unique_ptr<ConditionalTimeModel> read_boosted_model(const ParameterReader& reader, ModelHeader header);
 
 }  // namespace ontime::detail

@@ -5,6 +5,7 @@
 #include <set>
 
 #include "learn/conditional_kinds.hpp"
+#include "ontime/learn/boosted_time_model.hpp"
 #include "ontime/learn/fitting.hpp"
 #include "ontime/learn/hazard_time_model.hpp"
 #include "ontime/learn/pooled_time_model.hpp"
@@ -90,6 +91,16 @@ const std::vector<ConditionalModelKind>& conditional_model_kinds() {
        "(execution) on the standardised features",
        {{"ridge", "0.001", "L2 penalty on the feature weights (>= 0)"},
         {"bins", "0", "baseline hazard levels over 1..horizon, log-spaced (0: one per step)"}}},
+      {BoostedTimeModel::kind_name(),
+       "Gradient-boosted trees (XGBoost): a cure fraction and an accelerated failure time fitted together to the "
+       "right-censored planning times, and a log-normal execution time with a boosted location",
+       {{"trees", "100", "boosting rounds: the trees of each booster (1 to 10000)"},
+        {"depth", "3", "a tree's largest depth (1 to 16)"},
+        {"learning_rate", "0.3", "the shrinkage of each tree, XGBoost's eta (in (0, 1])"},
+        {"min_child_weight", "1", "the least hessian sum of a leaf (>= 0)"},
+        {"aft_distribution", "normal",
+         "the law of log(planning time) of an attempt that finds: normal, logistic or extreme (Weibull times)"},
+        {"aft_scale", "1", "the scale of that law (> 0, at most 100)"}}},
   };
   return kinds;
 }
@@ -102,7 +113,7 @@ ConditionalTimeModel::ConditionalTimeModel(std::vector<std::string> feature_name
       training_rows_(training_rows),
       training_worlds_(training_worlds) {}
 
-PredictedTimes ConditionalTimeModel::predict(std::span<const double> features) const {
+void ConditionalTimeModel::check_features(std::span<const double> features) const {
   if (features.size() != feature_count()) {
     throw UsageError("the " + kind() + " model takes " + std::to_string(feature_count()) + " features, got " +
                      std::to_string(features.size()));
@@ -112,7 +123,36 @@ PredictedTimes ConditionalTimeModel::predict(std::span<const double> features) c
       throw UsageError("feature " + std::to_string(i + 1) + " (" + feature_names_[i] + ") is not a finite number");
     }
   }
+}
+
+PredictedTimes ConditionalTimeModel::predict(std::span<const double> features) const {
+  check_features(features);
   return predict_checked(features);
+}
+
+std::vector<PredictedTimes> ConditionalTimeModel::predict_rows(std::span<const double> rows, std::size_t count) const {
+  if (rows.size() != count * feature_count()) {
+    throw UsageError(std::to_string(count) + " rows of the " + kind() + " model's " + std::to_string(feature_count()) +
+                     " features are " + std::to_string(count * feature_count()) + " numbers, got " +
+                     std::to_string(rows.size()));
+  }
+  for (std::size_t r = 0; r < count; ++r) {
+    try {
+      check_features(rows.subspan(r * feature_count(), feature_count()));
+    } catch (const UsageError& error) {
+      throw UsageError("row " + std::to_string(r + 1) + ": " + error.what());
+    }
+  }
+  return count == 0 ? std::vector<PredictedTimes>{} : predict_rows_checked(rows, count);
+}
+
+std::vector<PredictedTimes> ConditionalTimeModel::predict_rows_checked(std::span<const double> rows,
+                                                                       std::size_t count) const {
+  std::vector<PredictedTimes> out;
+  out.reserve(count);
+  for (std::size_t r = 0; r < count; ++r)
+    out.push_back(predict_checked(rows.subspan(r * feature_count(), feature_count())));
+  return out;
 }
 
 std::string ConditionalTimeModel::to_json() const {
@@ -155,6 +195,16 @@ std::unique_ptr<ConditionalTimeModel> fit_conditional_model(const ConditionalDat
     }
     return HazardTimeModel::fit(data, std::move(names), horizon, options.ridge, options.bins);
   }
+  if (options.kind == BoostedTimeModel::kind_name()) {
+    BoostedSettings settings;
+    settings.trees = options.trees;
+    settings.depth = options.depth;
+    settings.learning_rate = options.learning_rate;
+    settings.min_child_weight = options.min_child_weight;
+    settings.aft_distribution = options.aft_distribution;
+    settings.aft_scale = options.aft_scale;
+    return BoostedTimeModel::fit(data, std::move(names), horizon, settings);
+  }
   std::vector<std::string> known;
   for (const ConditionalModelKind& kind : conditional_model_kinds()) known.push_back(kind.name);
   throw unknown_name_error("conditional model kind", options.kind, known);
@@ -171,6 +221,12 @@ const ModelJson& ParameterReader::at(const std::string& key) const {
 
 void ParameterReader::fail(const std::string& key, const std::string& rule) const {
   throw InputError(source_, "parameters." + key, rule);
+}
+
+std::string ParameterReader::text(const std::string& key) const {
+  const ModelJson& value = at(key);
+  if (!value.is_string()) fail(key, "must be a string");
+  return value.get<std::string>();
 }
 
 double ParameterReader::real(const std::string& key) const {
@@ -250,6 +306,7 @@ std::unique_ptr<ConditionalTimeModel> parse_conditional_model(std::string_view t
   const std::string kind = json.contains("kind") && json["kind"].is_string() ? json["kind"].get<std::string>() : "";
   if (kind == PooledTimeModel::kind_name()) return detail::read_pooled_model(reader, std::move(header));
   if (kind == HazardTimeModel::kind_name()) return detail::read_hazard_model(reader, std::move(header));
+  if (kind == BoostedTimeModel::kind_name()) return detail::read_boosted_model(reader, std::move(header));
   std::string known;
   for (const ConditionalModelKind& k : conditional_model_kinds()) known += (known.empty() ? "" : ", ") + k.name;
   throw InputError(name, "kind", "unknown kind '" + kind + "' (known: " + known + ")");
@@ -271,17 +328,25 @@ Problem predict_problem(const ConditionalTimeModel& model, std::span<const Actio
     if (masses.size() > static_cast<std::size_t>(deadline) + 1) masses.resize(static_cast<std::size_t>(deadline) + 1);
     return Distribution::from_pmf(std::move(masses));
   };
+  // The distinct actions (the first of each id), checked one by one (an error names the action),
+  // then predicted in one call.
   std::map<std::string, int> index_of;
-  std::vector<Action> predicted;
+  std::vector<const ActionFeatures*> distinct;
+  std::vector<double> rows;
   for (const ActionFeatures& action : actions) {
-    if (!index_of.emplace(action.id, static_cast<int>(predicted.size())).second) continue;
-    PredictedTimes times;
+    if (!index_of.emplace(action.id, static_cast<int>(distinct.size())).second) continue;
     try {
-      times = model.predict(action.features);
+      model.check_features(action.features);
     } catch (const UsageError& error) {
       throw UsageError(action.id + ": " + error.what());
     }
-    predicted.push_back(Action{action.id, truncated(times.planning), truncated(times.execution)});
+    distinct.push_back(&action);
+    rows.insert(rows.end(), action.features.begin(), action.features.end());
+  }
+  const std::vector<PredictedTimes> times = model.predict_rows(rows, distinct.size());
+  std::vector<Action> predicted;
+  for (std::size_t a = 0; a < distinct.size(); ++a) {
+    predicted.push_back(Action{distinct[a]->id, truncated(times[a].planning), truncated(times[a].execution)});
   }
   std::vector<std::vector<int>> indices;
   if (skeletons.empty()) {

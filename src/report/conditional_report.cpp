@@ -30,7 +30,11 @@ std::string conditional_fit_json(const ConditionalTimeModel& model, const Condit
   out["worlds"] = std::set<std::string>(data.worlds.begin(), data.worlds.end()).size();
   out["found"] = found_share(data);
   if (!output.empty()) out["model"] = output;
-  out["parameters"] = file["parameters"];
+  // (The boosted kind's trees, XGBoost's model texts, stay in the model file.)
+  out["parameters"] = Json::object();
+  for (const auto& [key, value] : file["parameters"].items()) {
+    if (!key.ends_with("_booster")) out["parameters"][key] = value;
+  }
   return out.dump();
 }
 
@@ -43,9 +47,12 @@ std::string conditional_fit_text(const ConditionalTimeModel& model, const Condit
       std::set<std::string>(data.worlds.begin(), data.worlds.end()).size(), 100 * found_share(data),
       model.feature_count(), model.horizon(), model.step_seconds());
   const Json parameters = Json::parse(model.to_json())["parameters"];
-  if (parameters.contains("log_likelihood")) {
+  if (parameters.contains("log_likelihood") && parameters.contains("evaluations")) {
     text += fmt::format("Planning log-likelihood per record at the optimum: {:.6f} ({} evaluations).\n",
                         parameters["log_likelihood"].get<double>(), parameters["evaluations"].get<int>());
+  } else if (parameters.contains("log_likelihood") && parameters.contains("trees")) {
+    text += fmt::format("Planning log-likelihood per record after {} rounds of trees: {:.6f}.\n",
+                        parameters["trees"].get<int>(), parameters["log_likelihood"].get<double>());
   }
   return text;
 }

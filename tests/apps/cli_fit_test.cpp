@@ -14,6 +14,7 @@
 
 #include "apps/cli_test_support.hpp"
 #include "ontime/model/instance_io.hpp"
+#include "ontime/util/random.hpp"
 #include "support/bad_logs.hpp"
 #include "support/bad_ompl_logs.hpp"
 
@@ -223,6 +224,65 @@ TEST(Cli, ALaplaceAlphaThatSwampsTheLogIsAUsageError) {
   EXPECT_NE(fitted.err.find("laplace: the Laplace smoothing alpha must be between 0 and 1e+06"), std::string::npos)
       << fitted.err;
   EXPECT_FALSE(std::filesystem::exists(directory / "fit.json"));
+}
+
+// A corpus of 3,000 attempts whose planning time and share found depend on three features (one
+// of them without effect), cut off after 12 s: `fit --conditional boosted` writes the same model
+// file whichever build of libm's exp and log glibc picks for the CPU (with and without FMA and
+// AVX2, and SSE2 alone), and sums it up without XGBoost's trees.
+TEST(Cli, BoostedFitGivesTheSameBytesWhicheverLibmGlibcPicks) {
+  const auto directory = scratch("boosted");
+  const std::string log = (directory / "corpus.jsonl").string();
+  {
+    std::ofstream out(log);
+    SplitMix64 random(9);
+    for (int i = 0; i < 3000; ++i) {
+      const double width = 0.6 + 0.8 * uniform01(random), clutter = uniform01(random), noise = uniform01(random);
+      const double hazard = 0.05 + 0.4 * (width - 0.6) * (1 - 0.5 * clutter);
+      // Found within the step of `seconds` (a geometric number of steps), unless never or later
+      // than 12 s.
+      bool found = uniform01(random) > 0.1 + 0.3 * clutter;
+      double seconds = 0.5;
+      while (found && seconds < 12 && uniform01(random) > hazard) seconds += 1;
+      found = found && seconds < 12;
+      json record{{"action", "move"},
+                  {"world", std::string{'w', static_cast<char>('0' + i % 7)}},
+                  {"planning_seconds", found ? seconds : 12.0},
+                  {"found", found},
+                  {"features", {width, clutter, noise}}};
+      const double execution = 2 + 3 * uniform01(random) + 2 * clutter;
+      if (found) record["execution_seconds"] = execution;
+      out << record.dump() << "\n";
+    }
+  }
+  std::vector<std::string> models;
+  for (const char* tunables : {"glibc.cpu.hwcaps=", "glibc.cpu.hwcaps=-AVX2,-FMA,-AVX",
+                               "glibc.cpu.hwcaps=-AVX512F,-AVX2,-FMA,-AVX,-SSE4_1,-SSE4_2"}) {
+    const auto model = directory / ("model" + std::to_string(models.size()) + ".json");
+    const auto fitted = testing::run_process({"/usr/bin/env", std::string("GLIBC_TUNABLES=") + tunables, ONTIME_CLI,
+                                              "fit", log, "--conditional", "boosted", "--step", "1",
+                                              "--aft-distribution", "logistic", "--json", "-o", model.string()});
+    ASSERT_EQ(fitted.exit_code, 0) << tunables << ": " << fitted.err;
+    const json summary = json::parse(fitted.out);
+    EXPECT_EQ(summary["kind"], "boosted");
+    EXPECT_EQ(summary["horizon"], 12);
+    EXPECT_EQ(summary["worlds"], 7);
+    EXPECT_EQ(summary["parameters"]["trees"], 100);
+    EXPECT_FALSE(summary["parameters"].contains("never_booster"));
+    models.push_back(read_file(model));
+  }
+  EXPECT_TRUE(models[1] == models[0]);
+  EXPECT_TRUE(models[2] == models[0]);
+  // Its text summary, and a law it does not know.
+  const auto text = ontime({"fit", log, "--conditional", "boosted", "--step", "1", "--trees", "10", "-o",
+                            (directory / "ten.json").string()});
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("Planning log-likelihood per record after 10 rounds of trees: -"), std::string::npos)
+      << text.out;
+  const auto refused = ontime({"fit", log, "--conditional", "boosted", "--step", "1", "--aft-distribution", "weibull",
+                               "-o", (directory / "refused.json").string()});
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_FALSE(std::filesystem::exists(directory / "refused.json"));
 }
 
 }  // namespace

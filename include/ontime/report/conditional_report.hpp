@@ -12,7 +12,8 @@
 namespace ontime::report {
 
 // JSON object: kind, feature_names, step_seconds, horizon, rows, worlds, found (share of rows),
-// model (the output path, when given), parameters (the kind's members of the model file).
+// model (the output path, when given), parameters (the kind's members of the model file, but for
+// the boosted kind's boosters).
 std::string conditional_fit_json(const ConditionalTimeModel& model, const ConditionalData& data,
                                  const std::string& output);
 std::string conditional_fit_text(const ConditionalTimeModel& model, const ConditionalData& data,
