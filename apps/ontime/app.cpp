@@ -76,6 +76,8 @@ std::unique_ptr<CLI::App> make_app() {
   add_reduce_knapsack_command(*app);
   add_fit_command(*app);
   add_score_command(*app);
+  add_adapt_command(*app);
+  add_fit_strength_command(*app);
   add_sample_log_command(*app);
   add_plot_command(*app);
 #if ONTIME_WITH_DOMAINS

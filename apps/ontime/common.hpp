@@ -34,6 +34,8 @@ void add_collect_command(CLI::App& app);
 void add_map_command(CLI::App& app);
 void add_predict_command(CLI::App& app);
 void add_score_command(CLI::App& app);
+void add_adapt_command(CLI::App& app);
+void add_fit_strength_command(CLI::App& app);
 void add_generate_world_command(CLI::App& app);
 void add_run_command(CLI::App& app);
 void add_tamp_command(CLI::App& app);

@@ -13,6 +13,7 @@
 #include "ontime/learn/conditional_model.hpp"
 #include "ontime/learn/fitting.hpp"
 #include "ontime/learn/log_sampling.hpp"
+#include "ontime/learn/online_adaptation.hpp"
 #include "ontime/learn/online_update.hpp"
 #include "ontime/learn/ppo_training.hpp"
 #include "ontime/model/planner_log.hpp"
@@ -124,6 +125,36 @@ void bind_conditional(py::module_& m) {
         return Model(load_conditional_model(std::string(py::str(py::module_::import("os").attr("fspath")(path)))));
       },
       py::arg("path"), "Reads a model file (`ontime fit --conditional`); InputError names the place and rule.");
+
+  m.def(
+      "fit_strength",
+      [](const Model& model, const std::vector<py::object>& logs, const std::vector<double>& strengths) {
+        if (logs.empty()) throw UsageError("logs: give at least one planner log");
+        std::vector<std::filesystem::path> paths;
+        for (const py::object& log : logs) {
+          paths.emplace_back(std::string(py::str(py::module_::import("os").attr("fspath")(log))));
+        }
+        std::vector<StrengthScore> scores;
+        std::size_t attempts = 0;
+        {
+          const py::gil_scoped_release release;
+          const ConditionalData data = load_conditional_data(paths, model->step_seconds());
+          attempts = data.rows();
+          scores = score_prior_strengths(*model, data, strengths);
+        }
+        py::list list;
+        const StrengthScore* best = &scores.front();
+        for (const StrengthScore& score : scores) {
+          list.append(py::dict(py::arg("strength") = score.strength, py::arg("nll") = score.nll));
+          if (score.nll < best->nll) best = &score;
+        }
+        return py::dict(py::arg("attempts") = attempts, py::arg("scores") = list, py::arg("best") = best->strength);
+      },
+      py::arg("model"), py::arg("logs"), py::kw_only(),
+      py::arg("strengths") = std::vector<double>{0.5, 1, 2, 5, 10, 20, 50, 100, 200},
+      "`ontime fit-strength`: the prequential log score of each prior strength on logs of worlds the model was "
+      "not fitted on (each attempt scored by the posterior before it is seen); returns attempts, scores "
+      "(strength, nll) and the best strength.");
 
   m.def(
       "conditional_model_kinds",

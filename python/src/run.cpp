@@ -10,6 +10,7 @@
 
 #include "bindings.hpp"
 #include "ontime/allocators/optimal.hpp"
+#include "ontime/learn/online_adaptation.hpp"
 #include "ontime/report/report.hpp"
 #include "ontime/run/episode_runner.hpp"
 #include "ontime/run/evaluation.hpp"
@@ -316,6 +317,55 @@ void bind_run(py::module_& m) {
       "id) while the episodes and the exact value are drawn from `problem` (`ontime evaluate --belief`). "
       "Parameters of the allocator as keyword arguments. The GIL is released; Ctrl-C stops it "
       "(KeyboardInterrupt).");
+
+  m.def(
+      "adapt",
+      [](const py::object& problem, const py::object& belief, const std::string& solver,
+         Number<double, "strength", 1e-9, 1e9> strength, Number<std::uint64_t, "episodes", 1, 100'000> episodes,
+         Number<std::uint64_t, "sequences", 1, 10'000'000> sequences, Seed seed, Threads threads, bool exact,
+         const py::kwargs& kwargs) {
+        const std::shared_ptr<MdpHandle> truth = to_mdp(problem);
+        const std::shared_ptr<MdpHandle> prior = to_mdp(belief);
+        AdaptationOptions options;
+        options.solver = solver;
+        options.parameters = parameter_values(kwargs);
+        options.strength = strength;
+        options.episodes = episodes;
+        options.sequences = sequences;
+        options.seed = seed;
+        options.threads = threads;
+        options.exact = exact;
+        options.max_states = max_states_of(options.parameters);
+        AdaptationResult result;
+        {
+          const py::gil_scoped_release release;
+          result = run_adaptation(*truth->problem, *prior->problem, options);
+        }
+        py::list rates;
+        for (const std::uint64_t s : result.successes) {
+          rates.append(static_cast<double>(s) / static_cast<double>(result.sequences));
+        }
+        py::dict out;
+        out["instance"] = instance_label(problem, *truth->problem);
+        out["belief"] = instance_label(belief, *prior->problem);
+        out["solver"] = solver;
+        out["strength"] = options.strength;
+        out["episodes"] = options.episodes;
+        out["sequences"] = options.sequences;
+        out["seed"] = options.seed;
+        out["successes"] = result.successes;
+        out["success_rate"] = rates;
+        if (exact) out["exact_success_probability"] = result.exact;
+        return out;
+      },
+      py::arg("problem"), py::arg("belief"), py::arg("solver") = "dp-rerun", py::kw_only(),
+      py::arg("strength") = AdaptationOptions{}.strength, py::arg("episodes") = AdaptationOptions{}.episodes,
+      py::arg("sequences") = AdaptationOptions{}.sequences, py::arg("seed") = 1, py::arg("threads") = 0,
+      py::arg("exact") = true,
+      "`ontime adapt`: `sequences` independent runs of `episodes` episodes in `problem` (the truth), the "
+      "allocator planning with `belief` (the prior) updated after every episode by the attempts made in it; "
+      "per episode the successes and the exact success probability of its plan in the truth, as the "
+      "command's --json fields. Allocator parameters as keyword arguments.");
 
   m.def(
       "table",

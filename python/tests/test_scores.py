@@ -57,3 +57,36 @@ def test_evaluate_with_a_belief_matches_the_command_line(source_dir, tmp_path, c
     out = cli("evaluate", truth, "--belief", belief, "--solver", "dp-rerun", "--episodes", 300, "--exact", "--json")
     assert out["exact_success_probability"] == believing["exact_success_probability"]
     assert out["successes"] == believing["successes"]
+
+
+def test_adapt_and_fit_strength_match_the_command_line(source_dir, tmp_path, cli):
+    truth = source_dir / "data/instances/paper/instance4.json"
+    data = json.loads(truth.read_text())
+    data["actions"]["a1_1"]["planning"], data["actions"]["a2_1"]["planning"] = (
+        data["actions"]["a2_1"]["planning"], data["actions"]["a1_1"]["planning"])
+    prior = tmp_path / "prior.json"
+    prior.write_text(json.dumps(data))
+    adapted = ontime.adapt(str(truth), str(prior), "dp-rerun", strength=2, episodes=4, sequences=30)
+    out = cli("adapt", truth, "--belief", prior, "--solver", "dp-rerun", "--strength", 2, "--episodes", 4,
+              "--sequences", 30, "--json")
+    assert adapted == out
+    assert adapted["exact_success_probability"][-1] > adapted["exact_success_probability"][0]
+
+    def record(planning, found, world):
+        line = {"action": "a", "planning_seconds": planning, "found": found, "world": world, "features": [0]}
+        if found:
+            line["execution_seconds"] = 1
+        return json.dumps(line) + "\n"
+
+    train = tmp_path / "train.jsonl"
+    train.write_text(record(1, True, "t") + record(2, True, "t") + record(2, False, "t") + record(1, True, "t"))
+    unseen = tmp_path / "unseen.jsonl"
+    unseen.write_text(record(1, True, "v") + record(1, False, "v"))
+    model = ontime.fit_conditional([train], step=1.0, kind="pooled")
+    scores = ontime.fit_strength(model, [unseen], strengths=[1.0, 3.0])
+    assert scores["best"] == 3.0
+    for score in scores["scores"]:
+        s = score["strength"]
+        assert score["nll"] == pytest.approx(-(math.log(0.5) + math.log(s / 2 / (s + 1))) / 2, abs=1e-14)
+    with pytest.raises(ontime.UsageError):
+        ontime.fit_strength(model, [unseen], strengths=[0.0])

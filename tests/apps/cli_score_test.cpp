@@ -1,5 +1,6 @@
 // CLI tests of `score` (an instance's log and Brier scores on a planner log) and of `evaluate
-// --belief` (an allocator planning with other distributions, scored in the true instance).
+// --belief` (an allocator planning with other distributions, scored in the true instance), `adapt`
+// (episodes with the online update) and `fit-strength` (the prior strength on unseen logs).
 
 #include <gtest/gtest.h>
 
@@ -11,6 +12,7 @@
 
 #include "apps/cli_test_support.hpp"
 #include "ontime/allocators/dp_rerun.hpp"
+#include "ontime/learn/online_adaptation.hpp"
 #include "ontime/model/instance_io.hpp"
 #include "ontime/run/evaluation.hpp"
 #include "support/paper.hpp"
@@ -109,6 +111,74 @@ TEST(Cli, EvaluateWithABeliefPlansWithItAndScoresInTheInstance) {
                                "--solver", "dp-rerun", "--episodes", "10"});
   EXPECT_EQ(lacking.exit_code, 2);
   EXPECT_NE(lacking.err.find("lacking.json: no distributions for the action"), std::string::npos) << lacking.err;
+}
+
+TEST(Cli, AdaptRunsEpisodesWithTheUpdatedPriorAsTheLibraryDoes) {
+  const auto folder = scratch("adapt");
+  const Problem truth = testing::paper_instance("instance4");
+  std::vector<Action> actions(truth.actions().begin(), truth.actions().end());
+  std::swap(actions[static_cast<std::size_t>(truth.find_action("a1_1"))].planning,
+            actions[static_cast<std::size_t>(truth.find_action("a2_1"))].planning);
+  std::vector<std::vector<int>> skeletons;
+  for (int k = 0; k < truth.skeleton_count(); ++k) {
+    skeletons.emplace_back(truth.skeleton(k).begin(), truth.skeleton(k).end());
+  }
+  const Problem prior("prior", truth.deadline(), truth.step_seconds(), actions, skeletons);
+  save_problem(prior, folder / "prior.json");
+  const auto result = ontime({"adapt", paper("instance4"), "--belief", (folder / "prior.json").string(), "--solver",
+                              "dp-rerun", "--strength", "2", "--episodes", "4", "--sequences", "30", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const json out = json::parse(result.out);
+  AdaptationOptions options;
+  options.strength = 2;
+  options.episodes = 4;
+  options.sequences = 30;
+  const AdaptationResult expected = run_adaptation(truth, load_problem(folder / "prior.json"), options);
+  EXPECT_EQ(out["successes"].get<std::vector<std::uint64_t>>(), expected.successes);
+  EXPECT_EQ(out["exact_success_probability"].get<std::vector<double>>(), expected.exact);
+  EXPECT_EQ(out["success_rate"].size(), 4u);
+  // A prior of another deadline: exit 2 naming it, before any episode.
+  const auto other =
+      ontime({"adapt", paper("instance4"), "--belief", paper("instance1"), "--solver", "dp-rerun", "--episodes", "2"});
+  EXPECT_EQ(other.exit_code, 2);
+  EXPECT_NE(other.err.find("instance1.json: the deadlines differ"), std::string::npos) << other.err;
+}
+
+TEST(Cli, FitStrengthScoresEachStrengthOnUnseenLogs) {
+  const auto folder = scratch("fit_strength");
+  // Training: found at 1, at 2, cut off after 2, found at 1 (pooled p(1) = 1/2, p(2) = 1/4).
+  write_text(folder / "train.jsonl",
+             "{\"action\": \"a\", \"planning_seconds\": 1, \"found\": true, \"execution_seconds\": 1, "
+             "\"world\": \"t\", \"features\": [0]}\n"
+             "{\"action\": \"a\", \"planning_seconds\": 2, \"found\": true, \"execution_seconds\": 1, "
+             "\"world\": \"t\", \"features\": [0]}\n"
+             "{\"action\": \"a\", \"planning_seconds\": 2, \"found\": false, \"world\": \"t\", "
+             "\"features\": [0]}\n"
+             "{\"action\": \"a\", \"planning_seconds\": 1, \"found\": true, \"execution_seconds\": 1, "
+             "\"world\": \"t\", \"features\": [0]}\n");
+  write_text(folder / "unseen.jsonl",
+             "{\"action\": \"a\", \"planning_seconds\": 1, \"found\": true, \"execution_seconds\": 1, "
+             "\"world\": \"v\", \"features\": [0]}\n"
+             "{\"action\": \"a\", \"planning_seconds\": 1, \"found\": false, \"world\": \"v\", "
+             "\"features\": [0]}\n");
+  const auto fit = ontime({"fit", (folder / "train.jsonl").string(), "--conditional", "pooled", "--step", "1", "-o",
+                           (folder / "model.json").string()});
+  ASSERT_EQ(fit.exit_code, 0) << fit.err;
+  const auto result = ontime({"fit-strength", (folder / "unseen.jsonl").string(), "--model",
+                              (folder / "model.json").string(), "--strengths", "1,3", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const json out = json::parse(result.out);
+  ASSERT_EQ(out["scores"].size(), 2u);
+  // tests/learn/online_adaptation_test.cpp: -(log 1/2 + log((s/2) / (s + 1))) / 2.
+  for (const json& score : out["scores"]) {
+    const double s = score["strength"].get<double>();
+    EXPECT_NEAR(score["nll"].get<double>(), -(std::log(0.5) + std::log(s / 2 / (s + 1))) / 2, 1e-14);
+  }
+  EXPECT_EQ(out["best"].get<double>(), 3.0);  // (3/2)/4 = 0.375 foresees the cut-off better than (1/2)/2
+  EXPECT_EQ(ontime({"fit-strength", (folder / "unseen.jsonl").string(), "--model", (folder / "model.json").string(),
+                    "--strengths", "0"})
+                .exit_code,
+            2);
 }
 
 }  // namespace
