@@ -8,6 +8,7 @@
 #include "ontime/domains/library_messages.hpp"
 #include "ontime/domains/manipulation.hpp"
 #include "ontime/domains/manipulation_collision.hpp"
+#include "ontime/domains/manipulation_features.hpp"
 #include "ontime/domains/world_types.hpp"
 #include "ontime/util/random.hpp"
 
@@ -253,6 +254,12 @@ std::vector<std::array<double, 2>> ManipulationDomain::trace(const std::vector<C
 std::vector<std::array<double, 2>> ManipulationDomain::outline(const Configuration& configuration) const {
   const KitchenState at = state(configuration);
   return turned_rectangle(at.base.x, at.base.y, world_.robot.base_size[0], world_.robot.base_size[1], at.base.theta);
+}
+
+const std::vector<std::string>& ManipulationDomain::feature_names() const { return manipulation_feature_names(); }
+
+std::vector<double> ManipulationDomain::action_features(const std::string& action) const {
+  return manipulation_action_features(world_, action);
 }
 
 std::string ManipulationDomain::describe(const std::vector<std::string>& skeleton) const {

@@ -4,7 +4,6 @@
 #include <array>
 #include <charconv>
 #include <cmath>
-#include <limits>
 #include <map>
 #include <memory>
 #include <numbers>
@@ -20,11 +19,12 @@
 #include "ontime/util/atomic_file.hpp"
 #include "ontime/util/error.hpp"
 #include "ontime/util/random.hpp"
+#include "planar_geometry.hpp"
 
 namespace ontime::domains {
 namespace {
 
-using Point = std::array<double, 2>;
+using detail::Point;
 
 // The robot and the planner and collection settings of the office floor
 // (data/domains/navigation.json): the generated buildings are refined by the same robot with the
@@ -98,68 +98,9 @@ std::size_t below(SplitMix64& random, std::size_t count) {
   return std::min(count - 1, static_cast<std::size_t>(uniform01(random) * static_cast<double>(count)));
 }
 
-// ---- planar geometry of convex shapes given by their vertices: 1 (a point), 2 (a segment) or
-// more (a convex polygon).
+using detail::convex_distance;
 
-double cross(const Point& o, const Point& a, const Point& b) {
-  return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
-}
-
-double point_segment_distance(const Point& p, const Point& a, const Point& b) {
-  const double dx = b[0] - a[0], dy = b[1] - a[1];
-  const double length2 = dx * dx + dy * dy;
-  const double t = length2 == 0 ? 0 : std::clamp(((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / length2, 0.0, 1.0);
-  return std::hypot(p[0] - (a[0] + t * dx), p[1] - (a[1] + t * dy));
-}
-
-bool segments_cross(const Point& a, const Point& b, const Point& c, const Point& d) {
-  const double d1 = cross(c, d, a), d2 = cross(c, d, b), d3 = cross(a, b, c), d4 = cross(a, b, d);
-  return ((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0)) && d1 != 0 && d2 != 0 && d3 != 0 && d4 != 0;
-}
-
-bool inside_convex(const Point& p, const std::vector<Point>& polygon) {
-  if (polygon.size() < 3) return false;
-  bool positive = false, negative = false;
-  for (std::size_t i = 0; i < polygon.size(); ++i) {
-    const double side = cross(polygon[i], polygon[(i + 1) % polygon.size()], p);
-    positive = positive || side > 0;
-    negative = negative || side < 0;
-  }
-  return !(positive && negative);
-}
-
-std::vector<std::array<Point, 2>> edges(const std::vector<Point>& shape) {
-  std::vector<std::array<Point, 2>> result;
-  if (shape.size() == 1) return {{shape[0], shape[0]}};
-  if (shape.size() == 2) return {{shape[0], shape[1]}};
-  for (std::size_t i = 0; i < shape.size(); ++i) result.push_back({shape[i], shape[(i + 1) % shape.size()]});
-  return result;
-}
-
-// The distance between two convex shapes: 0 when they overlap.
-double distance(const std::vector<Point>& a, const std::vector<Point>& b) {
-  for (const Point& p : a) {
-    if (inside_convex(p, b)) return 0;
-  }
-  for (const Point& p : b) {
-    if (inside_convex(p, a)) return 0;
-  }
-  const auto a_edges = edges(a), b_edges = edges(b);
-  double nearest = std::numeric_limits<double>::infinity();
-  for (const auto& e : a_edges) {
-    for (const auto& f : b_edges) {
-      if (segments_cross(e[0], e[1], f[0], f[1])) return 0;
-      nearest = std::min({nearest, point_segment_distance(e[0], f[0], f[1]), point_segment_distance(e[1], f[0], f[1]),
-                          point_segment_distance(f[0], e[0], e[1]), point_segment_distance(f[1], e[0], e[1])});
-    }
-  }
-  return nearest;
-}
-
-std::vector<Point> corners(const Rectangle& rectangle) {
-  const auto four = rectangle.corners();
-  return {four.begin(), four.end()};
-}
+std::vector<Point> corners(const Rectangle& rectangle) { return detail::rectangle_corners(rectangle); }
 
 // ---- the building
 
@@ -346,10 +287,10 @@ class Generator {
       }
     }
     for (const ClearZone& zone : zones) {
-      if (distance(outline, zone.shape) < zone.radius) return false;
+      if (convex_distance(outline, zone.shape) < zone.radius) return false;
     }
     for (const Piece& piece : placed) {
-      if (distance(outline, corners(piece.shape)) < kFurnitureGap) return false;
+      if (convex_distance(outline, corners(piece.shape)) < kFurnitureGap) return false;
     }
     return true;
   }

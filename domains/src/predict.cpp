@@ -30,6 +30,11 @@ Problem predict_instance(const Domain& domain, const DomainDefaults& defaults, c
     for (const auto& skeleton : skeletons) ids.insert(ids.end(), skeleton.begin(), skeleton.end());
   } else {
     for (const StandaloneAction& action : domain.every_action()) ids.push_back(action.action);
+    if (ids.empty()) {
+      throw UsageError("the " + domain.name() +
+                       " domain cannot list every action it refines: predict the world's skeletons instead (without "
+                       "--library)");
+    }
   }
   std::vector<ActionFeatures> actions;
   actions.reserve(ids.size());

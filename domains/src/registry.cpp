@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "ontime/domains/manipulation.hpp"
+#include "ontime/domains/manipulation_features.hpp"
 #include "ontime/domains/navigation.hpp"
 #include "ontime/domains/navigation_features.hpp"
 #include "ontime/util/error.hpp"
@@ -30,7 +31,7 @@ std::vector<std::string> domain_names() { return {"navigation", "manipulation"};
 
 std::vector<std::string> domain_feature_names(std::string_view name) {
   if (name == "navigation") return navigation_feature_names();
-  if (name == "manipulation") throw UsageError("the manipulation domain has no features for conditional time models");
+  if (name == "manipulation") return manipulation_feature_names();
   throw unknown_name_error("domain", name, domain_names());
 }
 

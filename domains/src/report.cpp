@@ -172,6 +172,29 @@ std::string to_text(const GeneratedWorld& world) {
                      world.rooms, world.doors, world.furniture, world.start_room, world.goal_room);
 }
 
+std::string to_json(const GeneratedKitchen& kitchen) {
+  Json out;
+  out["output"] = kitchen.output;
+  out["name"] = kitchen.name;
+  out["tables"] = kitchen.tables;
+  out["regions"] = kitchen.regions;
+  out["objects"] = kitchen.objects;
+  out["skeletons"] = kitchen.skeletons;
+  out["actions"] = kitchen.actions;
+  Json goal = Json::object();
+  for (const auto& [object, region] : kitchen.goal) goal[object] = region;
+  out["goal"] = goal;
+  return dump(out);
+}
+
+std::string to_text(const GeneratedKitchen& kitchen) {
+  std::string goal;
+  for (const auto& [object, region] : kitchen.goal) goal += (goal.empty() ? "" : ", ") + object + " to " + region;
+  return fmt::format("Wrote {}: {} tables, {} regions, {} objects; goal {}; {} skeletons of {} actions.\n",
+                     kitchen.output, kitchen.tables, kitchen.regions, kitchen.objects, goal, kitchen.skeletons,
+                     kitchen.actions);
+}
+
 std::string to_json(const Tamp& tamp) {
   const TampOptions& options = *tamp.options;
   const TampResult& result = *tamp.result;

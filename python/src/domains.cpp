@@ -18,6 +18,7 @@
 #include "ontime/domains/collect_and_fit.hpp"
 #include "ontime/domains/collection.hpp"
 #include "ontime/domains/drawing.hpp"
+#include "ontime/domains/manipulation_generator.hpp"
 #include "ontime/domains/navigation_generator.hpp"
 #include "ontime/domains/planner_run.hpp"
 #include "ontime/domains/predict.hpp"
@@ -411,6 +412,53 @@ void bind_domains(py::module_& m) {
       "`ontime generate-world`: writes a generated navigation world (an office building of rows x cols rooms) "
       "to `output` and returns what it holds (the fields of `ontime generate-world --json`). Same options, same "
       "seed: the same file.");
+
+  m.def(
+      "generate_kitchen",
+      [](const py::object& output, Number<int, "tables", 1, domains::kMaxKitchenTables> tables,
+         Number<int, "regions", 1, domains::kMaxKitchenRegions> regions,
+         Number<double, "region_min", domains::kMinKitchenRegionSide, domains::kMaxKitchenRegionSide> region_min,
+         Number<double, "region_max", domains::kMinKitchenRegionSide, domains::kMaxKitchenRegionSide> region_max,
+         Number<int, "targets", 1, domains::kMaxKitchenTargets> targets,
+         Number<int, "min_objects", 1, domains::kMaxKitchenObjects> min_objects,
+         Number<int, "max_objects", 1, domains::kMaxKitchenObjects> max_objects,
+         Number<int, "min_clutter", 0, domains::kMaxKitchenClutter> min_clutter,
+         Number<int, "max_clutter", 0, domains::kMaxKitchenClutter> max_clutter,
+         const std::vector<std::string>& classes, Seed seed, const std::optional<std::string>& name) {
+        domains::KitchenOptions options;
+        options.tables = tables;
+        options.regions = regions;
+        options.region_min = region_min;
+        options.region_max = region_max;
+        options.targets = targets;
+        options.min_objects = min_objects;
+        options.max_objects = max_objects;
+        options.min_clutter = min_clutter;
+        options.max_clutter = max_clutter;
+        options.classes = classes;
+        if (name) options.name = *name;
+        const std::string path = path_text(output);
+        domains::GeneratedKitchen kitchen;
+        {
+          const py::gil_scoped_release release;
+          kitchen = domains::write_generated_kitchen(options, seed, path, python_spelling());
+        }
+        return json_object(domains::report::to_json(kitchen));
+      },
+      py::arg("output"), py::kw_only(), py::arg("tables") = domains::KitchenOptions{}.tables,
+      py::arg("regions") = domains::KitchenOptions{}.regions,
+      py::arg("region_min") = domains::KitchenOptions{}.region_min,
+      py::arg("region_max") = domains::KitchenOptions{}.region_max,
+      py::arg("targets") = domains::KitchenOptions{}.targets,
+      py::arg("min_objects") = domains::KitchenOptions{}.min_objects,
+      py::arg("max_objects") = domains::KitchenOptions{}.max_objects,
+      py::arg("min_clutter") = domains::KitchenOptions{}.min_clutter,
+      py::arg("max_clutter") = domains::KitchenOptions{}.max_clutter,
+      py::arg("classes") = domains::KitchenOptions{}.classes, py::arg("seed") = 1, py::arg("name") = py::none(),
+      "`ontime generate-world --domain manipulation` (ontime.domains.generate_world(..., domain='manipulation')): "
+      "writes a generated kitchen (a table scene with its goal and skeletons) to `output` and returns what it "
+      "holds (the fields of `ontime generate-world --domain manipulation --json`). Same options, same seed: the "
+      "same file.");
 }
 
 #else

@@ -149,3 +149,29 @@ def test_the_online_update_follows_the_beta_stacy_algebra():
     assert posterior.observations == 1
     with pytest.raises(ontime.UsageError):
         ontime.PlanningPosterior(mean, 2, 0.0)
+
+
+def test_the_kitchen_family_fits_and_predicts(tmp_path, cli):
+    """Generated kitchens collected with features, a pooled model over them, the instance of a kitchen
+    none of them is: the same from Python as from the command line."""
+    logs = []
+    for seed in (1, 2, 3):
+        ontime.domains.generate_world(tmp_path / f"k{seed}.json", domain="manipulation", targets=1, min_objects=2,
+                                      max_objects=3, min_clutter=1, max_clutter=1, seed=seed)
+    for seed in (1, 2):
+        kitchen = ontime.domains.load("manipulation", tmp_path / f"k{seed}.json")
+        records = ontime.domains.collect(kitchen, trials=2, threads=2, budget_steps=3, features=True)
+        assert records[0]["features"] == list(ontime.domains.features(kitchen, records[0]["action"]))
+        log = tmp_path / f"k{seed}.jsonl"
+        ontime.write_planner_log(records, log)
+        logs.append(log)
+    assert ontime.domains.feature_names("manipulation")[0] == "is_place"
+    model = ontime.fit_conditional(logs, step=7.0, kind="pooled", domain="manipulation")
+    model_file = tmp_path / "model.json"
+    cli("fit", *logs, "--conditional", "pooled", "--domain", "manipulation", "--step", 7, "-o", model_file, "--json")
+    assert model.to_json() == model_file.read_text()
+    unseen = ontime.domains.load("manipulation", tmp_path / "k3.json")
+    problem = ontime.domains.predict(unseen, model)
+    assert len(problem.skeletons) == len(unseen.skeletons)
+    with pytest.raises(ontime.UsageError, match="is not move\\+pick"):
+        ontime.domains.features(unseen, "move+pick(nothing)")

@@ -88,6 +88,27 @@ def test_generate_world_writes_the_clis_file(cli, tmp_path):
     assert not (tmp_path / "never.json").exists()
 
 
+def test_generate_world_writes_the_clis_kitchen(cli, tmp_path):
+    expected = cli("generate-world", "--domain", "manipulation", "--tables", 3, "--targets", 1, "--min-objects", 3,
+                   "--max-objects", 4, "--classes", "cup,bottle", "--seed", 4, "-o", tmp_path / "cli.json", "--json")
+    got = ontime.domains.generate_world(tmp_path / "python.json", domain="manipulation", tables=3, targets=1,
+                                        min_objects=3, max_objects=4, classes=["cup", "bottle"], seed=4)
+    assert (tmp_path / "python.json").read_bytes() == (tmp_path / "cli.json").read_bytes()
+    assert without(got, "output") == without(expected, "output")
+    assert (got["name"], got["tables"], len(got["goal"])) == ("kitchen", 3, 1)
+    kitchen = ontime.domains.load("manipulation", tmp_path / "python.json")
+    assert len(kitchen.skeletons) == got["skeletons"]
+    with pytest.raises(ontime.UsageError, match=r"^min_objects \(5\) must not exceed max_objects \(4\)$"):
+        ontime.domains.generate_world(tmp_path / "never.json", domain="manipulation", min_objects=5, max_objects=4)
+    with pytest.raises(ontime.UsageError, match="parameter 'tables'"):
+        ontime.domains.generate_world(tmp_path / "never.json", domain="manipulation", tables=0)
+    with pytest.raises(ontime.UsageError, match="rows is not an option of the manipulation generator"):
+        ontime.domains.generate_world(tmp_path / "never.json", domain="manipulation", rows=3)
+    with pytest.raises(ontime.UsageError, match="domain must be 'navigation' or 'manipulation'"):
+        ontime.domains.generate_world(tmp_path / "never.json", domain="garden")
+    assert not (tmp_path / "never.json").exists()
+
+
 def test_run_matches_the_cli(cli):
     expected = cli("run", "--domain", "navigation", "--world", NAVIGATION, "--instance", NAVIGATION_MODEL, "--solver",
                    "dp-rerun", "--episodes", 4, "--threads", 2, "--seed", 3, "--exact", "--json")

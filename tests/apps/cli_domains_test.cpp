@@ -207,6 +207,62 @@ TEST(Cli, GenerateWorldWritesTheSameBuildingForTheSameSeed) {
   EXPECT_EQ(std::count(missing.err.begin(), missing.err.end(), '\n'), 1) << missing.err;
 }
 
+// --domain manipulation writes a kitchen table scene with its goal and skeletons, the same file
+// for the same options and seed, and refuses the building's options and bad ones in one line.
+TEST(Cli, GenerateWorldWritesTheSameKitchenForTheSameSeed) {
+  const std::filesystem::path dir = scratch("generate-kitchen");
+  const std::vector<std::string> options{
+      "generate-world", "--domain", "manipulation",  "--tables", "3",         "--regions", "4", "--targets", "1",
+      "--min-objects",  "4",        "--max-objects", "5",        "--classes", "cup,box"};
+  const auto run = [&](const std::string& file, std::vector<std::string> extra) {
+    std::vector<std::string> arguments = options;
+    arguments.insert(arguments.end(), {"-o", (dir / file).string()});
+    arguments.insert(arguments.end(), extra.begin(), extra.end());
+    return ontime(arguments);
+  };
+  const auto first = run("first.json", {"--seed", "7", "--json"});
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  ASSERT_EQ(run("again.json", {"--seed", "7"}).exit_code, 0);
+  EXPECT_EQ(read_file(dir / "first.json"), read_file(dir / "again.json"));
+  const json out = json::parse(first.out);
+  EXPECT_EQ(out["name"], "kitchen");
+  EXPECT_EQ(out["tables"].get<int>(), 3);
+  EXPECT_EQ(out["regions"].get<int>(), 4);
+  EXPECT_EQ(out["goal"].size(), 1u);
+  const json world = json::parse(read_file(dir / "first.json"));
+  EXPECT_EQ(world["skeletons"].size(), out["skeletons"].get<std::size_t>());
+  EXPECT_EQ(world["collection"]["deadline"].get<int>(), 20);
+  EXPECT_GE(world["objects"].size(), 4u);
+  EXPECT_LE(world["objects"].size(), 5u);
+  for (const auto& [id, object] : world["objects"].items()) {
+    EXPECT_TRUE(id.starts_with("cup") || id.starts_with("box")) << id;
+  }
+  // Another seed, another scene; the kitchen is collected along its skeletons like the paper's.
+  ASSERT_EQ(run("other.json", {"--seed", "8"}).exit_code, 0);
+  EXPECT_NE(read_file(dir / "other.json"), read_file(dir / "first.json"));
+  const std::string never = (dir / "never.json").string();
+  for (const std::vector<std::string>& bad : std::vector<std::vector<std::string>>{
+           {"--min-objects", "5", "--max-objects", "4"},
+           {"--min-clutter", "2", "--max-clutter", "1"},
+           {"--tables", "4"},
+           {"--classes", "plate"},
+           {"--targets", "3"},
+           {"--rows", "3"},
+       }) {
+    std::vector<std::string> arguments{"generate-world", "--domain", "manipulation", "-o", never};
+    arguments.insert(arguments.end(), bad.begin(), bad.end());
+    const auto refused = ontime(arguments);
+    EXPECT_EQ(refused.exit_code, 2) << bad[0];
+    EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+    EXPECT_NE(refused.err.find(bad[0]), std::string::npos) << refused.err;
+    EXPECT_FALSE(std::filesystem::exists(never)) << bad[0];
+  }
+  const auto building = ontime({"generate-world", "--tables", "2", "-o", never});
+  EXPECT_EQ(building.exit_code, 2);
+  EXPECT_NE(building.err.find("--tables is an option of the manipulation generator"), std::string::npos)
+      << building.err;
+}
+
 TEST(Cli, MapDrawsAGeneratedBuildingWithoutSkeletons) {
   const std::filesystem::path dir = scratch("map-building");
   const std::string png = (dir / "building.png").string();

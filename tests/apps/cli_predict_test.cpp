@@ -129,5 +129,74 @@ TEST(Cli, PredictRefusesAModelOfOtherFeaturesAndWritesNothing) {
   EXPECT_FALSE(std::filesystem::exists(c.dir / "plain.json"));
 }
 
+// The kitchen family end to end: small generated scenes (one target, one or two neighbours), a
+// few trials of every action with features, a pooled model over them, the instance of a scene
+// none of them is; --library is refused (the kitchen cannot list its actions on their own).
+TEST(Cli, PredictWritesTheInstanceOfAnUnseenKitchen) {
+  const std::filesystem::path dir = scratch("predict-kitchen");
+  std::vector<std::string> logs;
+  std::string unseen;
+  for (const std::string seed : {"1", "2", "3"}) {
+    const std::string world = (dir / ("k" + seed + ".json")).string();
+    ASSERT_EQ(ontime({"generate-world", "--domain", "manipulation", "--targets", "1", "--min-objects", "3",
+                      "--max-objects", "3", "--min-clutter", "1", "--max-clutter", "2", "--seed", seed, "-o", world})
+                  .exit_code,
+              0);
+    if (seed == "3") {
+      unseen = world;
+      continue;
+    }
+    const std::string log = (dir / ("k" + seed + ".jsonl")).string();
+    const auto collected =
+        ontime({"collect", "--domain", "manipulation", "--world", world, "--features", "--trials", "2", "--budget", "4",
+                "--threads", "2", "--log", log, "-o", (dir / ("k" + seed + ".instance.json")).string()});
+    ASSERT_EQ(collected.exit_code, 0) << collected.err;
+    logs.push_back(log);
+  }
+  const std::string first = read_file(logs[0]);
+  const json record = json::parse(first.substr(0, first.find('\n')));
+  EXPECT_EQ(record["world"], "k1");
+  EXPECT_EQ(record["features"].size(), 11u);
+  EXPECT_EQ(record["features"][0].get<double>(), 0.0);  // the first action picks
+
+  const std::string model = (dir / "pooled.json").string();
+  std::vector<std::string> fit{"fit"};
+  fit.insert(fit.end(), logs.begin(), logs.end());
+  for (const std::string arg : {"--conditional", "pooled", "--domain", "manipulation", "--step", "7", "--json", "-o"}) {
+    fit.push_back(arg);
+  }
+  fit.push_back(model);
+  const auto fitted = ontime(fit);
+  ASSERT_EQ(fitted.exit_code, 0) << fitted.err;
+  EXPECT_EQ(json::parse(fitted.out)["worlds"].get<int>(), 2);
+  EXPECT_EQ(json::parse(fitted.out)["feature_names"][0], "is_place");
+
+  const std::string instance = (dir / "k3.predicted.json").string();
+  const auto predicted =
+      ontime({"predict", "--domain", "manipulation", "--world", unseen, "--model", model, "-o", instance, "--json"});
+  ASSERT_EQ(predicted.exit_code, 0) << predicted.err;
+  const json world = json::parse(read_file(unseen));
+  const json problem = json::parse(read_file(instance));
+  EXPECT_EQ(problem["skeletons"], world["skeletons"]);
+  EXPECT_EQ(problem["deadline"], world["collection"]["deadline"]);
+  EXPECT_EQ(json::parse(predicted.out)["skeletons"].get<std::size_t>(), world["skeletons"].size());
+  const auto solved = ontime({"solve", instance, "--json"});
+  EXPECT_EQ(solved.exit_code, 0) << solved.err;
+
+  // A model of unnamed features (fitted without --domain) is refused, as for buildings.
+  const std::string unnamed = (dir / "unnamed.json").string();
+  ASSERT_EQ(ontime({"fit", logs[0], "--conditional", "pooled", "--step", "7", "-o", unnamed}).exit_code, 0);
+  const auto other = ontime({"predict", "--domain", "manipulation", "--world", unseen, "--model", unnamed, "-o",
+                             (dir / "other.json").string()});
+  EXPECT_EQ(other.exit_code, 2);
+  EXPECT_NE(other.err.find("fitted on other features"), std::string::npos) << other.err;
+
+  const auto library = ontime({"predict", "--domain", "manipulation", "--world", unseen, "--model", model, "--library",
+                               "-o", (dir / "library.json").string()});
+  EXPECT_EQ(library.exit_code, 2);
+  EXPECT_NE(library.err.find("cannot list every action"), std::string::npos) << library.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "library.json"));
+}
+
 }  // namespace
 }  // namespace ontime

@@ -309,9 +309,32 @@ TEST(Collection, AWorldWithoutSkeletonsNeedsEveryAction) {
   EXPECT_THROW(collect(kitchen(), settings), UsageError);
 }
 
+// The office floor without features (Domain's defaults): a domain whose extractor cannot describe
+// its actions.
+class Featureless final : public Domain {
+ public:
+  const std::string& name() const override { return office().name(); }
+  const std::vector<std::vector<std::string>>& skeletons() const override { return office().skeletons(); }
+  Configuration initial_configuration() const override { return office().initial_configuration(); }
+  std::unique_ptr<Refinement> refine(const std::string& action, const Configuration& start, std::uint64_t seed,
+                                     const EffortSettings& effort) const override {
+    return office().refine(action, start, seed, effort);
+  }
+  Configuration fallback_start(const std::string& action, std::uint64_t seed) const override {
+    return office().fallback_start(action, seed);
+  }
+  Scene scene() const override { return office().scene(); }
+  std::vector<std::array<double, 2>> trace(const std::vector<Configuration>& motion) const override {
+    return office().trace(motion);
+  }
+  std::vector<std::array<double, 2>> outline(const Configuration& configuration) const override {
+    return office().outline(configuration);
+  }
+};
+
 // With features, every record names its world and carries its action's feature vector there;
 // the times are those of the collection without them. A domain without features refuses before
-// any trial.
+// any trial; the kitchen's records carry its features.
 TEST(Collection, FeaturesNameTheWorldAndDescribeEachAction) {
   CollectionOptions plain = options(2, 6, 2);
   plain.every_action = true;
@@ -330,10 +353,20 @@ TEST(Collection, FeaturesNameTheWorldAndDescribeEachAction) {
     stripped.features.clear();
     EXPECT_EQ(stripped, without[i]);
   }
-  CollectionOptions kitchen_features = kitchen_options(1, 1, 1, 1);
+  CollectionOptions refused = options(1, 1, 1);
+  refused.features = true;
+  refused.progress = [](std::uint64_t, std::uint64_t) { FAIL() << "a trial ran"; };
+  EXPECT_THROW(collect(Featureless(), refused), UsageError);
+
+  CollectionOptions kitchen_features = kitchen_options(1, 1, 2, 1);
   kitchen_features.features = true;
-  kitchen_features.progress = [](std::uint64_t, std::uint64_t) { FAIL() << "a trial ran"; };
-  EXPECT_THROW(collect(kitchen(), kitchen_features), UsageError);
+  const std::vector<RefinementAttempt> kitchen_log = collect(kitchen(), kitchen_features).log;
+  ASSERT_EQ(kitchen_log.size(), 36u);
+  for (const RefinementAttempt& attempt : kitchen_log) {
+    EXPECT_EQ(attempt.world, "kitchen-manipulation");
+    EXPECT_EQ(attempt.features, kitchen().action_features(attempt.action)) << attempt.action;
+    EXPECT_EQ(attempt.features.size(), kitchen().feature_names().size());
+  }
 }
 
 TEST(CollectionJournal, AnEveryActionCollectionResumesToTheSameLog) {

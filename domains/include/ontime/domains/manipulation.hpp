@@ -60,6 +60,9 @@ class ManipulationDomain final : public Domain {
   std::vector<std::array<double, 2>> outline(const Configuration& configuration) const override;
   // The moves of a skeleton, e.g. "B3→C1, B4→C1, B1→R1, B2→R2".
   std::string describe(const std::vector<std::string>& skeleton) const override;
+  // The features of manipulation_features.hpp.
+  const std::vector<std::string>& feature_names() const override;
+  std::vector<double> action_features(const std::string& action) const override;
 
   const ManipulationWorld& world() const noexcept { return world_; }
 

@@ -23,7 +23,8 @@ struct PredictOptions {
 // Domain::every_action as a skeleton of its own), each action predicted by `model` in whole steps
 // of the model's step. Throws UsageError when the model was fitted on other features (another
 // domain, or another version of its extractor) or the world's step differs from the model's, or
-// the domain has no features; InputError is left to loading.
+// the domain has no features, or an action cannot be described, or every action on its own is
+// asked of a domain that cannot list them (the kitchen); InputError is left to loading.
 Problem predict_instance(const Domain& domain, const DomainDefaults& defaults, const ConditionalTimeModel& model,
                          const PredictOptions& options);
 

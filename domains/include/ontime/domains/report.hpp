@@ -14,6 +14,7 @@
 
 #include "ontime/domains/collect_and_fit.hpp"
 #include "ontime/domains/drawing.hpp"
+#include "ontime/domains/manipulation_generator.hpp"
 #include "ontime/domains/navigation_generator.hpp"
 #include "ontime/domains/planner_run.hpp"
 #include "ontime/domains/tamp.hpp"
@@ -38,6 +39,9 @@ std::string to_json(const EpisodeDrawing& drawing);
 // A generated world: the file written and what it holds.
 std::string to_json(const GeneratedWorld& world);
 std::string to_text(const GeneratedWorld& world);
+// A generated kitchen: the file written, its counts and its goal.
+std::string to_json(const GeneratedKitchen& kitchen);
+std::string to_text(const GeneratedKitchen& kitchen);
 
 // The TAMP loop (tamp.hpp): the settings, the success rate, the skeletons found, the mean
 // charges and, when kept, every episode with its charges and timeline.
