@@ -9,7 +9,11 @@ many trials, which gives each its oracle (the world's own fit) and the attempts 
 - per attempt: planning NLL, integrated Brier score and execution NLL of the hazard model's
   prediction, of pooled Kaplan-Meier, and of the oracle (`ontime score`);
 - decision quality: the exact success probability, in the oracle instance, of dp-rerun (and the
-  optimal allocator) planning with each instance (`ontime evaluate --belief --exact`).
+  optimal allocator) planning with each instance (`ontime evaluate --belief --exact`);
+- online update: repeated episodes in each held-out building, dp-rerun planning with the hazard
+  model's (and pooled) prediction updated by every attempt made there (`ontime adapt`), the prior's
+  strength fitted on validation buildings (`ontime fit-strength`: models fitted on the first 40
+  training buildings, strengths scored on the last 10).
 
 Writes OUT/results.json, OUT/table.md and OUT/decision.png. Every step is an `ontime` command; the
 same settings give the same numbers (the collections count collision checks, not seconds).
@@ -99,6 +103,8 @@ def main():
     parser.add_argument("--skeletons", type=int, default=6, help="room paths of a held-out building")
     parser.add_argument("--episodes", type=int, default=2000, help="simulated episodes beside the exact value")
     parser.add_argument("--optimal-states", type=int, default=3_000_000, help="state cap of the optimal allocator")
+    parser.add_argument("--adapt-episodes", type=int, default=10, help="episodes of the online update per building")
+    parser.add_argument("--adapt-sequences", type=int, default=20, help="independent sequences of them")
     parser.add_argument("--mpi", type=int, default=0, help="collect over this many MPI ranks (mpirun -np N)")
     args = parser.parse_args()
     for folder in ("worlds", "logs", "oracles", "models", "predicted"):
@@ -118,6 +124,18 @@ def main():
             runner.run(["fit", *train_logs, "--conditional", kind, "--domain", "navigation", "--step", "3",
                         "-o", model])
 
+    # The prior's strength, on buildings the model was not fitted on: models of the first 80% of
+    # the training buildings, strengths scored on the rest.
+    split = max(1, (4 * len(train_logs)) // 5)
+    strengths = {}
+    for kind in ("hazard", "pooled"):
+        model = runner.path("models", f"{kind}-validation.json")
+        runner.run(["fit", *train_logs[:split], "--conditional", kind, "--domain", "navigation", "--step", "3",
+                    "-o", model])
+        scored = runner.json(["fit-strength", *train_logs[split:], "--model", model, "--strengths",
+                              "0.5,1,2,5,10,20,50,100,200,500"])
+        strengths[kind] = scored["best"]
+
     worlds = []
     for i, seed in enumerate(HELD_OUT_SEEDS[: args.held_out]):
         print(f"held-out building {i + 1}/{args.held_out} (seed {seed})", file=sys.stderr)
@@ -128,7 +146,7 @@ def main():
             instances[kind] = runner.path("predicted", f"building-{seed}-{kind}.json")
             runner.run(["predict", "--domain", "navigation", "--world", world, "--model",
                         runner.path("models", kind + ".json"), "-o", instances[kind]])
-        result = {"seed": seed, "family": family(seed), "scores": {}, "dp-rerun": {}, "optimal": {}}
+        result = {"seed": seed, "family": family(seed), "scores": {}, "dp-rerun": {}, "optimal": {}, "adapt": {}}
         for kind, instance in instances.items():
             result["scores"][kind] = runner.json(["score", instance, log])
             for solver in ("dp-rerun", "optimal"):
@@ -138,6 +156,11 @@ def main():
                                           "--episodes", str(args.episodes), "--no-timing", *extra],
                                          may_exceed=solver == "optimal")
                 result[solver][kind] = None if evaluation is None else evaluation["exact_success_probability"]
+            if kind != "oracle":
+                adapted = runner.json(["adapt", oracle, "--belief", instance, "--solver", "dp-rerun", "--strength",
+                                       str(strengths[kind]), "--episodes", str(args.adapt_episodes), "--sequences",
+                                       str(args.adapt_sequences)])
+                result["adapt"][kind] = adapted["exact_success_probability"]
         worlds.append(result)
 
     solved = [w for w in worlds if all(w["optimal"][kind] is not None for kind in MODELS)]
@@ -157,6 +180,11 @@ def main():
             "optimal": statistics.fmean(w["optimal"][kind] for w in solved) if solved else None,
             "optimal_worlds": len(solved),
         }
+    for kind in ("hazard", "pooled"):
+        # The exact value of the plan each episode starts with, averaged over the buildings.
+        summary[kind]["adapt"] = [statistics.fmean(w["adapt"][kind][e] for w in worlds)
+                                  for e in range(args.adapt_episodes)]
+        summary[kind]["strength"] = strengths[kind]
     with open(runner.path("results.json"), "w", encoding="utf-8") as out:
         json.dump({"settings": vars(args), "summary": summary, "worlds": worlds}, out, indent=1)
 
@@ -169,6 +197,11 @@ def main():
         lines.append(f"| {names[kind]} | {s['planning_nll']:.4f} | {s['integrated_brier']:.4f} | "
                      f"{s['execution_nll']:.4f} | {s['dp-rerun']:.4f} | "
                      + (f"{s['optimal']:.4f} |" if s["optimal"] is not None else "- |"))
+    lines += ["", f"| prior (strength) | episode 1 | episode {args.adapt_episodes} | oracle |", "|---|---|---|---|"]
+    for kind in ("hazard", "pooled"):
+        s = summary[kind]
+        lines.append(f"| {names[kind]} ({s['strength']:g}) | {s['adapt'][0]:.4f} | {s['adapt'][-1]:.4f} | "
+                     f"{summary['oracle']['dp-rerun']:.4f} |")
     table = "\n".join(lines) + "\n"
     with open(runner.path("table.md"), "w", encoding="utf-8") as out:
         out.write(table)
@@ -179,7 +212,7 @@ def main():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt  # pylint: disable=import-outside-toplevel
 
-    figure, axis = plt.subplots(figsize=(7, 3.5))
+    figure, (axis, learning) = plt.subplots(1, 2, figsize=(11, 3.5), gridspec_kw={"width_ratios": [3, 2]})
     order = sorted(range(len(worlds)), key=lambda i: worlds[i]["dp-rerun"]["oracle"])
     for kind, marker in zip(MODELS, ("o", "s", "^")):
         axis.plot(range(len(order)), [worlds[i]["dp-rerun"][kind] for i in order], marker=marker, linestyle="",
@@ -187,6 +220,13 @@ def main():
     axis.set_xlabel("held-out building (by the oracle's success)")
     axis.set_ylabel("dp-rerun success (exact)")
     axis.legend()
+    episodes = range(1, args.adapt_episodes + 1)
+    for kind, marker in (("hazard", "o"), ("pooled", "s")):
+        learning.plot(episodes, summary[kind]["adapt"], marker=marker, label=f"{names[kind]}, updated")
+    learning.axhline(summary["oracle"]["dp-rerun"], color="tab:green", linestyle="--", label=names["oracle"])
+    learning.set_xlabel("episode in the building")
+    learning.set_ylabel("dp-rerun success (exact, mean)")
+    learning.legend(fontsize="small")
     figure.tight_layout()
     figure.savefig(runner.path("decision.png"), dpi=120)
 

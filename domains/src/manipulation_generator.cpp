@@ -24,7 +24,7 @@ constexpr double kPi = std::numbers::pi;
 // The paper kitchen's room (data/domains/manipulation.json): floor, walls, start.
 constexpr double kFloorX = 6.0, kFloorY = 3.6;
 // Tables along the back wall: 1.4 m x 0.7 m, tops 4 cm thick on four legs of 5 cm.
-constexpr double kTableWidth = 1.4, kTableDepth = 0.7, kTopThickness = 0.04, kLeg = 0.05, kLegInset = 0.02;
+constexpr double kTableWidth = 1.4, kTopThickness = 0.04, kLeg = 0.05, kLegInset = 0.02;
 constexpr double kTableHeightMin = 0.70, kTableHeightMax = 0.80;
 // Object centres stand at most this deep from the front edge (the arm's reach from a base in
 // front of the table), targets at least kTargetDepth (room for neighbours in front).
@@ -136,7 +136,7 @@ class KitchenGenerator {
   }
 
  private:
-  static constexpr double kFront = 2.9;  // the tables' front edge: kFloorY - kTableDepth
+  static constexpr double kFront = 2.9;  // the tables' front edge: kFloorY less their depth, 0.7 m
 
   void place_tables(SplitMix64& random) {
     const auto count = static_cast<std::size_t>(options_.tables);

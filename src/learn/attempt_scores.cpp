@@ -74,7 +74,7 @@ AttemptScores score_attempts(std::span<const RefinementAttempt> attempts, const 
     (outcome.event ? events_at : censored_at)[static_cast<std::size_t>(outcome.time)] += 1;
   }
   std::vector<double> at_least(H + 2, 1.0);  // K(t), t = 0..H+1
-  double at_risk = static_cast<double>(outcomes.size());
+  auto at_risk = static_cast<double>(outcomes.size());
   for (std::size_t c = 0; c <= H; ++c) {
     at_risk -= events_at[c];  // found at c: not at risk of censoring at c
     const double keep = at_risk > 0 ? 1.0 - censored_at[c] / at_risk : 0.0;

@@ -66,6 +66,7 @@ Problem believed(const Problem& prior_on_truth, const std::vector<PlanningPoster
   std::vector<Action> actions(prior_on_truth.actions().begin(), prior_on_truth.actions().end());
   for (std::size_t a = 0; a < actions.size(); ++a) actions[a].planning = posteriors[a].mean();
   std::vector<std::vector<int>> skeletons;
+  skeletons.reserve(static_cast<std::size_t>(prior_on_truth.skeleton_count()));
   for (int k = 0; k < prior_on_truth.skeleton_count(); ++k) {
     skeletons.emplace_back(prior_on_truth.skeleton(k).begin(), prior_on_truth.skeleton(k).end());
   }
@@ -93,6 +94,7 @@ AdaptationResult run_adaptation(const Problem& truth, const Problem& prior, cons
     return [&](std::uint64_t begin, std::uint64_t end) {
       for (std::uint64_t r = begin; r < end; ++r) {
         std::vector<PlanningPosterior> posteriors;
+        posteriors.reserve(static_cast<std::size_t>(prior_on_truth.action_count()));
         for (const Action& action : prior_on_truth.actions()) {
           posteriors.emplace_back(action.planning, horizon, options.strength);
         }
@@ -155,6 +157,7 @@ std::vector<StrengthScore> score_prior_strengths(const ConditionalTimeModel& mod
 
   constexpr double kFloor = 1e-9;
   std::vector<StrengthScore> scores;
+  scores.reserve(strengths.size());
   for (const double strength : strengths) {
     double nll = 0;
     for (std::size_t g = 0; g < groups.size(); ++g) {

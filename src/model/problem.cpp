@@ -101,6 +101,7 @@ Problem with_distributions_of(const Problem& structure, const Problem& distribut
     action.execution = distributions.action(source).execution;
   }
   std::vector<std::vector<int>> skeletons;
+  skeletons.reserve(static_cast<std::size_t>(structure.skeleton_count()));
   for (int k = 0; k < structure.skeleton_count(); ++k) {
     skeletons.emplace_back(structure.skeleton(k).begin(), structure.skeleton(k).end());
   }
