@@ -22,7 +22,7 @@ namespace {
 // The options of one domain's generator, refused with the other's.
 const std::vector<std::string> kBuildingFlags{
     "--rows",     "--cols",     "--room-size",   "--door-density",    "--narrow-doors", "--narrow-min", "--narrow-max",
-    "--wide-min", "--wide-max", "--empty-rooms", "--cluttered-rooms", "--min-boxes",    "--max-boxes", "--skeletons"};
+    "--wide-min", "--wide-max", "--empty-rooms", "--cluttered-rooms", "--min-boxes",    "--max-boxes",  "--skeletons"};
 const std::vector<std::string> kKitchenFlags{"--tables",      "--regions",     "--region-min",  "--region-max",
                                              "--targets",     "--min-objects", "--max-objects", "--min-clutter",
                                              "--max-clutter", "--classes"};
