@@ -1,6 +1,7 @@
 #include "ontime/domains/manipulation_features.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -188,7 +189,8 @@ std::vector<double> manipulation_action_features(const ManipulationWorld& world,
     gap = std::min(gap, distance);
     neighbours += distance <= kManipulationNeighbourRadius ? 1 : 0;
   }
-  const Edge& edge = reach_edge(edges_of(world, *surface.top, centre[0], centre[1]));
+  const std::array<Edge, 4> edges = edges_of(world, *surface.top, centre[0], centre[1]);  // outlives `edge`
+  const Edge& edge = reach_edge(edges);
   const double strip = kManipulationApproachWidth * edge.distance;
   const double approach = strip > 0 ? std::min(1.0, covered(others, edge.strip) / strip) : 0.0;
 
