@@ -31,6 +31,17 @@ def files(tmp_path):
     return instance, log
 
 
+def misleading_belief(source_dir, folder):
+    """Instance 4 and a belief that swaps the planning times of its two skeletons' first actions."""
+    truth = source_dir / "data/instances/paper/instance4.json"
+    data = json.loads(truth.read_text())
+    data["actions"]["a1_1"]["planning"], data["actions"]["a2_1"]["planning"] = (
+        data["actions"]["a2_1"]["planning"], data["actions"]["a1_1"]["planning"])
+    belief = folder / "belief.json"
+    belief.write_text(json.dumps(data))
+    return truth, belief
+
+
 def test_score_gives_the_hand_computed_values_and_the_clis_fields(files, cli):
     instance, log = files
     scores = ontime.score(instance, [log])
@@ -44,12 +55,7 @@ def test_score_gives_the_hand_computed_values_and_the_clis_fields(files, cli):
 
 
 def test_evaluate_with_a_belief_matches_the_command_line(source_dir, tmp_path, cli):
-    truth = source_dir / "data/instances/paper/instance4.json"
-    data = json.loads(truth.read_text())
-    data["actions"]["a1_1"]["planning"], data["actions"]["a2_1"]["planning"] = (
-        data["actions"]["a2_1"]["planning"], data["actions"]["a1_1"]["planning"])
-    belief = tmp_path / "belief.json"
-    belief.write_text(json.dumps(data))
+    truth, belief = misleading_belief(source_dir, tmp_path)
     believing = ontime.evaluate(str(truth), "dp-rerun", episodes=300, exact=True, belief=str(belief))
     plain = ontime.evaluate(str(truth), "dp-rerun", episodes=300, exact=True)
     assert believing["exact_success_probability"] < plain["exact_success_probability"]
@@ -60,12 +66,7 @@ def test_evaluate_with_a_belief_matches_the_command_line(source_dir, tmp_path, c
 
 
 def test_adapt_and_fit_strength_match_the_command_line(source_dir, tmp_path, cli):
-    truth = source_dir / "data/instances/paper/instance4.json"
-    data = json.loads(truth.read_text())
-    data["actions"]["a1_1"]["planning"], data["actions"]["a2_1"]["planning"] = (
-        data["actions"]["a2_1"]["planning"], data["actions"]["a1_1"]["planning"])
-    prior = tmp_path / "prior.json"
-    prior.write_text(json.dumps(data))
+    truth, prior = misleading_belief(source_dir, tmp_path)
     adapted = ontime.adapt(str(truth), str(prior), "dp-rerun", strength=2, episodes=4, sequences=30)
     out = cli("adapt", truth, "--belief", prior, "--solver", "dp-rerun", "--strength", 2, "--episodes", 4,
               "--sequences", 30, "--json")

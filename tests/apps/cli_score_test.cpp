@@ -27,6 +27,19 @@ void write_text(const std::filesystem::path& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;
 }
 
+// `truth` with the planning times of its skeletons' first actions a1_1 and a2_1 swapped.
+Problem misleading_belief(const Problem& truth) {
+  std::vector<Action> actions(truth.actions().begin(), truth.actions().end());
+  std::swap(actions[static_cast<std::size_t>(truth.find_action("a1_1"))].planning,
+            actions[static_cast<std::size_t>(truth.find_action("a2_1"))].planning);
+  std::vector<std::vector<int>> skeletons;
+  skeletons.reserve(static_cast<std::size_t>(truth.skeleton_count()));
+  for (int k = 0; k < truth.skeleton_count(); ++k) {
+    skeletons.emplace_back(truth.skeleton(k).begin(), truth.skeleton(k).end());
+  }
+  return {"belief", truth.deadline(), truth.step_seconds(), std::move(actions), std::move(skeletons)};
+}
+
 TEST(Cli, ScorePrintsTheLogAndBrierScoresOfAnInstance) {
   const auto folder = scratch("score");
   // One action: found at step 1 with 0.6, at 2 with 0.2, never with 0.2; executes in 0 or 1 step.
@@ -67,18 +80,7 @@ TEST(Cli, ScorePrintsTheLogAndBrierScoresOfAnInstance) {
 TEST(Cli, EvaluateWithABeliefPlansWithItAndScoresInTheInstance) {
   const auto folder = scratch("evaluate_belief");
   const Problem truth = testing::paper_instance("instance4");
-  // The belief swaps the planning times of the two skeletons' first actions.
-  std::vector<Action> actions(truth.actions().begin(), truth.actions().end());
-  const int first = truth.find_action("a1_1");
-  const int second = truth.find_action("a2_1");
-  ASSERT_GE(first, 0);
-  ASSERT_GE(second, 0);
-  std::swap(actions[static_cast<std::size_t>(first)].planning, actions[static_cast<std::size_t>(second)].planning);
-  std::vector<std::vector<int>> skeletons;
-  for (int k = 0; k < truth.skeleton_count(); ++k) {
-    skeletons.emplace_back(truth.skeleton(k).begin(), truth.skeleton(k).end());
-  }
-  const Problem belief("belief", truth.deadline(), truth.step_seconds(), actions, skeletons);
+  const Problem belief = misleading_belief(truth);
   save_problem(belief, folder / "belief.json");
 
   const auto plain = ontime({"evaluate", paper("instance4"), "--solver", "dp-rerun", "--exact", "--episodes", "500",
@@ -116,14 +118,7 @@ TEST(Cli, EvaluateWithABeliefPlansWithItAndScoresInTheInstance) {
 TEST(Cli, AdaptRunsEpisodesWithTheUpdatedPriorAsTheLibraryDoes) {
   const auto folder = scratch("adapt");
   const Problem truth = testing::paper_instance("instance4");
-  std::vector<Action> actions(truth.actions().begin(), truth.actions().end());
-  std::swap(actions[static_cast<std::size_t>(truth.find_action("a1_1"))].planning,
-            actions[static_cast<std::size_t>(truth.find_action("a2_1"))].planning);
-  std::vector<std::vector<int>> skeletons;
-  for (int k = 0; k < truth.skeleton_count(); ++k) {
-    skeletons.emplace_back(truth.skeleton(k).begin(), truth.skeleton(k).end());
-  }
-  const Problem prior("prior", truth.deadline(), truth.step_seconds(), actions, skeletons);
+  const Problem prior = misleading_belief(truth);
   save_problem(prior, folder / "prior.json");
   const auto result = ontime({"adapt", paper("instance4"), "--belief", (folder / "prior.json").string(), "--solver",
                               "dp-rerun", "--strength", "2", "--episodes", "4", "--sequences", "30", "--json"});
