@@ -52,6 +52,8 @@ void add_tamp_command(CLI::App& app) {
     std::uint64_t picture_episode = 0;
     bool no_plot = false;
     bool json = false;
+    double adapt_strength = 0;
+    std::uint64_t sequences = 1;
     AllocatorFlags allocator;
   };
   auto options = std::make_shared<Options>();
@@ -98,11 +100,25 @@ void add_tamp_command(CLI::App& app) {
                       "NAME-timeline.png (data as .csv)");
   add_number_option(*command, "--picture-episode", options->picture_episode, "The episode --picture draws");
   command->add_flag("--no-plot", options->no_plot, "With --picture: write the data only");
+  add_number_option(*command, "--adapt-strength", options->adapt_strength,
+                    "Learn across episodes: each sequence's episodes plan with the library updated by every attempt of "
+                    "the episodes before (the online update), the library a prior worth this many attempts",
+                    1e-9, 1e9);
+  add_number_option(*command, "--sequences", options->sequences,
+                    "With --adapt-strength: independent sequences of --episodes episodes each", std::uint64_t{1});
   command->add_flag("--json", options->json, "Print JSON (with every episode and its timeline)");
   options->allocator.add_to(*command);
   command->callback([options, command] {
     if (options->picture.empty() && (command->count("--picture-episode") > 0 || options->no_plot)) {
       throw UsageError("--picture-episode and --no-plot need --picture");
+    }
+    if (command->count("--sequences") > 0 && command->count("--adapt-strength") == 0) {
+      throw UsageError("--sequences needs --adapt-strength");
+    }
+    if (!options->picture.empty() && command->count("--adapt-strength") > 0) {
+      throw UsageError(
+          "--picture is not taken with --adapt-strength: a picture redraws its episode with the library "
+          "alone");
     }
     if (options->clock == "real" &&
         (command->count("--decision-seconds") > 0 || command->count("--iteration-seconds") > 0)) {
@@ -141,6 +157,9 @@ void add_tamp_command(CLI::App& app) {
     if (options->clock == "model") tamp.thinking = options->thinking;
     tamp.keep_episodes = options->json;
     if (!options->picture.empty()) tamp.picture_episode = options->picture_episode;
+    if (command->count("--adapt-strength") > 0) {
+      tamp.adaptation = domains::TampAdaptation{.strength = options->adapt_strength, .sequences = options->sequences};
+    }
     tamp.world_name = world_file.filename().string();
     tamp.library_source = options->library;
     tamp.ranks = job_ranks();

@@ -80,6 +80,14 @@ std::optional<FoundSkeleton> PlannerWorld::next_skeleton() {
   return found;
 }
 
+void PlannerWorld::set_library(const Problem& library) {
+  if (!task_planner_) throw std::invalid_argument("set_library: this planner world does not stream skeletons");
+  if (std::abs(library.step_seconds() - step_seconds_) > 1e-9 * step_seconds_) {
+    throw std::invalid_argument("set_library: the library's step differs from the world's");
+  }
+  streaming_.library = &library;
+}
+
 const Refinement* PlannerWorld::refinement(int action) const {
   return refinements_.at(static_cast<std::size_t>(action)).get();
 }

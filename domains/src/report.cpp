@@ -227,6 +227,22 @@ std::string to_json(const Tamp& tamp) {
   out["refinements_started"] = result.refinements_started;
   out["seconds"] = summary.seconds;
   add_charges(out, summary.live_mean, "mean_");
+  if (options.adaptation) {
+    // Episode e of every sequence: how many succeeded, and the rate with its interval.
+    Json adaptation;
+    adaptation["strength"] = options.adaptation->strength;
+    adaptation["sequences"] = options.adaptation->sequences;
+    adaptation["episodes_per_sequence"] = options.episodes;
+    Json by_episode = Json::array();
+    for (const std::uint64_t successes : result.successes_by_episode) {
+      const double rate = static_cast<double>(successes) / static_cast<double>(options.adaptation->sequences);
+      by_episode.push_back({{"successes", successes},
+                            {"success_rate", rate},
+                            {"ci95", ci95_half_width(rate, options.adaptation->sequences)}});
+    }
+    adaptation["by_episode"] = std::move(by_episode);
+    out["adaptation"] = std::move(adaptation);
+  }
   out["episode_results"] = live_episodes(result.episodes, true);
   return dump(out);
 }
@@ -248,6 +264,16 @@ std::string to_text(const Tamp& tamp) {
       summary.live_mean.decision, summary.live_mean.planning, summary.live_mean.overrun, summary.live_mean.outside,
       summary.live_mean.elapsed, deadline_seconds(result));
   out += fmt::format("refinements started  {:.2f} per episode\n", result.refinements_started);
+  if (options.adaptation) {
+    const double sequences = static_cast<double>(options.adaptation->sequences);
+    out += fmt::format("online update        {} sequences of {} episodes, the library a prior of strength {}\n",
+                       options.adaptation->sequences, options.episodes, options.adaptation->strength);
+    out += "success by episode  ";
+    for (std::size_t e = 0; e < result.successes_by_episode.size(); ++e) {
+      out += fmt::format(" {}:{:.3f}", e + 1, static_cast<double>(result.successes_by_episode[e]) / sequences);
+    }
+    out += "\n";
+  }
   if (options.thinking) {
     out += fmt::format("clock                model: {} s per decision, {} s per search iteration; nothing real\n",
                        options.thinking->seconds_per_decision, options.thinking->seconds_per_iteration);

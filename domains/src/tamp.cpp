@@ -7,6 +7,7 @@
 #include "episode_options.hpp"
 #include "ontime/domains/planner_world.hpp"
 #include "ontime/domains/report.hpp"
+#include "ontime/learn/online_belief.hpp"
 #include "ontime/util/error.hpp"
 #include "ontime/util/random.hpp"
 
@@ -25,6 +26,20 @@ void check_tamp_request(const Domain& domain, const Problem& library, const Tamp
   if (options.picture_episode && *options.picture_episode >= options.episodes) {
     throw UsageError(fmt::format("{} {}: the run has episodes 0 to {}", spell_parameter(spelling, "picture-episode"),
                                  *options.picture_episode, options.episodes - 1));
+  }
+  if (options.adaptation) {
+    if (options.picture_episode) {
+      throw UsageError(fmt::format("{} is not taken with {}: a picture redraws its episode with the library alone",
+                                   spell_parameter(spelling, "picture-episode"),
+                                   spell_parameter(spelling, "adapt-strength")));
+    }
+    if (options.adaptation->sequences < 1) {
+      throw UsageError(fmt::format("{} must be at least 1", spell_parameter(spelling, "sequences")));
+    }
+    if (!(std::isfinite(options.adaptation->strength) && options.adaptation->strength > 0)) {
+      throw UsageError(fmt::format("{} {}: the prior's strength must be a positive number of attempts",
+                                   spell_parameter(spelling, "adapt-strength"), options.adaptation->strength));
+    }
   }
   const double steps = std::floor(options.deadline / library.step_seconds() + 1e-9);
   if (!(steps >= 1) || steps > static_cast<double>(Problem::kMaxDeadline)) {
@@ -71,21 +86,58 @@ TampResult run_tamp(const Domain& domain, const Problem& library, const TampOpti
   planner.thinking = options.thinking;
 
   MonteCarloOptions episodes = detail::monte_carlo_options(options);
+  const std::uint64_t sequences = options.adaptation ? options.adaptation->sequences : 1;
+  const std::uint64_t total = options.episodes * sequences;
+  episodes.episodes = total;
   // An anytime allocator given its own budget (its kind's declared decision budget: e.g.
   // iterations, time-budget) thinks that much per decision, charged all the same; otherwise the
   // session gives it decision_share of a slice.
   episodes.decision_budget = allocator_registry().decision_budget(options.solver, options.parameters);
   episodes.live = LiveRun{LiveOptions{.decision_share = options.decision_share}, options.keep_episodes};
-  if (options.keep_episodes) result.episodes.resize(options.episodes);
-  std::vector<int> skeletons_found(options.episodes, 0);
+  if (options.keep_episodes) result.episodes.resize(total);
+  std::vector<int> skeletons_found(total, 0);
+  std::vector<std::uint8_t> succeeded(total, 0);
+  // With adaptation, each sequence's belief and the library it believes now: episodes of one
+  // sequence run in order on one thread, so no two threads touch one sequence's slot.
+  struct Learning {
+    std::optional<OnlineBelief> belief;
+    Problem library;
+  };
+  std::vector<std::optional<Learning>> learning(options.adaptation ? sequences : 0);
+  if (options.adaptation) {
+    episodes.sequence_length = options.episodes;
+    streaming.keep_problem = true;
+    episodes.before_episode = [&](std::uint64_t episode, World& world) {
+      std::optional<Learning>& mine = learning[episode / options.episodes];
+      if (episode % options.episodes == 0) {
+        mine.emplace(Learning{OnlineBelief(library, options.adaptation->strength), library});
+      } else {
+        mine->library = mine->belief->believed();
+      }
+      // The worlds are the streaming planner worlds made below.
+      static_cast<PlannerWorld&>(world).set_library(mine->library);
+    };
+  }
   // Each episode writes its own slot: no two threads touch one.
   episodes.on_episode = [&](std::uint64_t episode, const EpisodeResult& outcome) {
     skeletons_found[episode] = outcome.skeletons;
+    succeeded[episode] = outcome.status == Status::success ? 1 : 0;
+    if (options.adaptation && outcome.problem != nullptr) {
+      // What the episode's attempts taught (another rank's episodes come without their problem,
+      // after every episode ended: that rank learned from them).
+      learning[episode / options.episodes]->belief->observe(*outcome.problem, outcome.attempts);
+    }
     if (options.keep_episodes) result.episodes[episode] = outcome;
   };
   result.summary = run_streaming_episodes(streaming, streaming_planner_worlds(domain, stream, planner), episodes);
   for (const int found : skeletons_found) result.mean_skeletons_found += found;
-  result.mean_skeletons_found /= static_cast<double>(options.episodes);
+  result.mean_skeletons_found /= static_cast<double>(total);
+  if (options.adaptation) {
+    result.successes_by_episode.assign(options.episodes, 0);
+    for (std::uint64_t episode = 0; episode < total; ++episode) {
+      result.successes_by_episode[episode % options.episodes] += succeeded[episode];
+    }
+  }
   result.refinements_started = result.summary.world_statistics.find("refinements_started").value_or(0.0) /
                                static_cast<double>(result.summary.episodes);
 

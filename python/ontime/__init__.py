@@ -24,6 +24,7 @@ from typing import Any, Iterable, Mapping, Optional, Sequence, Union
 from ._ontime import (  # noqa: F401  (re-exported)
     NEVER,
     Action,
+    ActionAttempt,
     Allocator,
     ConditionalTimeModel,
     Decision,
@@ -33,6 +34,7 @@ from ._ontime import (  # noqa: F401  (re-exported)
     LiveSession,
     ManualClock,
     Mdp,
+    OnlineBelief,
     PlanningPosterior,
     Problem,
     ResourceLimitError,
@@ -64,8 +66,8 @@ from . import _ontime
 __version__ = "0.1.0"
 
 __all__ = [
-    "NEVER", "Action", "Allocator", "ConditionalTimeModel", "Decision", "Distribution", "Error", "InputError", "LiveSession",
-    "ManualClock", "Mdp", "PlanningPosterior", "Problem",
+    "NEVER", "Action", "ActionAttempt", "Allocator", "ConditionalTimeModel", "Decision", "Distribution", "Error", "InputError", "LiveSession",
+    "ManualClock", "Mdp", "OnlineBelief", "PlanningPosterior", "Problem",
     "ResourceLimitError", "Session", "State", "Status", "UsageError", "World", "allocators", "conditional_model_kinds",
     "evaluate", "fit", "fit_conditional", "histogram_csv", "load_conditional_model", "load_problem", "make_allocator", "read_planner_log", "reduce_knapsack", "run_episodes", "sample_log", "score", "adapt", "fit_strength",
     "solve", "study", "table", "train_ppo",

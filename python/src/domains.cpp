@@ -246,8 +246,9 @@ void bind_domains(py::module_& m) {
          Number<int, "max_skeletons", 1, Problem::kMaxSkeletons> max_skeletons, DecisionShare decision_share,
          const std::string& clock, std::optional<Number<double, "decision_seconds", 0.0, 1e6>> decision_seconds,
          std::optional<Number<double, "iteration_seconds", 1e-12, 1e6>> iteration_seconds,
-         std::optional<Number<std::uint64_t, "picture_episode">> picture_episode, const py::object& progress,
-         const py::kwargs& kwargs) {
+         std::optional<Number<std::uint64_t, "picture_episode">> picture_episode,
+         std::optional<Number<double, "adapt_strength", 1e-9, 1e9>> adapt_strength,
+         Number<std::uint64_t, "sequences", 1> sequences, const py::object& progress, const py::kwargs& kwargs) {
         if (clock != "real" && clock != "model") {
           throw UsageError("clock must be 'real' or 'model' (got '" + clock + "')");
         }
@@ -275,6 +276,11 @@ void bind_domains(py::module_& m) {
         }
         options.keep_episodes = true;
         if (picture_episode) options.picture_episode = *picture_episode;
+        if (adapt_strength) {
+          options.adaptation = domains::TampAdaptation{.strength = *adapt_strength, .sequences = sequences};
+        } else if (sequences != 1) {
+          throw UsageError("sequences needs adapt_strength");
+        }
         options.world_name = std::filesystem::path(domain->world_file).filename().string();
         options.library_source = instance_label(library, *mdp->problem);
         domains::TampResult result;
@@ -299,14 +305,17 @@ void bind_domains(py::module_& m) {
       py::arg("task_seconds") = 0.5, py::arg("arrival_period") = 2, py::arg("max_skeletons") = 16,
       py::arg("decision_share") = 0.5, py::arg("clock") = "real", py::arg("decision_seconds") = py::none(),
       py::arg("iteration_seconds") = py::none(), py::arg("picture_episode") = py::none(),
-      py::arg("progress") = py::none(),
+      py::arg("adapt_strength") = py::none(), py::arg("sequences") = 1, py::arg("progress") = py::none(),
       "`ontime tamp`: the whole TAMP loop on the clock. The domain's task planner streams skeletons (at most "
       "max_skeletons, each charged task_seconds of search, one every arrival_period steps), the allocator "
       "`solver` (parameters as keyword arguments) decides which action the real motion planner refines next, "
       "with the distributions of `library` (a Problem or an instance path whose actions are the domain's). "
       "`deadline` in seconds. clock='model' charges thinking by decision_seconds and iteration_seconds, so that "
       "the same seed gives the same episodes on any machine. Returns the fields of `ontime tamp --json`; with "
-      "picture_episode, also 'picture': that episode's drawing (what plot_tamp.py draws) and timeline CSV.");
+      "picture_episode, also 'picture': that episode's drawing (what plot_tamp.py draws) and timeline CSV. "
+      "adapt_strength: `sequences` sequences of `episodes` episodes that learn as they go (`--adapt-strength`): "
+      "each episode plans with the library updated by the attempts of its sequence's episodes before, the "
+      "library a prior worth adapt_strength attempts; 'adaptation' gives the success rate by episode.");
 
   m.def(
       "map_data",

@@ -14,6 +14,7 @@
 #include "ontime/learn/fitting.hpp"
 #include "ontime/learn/log_sampling.hpp"
 #include "ontime/learn/online_adaptation.hpp"
+#include "ontime/learn/online_belief.hpp"
 #include "ontime/learn/online_update.hpp"
 #include "ontime/learn/ppo_training.hpp"
 #include "ontime/model/planner_log.hpp"
@@ -118,6 +119,46 @@ void bind_conditional(py::module_& m) {
       .def_property_readonly("observations", &PlanningPosterior::observations)
       .def_property_readonly("strength", &PlanningPosterior::strength)
       .def_property_readonly("horizon", &PlanningPosterior::horizon);
+
+  py::class_<OnlineBelief>(
+      m, "OnlineBelief",
+      "A robot's belief of a world's planning times (docs/learning.md, \"Online update\"): `prior` (a Problem or "
+      "an instance's path: a prediction, a library) worth `strength` attempts, updated by every attempt the "
+      "robot makes; believed() is the prior with the posterior means, to plan the next episode with.\n\n"
+      "    belief = ontime.OnlineBelief(predicted, strength=100)\n"
+      "    session = ontime.LiveSession(belief.believed_for(problem), 'dp-rerun')\n"
+      "    ... drive it ...\n"
+      "    belief.observe(session.problem, session.attempts)")
+      .def(py::init([](const py::object& prior, Number<double, "strength", 1e-9, 1e9> strength) {
+             return OnlineBelief(*to_mdp(prior)->problem, strength);
+           }),
+           py::arg("prior"), py::arg("strength"))
+      .def(
+          "observe",
+          [](OnlineBelief& belief, const std::string& action_id, Number<Steps, "effort", 0> effort, bool found) {
+            belief.observe(action_id, ActionAttempt{effort, found});
+          },
+          py::arg("action_id"), py::arg("effort"), py::arg("found"),
+          "One attempt on an action (by id or base id): found after `effort` steps, or cut off after them.")
+      .def(
+          "observe",
+          [](OnlineBelief& belief, const py::object& problem, const std::vector<ActionAttempt>& attempts) {
+            belief.observe(*to_mdp(problem)->problem, attempts);
+          },
+          py::arg("problem"), py::arg("attempts"),
+          "Every attempt of one episode: a session's problem and its attempts, by action index.")
+      .def("believed", &OnlineBelief::believed, "The prior with every observed action's posterior mean (a Problem).")
+      .def(
+          "believed_for",
+          [](const OnlineBelief& belief, const py::object& structure) {
+            return belief.believed_for(*to_mdp(structure)->problem);
+          },
+          py::arg("structure"),
+          "`structure`'s skeletons with the believed distributions, each action by its id or base id.")
+      .def("planning", &OnlineBelief::planning, py::arg("action_id"), "The planning Distribution believed now.")
+      .def_property_readonly("prior", &OnlineBelief::prior)
+      .def_property_readonly("strength", &OnlineBelief::strength)
+      .def_property_readonly("observations", &OnlineBelief::observations);
 
   m.def(
       "load_conditional_model",

@@ -141,6 +141,21 @@ void bind_live(py::module_& m) {
             h.current = std::make_shared<const Problem>(h.session.problem());
           },
           py::arg("skeleton"), "Skeleton k leaves; later skeletons move down by one index.")
+      .def(
+          "revise_distributions",
+          [](LiveSessionHandle& h, const py::object& beliefs) {
+            const std::shared_ptr<MdpHandle> source = to_mdp(beliefs);
+            session_call([&] { h.session.revise_distributions(*source->problem); });
+            h.current = std::make_shared<const Problem>(h.session.problem());
+          },
+          py::arg("beliefs"),
+          "Every action takes the distributions of the action of `beliefs` (a Problem or an instance's path) with "
+          "its id or its base id (move(A,B) for move(A,B)#2), e.g. OnlineBelief.believed(); the state stays and "
+          "the allocator is made anew to plan with them.")
+      .def_property_readonly(
+          "attempts", [](const LiveSessionHandle& h) { return h.session.attempts(); },
+          "What the session saw of each action of `problem`, by action index (ontime.ActionAttempt): the slices "
+          "of effort charged to it and whether a motion was found.")
       .def_property_readonly("status", [](const LiveSessionHandle& h) { return h.session.status(); })
       .def_property_readonly(
           "model_status", [](const LiveSessionHandle& h) { return h.session.model_status(); },

@@ -143,6 +143,20 @@ void bind_run(py::module_& m) {
                (d.action >= 0 ? " '" + d.problem->action(d.action).id + "'" : std::string()) + ")";
       });
 
+  py::class_<ActionAttempt>(m, "ActionAttempt",
+                            "What a session saw of one action: the steps of effort its refinement got and whether "
+                            "it found a motion (an OnlineBelief learns from it).")
+      .def(py::init([](Number<Steps, "effort", 0> effort, bool found) {
+             return ActionAttempt{effort, found};
+           }),
+           py::arg("effort"), py::arg("found"))
+      .def_readonly("effort", &ActionAttempt::effort)
+      .def_readonly("found", &ActionAttempt::found)
+      .def("__repr__", [](const ActionAttempt& a) {
+        return "ontime.ActionAttempt(effort=" + std::to_string(a.effort) + ", found=" + (a.found ? "True" : "False") +
+               ")";
+      });
+
   py::class_<SessionHandle>(
       m, "Session",
       "An online session: the caller's own planner does the work, the allocator decides.\n\n"
@@ -206,6 +220,13 @@ void bind_run(py::module_& m) {
           "The skeleton to execute after success, else None.")
       .def_property_readonly(
           "steps_used", [](const SessionHandle& h) { return h.session.steps_used(); }, "Steps of effort spent (CT).")
+      .def_property_readonly(
+          "problem", [](const SessionHandle& h) { return std::const_pointer_cast<Problem>(h.allocator->mdp->problem); },
+          "The session's problem.")
+      .def_property_readonly(
+          "attempts", [](const SessionHandle& h) { return h.session.attempts(); },
+          "What the session saw of each action of `problem`, by action index (ontime.ActionAttempt): "
+          "OnlineBelief.observe(session.problem, session.attempts) learns from it.")
       .def("__repr__", [](const SessionHandle& h) {
         return std::string("ontime.Session(") + h.allocator->name + ", " + status_name(h.session.status()) +
                ", steps used " + std::to_string(h.session.steps_used()) + ")";

@@ -44,6 +44,28 @@ def test_tamp_on_the_modelled_clock_matches_the_cli(cli, tmp_path):
         skeleton["executed"] for skeleton in drawing["skeletons"])
 
 
+def test_tamp_that_learns_across_episodes_matches_the_cli(cli):
+    # Two sequences of three episodes, each planning with the library updated by the sequence's
+    # attempts so far: the same successes by episode from both.
+    expected = cli("tamp", "--world", BUILDING, "--library", BUILDING_MOVES, "--deadline", 150, "--solver", "dp-rerun",
+                   "--episodes", 3, "--sequences", 2, "--adapt-strength", 5, "--threads", 2, "--max-skeletons", 3,
+                   "--seed", 5, "--clock", "model", "--json")
+    building = ontime.domains.load("navigation", BUILDING)
+    got = ontime.domains.tamp(building, BUILDING_MOVES, "dp-rerun", 150, episodes=3, sequences=2, adapt_strength=5,
+                              threads=1, max_skeletons=3, seed=5, clock="model")
+    assert without(got, "seconds") == without(expected, "seconds")
+    adaptation = got["adaptation"]
+    assert adaptation["sequences"] == 2 and adaptation["episodes_per_sequence"] == 3 and adaptation["strength"] == 5
+    assert len(adaptation["by_episode"]) == 3 and got["episodes"] == 6
+    assert sum(e["successes"] for e in adaptation["by_episode"]) == got["successes"]
+    # The first episode of each sequence plans with the library itself: episodes 0 and 3 of a run
+    # without learning.
+    plain = ontime.domains.tamp(building, BUILDING_MOVES, "dp-rerun", 150, episodes=6, threads=1, max_skeletons=3,
+                                seed=5, clock="model")
+    for first in (0, 3):
+        assert got["episode_results"][first] == plain["episode_results"][first]
+
+
 def test_tamp_refuses_what_the_cli_refuses():
     building = ontime.domains.load("navigation", BUILDING)
     with pytest.raises(ontime.UsageError, match="^deadline 2: 0 steps of 3 s"):
@@ -54,6 +76,10 @@ def test_tamp_refuses_what_the_cli_refuses():
         ontime.domains.tamp(building, BUILDING_MOVES, "dp-rerun", 45, decision_seconds=0.001)
     with pytest.raises(ontime.UsageError, match="picture_episode 3: the run has episodes 0 to 2"):
         ontime.domains.tamp(building, BUILDING_MOVES, "dp-rerun", 45, episodes=3, picture_episode=3)
+    with pytest.raises(ontime.UsageError, match="sequences needs adapt_strength"):
+        ontime.domains.tamp(building, BUILDING_MOVES, "dp-rerun", 45, sequences=2)
+    with pytest.raises(ontime.UsageError, match="picture_episode is not taken with adapt_strength"):
+        ontime.domains.tamp(building, BUILDING_MOVES, "dp-rerun", 45, adapt_strength=5, picture_episode=0)
     paper = str(SOURCE_DIR / "data" / "instances" / "paper" / "instance1.json")
     with pytest.raises(ontime.InputError, match=r"instance1.json: actions: no action 'move\(R1,"):
         ontime.domains.tamp(building, paper, "dp-rerun", 45)

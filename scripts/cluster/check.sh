@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Checks that OnTime split over MPI ranks gives the numbers of one process, to the byte, and
 # loses no work when a rank dies:
-#  1. a navigation collection of 100 trials per action and an evaluation of the fitted instance,
-#     as one process, under `mpirun -np 2`, and under SLURM (`sbatch` of the scripts here, whose
+#  1. a navigation collection of 100 trials per action (with features: a corpus's records) and an
+#     evaluation of the fitted instance, as one process, under `mpirun -np 2`, and under SLURM (`sbatch` of the scripts here, whose
 #     `srun --mpi=pmix` starts 2 tasks) on a single-node cluster brought up for the check
 #     (slurm-up.sh); the logs, the fitted instances and the evaluations must be identical;
 #  2. a rank killed in the middle of a 2-rank collection, and a 2-task SLURM job cancelled in
@@ -28,7 +28,9 @@ trap cleanup EXIT
 mpirun=(mpirun -np 2 --oversubscribe)
 if [ "$(id -u)" -eq 0 ]; then mpirun+=(--allow-run-as-root); fi
 world="$root/data/domains/navigation.json"
-collect=(collect --domain navigation --world "$world" --trials 100 --seed 1 --threads 1 --log nav.jsonl
+# With --features: the records of a corpus for conditional models (docs/learning.md) come out of
+# the ranks as out of one process.
+collect=(collect --domain navigation --world "$world" --trials 100 --seed 1 --threads 1 --features --log nav.jsonl
   --instance nav.json)
 evaluate=(evaluate nav.json --solver dp-rerun --episodes 20000 --seed 1 --threads 1 --json --no-timing)
 kitchen="$root/data/instances/manipulation.json"

@@ -6,6 +6,7 @@
 #include <memory>
 #include <utility>
 
+#include "ontime/learn/online_belief.hpp"
 #include "ontime/learn/online_update.hpp"
 #include "ontime/mdp/mdp.hpp"
 #include "ontime/run/episode_runner.hpp"
@@ -16,65 +17,6 @@
 #include "ontime/util/random.hpp"
 
 namespace ontime {
-namespace {
-
-// What the robot saw of each action in one episode: the step its motion was found at, or the
-// steps spent without one when the episode ended.
-struct Attempts {
-  std::vector<Steps> found;  // 0: not found
-  std::vector<Steps> spent;
-};
-
-// The allocator the episode runner drives, recording each action's attempt from the transitions
-// it is told of (one runner: the episode loop is the library's).
-class RecordingAllocator final : public Allocator {
- public:
-  RecordingAllocator(const Mdp& mdp, std::unique_ptr<Allocator> inner, Attempts& attempts)
-      : mdp_(&mdp), inner_(std::move(inner)), attempts_(&attempts) {
-    const auto actions = static_cast<std::size_t>(mdp.problem().action_count());
-    attempts_->found.assign(actions, 0);
-    attempts_->spent.assign(actions, 0);
-  }
-
-  std::string_view name() const noexcept override { return inner_->name(); }
-  void begin_episode(std::uint64_t seed) override { inner_->begin_episode(seed); }
-  int choose(const State& state) override { return inner_->choose(state); }
-  int choose(const State& state, const DecisionBudget& budget) override { return inner_->choose(state, budget); }
-  bool is_stationary() const noexcept override { return inner_->is_stationary(); }
-
-  void observe(const State& before, int choice, const State& after, Status status) override {
-    inner_->observe(before, choice, after, status);
-    const int action = mdp_->next_action(before, choice);
-    if (action < 0) return;  // an idle step
-    const auto k = static_cast<std::size_t>(choice);
-    const auto a = static_cast<std::size_t>(action);
-    if (after.refined[k] > before.refined[k]) {
-      attempts_->found[a] = static_cast<Steps>(before.spent[k]) + 1;
-    } else {
-      attempts_->spent[a] = static_cast<Steps>(after.spent[k]);
-    }
-  }
-
- private:
-  const Mdp* mdp_;
-  std::unique_ptr<Allocator> inner_;
-  Attempts* attempts_;
-};
-
-// The truth's skeletons with the posterior means as planning times and the prior's executions.
-Problem believed(const Problem& prior_on_truth, const std::vector<PlanningPosterior>& posteriors) {
-  std::vector<Action> actions(prior_on_truth.actions().begin(), prior_on_truth.actions().end());
-  for (std::size_t a = 0; a < actions.size(); ++a) actions[a].planning = posteriors[a].mean();
-  std::vector<std::vector<int>> skeletons;
-  skeletons.reserve(static_cast<std::size_t>(prior_on_truth.skeleton_count()));
-  for (int k = 0; k < prior_on_truth.skeleton_count(); ++k) {
-    skeletons.emplace_back(prior_on_truth.skeleton(k).begin(), prior_on_truth.skeleton(k).end());
-  }
-  return {prior_on_truth.name(), prior_on_truth.deadline(), prior_on_truth.step_seconds(),
-          std::move(actions),    std::move(skeletons),      prior_on_truth.description()};
-}
-
-}  // namespace
 
 AdaptationResult run_adaptation(const Problem& truth, const Problem& prior, const AdaptationOptions& options) {
   if (!(std::isfinite(options.strength) && options.strength > 0)) {
@@ -83,7 +25,6 @@ AdaptationResult run_adaptation(const Problem& truth, const Problem& prior, cons
   if (options.episodes < 1 || options.sequences < 1) throw UsageError("episodes and sequences must be at least 1");
   const Problem prior_on_truth = with_distributions_of(truth, prior);
   const Mdp truth_mdp(truth);
-  const Steps horizon = truth.deadline();
 
   AdaptationResult result;
   result.sequences = options.sequences;
@@ -93,32 +34,23 @@ AdaptationResult run_adaptation(const Problem& truth, const Problem& prior, cons
   for_each_block(options.sequences, options.threads, 1, [&](unsigned) {
     return [&](std::uint64_t begin, std::uint64_t end) {
       for (std::uint64_t r = begin; r < end; ++r) {
-        std::vector<PlanningPosterior> posteriors;
-        posteriors.reserve(static_cast<std::size_t>(prior_on_truth.action_count()));
-        for (const Action& action : prior_on_truth.actions()) {
-          posteriors.emplace_back(action.planning, horizon, options.strength);
-        }
+        OnlineBelief belief(prior_on_truth, options.strength);
         HiddenWorld world(truth, 0);
         const std::uint64_t sequence_seed = stream_seed(options.seed, r);
         for (std::uint64_t e = 0; e < episodes; ++e) {
-          const Problem belief = believed(prior_on_truth, posteriors);
-          const Mdp belief_mdp(belief);
+          const Problem believed = belief.believed();
+          const Mdp belief_mdp(believed);
           const AllocatorFactory factory = make_allocator_factory(options.solver, belief_mdp, options.parameters);
           if (options.exact) {
             const std::unique_ptr<Allocator> judged = factory();
             exact[r * episodes + e] = evaluate_exactly(truth_mdp, *judged, options.max_states).success_probability;
           }
-          Attempts attempts;
-          RecordingAllocator allocator(truth_mdp, factory(), attempts);
-          const EpisodeResult episode = run_episode(truth_mdp, allocator, world, stream_seed(sequence_seed, e));
+          // The allocator plans with the belief; the truth's transitions answer (the same state
+          // layout: the belief is the truth's structure).
+          const std::unique_ptr<Allocator> allocator = factory();
+          const EpisodeResult episode = run_episode(truth_mdp, *allocator, world, stream_seed(sequence_seed, e));
           succeeded[r * episodes + e] = episode.status == Status::success ? 1 : 0;
-          for (std::size_t a = 0; a < posteriors.size(); ++a) {
-            if (attempts.found[a] > 0) {
-              posteriors[a].observe_found(attempts.found[a]);
-            } else if (attempts.spent[a] > 0) {
-              posteriors[a].observe_cut_off(attempts.spent[a]);
-            }
-          }
+          belief.observe(truth, episode.attempts);
         }
       }
     };

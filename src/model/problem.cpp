@@ -83,6 +83,15 @@ int Problem::find_action(std::string_view id) const noexcept {
   return -1;
 }
 
+std::string_view action_base_id(std::string_view id) noexcept {
+  const std::size_t hash = id.rfind('#');
+  if (hash == std::string_view::npos || hash == 0 || hash + 1 == id.size()) return id;
+  for (std::size_t i = hash + 1; i < id.size(); ++i) {
+    if (id[i] < '0' || id[i] > '9') return id;
+  }
+  return id.substr(0, hash);
+}
+
 Problem with_distributions_of(const Problem& structure, const Problem& distributions) {
   if (distributions.deadline() != structure.deadline()) {
     reject("the deadlines differ (" + std::to_string(distributions.deadline()) + " and " +
@@ -95,18 +104,13 @@ Problem with_distributions_of(const Problem& structure, const Problem& distribut
   }
   std::vector<Action> actions(structure.actions().begin(), structure.actions().end());
   for (Action& action : actions) {
-    const int source = distributions.find_action(action.id);
+    int source = distributions.find_action(action.id);
+    if (source < 0) source = distributions.find_action(action_base_id(action.id));
     if (source < 0) reject("no distributions for the action " + action.id);
     action.planning = distributions.action(source).planning;
     action.execution = distributions.action(source).execution;
   }
-  std::vector<std::vector<int>> skeletons;
-  skeletons.reserve(static_cast<std::size_t>(structure.skeleton_count()));
-  for (int k = 0; k < structure.skeleton_count(); ++k) {
-    skeletons.emplace_back(structure.skeleton(k).begin(), structure.skeleton(k).end());
-  }
-  return {structure.name(),   structure.deadline(), structure.step_seconds(),
-          std::move(actions), std::move(skeletons), structure.description()};
+  return structure.with_actions(std::move(actions));
 }
 
 }  // namespace ontime

@@ -135,6 +135,7 @@ EpisodeResult drive(Session& session, World& world, const DecisionBudget& budget
   result.solution = session.solution();
   result.steps_used = session.steps_used();
   result.skeletons = session.problem().skeleton_count();
+  result.attempts = session.take_attempts();
   if (live) {
     result.live = session.totals();
     result.model_status = session.model_status();
@@ -187,7 +188,9 @@ EpisodeResult run_streaming_episode(const StreamingRun& streaming, World& world,
   session.expect_more_skeletons(arrivals.open);
   if (live) session.charge_outside(first->charged_seconds + first_search);
   EpisodeResult result = drive(session, world, budget, timer, live, &arrivals);
-  if (live && live->keep_timeline) result.problem = std::make_shared<const Problem>(session.problem());
+  if (streaming.keep_problem || (live && live->keep_timeline)) {
+    result.problem = std::make_shared<const Problem>(session.problem());
+  }
   return result;
 }
 
@@ -362,13 +365,20 @@ MonteCarloResult run_many(const WorldFactory& worlds, const AllocatorFactory* al
                           const MonteCarloOptions& options, const RunOne& run_one) {
   const auto started = std::chrono::steady_clock::now();
   const bool split = split_over_ranks(options.ranks);
-  const RankUnits mine = rank_units(options.episodes, options.ranks);
+  // The units handed out are whole sequences (one episode each unless sequence_length says more).
+  const std::uint64_t length = options.sequence_length;
+  if (length < 1 || options.episodes % length != 0) {
+    throw UsageError("episodes in sequences: " + std::to_string(options.episodes) + " episodes are not sequences of " +
+                     std::to_string(length));
+  }
+  const RankUnits mine = rank_units(options.episodes / length, options.ranks);
   const std::uint64_t count = mine.count;
   // Episodes are handed out in blocks: the hand-out and the progress report cost little even
   // when an episode takes a fraction of a microsecond. Short runs (often of long episodes,
   // against a real planner) get smaller blocks, so that every thread has some.
   std::vector<ThreadRun> runs(worker_count(count, options.threads));
-  const std::uint64_t block = std::clamp<std::uint64_t>(count / (8 * runs.size()), 1, 256);
+  const std::uint64_t block =
+      std::clamp<std::uint64_t>(count / (8 * runs.size()), 1, std::max<std::uint64_t>(1, 256 / length));
   std::atomic<std::uint64_t> done{0};
   std::mutex progress_mutex;
   // Split runs: this rank's episode results, packed for the other ranks' on_episode.
@@ -379,9 +389,10 @@ MonteCarloResult run_many(const WorldFactory& worlds, const AllocatorFactory* al
     if (allocators != nullptr) run.allocator = (*allocators)();
     run.world = worlds();
     return [&](std::uint64_t begin, std::uint64_t end) {
-      for (std::uint64_t local = begin; local < end; ++local) {
-        const std::uint64_t episode = mine.unit(local);
+      for (std::uint64_t local = 0; local < (end - begin) * length; ++local) {
+        const std::uint64_t episode = mine.unit(begin + local / length) * length + local % length;
         if (options.stop && options.stop()) throw Cancelled("episodes stopped at the caller's request");
+        if (options.before_episode) options.before_episode(episode, *run.world);
         const EpisodeResult result = run_one(run, stream_seed(options.seed, episode));
         if (result.status == Status::success) ++run.successes;
         if (options.live) {
@@ -400,10 +411,11 @@ MonteCarloResult run_many(const WorldFactory& worlds, const AllocatorFactory* al
         }
         if (options.time_decisions) run.timer.end_episode();
       }
-      const std::uint64_t finished = done.fetch_add(end - begin) + (end - begin);
+      const std::uint64_t episodes_done = (end - begin) * length;
+      const std::uint64_t finished = done.fetch_add(episodes_done) + episodes_done;
       if (options.progress) {
         const std::lock_guard lock(progress_mutex);
-        options.progress(finished, count);
+        options.progress(finished, count * length);
       }
     };
   });

@@ -174,6 +174,11 @@ Status Session::report_live(int choice, int action, const Observation& observati
   const double elapsed = reported - started_ + charged_outside_;
   // The model counted one step; the clock may say more (an overrun) or less (an early answer).
   const auto effort = static_cast<Steps>(std::max(1.0, std::floor(planning / step_seconds_ + kSliceTolerance)));
+  if (action >= 0) {
+    ActionAttempt& attempt = attempts_[static_cast<std::size_t>(action)];
+    attempt.effort = std::min<Steps>(attempt.effort + effort, Distribution::kMaxStep);
+    attempt.found = observation.refined;
+  }
   if (action >= 0 && !observation.refined && effort > 1) {
     for (const int member : mdp_->problem().members(action)) {
       std::uint16_t& spent = state_.spent[static_cast<std::size_t>(member)];

@@ -24,7 +24,12 @@
 namespace ontime {
 
 Session::Session(const Mdp& mdp, Allocator& allocator, std::uint64_t seed)
-    : mdp_(&mdp), allocator_(&allocator), state_(mdp.start()), before_(state_), seed_(seed) {
+    : mdp_(&mdp),
+      allocator_(&allocator),
+      state_(mdp.start()),
+      before_(state_),
+      attempts_(static_cast<std::size_t>(mdp.problem().action_count())),
+      seed_(seed) {
   allocator_->begin_episode(seed);
 }
 
@@ -35,7 +40,11 @@ Session::Session(const Mdp& mdp, Allocator& allocator, std::uint64_t seed, const
 
 // before_ stays empty until a transition needs it (a live report): a caller-decided session that
 // is not live never copies its state.
-Session::Session(const Mdp& mdp) : mdp_(&mdp), allocator_(nullptr), state_(mdp.start()) {}
+Session::Session(const Mdp& mdp)
+    : mdp_(&mdp),
+      allocator_(nullptr),
+      state_(mdp.start()),
+      attempts_(static_cast<std::size_t>(mdp.problem().action_count())) {}
 
 Session::Session(const Mdp& mdp, const Clock& clock, LiveOptions options) : Session(mdp) { start_live(clock, options); }
 
@@ -55,6 +64,7 @@ Session::Session(Problem problem, AllocatorMaker make_allocator, std::uint64_t s
   allocator_ = owned_allocator_.get();
   state_ = mdp_->start();
   before_ = state_;
+  attempts_.assign(static_cast<std::size_t>(owned_problem_->action_count()), ActionAttempt{});
   action_execution_steps_.assign(static_cast<std::size_t>(owned_problem_->action_count()), -1);
   action_execution_seconds_.assign(static_cast<std::size_t>(owned_problem_->action_count()), -1.0);
   if (allocator_ != nullptr) allocator_->begin_episode(seed);
@@ -153,6 +163,12 @@ Status Session::report(const Observation& observation, double execution_seconds)
   if (allocator_ != nullptr || clock_ != nullptr) before_ = state_;
   const Status model_status = mdp_->apply(state_, choice, observation);
   pending_ = -1;
+  if (action >= 0 && clock_ == nullptr) {
+    // One step of effort (a live session counts the slices its report charges: report_live).
+    ActionAttempt& attempt = attempts_[static_cast<std::size_t>(action)];
+    ++attempt.effort;
+    attempt.found = observation.refined;
+  }
   // Only live and owning sessions keep what each action revealed; a plain session (an episode of
   // a Monte Carlo run) does no work for it.
   if (action >= 0 && observation.refined && !action_execution_steps_.empty()) {
@@ -223,6 +239,7 @@ void Session::change_skeletons(std::vector<Action> actions, std::vector<std::vec
   allocator_ = owned_allocator_.get();
   state_ = std::move(state);
   before_ = state_;
+  attempts_.resize(static_cast<std::size_t>(owned_problem_->action_count()));
   action_execution_steps_.resize(static_cast<std::size_t>(owned_problem_->action_count()), -1);
   action_execution_seconds_.resize(static_cast<std::size_t>(owned_problem_->action_count()), -1.0);
   ++changes_;
@@ -268,14 +285,18 @@ int Session::add_skeleton(const std::vector<std::string>& action_ids, std::vecto
     }
     path.push_back(index);
   }
-  std::vector<std::vector<int>> skeletons;
-  skeletons.reserve(static_cast<std::size_t>(current.skeleton_count()) + 1);
-  for (int k = 0; k < current.skeleton_count(); ++k)
-    skeletons.emplace_back(current.skeleton(k).begin(), current.skeleton(k).end());
+  std::vector<std::vector<int>> skeletons = current.skeleton_lists();
   skeletons.push_back(std::move(path));
   const int added = current.skeleton_count();
   change_skeletons(std::move(actions), std::move(skeletons));
   return added;
+}
+
+void Session::revise_distributions(const Problem& beliefs) {
+  check_changeable(owned_problem_ != nullptr, pending_, status_, "revise_distributions");
+  const Problem& current = mdp_->problem();
+  const Problem revised = with_distributions_of(current, beliefs);
+  change_skeletons(std::vector<Action>(revised.actions().begin(), revised.actions().end()), current.skeleton_lists());
 }
 
 void Session::retire_skeleton(int k) {

@@ -130,6 +130,55 @@ TEST(Cli, TampOnTheModelledClockReproducesToTheEpisode) {
   EXPECT_NE(wall.err.find("--clock model needs --effort checks"), std::string::npos) << wall.err;
 }
 
+// Learning across episodes: the success by episode index over the sequences, adding up to the
+// run's; the text report prints it; options that do not go together are refused before any work.
+TEST(Cli, TampLearnsAcrossTheEpisodesOfEachSequence) {
+  const std::string world = testing::source_path("data/domains/navigation.json").string();
+  const std::string library = testing::source_path("data/instances/navigation.json").string();
+  const std::vector<std::string> base = {"tamp",       "--world", world,      "--library",  library,
+                                         "--deadline", "45",      "--solver", "dp-rerun",   "--max-skeletons",
+                                         "3",          "--clock", "model",    "--episodes", "3"};
+  std::vector<std::string> command = base;
+  command.insert(command.end(), {"--sequences", "4", "--adapt-strength", "2", "--json"});
+  const auto result = ontime(command);
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const json out = json::parse(result.out);
+  EXPECT_EQ(out["episodes"].get<int>(), 12);
+  const json& adaptation = out["adaptation"];
+  EXPECT_EQ(adaptation["sequences"].get<int>(), 4);
+  EXPECT_EQ(adaptation["episodes_per_sequence"].get<int>(), 3);
+  ASSERT_EQ(adaptation["by_episode"].size(), 3u);
+  int successes = 0;
+  for (const json& episode : adaptation["by_episode"]) {
+    const int count = episode["successes"].get<int>();
+    EXPECT_DOUBLE_EQ(episode["success_rate"].get<double>(), count / 4.0);
+    successes += count;
+  }
+  EXPECT_EQ(successes, out["successes"].get<int>());
+  command = base;
+  command.insert(command.end(), {"--sequences", "2", "--adapt-strength", "2"});
+  const auto text = ontime(command);
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("online update        2 sequences of 3 episodes, the library a prior of strength 2"),
+            std::string::npos)
+      << text.out;
+  EXPECT_NE(text.out.find("success by episode   1:"), std::string::npos) << text.out;
+
+  command = base;
+  command.insert(command.end(), {"--sequences", "2"});
+  const auto lonely = ontime(command);
+  EXPECT_EQ(lonely.exit_code, 2);
+  EXPECT_NE(lonely.err.find("--sequences needs --adapt-strength"), std::string::npos) << lonely.err;
+  command = base;
+  command.insert(command.end(), {"--adapt-strength", "0"});
+  EXPECT_EQ(ontime(command).exit_code, 2);
+  command = base;
+  command.insert(command.end(), {"--adapt-strength", "2", "--picture", "x.png"});
+  const auto picture = ontime(command);
+  EXPECT_EQ(picture.exit_code, 2);
+  EXPECT_NE(picture.err.find("--picture is not taken with --adapt-strength"), std::string::npos) << picture.err;
+}
+
 // Live episodes against the real planner: every episode's charges and timeline in the JSON, one
 // episode's timeline as CSV; the live options need a live run.
 TEST(Cli, RunLiveReportsEveryEpisodesChargesAndTimeline) {

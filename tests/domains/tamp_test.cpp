@@ -210,22 +210,28 @@ TEST(DomainInterface, TaskPlannersAndSkeletonPointsOfEachDomain) {
   EXPECT_TRUE(kitchen.domain->skeleton_points(kitchen.domain->skeletons().front()).empty());
 }
 
-// The loop on the modelled clock: the same episodes for any thread count, every one kept with the
-// skeletons found, and the drawn episode the same as the run's.
-TEST(RunTamp, TheModelledClockGivesTheSameEpisodesForAnyThreadCount) {
-  const Fixture& f = fixture();
+// dp-rerun on the office's first three room paths, 45 s, on the modelled clock, every episode kept.
+TampOptions modelled_tamp(std::uint64_t episodes, std::uint64_t seed) {
   TampOptions options;
   options.solver = "dp-rerun";
   options.deadline = 45;
   options.effort = EffortSettings{EffortUnit::collision_checks, 1200.0};
-  options.episodes = 4;
-  options.seed = 3;
+  options.episodes = episodes;
+  options.seed = seed;
   options.max_skeletons = 3;
   options.thinking = ThinkingModel{};
   options.keep_episodes = true;
-  options.picture_episode = 2;
   options.world_name = "navigation.json";
   options.threads = 1;
+  return options;
+}
+
+// The loop on the modelled clock: the same episodes for any thread count, every one kept with the
+// skeletons found, and the drawn episode the same as the run's.
+TEST(RunTamp, TheModelledClockGivesTheSameEpisodesForAnyThreadCount) {
+  const Fixture& f = fixture();
+  TampOptions options = modelled_tamp(4, 3);
+  options.picture_episode = 2;
   const TampResult one = run_tamp(f.domain, f.library, options);
   options.threads = 2;
   const TampResult two = run_tamp(f.domain, f.library, options);
@@ -245,6 +251,50 @@ TEST(RunTamp, TheModelledClockGivesTheSameEpisodesForAnyThreadCount) {
   for (const EpisodeSkeleton& skeleton : one.picture->drawing.skeletons) EXPECT_GE(skeleton.points.size(), 3U);
 
   options.deadline = 2;
+  EXPECT_THROW(run_tamp(f.domain, f.library, options), UsageError);
+}
+
+// Learning across episodes (the online update): sequences give the same episodes for any thread
+// count, each sequence's first episode is the plain run's episode of the same index (it plans with
+// the library itself), and the successes by episode add up to the run's.
+TEST(RunTamp, SequencesThatLearnAcrossEpisodesStartFromTheLibraryAndReproduce) {
+  const Fixture& f = fixture();
+  TampOptions options = modelled_tamp(6, 5);
+  const TampResult plain = run_tamp(f.domain, f.library, options);
+
+  options.episodes = 3;
+  options.adaptation = TampAdaptation{.strength = 1.0, .sequences = 2};
+  const TampResult one = run_tamp(f.domain, f.library, options);
+  options.threads = 2;
+  const TampResult two = run_tamp(f.domain, f.library, options);
+  ASSERT_EQ(one.episodes.size(), 6U);
+  ASSERT_EQ(one.successes_by_episode.size(), 3U);
+  EXPECT_EQ(one.successes_by_episode, two.successes_by_episode);
+  EXPECT_EQ(one.successes_by_episode[0] + one.successes_by_episode[1] + one.successes_by_episode[2],
+            one.summary.successes);
+  EXPECT_EQ(one.summary.episodes, 6U);
+  for (std::size_t e = 0; e < 6; ++e) {
+    EXPECT_EQ(one.episodes[e].status, two.episodes[e].status) << e;
+    EXPECT_EQ(one.episodes[e].live.elapsed, two.episodes[e].live.elapsed) << e;
+  }
+  for (const std::size_t first : {std::size_t{0}, std::size_t{3}}) {
+    EXPECT_EQ(one.episodes[first].status, plain.episodes[first].status) << first;
+    EXPECT_EQ(one.episodes[first].live.elapsed, plain.episodes[first].live.elapsed) << first;
+    EXPECT_EQ(one.episodes[first].attempts.size(), plain.episodes[first].attempts.size()) << first;
+  }
+  // Every episode saw some effort on some action: what the next one learns from.
+  for (const EpisodeResult& episode : one.episodes) {
+    Steps effort = 0;
+    for (const ActionAttempt& attempt : episode.attempts) effort += attempt.effort;
+    EXPECT_GT(effort, 0);
+  }
+
+  options.adaptation = TampAdaptation{.strength = 0.0, .sequences = 2};
+  EXPECT_THROW(run_tamp(f.domain, f.library, options), UsageError);
+  options.adaptation = TampAdaptation{.strength = 1.0, .sequences = 0};
+  EXPECT_THROW(run_tamp(f.domain, f.library, options), UsageError);
+  options.adaptation = TampAdaptation{.strength = 1.0, .sequences = 2};
+  options.picture_episode = 0;
   EXPECT_THROW(run_tamp(f.domain, f.library, options), UsageError);
 }
 

@@ -215,6 +215,72 @@ TEST(ChangingSkeletons, EveryAllocatorPlaysThroughArrivalsAndRetirements) {
   }
 }
 
+// Revised distributions (an online belief's posterior): the state stays, every action takes the
+// belief's distributions (a node "x#2" its base's), and the allocator decides as a fresh one made
+// for the revised problem; a belief that lacks an action changes nothing.
+TEST(ChangingSkeletons, RevisedDistributionsKeepTheStateAndTheAllocatorPlansWithThem) {
+  const Problem full = testing::paper_instance("instance1");
+  // The belief: every action's planning distribution that of the action after it (cyclically).
+  std::vector<Action> shifted(full.actions().begin(), full.actions().end());
+  for (std::size_t a = 0; a < shifted.size(); ++a) {
+    shifted[a].planning = full.action(static_cast<int>((a + 1) % shifted.size())).planning;
+  }
+  const Problem belief(full.name(), full.deadline(), full.step_seconds(), shifted, {{0}});
+  for (const char* name : {"optimal", "dp-rerun", "greedy"}) {
+    SCOPED_TRACE(name);
+    for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+      Session session(with_skeletons(full, {0, 1, 2}), maker(name), seed);
+      HiddenWorld world(full, seed);
+      std::vector<std::pair<int, Observation>> history;
+      play(session, world, 2, history);
+      if (session.status() != Status::running) continue;
+      const State before = session.state();
+      session.revise_distributions(belief);
+      EXPECT_EQ(session.state(), before);
+      for (int a = 0; a < full.action_count(); ++a) {
+        EXPECT_EQ(session.problem().action(a).planning, belief.action(a).planning) << a;
+        EXPECT_EQ(session.problem().action(a).execution, full.action(a).execution) << a;
+      }
+      if (session.status() != Status::running) continue;
+      const Problem revised = with_distributions_of(with_skeletons(full, {0, 1, 2}), belief);
+      const Mdp fresh_mdp(revised);
+      auto fresh = make_allocator_factory(name, fresh_mdp)();
+      fresh->begin_episode(0);
+      EXPECT_EQ(session.choose().skeleton, fresh->choose(session.state())) << "seed " << seed;
+    }
+  }
+  // A belief without some action: refused, nothing changed.
+  Session session(with_skeletons(full, {0, 1}), maker("dp-rerun"), 1);
+  const Problem partial(full.name(), full.deadline(), full.step_seconds(), {full.action(0)}, {{0}});
+  EXPECT_THROW(session.revise_distributions(partial), UsageError);
+  EXPECT_EQ(session.problem().action(1).planning, full.action(1).planning);
+  // Only a session that owns its problem can revise it.
+  const Mdp mdp(full);
+  auto allocator = make_allocator_factory("greedy", mdp)();
+  Session fixed(mdp, *allocator);
+  EXPECT_THROW(fixed.revise_distributions(full), std::logic_error);
+}
+
+// Each action's attempt as the session saw it: a step of effort per call in the model; on the
+// clock, the slices its calls were charged (as PT_k counts them).
+TEST(ChangingSkeletons, TheSessionRecordsEachActionsAttempt) {
+  const Problem full = testing::paper_instance("instance1");
+  ManualClock clock;
+  Session session(with_skeletons(full, {0}), nullptr, 1, &clock);
+  const int first = full.skeleton(0)[0];
+  session.decide(0);
+  clock.advance(full.step_seconds() * 2.5);  // an overrun: 2 slices of effort
+  session.report_not_yet();
+  EXPECT_EQ(session.attempts()[static_cast<std::size_t>(first)].effort, 2);
+  EXPECT_FALSE(session.attempts()[static_cast<std::size_t>(first)].found);
+  session.decide(0);
+  clock.advance(full.step_seconds());
+  session.report_refined(1);
+  EXPECT_EQ(session.attempts()[static_cast<std::size_t>(first)].effort, 3);
+  EXPECT_TRUE(session.attempts()[static_cast<std::size_t>(first)].found);
+  EXPECT_EQ(session.state().spent[0], 0);
+}
+
 TEST(ChangingSkeletons, ALiveSessionKeepsItsClockAcrossChanges) {
   const Problem full = testing::paper_instance("instance1");
   ManualClock clock;

@@ -262,6 +262,57 @@ TEST(EpisodeRunner, EpisodeEHasItsOwnSeedForTheWorldAndAnotherStreamForTheAlloca
   }
 }
 
+// Episodes in sequences: each sequence's episodes run in order on one thread, before_episode sees
+// the thread's own world just before each, and the seeds and results stay those of the episodes'
+// indices (the same successes as a run without sequences, for any thread count).
+TEST(EpisodeRunner, SequencesRunInOrderOnOneThreadWithTheSameSeedsAndResults) {
+  const Problem problem = testing::paper_instance("instance3");
+  const Mdp mdp(problem);
+  const AllocatorFactory factory = make_allocator_factory("dp-rerun", mdp);
+  const WorldFactory worlds = [&problem] { return std::make_unique<HiddenWorld>(problem, 0); };
+  MonteCarloOptions options;
+  options.episodes = 600;
+  options.seed = 5;
+  options.threads = 1;
+  std::vector<std::uint8_t> plain(600, 0);
+  options.on_episode = [&](std::uint64_t episode, const EpisodeResult& result) {
+    plain[episode] = result.status == Status::success ? 1 : 0;
+  };
+  const MonteCarloResult independent = run_episodes(mdp, worlds, factory, options);
+
+  for (const unsigned threads : {1U, 2U, 3U}) {
+    SCOPED_TRACE(threads);
+    options.threads = threads;
+    options.sequence_length = 20;
+    std::vector<std::uint8_t> sequenced(600, 0);
+    std::vector<std::uint64_t> last(30, 0);  // per sequence: the next episode expected
+    std::vector<const World*> world_of(30, nullptr);
+    std::mutex mutex;
+    bool in_order = true, one_world = true;
+    options.before_episode = [&](std::uint64_t episode, World& world) {
+      const std::lock_guard lock(mutex);
+      const std::uint64_t sequence = episode / 20;
+      in_order = in_order && episode == sequence * 20 + last[sequence];
+      ++last[sequence];
+      if (world_of[sequence] == nullptr) world_of[sequence] = &world;
+      one_world = one_world && world_of[sequence] == &world;
+    };
+    options.on_episode = [&](std::uint64_t episode, const EpisodeResult& result) {
+      sequenced[episode] = result.status == Status::success ? 1 : 0;
+    };
+    const MonteCarloResult run = run_episodes(mdp, worlds, factory, options);
+    EXPECT_TRUE(in_order);
+    EXPECT_TRUE(one_world);
+    EXPECT_EQ(last, std::vector<std::uint64_t>(30, 20));
+    EXPECT_EQ(run.successes, independent.successes);
+    EXPECT_EQ(sequenced, plain);
+  }
+  options.sequence_length = 7;  // 600 episodes are no whole number of sequences of 7
+  EXPECT_THROW(run_episodes(mdp, worlds, factory, options), UsageError);
+  options.sequence_length = 0;
+  EXPECT_THROW(run_episodes(mdp, worlds, factory, options), UsageError);
+}
+
 // Decides as dp-rerun does, and counts the decisions that came with a budget of 7 iterations.
 class BudgetRecorder final : public Allocator {
  public:

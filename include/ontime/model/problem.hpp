@@ -9,6 +9,8 @@
 #include <cstddef>
 #include <span>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "ontime/model/distribution.hpp"
@@ -62,6 +64,14 @@ class Problem {
   // True when some skeleton ends with this action (refining it may complete a plan).
   bool completes_a_skeleton(int action) const { return completes_.at(static_cast<std::size_t>(action)) != 0; }
 
+  // The skeletons as lists of action indices (a copy, e.g. to build a changed problem).
+  std::vector<std::vector<int>> skeleton_lists() const { return skeletons_; }
+  // This problem (name, deadline, step, skeletons, description) with other actions, in the same
+  // order: e.g. other distributions for the same ids. Throws UsageError as the constructor does.
+  Problem with_actions(std::vector<Action> actions) const {
+    return {name_, deadline_, step_seconds_, std::move(actions), skeletons_, description_};
+  }
+
  private:
   std::string name_;
   std::string description_;
@@ -75,9 +85,16 @@ class Problem {
   std::vector<char> completes_;
 };
 
+// The action an id names in the world: the id without a trailing "#n" (one or more digits). A
+// skeletons' prefix tree holds an action reached under another prefix as a node of its own,
+// "move(R8,R9)#2" (the streaming TAMP loop and generated buildings name it so); it is the same
+// action, with the same distributions, features and refinement. An id without such a suffix is
+// its own base.
+std::string_view action_base_id(std::string_view id) noexcept;
+
 // `structure` (its name, skeletons, deadline and step) with every action's distributions taken
-// from the action of the same id in `distributions`: the instance an allocator plans with when
-// its beliefs differ from the world's (a prediction, a pooled fit, a posterior), in the state
+// from the action of the same id in `distributions` (failing that, of the same action_base_id): the instance an
+// allocator plans with when its beliefs differ from the world's (a prediction, a pooled fit, a posterior), in the state
 // layout of `structure`, so that its decisions can be scored in the true instance. Throws
 // UsageError naming the first action `distributions` lacks, or a deadline or step that differs.
 Problem with_distributions_of(const Problem& structure, const Problem& distributions);

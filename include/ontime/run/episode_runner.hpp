@@ -48,10 +48,13 @@ struct EpisodeResult {
   LiveTotals live;
   Status model_status = Status::running;
   std::vector<LiveStep> timeline;
-  // Streaming episodes: the skeletons found, and (when the timeline is kept) the episode's final
-  // problem, whose action and skeleton indices the timeline uses.
+  // Streaming episodes: the skeletons found, and (when the timeline is kept, or
+  // StreamingRun::keep_problem) the episode's final problem, whose action and skeleton indices the
+  // timeline and `attempts` use.
   int skeletons = 0;
   std::shared_ptr<const Problem> problem;
+  // What the episode saw of each action (Session::attempts), by action index.
+  std::vector<ActionAttempt> attempts;
 };
 
 // Live episodes (session.hpp): each a live session on its world's clock (World::clock(), else
@@ -82,6 +85,7 @@ struct StreamingRun {
   Session::AllocatorMaker make_allocator;
   int period = 1;
   int max_skeletons = kMaxExactSkeletons;
+  bool keep_problem = false;  // every episode's final problem in its result (the ids of its attempts)
 };
 
 // One streaming episode with seed `seed`, as run_episode.
@@ -108,10 +112,19 @@ struct MonteCarloOptions {
   // are numbered 0 .. episodes - 1). In a run split over ranks, every rank gets every episode:
   // its own as they end, the other ranks' (without `problem`) once all have ended.
   std::function<void(std::uint64_t episode, const EpisodeResult& result)> on_episode;
+  // Episodes in sequences of this many consecutive ones (`episodes` must be a multiple of it):
+  // each sequence runs in order on one thread (and one rank), so that what one episode taught
+  // (on_episode) can shape the next (before_episode): a robot that learns across the episodes of
+  // one world (online_belief.hpp). 1: every episode on its own. Seeds and results stay those of
+  // the episode's index, so the numbers do not depend on the thread or rank count.
+  std::uint64_t sequence_length = 1;
+  // Called on the thread that runs it, just before episode `episode` begins, with that thread's
+  // world (the one `worlds` made for it).
+  std::function<void(std::uint64_t episode, World& world)> before_episode;
   // When set, the episodes are split over these ranks (ranks.hpp): each runs its share on its
   // own threads, then they exchange their results, and every rank returns the same totals (the
   // numbers of one process, latencies aside). Every rank must make the same call. `progress`
-  // counts the rank's own share.
+  // counts the rank's own share. Sequences are not split: each rank takes whole ones.
   const Ranks* ranks = nullptr;
 };
 

@@ -91,6 +91,17 @@ struct Decision {
   int action = -1;    // the action to refine now, or -1: the step is spent idle
 };
 
+// What a session saw of one action: the steps of effort its refinement got (a live session
+// counts each planner call as the slices it charged to the action, as PT_k does, at least one)
+// and whether that refinement found a motion. An action never picked has effort 0. Within an
+// episode an action is refined once, so this is one attempt: found after `effort` steps, or cut
+// off after `effort` steps without a motion when the session ended (online_belief.hpp learns from
+// it).
+struct ActionAttempt {
+  Steps effort = 0;
+  bool found = false;
+};
+
 class Session {
  public:
   // Makes the allocator of a session whose skeletons change: called with the first Mdp and
@@ -174,6 +185,16 @@ class Session {
   // infeasible); later skeletons move down by one index. The last one leaving ends the session
   // as a failure. Same errors as add_skeleton.
   void retire_skeleton(int k);
+  // Sessions that own their problem: every action takes the distributions of the action of
+  // `beliefs` with the same id or, failing that, the same action_base_id (problem.hpp: a node
+  // "move(A,B)#2" takes the belief's "move(A,B)"), e.g. an online belief's posterior means
+  // (online_belief.hpp); the skeletons, the state and what was refined stay. The allocator is made
+  // anew for the revised problem and decides from the current state, as after add_skeleton (so a
+  // search or the exact solver plans with the new distributions). An action still in progress
+  // keeps the effort spent on it, and the revised distribution is conditioned on it as any is.
+  // Throws UsageError for an action `beliefs` lacks, or another deadline or step; the same
+  // std::logic_error as add_skeleton. The session is unchanged when it throws.
+  void revise_distributions(const Problem& beliefs);
   // Sessions that own their problem: while more skeletons are expected (a task planner is still
   // searching), the session does not end when no skeleton found so far can still succeed; the
   // caller adds one (can_succeed() tells when it must) or says no more will come, which ends
@@ -191,6 +212,10 @@ class Session {
   int solution() const noexcept { return solution_; }
   // Steps of effort spent so far (CT).
   Steps steps_used() const noexcept { return state_.time; }
+  // What the session saw of each action of problem() so far, by action index.
+  const std::vector<ActionAttempt>& attempts() const noexcept { return attempts_; }
+  // The same, moved out (the episode runner's result takes it when the session is done).
+  std::vector<ActionAttempt> take_attempts() noexcept { return std::move(attempts_); }
 
   bool is_live() const noexcept { return clock_ != nullptr; }
   // Whether an allocator decides (choose()) rather than the caller (decide()).
@@ -239,6 +264,8 @@ class Session {
   int pending_ = -1;         // the skeleton decided, awaiting its report
   int pending_action_ = -1;  // its action (-1: an idle step)
   int solution_ = -1;
+  // By action index (every session: one entry updated per step, nothing allocated).
+  std::vector<ActionAttempt> attempts_;
 
   // Live and owning sessions: what every action revealed (by action index; actions are only
   // ever appended): its execution once refined, in steps and seconds, -1 before. Empty otherwise.

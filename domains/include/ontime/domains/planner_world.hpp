@@ -104,6 +104,10 @@ class PlannerWorld final : public World {
   // (nullptr) in the wall-clock unit, where planner calls take the time they take.
   const Clock* clock() const noexcept override;
   std::optional<FoundSkeleton> next_skeleton() override;
+  // Streaming worlds: the library the distributions of the skeletons found from now on come from
+  // (e.g. an online belief's, between two episodes); it must outlive its use and have the
+  // library's step. Throws std::invalid_argument for a world that does not stream or another step.
+  void set_library(const Problem& library);
 
   // The episode's actions so far (domain action ids, prefix-tree parents) and their refinements
   // (null for an action never picked), for pictures of the last episode.

@@ -29,13 +29,24 @@
 
 namespace ontime::domains {
 
+// Repeated episodes in the world with the online update (online_belief.hpp): `sequences`
+// independent sequences of TampOptions::episodes episodes each; in a sequence, each episode's
+// allocator plans with the library's planning distributions updated by every attempt the robot
+// made in the sequence's episodes before it (found after t steps, or still unrefined after c when
+// the episode ended), the library as the prior worth `strength` attempts.
+struct TampAdaptation {
+  double strength = 10;
+  std::uint64_t sequences = 1;
+};
+
 struct TampOptions {
   std::string solver;
   ParameterValues parameters;
   double deadline = 0;  // seconds; whole steps of the library's step_seconds count
   EffortSettings effort;
-  std::uint64_t episodes = 100;
-  std::uint64_t seed = 1;       // episode e uses stream e of it
+  std::uint64_t episodes = 100;  // with `adaptation`: per sequence
+  std::uint64_t seed = 1;        // episode e uses stream e of it (episode e of sequence r: r * episodes + e)
+  std::optional<TampAdaptation> adaptation;
   unsigned threads = 0;         // 0: one per hardware thread
   double task_seconds = 0.5;    // search seconds charged for each skeleton found
   int arrival_period = 2;       // steps between two skeletons (sooner when none found can still succeed)
@@ -66,7 +77,9 @@ struct TampResult {
   MonteCarloResult summary;
   double mean_skeletons_found = 0;      // per episode
   double refinements_started = 0;       // per episode
-  std::vector<EpisodeResult> episodes;  // with keep_episodes
+  std::vector<EpisodeResult> episodes;  // with keep_episodes (sequence by sequence with adaptation)
+  // With adaptation: per episode index of a sequence, how many of the sequences succeeded there.
+  std::vector<std::uint64_t> successes_by_episode;
   // With picture_episode, on the root rank, unless the task planner found no skeleton then.
   std::optional<TampPicture> picture;
 };
@@ -75,9 +88,9 @@ struct TampResult {
 Steps tamp_deadline_steps(const Problem& library, double deadline);
 
 // Refuses, before any work: the modelled clock with wall-clock effort, a picture episode past
-// the run, a deadline of less than one or more than Problem::kMaxDeadline steps (UsageError,
-// parameters named as `spelling` writes them), and a library without an action that a skeleton
-// of the task planner needs (InputError naming the library).
+// the run, an adaptation without sequences or with a strength that is not positive and finite, a deadline of less than
+// one or more than Problem::kMaxDeadline steps (UsageError, parameters named as `spelling` writes them), and a library
+// without an action that a skeleton of the task planner needs (InputError naming the library).
 void check_tamp_request(const Domain& domain, const Problem& library, const TampOptions& options,
                         const ParameterSpelling& spelling = nullptr);
 
