@@ -18,10 +18,10 @@ namespace {
 std::filesystem::path kitchen() { return testing::source_path("tests/data/ompl_logs/kitchen.log"); }
 
 RefinementAttempt found(std::string action, double planning, double execution) {
-  return {std::move(action), planning, true, execution, std::nullopt, std::nullopt, std::nullopt, {}};
+  return {std::move(action), planning, true, execution, std::nullopt, std::nullopt, std::nullopt, {}, std::nullopt};
 }
 RefinementAttempt cut_off(std::string action, double planning) {
-  return {std::move(action), planning, false, 0.0, std::nullopt, std::nullopt, std::nullopt, {}};
+  return {std::move(action), planning, false, 0.0, std::nullopt, std::nullopt, std::nullopt, {}, std::nullopt};
 }
 
 TEST(OmplBenchmarkLog, ReadsEveryRunOfEveryPlannerAndCensorsAtTheTimeLimit) {

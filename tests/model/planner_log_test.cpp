@@ -32,7 +32,7 @@ TEST(PlannerLog, ReadsEveryFieldAndSkipsBlankLines) {
 
 TEST(PlannerLog, WritesWhatItReads) {
   RefinementAttempt found{"a", 0.1 + 0.2, true, 1.0 / 3.0, 12, 3456, std::nullopt, {}};
-  RefinementAttempt cut_off{"b(x,y)", 44.0, false, 0.0, std::nullopt, std::nullopt, std::nullopt, {}};
+  RefinementAttempt cut_off{"b(x,y)", 44.0, false, 0.0, std::nullopt, std::nullopt, std::nullopt, {}, std::nullopt};
   const std::string text = planner_log_line(found) + planner_log_line(cut_off);
   const std::vector<RefinementAttempt> back = parse_planner_log(text, "log");
   ASSERT_EQ(back.size(), 2u);
