@@ -212,9 +212,20 @@ def main():
                               "0.5,1,2,5,10,20,50,100,200,500"])
         strengths[kind] = scored["best"]
 
+    # A run that was stopped continues: the worlds results.json already holds under the same
+    # settings are kept, not measured again.
     worlds = []
+    done = {}
+    if os.path.exists(runner.path("results.json")):
+        with open(runner.path("results.json"), encoding="utf-8") as text:
+            previous = json.load(text)
+        if previous.get("settings") == vars(args) and previous.get("strengths") == strengths:
+            done = {w["seed"]: w for w in previous["worlds"]}
     for i, seed in enumerate(HELD_OUT_SEEDS[: args.held_out]):
         print(f"held-out world {i + 1}/{args.held_out} (seed {seed})", file=sys.stderr)
+        if seed in done:
+            worlds.append(done[seed])
+            continue
         world = runner.world(seed, held_out=True)
         deadline = runner.deadline(world)
         log, oracle = runner.collect(world, args.oracle_trials, "", False, deadline)

@@ -265,7 +265,7 @@ std::string to_text(const Tamp& tamp) {
       summary.live_mean.elapsed, deadline_seconds(result));
   out += fmt::format("refinements started  {:.2f} per episode\n", result.refinements_started);
   if (options.adaptation) {
-    const double sequences = static_cast<double>(options.adaptation->sequences);
+    const auto sequences = static_cast<double>(options.adaptation->sequences);
     out += fmt::format("online update        {} sequences of {} episodes, the library a prior of strength {}\n",
                        options.adaptation->sequences, options.episodes, options.adaptation->strength);
     out += "success by episode  ";

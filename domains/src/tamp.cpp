@@ -115,7 +115,7 @@ TampResult run_tamp(const Domain& domain, const Problem& library, const TampOpti
         mine->library = mine->belief->believed();
       }
       // The worlds are the streaming planner worlds made below.
-      static_cast<PlannerWorld&>(world).set_library(mine->library);
+      dynamic_cast<PlannerWorld&>(world).set_library(mine->library);
     };
   }
   // Each episode writes its own slot: no two threads touch one.

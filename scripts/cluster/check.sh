@@ -30,8 +30,9 @@ if [ "$(id -u)" -eq 0 ]; then mpirun+=(--allow-run-as-root); fi
 world="$root/data/domains/navigation.json"
 # With --features: the records of a corpus for conditional models (docs/learning.md) come out of
 # the ranks as out of one process.
-collect=(collect --domain navigation --world "$world" --trials 100 --seed 1 --threads 1 --features --log nav.jsonl
+job_collect=(--domain navigation --world "$world" --trials 100 --seed 1 --features --log nav.jsonl
   --instance nav.json)
+collect=(collect "${job_collect[@]}" --threads 1)
 evaluate=(evaluate nav.json --solver dp-rerun --episodes 20000 --seed 1 --threads 1 --json --no-timing)
 kitchen="$root/data/instances/manipulation.json"
 cut=("$kitchen" --max-states 300000 --json --stats --no-timing)
@@ -122,8 +123,7 @@ usage_error_once mpirun "${mpirun[@]}"
 eval "$("$root/scripts/cluster/slurm-up.sh" "$slurm_dir")"
 export ONTIME="$ontime"
 sbatch --wait --ntasks 2 --chdir "$work/slurm-run" --output "$work/slurm-run/collect.out" \
-  "$root/scripts/cluster/collect.sbatch" --domain navigation --world "$world" --trials 100 --seed 1 \
-  --log nav.jsonl --instance nav.json > /dev/null
+  "$root/scripts/cluster/collect.sbatch" "${job_collect[@]}" > /dev/null
 sbatch --wait --ntasks 2 --chdir "$work/slurm-run" --output "$work/slurm-run/evaluate.json" --error "$work/slurm-run/evaluate.err" \
   "$root/scripts/cluster/evaluate.sbatch" nav.json --solver dp-rerun --episodes 20000 --seed 1 --json \
   --no-timing > /dev/null
@@ -135,8 +135,7 @@ same slurm-run solve-cut.json
 # --resume as a job of one task, it completes to the same files.
 mkdir -p "$work/slurm-cancel"
 job=$(sbatch --parsable --ntasks 2 --chdir "$work/slurm-cancel" --output "$work/slurm-cancel/collect.out" \
-  "$root/scripts/cluster/collect.sbatch" --domain navigation --world "$world" --trials 100 --seed 1 \
-  --log nav.jsonl --instance nav.json)
+  "$root/scripts/cluster/collect.sbatch" "${job_collect[@]}")
 wait_for_journal "$work/slurm-cancel"
 scancel "$job"
 for _ in $(seq 600); do
@@ -149,8 +148,7 @@ if [ -e "$work/slurm-cancel/nav.jsonl" ] || [ "$cancelled_at" -eq 0 ]; then
   exit 1
 fi
 sbatch --wait --ntasks 1 --chdir "$work/slurm-cancel" --output "$work/slurm-cancel/resumed.out" \
-  "$root/scripts/cluster/collect.sbatch" --domain navigation --world "$world" --trials 100 --seed 1 \
-  --log nav.jsonl --instance nav.json --resume > /dev/null
+  "$root/scripts/cluster/collect.sbatch" "${job_collect[@]}" --resume > /dev/null
 grep -q "attempts were done before" "$work/slurm-cancel/resumed.out"
 same slurm-cancel nav.jsonl nav.json
 echo "cluster check: a job cancelled after $cancelled_at journal lines, resumed as a job of one task"
