@@ -54,10 +54,12 @@ class PythonWorld final : public World {
     const py::gil_scoped_acquire acquire;
     const py::object result = world_.attr("step")(action, spent);
     if (result.is_none()) return Observation::not_yet();
-    if (py::isinstance<py::tuple>(result) && py::len(result) == 2 &&
-        py::str(result[0]).cast<std::string>() == "backtrack") {
-      // ("backtrack", culprit action index): the attempt gave up blaming that action (SPEC §7).
-      return Observation::backtracked(result[1].cast<int>());
+    if (py::isinstance<py::tuple>(result)) {
+      const auto pair = result.cast<py::tuple>();
+      if (py::len(pair) == 2 && py::isinstance<py::str>(pair[0]) && pair[0].cast<std::string>() == "backtrack") {
+        // ("backtrack", culprit action index): the attempt gave up blaming that action (SPEC §7).
+        return Observation::backtracked(pair[1].cast<int>());
+      }
     }
     if (py::isinstance<py::bool_>(result)) {
       throw UsageError("World.step must return None (not yet) or the execution time in steps, not a bool");

@@ -35,6 +35,11 @@ double BacktrackingSuccess::found_continuation(int k, int l, std::int64_t ct, st
   next.push_back(problem.culprit_slot(action) >= 0
                      ? static_cast<std::uint16_t>(std::min<std::int64_t>(et, deadline_ + 1))
                      : std::uint16_t{0});
+  // A skeleton sharing this action that ends with it is complete, and succeeds (x <= left), as
+  // in Eq. (1).
+  const auto next_value = [&](int member, std::int64_t x) {
+    return problem.skeleton_length(member) == l + 1 ? 1.0 : fresh(member, l + 1, ct, et + x, next);
+  };
   double total = 0;
   for (std::int64_t x = 0; x <= left; ++x) {
     const double mass = execution.pmf(static_cast<Steps>(x));
@@ -45,12 +50,10 @@ double BacktrackingSuccess::found_continuation(int k, int l, std::int64_t ct, st
         combined = fresh(k, l + 1, ct, et + x, next);
         break;
       case Aggregation::sum:
-        for (const int member : problem.members(action)) combined += fresh(member, l + 1, ct, et + x, next);
+        for (const int member : problem.members(action)) combined += next_value(member, x);
         break;
       case Aggregation::max:
-        for (const int member : problem.members(action)) {
-          combined = std::max(combined, fresh(member, l + 1, ct, et + x, next));
-        }
+        for (const int member : problem.members(action)) combined = std::max(combined, next_value(member, x));
         break;
     }
     total += mass * combined;

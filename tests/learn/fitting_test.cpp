@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
+#include <string>
+#include <utility>
 
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/learn/log_sampling.hpp"
@@ -15,6 +18,18 @@
 
 namespace ontime {
 namespace {
+
+// One attempt of a log (RefinementAttempt has more optional fields than these tests use).
+RefinementAttempt attempt(std::string action, double planning_seconds, bool found, double execution_seconds = 0,
+                          std::optional<std::string> backtrack = std::nullopt) {
+  RefinementAttempt made;
+  made.action = std::move(action);
+  made.planning_seconds = planning_seconds;
+  made.found = found;
+  made.execution_seconds = execution_seconds;
+  made.backtrack = std::move(backtrack);
+  return made;
+}
 
 // A heavy-tailed planning time: geometric over 1..40 (so partly beyond D = 22), 10% never.
 Distribution heavy_tailed_planning() {
@@ -56,25 +71,25 @@ TEST(Fitting, RoundsTimesUpToWholeSteps) {
 
 TEST(Fitting, CensoredAttemptsLowerTheHazardInsteadOfBeingDropped) {
   // Two found at step 1, two cut off after the whole deadline: half the mass is "never".
-  const Distribution fitted = estimate_planning({{1, 1}, {4, 4}}, 4);
+  const Distribution fitted = estimate_planning({{1, 1}, {4, 4}, {}, {}}, 4);
   EXPECT_DOUBLE_EQ(fitted.pmf(1), 0.5);
   EXPECT_DOUBLE_EQ(fitted.never(), 0.5);
   // Found at 1 and 3, two cut off after 2 steps: h(1) = 1/4, h(2) = 0/3, h(3) = 1/1.
-  const Distribution km = estimate_planning({{1, 3}, {2, 2}}, 4);
+  const Distribution km = estimate_planning({{1, 3}, {2, 2}, {}, {}}, 4);
   EXPECT_DOUBLE_EQ(km.pmf(1), 0.25);
   EXPECT_DOUBLE_EQ(km.pmf(2), 0.0);
   EXPECT_DOUBLE_EQ(km.pmf(3), 0.75);
   EXPECT_NEAR(km.never(), 0.0, 1e-15);
   // Nobody at risk after the last cut-off: the log says nothing about that mass, so "never".
-  const Distribution unknown = estimate_planning({{1}, {2}}, 5);
+  const Distribution unknown = estimate_planning({{1}, {2}, {}, {}}, 5);
   EXPECT_DOUBLE_EQ(unknown.pmf(1), 0.5);
   EXPECT_DOUBLE_EQ(unknown.never(), 0.5);
   // Found after the deadline, or cut off after more steps than it: only survival is known.
-  const Distribution late = estimate_planning({{2, 9}, {30}}, 3);
+  const Distribution late = estimate_planning({{2, 9}, {30}, {}, {}}, 3);
   EXPECT_NEAR(late.pmf(2), 1.0 / 3.0, 1e-15);
   EXPECT_NEAR(late.never(), 2.0 / 3.0, 1e-15);
   // An attempt cut off before its first step ended carries no information.
-  const Distribution early = estimate_planning({{1, 2}, {0, 0, 0}}, 2);
+  const Distribution early = estimate_planning({{1, 2}, {0, 0, 0}, {}, {}}, 2);
   EXPECT_DOUBLE_EQ(early.pmf(1), 0.5);
   EXPECT_DOUBLE_EQ(early.pmf(2), 0.5);
 }
@@ -109,12 +124,9 @@ TEST(Fitting, BacktracksAreASecondKindOfEventNotACutOff) {
 // A log with backtrack records fits an instance that backtracks; a record blaming an action that
 // is not before it on the skeletons' path is refused naming the log.
 TEST(Fitting, FitsBacktrackingFromTheLog) {
-  const std::vector<RefinementAttempt> log{
-      {.action = "a", .planning_seconds = 1, .found = true, .execution_seconds = 1},
-      {.action = "b", .planning_seconds = 2, .found = false, .backtrack = "a"},
-      {.action = "b", .planning_seconds = 1, .found = false, .backtrack = "a"},
-      {.action = "b", .planning_seconds = 3, .found = true, .execution_seconds = 1},
-      {.action = "b", .planning_seconds = 1, .found = true, .execution_seconds = 2}};
+  const std::vector<RefinementAttempt> log{attempt("a", 1, true, 1), attempt("b", 2, false, 0, "a"),
+                                           attempt("b", 1, false, 0, "a"), attempt("b", 3, true, 1),
+                                           attempt("b", 1, true, 2)};
   const SkeletonList skeletons{"skeletons.json", {{"a", "b"}}};
   FitOptions options;
   options.deadline = 5;
@@ -129,9 +141,7 @@ TEST(Fitting, FitsBacktrackingFromTheLog) {
   EXPECT_EQ(fit.actions[1].censored, 0U);
   EXPECT_FALSE(fit.problem.action(0).backtrack.never() < 1.0);
 
-  const std::vector<RefinementAttempt> wrong{
-      {.action = "a", .planning_seconds = 1, .found = false, .backtrack = "b"},
-      {.action = "b", .planning_seconds = 1, .found = true, .execution_seconds = 1}};
+  const std::vector<RefinementAttempt> wrong{attempt("a", 1, false, 0, "b"), attempt("b", 1, true, 1)};
   try {
     fit_problem(wrong, "log.jsonl", skeletons, options);
     ADD_FAILURE() << "no error";
@@ -203,12 +213,12 @@ TEST(Fitting, SampledBacktrackingLogsFitBack) {
 
 TEST(Fitting, LaplaceSmoothingIsAddAlphaOverTheCategories) {
   // Uncensored: exactly (count + alpha) / (n + alpha (D + 1)) over 1..D and "never".
-  const Distribution plain = estimate_planning({{1, 1, 2}, {}}, 2, 1.0);
+  const Distribution plain = estimate_planning({{1, 1, 2}, {}, {}, {}}, 2, 1.0);
   EXPECT_NEAR(plain.pmf(1), 3.0 / 6.0, 1e-15);
   EXPECT_NEAR(plain.pmf(2), 2.0 / 6.0, 1e-15);
   EXPECT_NEAR(plain.never(), 1.0 / 6.0, 1e-15);
   // With a cut-off attempt: h(1) = (1 + 1) / (2 + 3), h(2) = (0 + 1) / (0 + 2).
-  const Distribution censored = estimate_planning({{1}, {1}}, 2, 1.0);
+  const Distribution censored = estimate_planning({{1}, {1}, {}, {}}, 2, 1.0);
   EXPECT_NEAR(censored.pmf(1), 0.4, 1e-15);
   EXPECT_NEAR(censored.pmf(2), 0.3, 1e-15);
   EXPECT_NEAR(censored.never(), 0.3, 1e-15);
@@ -277,7 +287,7 @@ TEST(Fitting, RecoversAKnownDistributionFromCensoredData) {
   double at_risk = static_cast<double>(n) - leaving_at[0];
   double greenwood_sum = 0;
   double largest_naive_error = 0, largest_bound = 0;
-  PlanningSample naive{found_only, {}};
+  PlanningSample naive{found_only, {}, {}, {}};
   const Distribution dropped = estimate_planning(naive, deadline);
   for (Steps t = 1; t <= deadline; ++t) {
     if (at_risk > found_at[t]) greenwood_sum += found_at[t] / (at_risk * (at_risk - found_at[t]));
@@ -307,9 +317,9 @@ TEST(Fitting, RecoversAKnownExecutionDistributionWithinTheDkwBound) {
 }
 
 TEST(Fitting, RejectsBadEstimationOptions) {
-  EXPECT_THROW(estimate_planning({{1}, {}}, 0), UsageError);
-  EXPECT_THROW(estimate_planning({{1}, {}}, 5, -1.0), UsageError);
-  EXPECT_THROW(estimate_planning({{0}, {}}, 5), UsageError);
+  EXPECT_THROW(estimate_planning({{1}, {}, {}, {}}, 0), UsageError);
+  EXPECT_THROW(estimate_planning({{1}, {}, {}, {}}, 5, -1.0), UsageError);
+  EXPECT_THROW(estimate_planning({{0}, {}, {}, {}}, 5), UsageError);
   EXPECT_THROW(estimate_execution(std::vector<Steps>{-1}, 5), UsageError);
 }
 
