@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Backtracking-aware against backtracking-ignorant allocation (docs/backtracking.md), exactly.
+"""Backtracking-aware against backtracking-ignorant allocation (docs/spec.md §7), exactly.
 
 For each instance (the truth, with backtracking, SPEC §7): a planner log of N attempts per action is
 drawn from it (`ontime sample-log`, backtrack records included) and fitted three ways:
