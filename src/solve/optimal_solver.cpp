@@ -47,7 +47,7 @@ class OptimalBacktrackPolicy {
   void choices(const Compact& state, std::vector<int>& out) const {
     for (const int choice : mdp_->useful_choices(state)) out.push_back(choice);
   }
-  const Compact& key(const Compact& state) const { return state; }
+  static const Compact& key(const Compact& state) { return state; }
 
  private:
   const Mdp* mdp_;
