@@ -20,13 +20,16 @@
 // Unlike Eq. (1) V depends on CT and ET separately (a backtrack keeps the time and restores the
 // execution), and on the restore values later backtracks may use, so it is not tabulated up
 // front: values are memoised as they are asked for (a query the first time costs
-// O(positions x D x (|supp e| |N| + |culprits|)) recursively, later ones a hash lookup). One
-// evaluator per allocator: it is not thread-safe.
+// O(positions x D x (|supp e| |N| + |culprits|)), later ones a hash lookup). Every value depends
+// only on values at a later CT (an attempt takes at least one step), so they are settled with an
+// explicit stack, deepest first, rather than by recursion that the deadline would make deep. A
+// key is five integers: the restore lists are interned (one number per distinct list), so a
+// decision after warm-up allocates nothing. One evaluator per allocator: it is not thread-safe.
 
 #include <absl/container/flat_hash_map.h>
 
 #include <cstdint>
-#include <string>
+#include <utility>
 #include <vector>
 
 #include "ontime/mdp/mdp.hpp"
@@ -46,18 +49,48 @@ class BacktrackingSuccess {
   std::size_t memoised() const noexcept { return memo_.size(); }
 
  private:
-  // V(k, l, ct, et, restores) for a fresh attempt at position l; `restores` holds, for every
-  // position before l whose action some action may blame, its restore value (by position).
-  double fresh(int k, int l, std::int64_t ct, std::int64_t et, const std::vector<std::uint16_t>& restores);
-  // The part of a step that ends the attempt at CT' = ct with a motion, or a backtrack.
-  double found_continuation(int k, int l, std::int64_t ct, std::int64_t et, const std::vector<std::uint16_t>& restores);
-  double backtrack_continuation(int k, int l, std::int64_t ct, const std::vector<std::uint16_t>& restores);
+  // A fresh attempt at position l of skeleton k at time ct with execution et, and the restore
+  // values of the positions before l (an interned list: restore_parent_ and restore_value_).
+  struct Key {
+    std::int32_t skeleton;
+    std::int32_t position;
+    std::int32_t time;
+    std::int32_t execution;
+    std::uint32_t restores;
+    bool operator==(const Key&) const = default;
+    template <typename H>
+    friend H AbslHashValue(H hash, const Key& key) {
+      return H::combine(std::move(hash), key.skeleton, key.position, key.time, key.execution, key.restores);
+    }
+  };
+
+  // V of `key`, settling every value it needs first.
+  double fresh(const Key& key);
+  // The sum over the attempt's steps for `key`, its attempt already `spent` steps old (not
+  // divided by the survival). Values it needs that are not known yet are pushed on pending_ and
+  // `ready` is cleared (the sum is then incomplete).
+  double attempt(const Key& key, Steps spent, bool& ready);
+  // The value of a needed key: 0 past the deadline, memoised, or pending (0, not ready).
+  double need(const Key& key, bool& ready);
+  // Settles pending_ until it is empty.
+  void settle();
+
+  // The list `parent` with `value` appended, and the value at `position` of a list of length
+  // `length` and its prefix of that length.
+  std::uint32_t append_restore(std::uint32_t parent, std::uint16_t value);
+  std::uint16_t restore_at(std::uint32_t list, int length, int position) const;
+  std::uint32_t restore_prefix(std::uint32_t list, int length, int position) const;
 
   const Mdp* mdp_;
   Aggregation aggregation_;
   Steps deadline_;
-  // Keys: skeleton, position, CT, ET and the restores before it, as text of 16-bit values.
-  absl::flat_hash_map<std::string, double> memo_;
+  absl::flat_hash_map<Key, double> memo_;
+  std::vector<Key> pending_;
+  // Interned restore lists: list 0 is empty, list i > 0 is list restore_parent_[i] followed by
+  // restore_value_[i]; restore_child_ finds a list from (parent << 16 | value).
+  std::vector<std::uint32_t> restore_parent_{0};
+  std::vector<std::uint16_t> restore_value_{0};
+  absl::flat_hash_map<std::uint64_t, std::uint32_t> restore_child_;
 };
 
 }  // namespace ontime
