@@ -181,6 +181,41 @@ TEST(Backtracking, DpAndDpRerunDecideWithTheExtendedEquation) {
   }
 }
 
+// Every allocator of the registry runs under backtracking: the stationary ones' exact values stay
+// below the optimum and their simulated success rates agree with them, the randomised ones'
+// rates stay below the optimum (within sampling error). ppo, which needs a trained policy, is
+// tested in tests/learn/ppo_test.cpp (Ppo.DecidesUnderBacktracking).
+TEST(Backtracking, EveryAllocatorDecidesUnderIt) {
+  const AllocatorRegistry& registry = allocator_registry();
+  int instances = 0;
+  for (std::uint64_t seed = 1; instances < 4; ++seed) {
+    const Problem problem = with_backtracking(testing::random_instance(seed, 3, 3, 7), seed + 4000);
+    if (!problem.has_backtracking()) continue;
+    ++instances;
+    const Mdp mdp(problem);
+    OptimalSolver solver(mdp);
+    const double optimum = solver.solve(mdp.start());
+    for (const std::string& name : registry.names({}, {Capability::needs_policy})) {
+      SCOPED_TRACE("seed " + std::to_string(seed) + " " + name);
+      const ParameterValues values = name == "mcts" ? ParameterValues{{"iterations", "200"}} : ParameterValues{};
+      const AllocatorFactory factory = make_allocator_factory(name, mdp, values);
+      MonteCarloOptions options;
+      options.episodes = name == "mcts" ? 1'000 : 4'000;
+      options.seed = seed;
+      options.threads = 1;
+      const double rate = run_monte_carlo(mdp, factory, options).success_rate;
+      const double error = std::sqrt(std::max(optimum * (1 - optimum), 1e-4) / static_cast<double>(options.episodes));
+      EXPECT_LE(rate, optimum + 4 * error);
+      if (registry.find(name).capabilities.has(Capability::stationary)) {
+        const double exact = evaluate_exactly(mdp, *factory()).success_probability;
+        EXPECT_LE(exact, optimum + 1e-12);
+        EXPECT_NEAR(rate, exact,
+                    4 * std::sqrt(std::max(exact * (1 - exact), 1e-4) / static_cast<double>(options.episodes)));
+      }
+    }
+  }
+}
+
 // The simulator's hidden worlds (each attempt drawn from its own stream) give the exact value's
 // success rate.
 TEST(Backtracking, SimulatedEpisodesAgreeWithTheExactValue) {
@@ -223,6 +258,22 @@ TEST(Backtracking, ZeroBacktrackProbabilitiesGiveTodaysValuesBitForBit) {
       EXPECT_EQ(evaluate_exactly(plain_mdp, *plain_allocator).success_probability,
                 evaluate_exactly(zero_mdp, *zero_allocator).success_probability);
     }
+  }
+  // The navigation instance (collected from the real planner): the allocators' exact values (its
+  // optimum is the layered solver's, which refuses nothing here: the zero problem has no
+  // backtracking).
+  const Problem plain = load_problem(testing::source_path("data/instances/navigation.json"));
+  std::vector<Action> actions(plain.actions().begin(), plain.actions().end());
+  for (Action& action : actions) action.backtrack = Distribution::from_pmf({0.0, 0.0});
+  const Problem zero = plain.with_actions(std::move(actions));
+  ASSERT_FALSE(zero.has_backtracking());
+  const Mdp plain_mdp(plain), zero_mdp(zero);
+  for (const char* solver : {"dp-rerun", "dp", "greedy"}) {
+    SCOPED_TRACE(std::string("navigation ") + solver);
+    const auto plain_allocator = make_allocator_factory(solver, plain_mdp)();
+    const auto zero_allocator = make_allocator_factory(solver, zero_mdp)();
+    EXPECT_EQ(evaluate_exactly(plain_mdp, *plain_allocator).success_probability,
+              evaluate_exactly(zero_mdp, *zero_allocator).success_probability);
   }
 }
 
