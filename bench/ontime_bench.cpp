@@ -61,6 +61,33 @@ void BM_DpRerunDecision(benchmark::State& bench) {
 }
 BENCHMARK(BM_DpRerunDecision)->DenseRange(1, 5);
 
+// The same instance with SeSamE's backtracking (SPEC §7) on every action after a skeleton's first:
+// a fifth of each planning mass becomes backtrack mass at the same step, blaming the action just
+// before. dp-rerun then values skeletons with the extended Eq. (1) (BacktrackingSuccess).
+ontime::Problem with_sesame_backtracking(const ontime::Problem& problem) {
+  std::vector<ontime::Action> actions(problem.actions().begin(), problem.actions().end());
+  for (int a = 0; a < problem.action_count(); ++a) {
+    const int parent = problem.parent(a);
+    if (parent < 0) continue;
+    ontime::Action& action = actions[static_cast<std::size_t>(a)];
+    std::vector<double> planning(action.planning.masses().begin(), action.planning.masses().end());
+    std::vector<double> backtrack(planning.size(), 0.0);
+    for (std::size_t t = 0; t < planning.size(); ++t) {
+      backtrack[t] = planning[t] / 5;
+      planning[t] -= backtrack[t];
+    }
+    action.planning = ontime::Distribution::from_pmf(std::move(planning));
+    action.backtrack = ontime::Distribution::from_pmf(std::move(backtrack));
+    action.culprits = {{problem.action(parent).id, 1.0}};
+  }
+  return problem.with_actions(std::move(actions));
+}
+
+void BM_DpRerunDecisionBacktracking(benchmark::State& bench) {
+  time_dp_rerun_decisions(bench, with_sesame_backtracking(paper(static_cast<int>(bench.range(0)))), 2000);
+}
+BENCHMARK(BM_DpRerunDecisionBacktracking)->DenseRange(1, 5);
+
 // A task planner's many skeletons: `families` groups of skeletons sharing their first two
 // actions, each skeleton with three more of its own, D = 200. Planning takes 1-30 steps (with
 // some chance of never), execution 0-10.

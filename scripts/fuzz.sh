@@ -18,6 +18,6 @@ run() {
   (cd build-fuzz && "./fuzz/$target" -max_total_time="$seconds" -print_final_stats=1 -timeout=10 -max_len=8192 \
      -rss_limit_mb=4096 "corpus/$target" "$@" 2>&1 | tail -n 25)
 }
-run instance_fuzzer ../data/instances/paper ../tests/data/bad ../tests/data/fuzz_regressions ../data/knapsack
+run instance_fuzzer ../data/instances/paper ../data/instances/backtracking ../tests/data/bad ../tests/data/fuzz_regressions ../data/knapsack
 run planner_log_fuzzer ../tests/data/bad_logs ../tests/data/fuzz_regressions ../fuzz/seeds/planner_log
 run ompl_benchmark_log_fuzzer ../tests/data/bad_ompl_logs ../fuzz/seeds/ompl_benchmark_log

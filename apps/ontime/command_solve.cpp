@@ -124,7 +124,8 @@ void add_solve_command(CLI::App& app) {
   command
       ->add_option("--method", options->method,
                    "layered (default: the whole tree; where a cap cuts it, a split follows), split (the strongest "
-                   "first-action subtree enumerated, the others bounded) or memoised")
+                   "first-action subtree enumerated, the others bounded) or memoised (the default for an instance "
+                   "with backtracking, which the others do not take)")
       ->check(CLI::IsMember({"layered", "split", "memoised"}));
   add_number_option(*command, "--max-states", options->max_states,
                     "Cap on states: layered gives an interval past it, memoised stops with an error (default: "
@@ -151,10 +152,19 @@ void add_solve_command(CLI::App& app) {
   command->add_flag("--json", options->json, "Print JSON");
   command->add_flag("--no-timing", options->no_timing,
                     "Layered: leave out measured times and memory, so that outputs can be compared byte for byte");
-  command->callback([options] {
+  command->callback([options, command] {
     const Problem problem = load_problem(options->instance);
     if (problem.skeleton_count() > kMaxExactSkeletons) check_exact_work(problem, 1, options->instance);
     const Mdp mdp(problem);
+    if (problem.has_backtracking()) {
+      // The layered solver and its bounds do not take backtracking (SPEC §7) yet; the memoised
+      // solver does, and is the default for such an instance.
+      if (command->count("--method") > 0 && options->method != "memoised") {
+        throw UsageError("solve --method " + options->method +
+                         " does not take an instance with backtracking (SPEC §7): use --method memoised");
+      }
+      options->method = "memoised";
+    }
     if (options->method == "memoised") {
       if (split_over_ranks(job_ranks())) {
         throw UsageError("solve --method memoised does not split over MPI ranks: use --method layered");

@@ -86,8 +86,10 @@ class World:
     begin_episode(seed) starts an episode whose randomness comes from `seed` alone.
     step(action, spent) spends one step of effort on the action with index `action` (into
     Problem.actions; its parent action is already refined in this episode) which has had `spent`
-    steps so far, and returns None (no motion yet) or the refined motion's execution time in steps
-    (an int >= 0; ontime.NEVER or math.inf when it cannot be executed).
+    steps so far in this attempt, and returns None (no motion yet) or the refined motion's execution
+    time in steps (an int >= 0; ontime.NEVER or math.inf when it cannot be executed); with
+    backtracking (docs/spec.md §7), ("backtrack", culprit) when the attempt gives up blaming the
+    earlier action with index `culprit`.
     statistics() may return counters (name -> number) summed over the run.
     """
 

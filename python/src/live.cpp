@@ -121,6 +121,16 @@ void bind_live(py::module_& m) {
           py::arg("execution_seconds"),
           "The call found a motion taking `execution_seconds` to execute (math.inf: it cannot be executed).")
       .def(
+          "report_backtrack",
+          [](LiveSessionHandle& h, const std::string& culprit) {
+            const int index = h.current->find_action(culprit);
+            if (index < 0) throw UsageError("report_backtrack: no action '" + culprit + "'");
+            return session_call([&] { return h.session.report(Observation::backtracked(index)); });
+          },
+          py::arg("culprit"),
+          "The planner's call gave up (SPEC §7) blaming the earlier action `culprit` (its id): its motion and "
+          "everything refined after it are discarded. Returns the status.")
+      .def(
           "charge_outside",
           [](LiveSessionHandle& h, Seconds seconds) { session_call([&] { h.session.charge_outside(seconds); }); },
           py::arg("seconds"), "Time the clock did not see but the deadline must.")

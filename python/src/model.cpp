@@ -98,6 +98,16 @@ void bind_model(py::module_& m) {
       .def_readonly("id", &Action::id, "The action's id, e.g. 'move(R1,R5)'.")
       .def_readonly("planning", &Action::planning, "Steps of effort until refined (t >= 1).")
       .def_readonly("execution", &Action::execution, "Steps to execute the refined motion (x >= 0).")
+      .def_readonly("backtrack", &Action::backtrack,
+                    "Backtracking (SPEC §7): the steps after which an attempt gives up (all 'never': it does not).")
+      .def_property_readonly(
+          "culprits",
+          [](const Action& a) {
+            py::dict out;
+            for (const Culprit& culprit : a.culprits) out[py::str(culprit.id)] = culprit.probability;
+            return out;
+          },
+          "Backtracking: the earlier actions an attempt that gives up blames, with their probabilities.")
       .def("__repr__", [](const Action& a) { return "ontime.Action('" + a.id + "')"; });
 
   py::class_<Problem, std::shared_ptr<Problem>>(

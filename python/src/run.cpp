@@ -54,6 +54,13 @@ class PythonWorld final : public World {
     const py::gil_scoped_acquire acquire;
     const py::object result = world_.attr("step")(action, spent);
     if (result.is_none()) return Observation::not_yet();
+    if (py::isinstance<py::tuple>(result)) {
+      const auto pair = result.cast<py::tuple>();
+      if (py::len(pair) == 2 && py::isinstance<py::str>(pair[0]) && pair[0].cast<std::string>() == "backtrack") {
+        // ("backtrack", culprit action index): the attempt gave up blaming that action (SPEC §7).
+        return Observation::backtracked(pair[1].cast<int>());
+      }
+    }
     if (py::isinstance<py::bool_>(result)) {
       throw UsageError("World.step must return None (not yet) or the execution time in steps, not a bool");
     }
@@ -206,6 +213,16 @@ void bind_run(py::module_& m) {
           py::arg("execution_steps"),
           "The step just decided found a motion that takes `execution_steps` to execute (ontime.NEVER: it "
           "cannot be executed). Returns the status.")
+      .def(
+          "report_backtrack",
+          [](SessionHandle& h, const std::string& culprit) {
+            const int index = h.allocator->mdp->problem->find_action(culprit);
+            if (index < 0) throw UsageError("report_backtrack: no action '" + culprit + "'");
+            return session_call([&] { return h.session.report(Observation::backtracked(index)); });
+          },
+          py::arg("culprit"),
+          "The step just decided gave up (SPEC §7) blaming the earlier action `culprit` (its id): its motion and "
+          "everything refined after it are discarded. Returns the status.")
       .def_property_readonly("status", [](const SessionHandle& h) { return h.session.status(); })
       .def_property_readonly("state",
                              [](const SessionHandle& h) {

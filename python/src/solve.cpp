@@ -41,13 +41,40 @@ void bind_solve(py::module_& m) {
   m.def(
       "solve",
       [](const py::object& problem, Number<std::uint64_t, "max_states", 1> max_states, Threads threads,
-         const std::string& method, Number<double, "tolerance", 0.0, 1.0> tolerance,
+         const std::optional<std::string>& method_given, Number<double, "tolerance", 0.0, 1.0> tolerance,
          Number<std::uint64_t, "max_memory_mib", 0, (std::uint64_t{1} << 40)> max_memory_mib,
          Number<std::uint64_t, "max_disk_mib", 0, (std::uint64_t{1} << 40)> max_disk_mib, const py::object& scratch,
          const py::object& policy, Number<int, "policy_layers", 1, 1'000'000> policy_layers) {
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
-        if (method != "layered" && method != "split") {
-          throw UsageError("method must be 'layered' or 'split' (got '" + method + "')");
+        // As `ontime solve`: the memoised solver is the default (and the only method) for an
+        // instance with backtracking (SPEC §7), which the layered solver does not take yet.
+        const bool backtracking = mdp->problem->has_backtracking();
+        const std::string method = method_given.value_or(backtracking ? "memoised" : "layered");
+        if (method != "layered" && method != "split" && method != "memoised") {
+          throw UsageError("method must be 'layered', 'split' or 'memoised' (got '" + method + "')");
+        }
+        if (backtracking && method != "memoised") {
+          throw UsageError("solve method '" + method +
+                           "' does not take an instance with backtracking (SPEC §7): use method='memoised'");
+        }
+        if (method == "memoised") {
+          report::Solve solve{.instance = instance_label(problem, *mdp->problem),
+                              .problem = mdp->problem.get(),
+                              .mdp = &mdp->mdp,
+                              .method = method};
+          {
+            const py::gil_scoped_release release;
+            const auto started = std::chrono::steady_clock::now();
+            OptimalSolver solver(mdp->mdp, max_states);
+            const double value = solver.solve(mdp->mdp.start());
+            solve.memoised = true;
+            solve.solution.exact = true;
+            solve.solution.lower = solve.solution.upper = value;
+            solve.solution.states = solver.states();
+            solve.solution.first_choice = solver.best_choice(mdp->mdp.start()).value_or(-1);
+            solve.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+          }
+          return json_object(report::to_json(solve));
         }
         LayeredSolveOptions options;
         options.max_states = max_states;
@@ -82,7 +109,7 @@ void bind_solve(py::module_& m) {
         return json_object(report::to_json(solve));
       },
       py::arg("problem"), py::arg("max_states") = OptimalSolver::kDefaultMaxStates, py::arg("threads") = 0,
-      py::kw_only(), py::arg("method") = "layered", py::arg("tolerance") = 0.0, py::arg("max_memory_mib") = 0,
+      py::kw_only(), py::arg("method") = py::none(), py::arg("tolerance") = 0.0, py::arg("max_memory_mib") = 0,
       py::arg("max_disk_mib") = 0, py::arg("scratch") = py::none(), py::arg("policy") = py::none(),
       py::arg("policy_layers") = 1,
       "The exact optimal success probability and first choice (the layered solver), as `ontime solve --json` "
@@ -94,7 +121,8 @@ void bind_solve(py::module_& m) {
       "in `scratch`, default the system's temporary folder); 0: 80% of the available memory and 90% of the free "
       "disk. policy=FILE writes the choices of the first `policy_layers` layers as `ontime solve --policy` does "
       "(JSON Lines: a state, its choice and the bounds of its value). The GIL is released; Ctrl-C stops it "
-      "(KeyboardInterrupt).");
+      "(KeyboardInterrupt). method='memoised' is the memoised expectimax (OptimalSolver: exact, or an error past "
+      "max_states), the default and only method for an instance with backtracking.");
 }
 
 }  // namespace ontime::python

@@ -1,16 +1,27 @@
 #include "ontime/allocators/dp.hpp"
 
+#include <optional>
+
 #include "ontime/allocators/allocator_registry.hpp"
+#include "ontime/solve/backtracking_success.hpp"
 
 namespace ontime {
 namespace {
 
 int best_single_skeleton(const Mdp& mdp) {
-  const ContiguousSuccessTable table(mdp, Aggregation::self);
+  // Eq. (1), or with backtracking (SPEC §7) its extension, for every skeleton from the start.
+  std::optional<ContiguousSuccessTable> table;
+  std::optional<BacktrackingSuccess> backtracking;
+  if (mdp.has_backtracking()) {
+    backtracking.emplace(mdp, Aggregation::self);
+  } else {
+    table.emplace(mdp, Aggregation::self);
+  }
+  const State start = mdp.start();
   int best = 0;
   double best_value = -1;
   for (int k = 0; k < mdp.skeleton_count(); ++k) {
-    const double value = table.success_probability(k, 0, 0, 0);
+    const double value = table ? table->success_probability(k, 0, 0, 0) : backtracking->success_probability(start, k);
     if (value > best_value) {
       best_value = value;
       best = k;

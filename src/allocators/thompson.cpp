@@ -31,8 +31,79 @@ std::int64_t ThompsonAllocator::drawn_time(int action, Steps spent) {
   return drawn_time_[slot];
 }
 
+std::int64_t ThompsonAllocator::drawn_finish_with_backtracking(const State& state, int k) {
+  const Problem& problem = mdp_->problem();
+  const auto slot = static_cast<std::size_t>(k);
+  const std::span<const int> actions = problem.skeleton(k);
+  const std::int64_t deadline = mdp_->deadline();
+  execution_before_.assign(actions.size() + 1, 0);
+  // The execution before each refined position: the restore values recorded in the state where
+  // there are any (every position some action may blame), else unknown and unneeded.
+  for (std::size_t position = 0; position < state.refined[slot]; ++position) {
+    const int culprit_slot = problem.culprit_slot(actions[position]);
+    if (culprit_slot >= 0) execution_before_[position] = state.restore[static_cast<std::size_t>(culprit_slot)];
+  }
+  std::int64_t time = state.time;
+  std::int64_t execution = state.execution[slot];
+  std::size_t position = state.refined[slot];
+  Steps spent = state.spent[slot];
+  while (position < actions.size()) {
+    const Action& action = problem.action(actions[position]);
+    // The attempt's end, conditioned on `spent` steps that neither found nor backtracked.
+    double ended = 0;
+    for (Steps u = 1; u <= spent; ++u) ended += action.planning.pmf(u) + action.backtrack.pmf(u);
+    const double u = ended + uniform01(generator_) * (1.0 - ended);
+    double cumulative = ended;
+    Steps end = kNever;
+    bool found = false;
+    for (Steps t = spent + 1; t + time - spent <= deadline && end == kNever; ++t) {
+      cumulative += action.planning.pmf(t);
+      if (u < cumulative) {
+        end = t;
+        found = true;
+        break;
+      }
+      cumulative += action.backtrack.pmf(t);
+      if (u < cumulative) end = t;
+    }
+    if (end == kNever) return kNeverFinishes;
+    time += end - spent;
+    spent = 0;
+    if (found) {
+      const Steps drawn = action.execution.sample(generator_);
+      if (drawn == kNever) return kNeverFinishes;
+      execution_before_[position] = execution;
+      execution += drawn;
+      ++position;
+    } else {
+      const auto culprits = problem.culprits(actions[position]);
+      const int culprit =
+          culprits[sample_index(
+                       culprits.size(), [&culprits](std::size_t i) { return culprits[i].probability; }, generator_)]
+              .action;
+      position = static_cast<std::size_t>(problem.position(culprit));
+      execution = execution_before_[position];
+    }
+    if (time >= deadline) return kNeverFinishes;
+  }
+  return time + execution;
+}
+
 int ThompsonAllocator::choose(const State& state) {
   ++decision_;
+  if (mdp_->has_backtracking()) {
+    int best = -1;
+    std::int64_t best_finish = kNeverFinishes;
+    for (int k = 0; k < mdp_->skeleton_count(); ++k) {
+      if (!mdp_->can_succeed(state, k)) continue;
+      const std::int64_t finish = drawn_finish_with_backtracking(state, k);
+      if (best < 0 || finish < best_finish) {
+        best = k;
+        best_finish = finish;
+      }
+    }
+    return best >= 0 ? best : mdp_->first_with_work_left(state);
+  }
   const Problem& problem = mdp_->problem();
   int best = -1;
   std::int64_t best_finish = kNeverFinishes;

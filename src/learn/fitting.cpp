@@ -94,6 +94,58 @@ Distribution estimate_planning(const PlanningSample& sample, Steps deadline, dou
   return Distribution::from_pmf(std::move(masses));
 }
 
+AttemptEstimate estimate_attempts(const PlanningSample& sample, Steps deadline, double laplace) {
+  if (sample.backtracked.empty()) return {estimate_planning(sample, deadline, laplace), Distribution{}, {}};
+  check_estimation_options(deadline, laplace);
+  if (sample.blamed.size() != sample.backtracked.size()) {
+    throw UsageError("every backtracked attempt names the action it blamed");
+  }
+  const auto size = static_cast<std::size_t>(deadline) + 1;
+  std::vector<double> found_at(size, 0.0), back_at(size, 0.0), leaving_at(size, 0.0);
+  double at_risk = 0;
+  const auto event = [&](Steps t, std::vector<double>& at) {
+    if (t < 1) throw UsageError("an attempt ends after at least 1 step");
+    if (t <= deadline) {
+      at[static_cast<std::size_t>(t)] += 1;
+    } else {
+      leaving_at[static_cast<std::size_t>(deadline)] += 1;  // within D it only survived
+    }
+    at_risk += 1;
+  };
+  for (const Steps t : sample.found) event(t, found_at);
+  for (const Steps t : sample.backtracked) event(t, back_at);
+  for (const Steps c : sample.censored) {
+    if (c < 0) throw UsageError("a cut-off attempt survived at least 0 steps");
+    leaving_at[static_cast<std::size_t>(std::min(c, deadline))] += 1;
+    at_risk += 1;
+  }
+  at_risk -= leaving_at[0];
+  std::vector<double> planning(size, 0.0), backtrack(size, 0.0);
+  double survival = 1.0;
+  for (Steps t = 1; t <= deadline; ++t) {
+    const auto slot = static_cast<std::size_t>(t);
+    const double denominator = at_risk + laplace * static_cast<double>(deadline - t + 2);
+    const double found = denominator > 0 ? (found_at[slot] + laplace) / denominator : 0.0;
+    const double back = denominator > 0 ? back_at[slot] / denominator : 0.0;
+    planning[slot] = survival * found;
+    backtrack[slot] = survival * back;
+    survival *= std::max(0.0, 1.0 - found - back);
+    at_risk -= found_at[slot] + back_at[slot] + leaving_at[slot];
+  }
+  AttemptEstimate estimate{
+      Distribution::from_pmf(std::move(planning)), Distribution::from_pmf(std::move(backtrack)), {}};
+  if (estimate.backtrack.never() < 1.0) {
+    for (const std::string& id : sample.blamed) {
+      auto known = std::find_if(estimate.culprits.begin(), estimate.culprits.end(),
+                                [&id](const Culprit& culprit) { return culprit.id == id; });
+      if (known == estimate.culprits.end()) known = estimate.culprits.insert(estimate.culprits.end(), Culprit{id, 0.0});
+      known->probability += 1.0;
+    }
+    for (Culprit& culprit : estimate.culprits) culprit.probability /= static_cast<double>(sample.blamed.size());
+  }
+  return estimate;
+}
+
 Distribution estimate_execution(std::span<const Steps> execution_steps, Steps deadline, double laplace) {
   check_estimation_options(deadline, laplace);
   const auto size = static_cast<std::size_t>(deadline) + 1;
@@ -141,7 +193,7 @@ FitResult fit_problem(std::span<const RefinementAttempt> attempts, std::string_v
     std::vector<int>& indices = skeleton_indices.emplace_back();
     for (const std::string& id : skeleton) {
       const auto [entry, fresh] = index_of.try_emplace(id, static_cast<int>(fits.size()));
-      if (fresh) fits.push_back(ActionFit{id, 0, 0, 0});
+      if (fresh) fits.push_back(ActionFit{id, 0, 0, 0, 0});
       indices.push_back(entry->second);
     }
   }
@@ -157,6 +209,11 @@ FitResult fit_problem(std::span<const RefinementAttempt> attempts, std::string_v
       planning[slot].found.push_back(
           std::max<Steps>(1, steps_to_complete(attempt.planning_seconds, options.step_seconds)));
       execution[slot].push_back(steps_to_complete(attempt.execution_seconds, options.step_seconds));
+    } else if (attempt.backtrack) {
+      ++fits[slot].backtracked;
+      planning[slot].backtracked.push_back(
+          std::max<Steps>(1, steps_to_complete(attempt.planning_seconds, options.step_seconds)));
+      planning[slot].blamed.push_back(*attempt.backtrack);
     } else {
       ++fits[slot].censored;
       planning[slot].censored.push_back(whole_steps_within(attempt.planning_seconds, options.step_seconds));
@@ -173,12 +230,22 @@ FitResult fit_problem(std::span<const RefinementAttempt> attempts, std::string_v
   }
   std::vector<Action> actions;
   for (std::size_t a = 0; a < fits.size(); ++a) {
-    actions.push_back(Action{fits[a].id, estimate_planning(planning[a], options.deadline, options.laplace),
-                             estimate_execution(execution[a], options.deadline, options.laplace)});
+    AttemptEstimate attempt = estimate_attempts(planning[a], options.deadline, options.laplace);
+    actions.emplace_back(fits[a].id, std::move(attempt.planning),
+                         estimate_execution(execution[a], options.deadline, options.laplace),
+                         std::move(attempt.backtrack), std::move(attempt.culprits));
   }
-  Problem problem(options.name, options.deadline, options.step_seconds, std::move(actions), std::move(skeleton_indices),
-                  options.description);
-  return FitResult{std::move(problem), std::move(fits)};
+  try {
+    Problem problem(options.name, options.deadline, options.step_seconds, std::move(actions),
+                    std::move(skeleton_indices), options.description);
+    return FitResult{std::move(problem), std::move(fits)};
+  } catch (const BacktrackingError& error) {
+    // A backtrack record blaming an action that is not before it on the skeletons' path.
+    throw InputError(std::string(log_source), "action '" + error.action() + "'",
+                     error.culprit().empty() ? error.rule()
+                                             : "blames '" + error.culprit() + "': " + error.rule() + " (skeletons " +
+                                                   skeletons.source + ")");
+  }
 }
 
 }  // namespace ontime

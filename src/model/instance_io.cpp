@@ -78,6 +78,13 @@ class InstanceReader {
     try {
       return Problem(std::move(name), static_cast<Steps>(*deadline), step_seconds, std::move(actions),
                      std::move(skeletons), std::move(description));
+    } catch (const BacktrackingError& error) {
+      // The backtracking rules need the skeletons (a culprit must come before the action on its
+      // path): checked by the Problem, placed here.
+      const std::string action = detail::json_member("actions", error.action());
+      fail(error.culprit().empty() ? action
+                                   : detail::json_member(detail::json_member(action, "culprits"), error.culprit()),
+           error.rule());
     } catch (const std::invalid_argument& error) {
       fail("top level", error.what());  // every rule is checked above with its place; kept as a guard
     }
@@ -112,7 +119,7 @@ class InstanceReader {
       if (!value.is_object())
         fail(path, "an action must be an object with 'planning' and 'execution' (got " +
                        detail::describe_json_type(value) + ")");
-      check_keys(value, path, {"planning", "execution"});
+      check_keys(value, path, {"planning", "execution", "backtrack", "culprits"});
       for (const char* required : {"planning", "execution"}) {
         if (!value.contains(required)) fail(path, std::string("missing required key '") + required + "'");
       }
@@ -120,9 +127,28 @@ class InstanceReader {
       action.id = id;
       action.planning = read_distribution(value["planning"], detail::json_member(path, "planning"), 1, "planning");
       action.execution = read_distribution(value["execution"], detail::json_member(path, "execution"), 0, "execution");
+      if (value.contains("backtrack")) {
+        action.backtrack =
+            read_distribution(value["backtrack"], detail::json_member(path, "backtrack"), 1, "backtrack");
+      }
+      if (value.contains("culprits"))
+        action.culprits = read_culprits(value["culprits"], detail::json_member(path, "culprits"));
       actions.push_back(std::move(action));
     }
     return actions;
+  }
+
+  // {"ACTION ID": probability, ...}: the actions an attempt that backtracks blames (SPEC §7).
+  std::vector<Culprit> read_culprits(const Json& value, const std::string& path) const {
+    if (!value.is_object()) {
+      fail(path, "must be an object mapping earlier action ids to probabilities (got " +
+                     detail::describe_json_type(value) + ")");
+    }
+    std::vector<Culprit> culprits;
+    for (const auto& [id, probability] : value.items()) {
+      culprits.push_back({id, read_probability(probability, detail::json_member(path, id))});
+    }
+    return culprits;
   }
 
   Steps read_step(const std::string& key, const std::string& path, Steps first, const char* kind) const {
@@ -250,8 +276,15 @@ std::string problem_to_json(const Problem& problem) {
   root["step_seconds"] = problem.step_seconds();
   Json actions = Json::object();
   for (const Action& action : problem.actions()) {
-    actions[action.id] = Json{{"planning", distribution_to_json(action.planning)},
-                              {"execution", distribution_to_json(action.execution)}};
+    Json entry{{"planning", distribution_to_json(action.planning)},
+               {"execution", distribution_to_json(action.execution)}};
+    if (action.backtrack.never() < 1.0) {
+      entry["backtrack"] = distribution_to_json(action.backtrack);
+      Json culprits = Json::object();
+      for (const Culprit& culprit : action.culprits) culprits[culprit.id] = culprit.probability;
+      entry["culprits"] = culprits;
+    }
+    actions[action.id] = entry;
   }
   root["actions"] = actions;
   Json skeletons = Json::array();

@@ -35,10 +35,10 @@ class LineReader {
       fail("", "a record must be a JSON object (got " + detail::describe_json_type(record) + ")");
     for (const auto& [key, value] : record.items()) {
       if (key != "action" && key != "planning_seconds" && key != "found" && key != "execution_seconds" &&
-          key != "trial" && key != "collision_checks" && key != "world" && key != "features") {
+          key != "trial" && key != "collision_checks" && key != "world" && key != "features" && key != "backtrack") {
         fail(key,
              "unknown key (expected 'action', 'planning_seconds', 'found', 'execution_seconds', 'trial', "
-             "'collision_checks', 'world', 'features')");
+             "'collision_checks', 'world', 'features', 'backtrack')");
       }
     }
     RefinementAttempt attempt;
@@ -61,6 +61,15 @@ class LineReader {
     if (record.contains("trial")) attempt.trial = count(record["trial"], "trial");
     if (record.contains("collision_checks"))
       attempt.collision_checks = count(record["collision_checks"], "collision_checks");
+    if (record.contains("backtrack")) {
+      const Json& blamed = record["backtrack"];
+      if (!blamed.is_string() || blamed.get<std::string>().empty()) {
+        fail("backtrack", "must be a non-empty string naming the earlier action blamed (got " + blamed.dump() + ")");
+      }
+      if (attempt.found) fail("backtrack", "an attempt that backtracked found no motion ('found' must be false)");
+      if (blamed.get<std::string>() == attempt.action) fail("backtrack", "an action cannot blame itself");
+      attempt.backtrack = blamed.get<std::string>();
+    }
     if (record.contains("world")) {
       const Json& world = record["world"];
       if (!world.is_string() || world.get<std::string>().empty()) {
@@ -161,6 +170,7 @@ std::string planner_log_line(const RefinementAttempt& attempt) {
   record["found"] = attempt.found;
   if (attempt.found) record["execution_seconds"] = attempt.execution_seconds;
   if (attempt.collision_checks) record["collision_checks"] = *attempt.collision_checks;
+  if (attempt.backtrack) record["backtrack"] = *attempt.backtrack;
   if (attempt.world) record["world"] = *attempt.world;
   if (!attempt.features.empty()) record["features"] = attempt.features;
   return record.dump() + "\n";

@@ -74,6 +74,64 @@ Problem::Problem(std::string name, Steps deadline, double step_seconds, std::vec
     }
     completes_[static_cast<std::size_t>(path.back())] = 1;
   }
+  index_culprits();
+}
+
+void Problem::index_culprits() {
+  const std::size_t count = actions_.size();
+  culprit_indices_.assign(count, {});
+  culprit_slot_.assign(count, -1);
+  for (std::size_t a = 0; a < count; ++a) {
+    const Action& action = actions_[a];
+    const double backtracking = 1.0 - action.backtrack.never();
+    if (action.backtrack.pmf(0) > 0) throw BacktrackingError(action.id, "", "backtrack steps start at 1");
+    if (backtracking > 0 && 1.0 - action.planning.never() + backtracking > 1.0 + Distribution::kSumTolerance) {
+      throw BacktrackingError(action.id, "", "planning and backtrack probabilities sum above 1");
+    }
+    if (backtracking <= 0) {
+      if (!action.culprits.empty()) {
+        throw BacktrackingError(action.id, action.culprits.front().id, "culprits without a backtrack distribution");
+      }
+      continue;
+    }
+    if (action.culprits.empty()) throw BacktrackingError(action.id, "", "an action that backtracks needs culprits");
+    double total = 0;
+    for (const Culprit& culprit : action.culprits) {
+      if (!(culprit.probability >= 0.0 && culprit.probability <= 1.0)) {
+        throw BacktrackingError(action.id, culprit.id, "a probability must be within [0, 1]");
+      }
+      const int index = find_action(culprit.id);
+      if (index < 0) throw BacktrackingError(action.id, culprit.id, "no such action");
+      // A culprit is an action before this one on its path: an ancestor in the prefix tree.
+      bool before = false;
+      for (int up = parent_[a]; up >= 0 && !before; up = parent_[static_cast<std::size_t>(up)]) before = up == index;
+      if (!before) {
+        const bool after = [&] {
+          for (int up = parent_[static_cast<std::size_t>(index)]; up >= 0; up = parent_[static_cast<std::size_t>(up)]) {
+            if (up == static_cast<int>(a)) return true;
+          }
+          return false;
+        }();
+        throw BacktrackingError(action.id, culprit.id,
+                                index == static_cast<int>(a)
+                                    ? "an action cannot blame itself"
+                                    : (after ? "the culprit comes after the failing action"
+                                             : "the culprit is not before the action on its skeletons' path"));
+      }
+      for (const CulpritIndex& earlier : culprit_indices_[a]) {
+        if (earlier.action == index) throw BacktrackingError(action.id, culprit.id, "the culprit is listed twice");
+      }
+      culprit_indices_[a].push_back({index, culprit.probability});
+      total += culprit.probability;
+    }
+    if (std::abs(total - 1.0) > Distribution::kSumTolerance) {
+      throw BacktrackingError(action.id, "", "the culprits' probabilities sum to " + std::to_string(total) + ", not 1");
+    }
+    for (const CulpritIndex& culprit : culprit_indices_[a]) {
+      int& slot = culprit_slot_[static_cast<std::size_t>(culprit.action)];
+      if (slot < 0) slot = culprit_slots_++;
+    }
+  }
 }
 
 int Problem::find_action(std::string_view id) const noexcept {
@@ -107,8 +165,11 @@ Problem with_distributions_of(const Problem& structure, const Problem& distribut
     int source = distributions.find_action(action.id);
     if (source < 0) source = distributions.find_action(action_base_id(action.id));
     if (source < 0) reject("no distributions for the action " + action.id);
-    action.planning = distributions.action(source).planning;
-    action.execution = distributions.action(source).execution;
+    const Action& from = distributions.action(source);
+    action.planning = from.planning;
+    action.execution = from.execution;
+    action.backtrack = from.backtrack;
+    action.culprits = from.culprits;
   }
   return structure.with_actions(std::move(actions));
 }

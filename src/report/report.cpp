@@ -502,16 +502,29 @@ std::string format_mean(double mean) { return std::isfinite(mean) ? fmt::format(
 }  // namespace
 
 std::string fit_markdown(const FitResult& fit) {
-  const std::vector<std::string> header{"action",   "attempts",     "found",        "cut off",
-                                        "P(T ≤ D)", "E[T | T ≤ D]", "E[X | X ≤ D]", "P(X > D)"};
+  std::vector<std::string> header{"action",   "attempts",     "found",        "cut off",
+                                  "P(T ≤ D)", "E[T | T ≤ D]", "E[X | X ≤ D]", "P(X > D)"};
+  // A log with backtracks (SPEC §7): their count and the fitted chance of backtracking, too.
+  const bool backtracking = fit.problem.has_backtracking();
+  if (backtracking) header.insert(header.begin() + 4, {"backtracked", "P(backtrack)"});
   std::vector<std::vector<std::string>> body;
   for (std::size_t a = 0; a < fit.actions.size(); ++a) {
     const ActionFit& counts = fit.actions[a];
-    const ActionSummary summary = summarise(fit.problem.action(static_cast<int>(a)));
-    body.push_back({counts.id, std::to_string(counts.attempts), std::to_string(counts.found),
-                    std::to_string(counts.censored), fmt::format("{:.3f}", summary.found_in_time),
-                    format_mean(summary.mean_planning), format_mean(summary.mean_execution),
-                    fmt::format("{:.3f}", summary.execution_never)});
+    const Action& action = fit.problem.action(static_cast<int>(a));
+    const ActionSummary summary = summarise(action);
+    std::vector<std::string> row{counts.id,
+                                 std::to_string(counts.attempts),
+                                 std::to_string(counts.found),
+                                 std::to_string(counts.censored),
+                                 fmt::format("{:.3f}", summary.found_in_time),
+                                 format_mean(summary.mean_planning),
+                                 format_mean(summary.mean_execution),
+                                 fmt::format("{:.3f}", summary.execution_never)};
+    if (backtracking) {
+      row.insert(row.begin() + 4,
+                 {std::to_string(counts.backtracked), fmt::format("{:.3f}", 1.0 - action.backtrack.never())});
+    }
+    body.push_back(std::move(row));
   }
   return markdown_table(header, body);
 }
@@ -526,6 +539,14 @@ std::string fit_json(const FitResult& fit) {
     entry["attempts"] = counts.attempts;
     entry["found"] = counts.found;
     entry["cut_off"] = counts.censored;
+    if (fit.problem.has_backtracking()) {
+      const Action& action = fit.problem.action(static_cast<int>(a));
+      entry["backtracked"] = counts.backtracked;
+      entry["backtrack_probability"] = 1.0 - action.backtrack.never();
+      Json culprits = Json::object();
+      for (const Culprit& culprit : action.culprits) culprits[culprit.id] = culprit.probability;
+      entry["culprits"] = culprits;
+    }
     entry["planning_within_deadline"] = summary.found_in_time;
     entry["mean_planning_steps"] = std::isfinite(summary.mean_planning) ? Json(summary.mean_planning) : Json(nullptr);
     entry["mean_execution_steps"] =

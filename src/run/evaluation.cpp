@@ -12,12 +12,13 @@ namespace {
 
 // The allocator's own choice is the only choice; states are keyed by their fixed-size copy
 // (packed into Words 64-bit words when Words > 0).
-template <std::size_t Words>
+template <std::size_t Words, class CompactType = detail::CompactState>
 class StationaryPolicy {
  public:
-  StationaryPolicy(Allocator& allocator, int skeleton_count)
-      : allocator_(&allocator), skeleton_count_(skeleton_count) {}
-  void choices(const detail::CompactState& state, std::vector<int>& out) const {
+  using Compact = CompactType;
+  StationaryPolicy(Allocator& allocator, const Mdp& mdp)
+      : allocator_(&allocator), skeleton_count_(mdp.skeleton_count()), scratch_(mdp.start()) {}
+  void choices(const Compact& state, std::vector<int>& out) const {
     detail::expanded(state, scratch_);
     const int choice = allocator_->choose(scratch_);
     if (choice < 0 || choice >= skeleton_count_) {
@@ -26,7 +27,7 @@ class StationaryPolicy {
     }
     out.push_back(choice);
   }
-  auto key(const detail::CompactState& state) const {
+  auto key(const Compact& state) const {
     if constexpr (Words > 0) {
       return detail::pack<Words>(state, skeleton_count_);
     } else {
@@ -62,13 +63,14 @@ ExactEvaluation evaluate_exactly(const Mdp& mdp, Allocator& allocator, std::size
     result.states = search.memo().size();
     return result;
   };
+  if (mdp.has_backtracking()) return run(StationaryPolicy<0, detail::CompactBacktrackState>(allocator, mdp));
   switch (detail::packed_words(mdp)) {
     case 2:
-      return run(StationaryPolicy<2>(allocator, mdp.skeleton_count()));
+      return run(StationaryPolicy<2>(allocator, mdp));
     case 4:
-      return run(StationaryPolicy<4>(allocator, mdp.skeleton_count()));
+      return run(StationaryPolicy<4>(allocator, mdp));
     default:
-      return run(StationaryPolicy<0>(allocator, mdp.skeleton_count()));
+      return run(StationaryPolicy<0>(allocator, mdp));
   }
 }
 

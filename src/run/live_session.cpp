@@ -179,7 +179,7 @@ Status Session::report_live(int choice, int action, const Observation& observati
     attempt.effort = std::min<Steps>(attempt.effort + effort, Distribution::kMaxStep);
     attempt.found = observation.refined;
   }
-  if (action >= 0 && !observation.refined && effort > 1) {
+  if (action >= 0 && !observation.refined && !observation.is_backtrack() && effort > 1) {
     for (const int member : mdp_->problem().members(action)) {
       std::uint16_t& spent = state_.spent[static_cast<std::size_t>(member)];
       spent = static_cast<std::uint16_t>(std::min<Steps>(spent + effort - 1, mdp_->deadline() + 1));

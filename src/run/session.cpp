@@ -171,6 +171,17 @@ Status Session::report(const Observation& observation, double execution_seconds)
   }
   // Only live and owning sessions keep what each action revealed; a plain session (an episode of
   // a Monte Carlo run) does no work for it.
+  if (observation.is_backtrack() && !action_execution_steps_.empty()) {
+    // The culprit's motion and every motion after it on its paths are discarded.
+    const Problem& problem = mdp_->problem();
+    for (int a = 0; a < problem.action_count(); ++a) {
+      bool below = a == observation.culprit;
+      for (int up = problem.parent(a); up >= 0 && !below; up = problem.parent(up)) below = up == observation.culprit;
+      if (!below) continue;
+      action_execution_steps_[static_cast<std::size_t>(a)] = -1;
+      action_execution_seconds_[static_cast<std::size_t>(a)] = -1.0;
+    }
+  }
   if (action >= 0 && observation.refined && !action_execution_steps_.empty()) {
     const auto slot = static_cast<std::size_t>(action);
     action_execution_steps_[slot] =
@@ -198,8 +209,19 @@ State Session::carried_over(const State& old, const Problem& next) const {
     if (action >= 0) spent[static_cast<std::size_t>(action)] = old.spent[static_cast<std::size_t>(k)];
   }
   const std::int64_t saturated = std::int64_t{next.deadline()} + 1;
-  State out(static_cast<std::size_t>(next.skeleton_count()));
+  State out(static_cast<std::size_t>(next.skeleton_count()), static_cast<std::size_t>(next.culprit_slot_count()));
   out.time = old.time;
+  // Backtracking (SPEC §7): B_c of every refined culprit, the execution before it on its path.
+  for (int c = 0; c < next.action_count(); ++c) {
+    const int slot = next.culprit_slot(c);
+    const auto index = static_cast<std::size_t>(c);
+    if (slot < 0 || index >= action_execution_steps_.size() || action_execution_steps_[index] < 0) continue;
+    std::int64_t before = 0;
+    for (int up = next.parent(c); up >= 0; up = next.parent(up)) {
+      before = std::min(saturated, before + std::max<Steps>(0, action_execution_steps_[static_cast<std::size_t>(up)]));
+    }
+    out.restore[static_cast<std::size_t>(slot)] = static_cast<std::uint16_t>(before);
+  }
   for (int k = 0; k < next.skeleton_count(); ++k) {
     const std::span<const int> path = next.skeleton(k);
     std::size_t refined = 0;

@@ -1,6 +1,9 @@
 #include "ontime/run/simulator.hpp"
 
+#include <algorithm>
 #include <memory>
+
+#include "ontime/util/random.hpp"
 
 namespace ontime {
 
@@ -12,6 +15,13 @@ HiddenWorld::HiddenWorld(const Problem& problem, std::uint64_t seed)
 }
 
 void HiddenWorld::begin_episode(std::uint64_t seed) {
+  if (problem_->has_backtracking()) {
+    seed_ = seed;
+    attempt_.assign(planning_.size(), 0);
+    culprit_.assign(planning_.size(), -1);
+    for (std::size_t a = 0; a < planning_.size(); ++a) draw_attempt(a);
+    return;
+  }
   SplitMix64 generator(seed);
   // A fixed draw order (action by action, planning then execution), whatever the allocator
   // later touches, so that every allocator meets the same world for the same seed.
@@ -22,9 +32,59 @@ void HiddenWorld::begin_episode(std::uint64_t seed) {
   }
 }
 
+void HiddenWorld::draw_attempt(std::size_t a) {
+  const Action& action = problem_->actions()[a];
+  SplitMix64 generator(stream_seed(stream_seed(seed_, a), attempt_[a]));
+  // The attempt ends at the first step t where the cumulative P(motion by t) + P(backtrack by t)
+  // passes a uniform draw; at that step the motion comes first.
+  const double u = uniform01(generator);
+  const auto found = action.planning.masses();
+  const auto back = action.backtrack.masses();
+  planning_[a] = kNever;
+  execution_[a] = 0;
+  culprit_[a] = -1;
+  double cumulative = 0;
+  for (std::size_t t = 1; t < std::max(found.size(), back.size()); ++t) {
+    cumulative += t < found.size() ? found[t] : 0.0;
+    if (u < cumulative) {
+      planning_[a] = static_cast<Steps>(t);
+      execution_[a] = action.execution.sample(generator);
+      return;
+    }
+    cumulative += t < back.size() ? back[t] : 0.0;
+    if (u < cumulative) {
+      planning_[a] = static_cast<Steps>(t);
+      const auto culprits = problem_->culprits(static_cast<int>(a));
+      culprit_[a] =
+          culprits[sample_index(
+                       culprits.size(), [&culprits](std::size_t i) { return culprits[i].probability; }, generator)]
+              .action;
+      return;
+    }
+  }
+}
+
 Observation HiddenWorld::observe(int action, Steps spent) const {
-  if (planning_time(action) == spent + 1) return Observation::found(execution_time(action));
-  return Observation::not_yet();
+  if (planning_time(action) != spent + 1) return Observation::not_yet();
+  if (!culprit_.empty() && culprit_[static_cast<std::size_t>(action)] >= 0) {
+    return Observation::backtracked(culprit_[static_cast<std::size_t>(action)]);
+  }
+  return Observation::found(execution_time(action));
+}
+
+Observation HiddenWorld::step(int action, Steps spent) {
+  const Observation seen = observe(action, spent);
+  if (seen.is_backtrack()) {
+    // The culprit and every action below it start new attempts.
+    for (int a = 0; a < problem_->action_count(); ++a) {
+      bool below = a == seen.culprit;
+      for (int up = problem_->parent(a); up >= 0 && !below; up = problem_->parent(up)) below = up == seen.culprit;
+      if (!below) continue;
+      ++attempt_[static_cast<std::size_t>(a)];
+      draw_attempt(static_cast<std::size_t>(a));
+    }
+  }
+  return seen;
 }
 
 WorldFactory hidden_worlds(const Problem& problem) {

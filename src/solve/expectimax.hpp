@@ -84,14 +84,39 @@ struct CompactState {
 };
 static_assert(sizeof(CompactState) == 2 + 16 + 32 + 32, "CompactState must have no padding: it is hashed as bytes");
 
-inline CompactState compact(const State& state, int skeleton_count) noexcept {
-  CompactState out;
+// The most actions backtracking may blame (Problem::culprit_slot_count) in a problem the exact
+// solvers take.
+inline constexpr int kMaxExactCulpritSlots = 16;
+
+// A CompactState with backtracking's restore values (SPEC §7): the state the exact solvers work
+// on, and its key, for a problem whose actions may backtrack. (A type of its own, so that the
+// states of every other problem stay 82 bytes.)
+struct CompactBacktrackState : CompactState {
+  std::array<std::uint16_t, kMaxExactCulpritSlots> restore{};
+
+  friend bool operator==(const CompactBacktrackState&, const CompactBacktrackState&) = default;
+};
+static_assert(sizeof(CompactBacktrackState) == sizeof(CompactState) + 32,
+              "CompactBacktrackState must have no padding: it is hashed as bytes");
+
+// The fixed-size copy of a state: a CompactState, or with restore values a CompactBacktrackState
+// (`culprit_slots` of them).
+template <class Compact = CompactState>
+Compact compact(const State& state, int skeleton_count, int culprit_slots = 0) noexcept {
+  Compact out;
   out.time = state.time;
   for (int k = 0; k < skeleton_count; ++k) {
     const auto slot = static_cast<std::size_t>(k);
     out.refined[slot] = state.refined[slot];
     out.spent[slot] = state.spent[slot];
     out.execution[slot] = state.execution[slot];
+  }
+  if constexpr (kHoldsRestore<Compact>) {
+    for (int c = 0; c < culprit_slots; ++c) {
+      out.restore[static_cast<std::size_t>(c)] = state.restore[static_cast<std::size_t>(c)];
+    }
+  } else {
+    (void)culprit_slots;
   }
   return out;
 }
@@ -112,8 +137,15 @@ PackedState<Words> pack(const CompactState& state, int skeleton_count) noexcept 
   return packed;
 }
 
-// The state a CompactState holds, written into `out` (sized for `compact`'s skeletons).
-inline void expanded(const CompactState& compact, State& out) noexcept {
+// The state a CompactState holds, written into `out` (sized for `compact`'s skeletons, and its
+// restore values for a CompactBacktrackState's).
+template <class Compact>
+void expanded(const Compact& compact, State& out) noexcept {
+  if constexpr (kHoldsRestore<Compact>) {
+    for (std::size_t c = 0; c < compact.restore.size() && c < out.restore.capacity(); ++c) {
+      out.restore[c] = compact.restore[c];
+    }
+  }
   out.time = compact.time;
   for (std::size_t k = 0; k < compact.refined.size(); ++k) {
     out.refined[k] = compact.refined[k];
@@ -122,10 +154,11 @@ inline void expanded(const CompactState& compact, State& out) noexcept {
   }
 }
 
+// Hashes a compact state (of either kind) as its bytes: it has no padding.
 struct CompactStateHash {
-  std::size_t operator()(const CompactState& state) const noexcept {
-    return absl::Hash<std::string_view>{}(
-        std::string_view(reinterpret_cast<const char*>(&state), sizeof(CompactState)));
+  template <class Compact>
+  std::size_t operator()(const Compact& state) const noexcept {
+    return absl::Hash<std::string_view>{}(std::string_view(reinterpret_cast<const char*>(&state), sizeof(Compact)));
   }
 };
 
@@ -148,26 +181,34 @@ inline void blank_hopeless(const Mdp& mdp, CompactState& state) noexcept {
   }
 }
 
-// Throws UsageError when the problem has more skeletons than the exact solvers' keys hold.
+// Throws UsageError when the problem has more skeletons, or more actions that backtracking may
+// blame, than the exact solvers' keys hold.
 inline void require_exact_size(const Mdp& mdp, const std::string& what) {
   if (mdp.skeleton_count() > kMaxExactSkeletons) {
     throw UsageError(what + ": the instance has " + std::to_string(mdp.skeleton_count()) +
                      " skeletons; exact solving and exact evaluation take at most " +
                      std::to_string(kMaxExactSkeletons) + " (use a sampled evaluation or an approximate allocator)");
   }
+  if (mdp.problem().culprit_slot_count() > kMaxExactCulpritSlots) {
+    throw UsageError(what + ": the instance has " + std::to_string(mdp.problem().culprit_slot_count()) +
+                     " actions that backtracking may blame; exact solving and exact evaluation take at most " +
+                     std::to_string(kMaxExactCulpritSlots) + " (use a sampled evaluation or an approximate allocator)");
+  }
 }
 
-// The search runs on CompactStates (the Mdp's functions are templates on the state type): a
-// copy is a plain 82-byte copy, with no indirection.
+// The search runs on compact states (the Mdp's functions are templates on the state type): a
+// copy is a plain 82-byte copy (114 with backtracking's restore values), with no indirection.
 //
 // Policy provides:
-//   void choices(const CompactState&, std::vector<int>& out) const;  // in increasing preference on ties
-//   Key key(const CompactState&) const;   // states with one key share a value; CompactState or PackedState
+//   using Compact = CompactState or CompactBacktrackState;  // the state type (the latter for backtracking)
+//   void choices(const Compact&, std::vector<int>& out) const;  // in increasing preference on ties
+//   Key key(const Compact&) const;   // states with one key share a value; Compact or PackedState
 template <class Policy>
 class Expectimax {
  public:
-  using Key = std::remove_cvref_t<decltype(std::declval<const Policy&>().key(std::declval<const CompactState&>()))>;
-  using Hash = std::conditional_t<std::is_same_v<Key, CompactState>, CompactStateHash, PackedStateHash>;
+  using Compact = typename Policy::Compact;
+  using Key = std::remove_cvref_t<decltype(std::declval<const Policy&>().key(std::declval<const Compact&>()))>;
+  using Hash = std::conditional_t<std::is_same_v<Key, Compact>, CompactStateHash, PackedStateHash>;
   using Memo = absl::flat_hash_map<Key, ExpectimaxEntry, Hash>;
 
   Expectimax(const Mdp& mdp, Policy policy, std::size_t max_states, double tie_tolerance, std::string what)
@@ -184,7 +225,7 @@ class Expectimax {
   void set_stop(std::function<bool()> stop) { stop_ = std::move(stop); }
 
   ExpectimaxEntry solve(const State& start_state) {
-    const CompactState start = compact(start_state, mdp_->skeleton_count());
+    const Compact start = compact_of(start_state);
     const Key start_key = policy_.key(start);
     if (const auto found = memo_.find(start_key); found != memo_.end()) return found->second;
     push(start, start_key);
@@ -194,7 +235,7 @@ class Expectimax {
       while (frames_[top].cursor < frames_[top].end) {
         const Item& item = items_[frames_[top].cursor++];
         if (item.status == Status::running && !memo_.contains(item.key)) {
-          const CompactState next = item.next;  // push may move the items
+          const Compact next = item.next;  // push may move the items
           const Key next_key = item.key;
           push(next, next_key);
           descended = true;
@@ -208,7 +249,7 @@ class Expectimax {
   }
 
   const Memo& memo() const noexcept { return memo_; }
-  Key key_of(const State& state) const { return policy_.key(compact(state, mdp_->skeleton_count())); }
+  Key key_of(const State& state) const { return policy_.key(compact_of(state)); }
   const Policy& policy() const noexcept { return policy_; }
 
   // Memory held by the memo (table slots and their control bytes).
@@ -219,7 +260,7 @@ class Expectimax {
     int choice = -1;
     Status status = Status::running;
     double probability = 0.0;
-    CompactState next;
+    Compact next;
     Key key;  // of `next`, when running
   };
   struct Frame {
@@ -227,12 +268,16 @@ class Expectimax {
     std::size_t begin, end, cursor;
   };
 
-  void push(const CompactState& state, const Key& key) {
+  Compact compact_of(const State& state) const {
+    return compact<Compact>(state, mdp_->skeleton_count(), mdp_->problem().culprit_slot_count());
+  }
+
+  void push(const Compact& state, const Key& key) {
     Frame frame{key, items_.size(), 0, items_.size()};
     choices_.clear();
     policy_.choices(state, choices_);
     for (const int choice : choices_) {
-      mdp_->for_each_outcome(state, choice, [&](double probability, Status status, const CompactState& next) {
+      mdp_->for_each_outcome(state, choice, [&](double probability, Status status, const Compact& next) {
         items_.push_back(
             Item{choice, status, probability, next, status == Status::running ? policy_.key(next) : Key{}});
       });

@@ -136,6 +136,11 @@ LayeredSolution solve_split(const Mdp& mdp, const LayeredSolveOptions& options, 
 
 LayeredSolution solve_layered(const Mdp& mdp, const LayeredSolveOptions& options) {
   detail::require_exact_size(mdp, "solve");
+  if (mdp.has_backtracking()) {
+    throw UsageError(
+        "solve: the layered solver does not take an instance with backtracking (SPEC §7); the "
+        "memoised solver (OptimalSolver, --method memoised) does");
+  }
   if (!(options.tolerance >= 0.0 && options.tolerance <= 1.0)) {
     throw UsageError("solve: the tolerance must lie in [0, 1] (got " + std::to_string(options.tolerance) + ")");
   }

@@ -14,9 +14,10 @@ namespace {
 template <std::size_t Words>
 class OptimalPolicy {
  public:
+  using Compact = detail::CompactState;
   explicit OptimalPolicy(const Mdp& mdp) : mdp_(&mdp) {}
 
-  void choices(const detail::CompactState& state, std::vector<int>& out) const {
+  void choices(const Compact& state, std::vector<int>& out) const {
     for (const int choice : mdp_->useful_choices(state)) out.push_back(choice);
   }
 
@@ -36,8 +37,24 @@ class OptimalPolicy {
   const Mdp* mdp_;
 };
 
+// With backtracking (SPEC §7): states with their restore values, keyed whole. No slot is blanked:
+// a step on a group that cannot succeed may still backtrack and restore an action others share.
+class OptimalBacktrackPolicy {
+ public:
+  using Compact = detail::CompactBacktrackState;
+  explicit OptimalBacktrackPolicy(const Mdp& mdp) : mdp_(&mdp) {}
+
+  void choices(const Compact& state, std::vector<int>& out) const {
+    for (const int choice : mdp_->useful_choices(state)) out.push_back(choice);
+  }
+  static const Compact& key(const Compact& state) { return state; }
+
+ private:
+  const Mdp* mdp_;
+};
+
 using Search = std::variant<detail::Expectimax<OptimalPolicy<2>>, detail::Expectimax<OptimalPolicy<4>>,
-                            detail::Expectimax<OptimalPolicy<0>>>;
+                            detail::Expectimax<OptimalPolicy<0>>, detail::Expectimax<OptimalBacktrackPolicy>>;
 
 }  // namespace
 
@@ -49,6 +66,10 @@ struct OptimalSolver::Impl {
       return detail::Expectimax<OptimalPolicy<Words>>(mdp, OptimalPolicy<Words>(mdp), max_states,
                                                       OptimalSolver::kTieTolerance, "optimal");
     };
+    if (mdp.has_backtracking()) {
+      return detail::Expectimax<OptimalBacktrackPolicy>(mdp, OptimalBacktrackPolicy(mdp), max_states,
+                                                        OptimalSolver::kTieTolerance, "optimal");
+    }
     switch (detail::packed_words(mdp)) {
       case 2:
         return build.template operator()<2>();
@@ -86,8 +107,10 @@ std::optional<int> OptimalSolver::best_choice(const State& state) const {
 }
 
 double OptimalSolver::max_bytes(const Problem& problem, std::size_t max_states) {
-  const double slot_bytes =
-      problem.skeleton_count() <= 4 && problem.deadline() <= 253 ? 33 : (problem.skeleton_count() <= 10 ? 49 : 99);
+  const double slot_bytes = problem.has_backtracking() ? 131
+                                                       : (problem.skeleton_count() <= 4 && problem.deadline() <= 253
+                                                              ? 33
+                                                              : (problem.skeleton_count() <= 10 ? 49 : 99));
   return 3.0 * slot_bytes * static_cast<double>(max_states);
 }
 
@@ -106,6 +129,12 @@ void check_exact_work(const Problem& problem, std::size_t max_states, const std:
                          " skeletons; exact solving and exact evaluation take at most " +
                          std::to_string(kMaxExactSkeletons) +
                          " (sampled evaluation and the approximate allocators take any number)");
+  }
+  if (problem.culprit_slot_count() > detail::kMaxExactCulpritSlots) {
+    throw InputError(source, "actions",
+                     std::to_string(problem.culprit_slot_count()) +
+                         " actions that backtracking may blame; exact solving and exact evaluation take at most " +
+                         std::to_string(detail::kMaxExactCulpritSlots));
   }
   check_memory_for(spell_parameter(spelling, "max-states") + " " + std::to_string(max_states),
                    OptimalSolver::max_bytes(problem, max_states));

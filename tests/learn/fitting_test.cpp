@@ -4,15 +4,32 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
+#include <string>
+#include <utility>
 
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/learn/log_sampling.hpp"
+#include "ontime/mdp/mdp.hpp"
+#include "ontime/solve/optimal_solver.hpp"
 #include "ontime/util/error.hpp"
 #include "ontime/util/random.hpp"
 #include "support/paper.hpp"
 
 namespace ontime {
 namespace {
+
+// One attempt of a log (RefinementAttempt has more optional fields than these tests use).
+RefinementAttempt attempt(std::string action, double planning_seconds, bool found, double execution_seconds = 0,
+                          std::optional<std::string> backtrack = std::nullopt) {
+  RefinementAttempt made;
+  made.action = std::move(action);
+  made.planning_seconds = planning_seconds;
+  made.found = found;
+  made.execution_seconds = execution_seconds;
+  made.backtrack = std::move(backtrack);
+  return made;
+}
 
 // A heavy-tailed planning time: geometric over 1..40 (so partly beyond D = 22), 10% never.
 Distribution heavy_tailed_planning() {
@@ -54,37 +71,154 @@ TEST(Fitting, RoundsTimesUpToWholeSteps) {
 
 TEST(Fitting, CensoredAttemptsLowerTheHazardInsteadOfBeingDropped) {
   // Two found at step 1, two cut off after the whole deadline: half the mass is "never".
-  const Distribution fitted = estimate_planning({{1, 1}, {4, 4}}, 4);
+  const Distribution fitted = estimate_planning({{1, 1}, {4, 4}, {}, {}}, 4);
   EXPECT_DOUBLE_EQ(fitted.pmf(1), 0.5);
   EXPECT_DOUBLE_EQ(fitted.never(), 0.5);
   // Found at 1 and 3, two cut off after 2 steps: h(1) = 1/4, h(2) = 0/3, h(3) = 1/1.
-  const Distribution km = estimate_planning({{1, 3}, {2, 2}}, 4);
+  const Distribution km = estimate_planning({{1, 3}, {2, 2}, {}, {}}, 4);
   EXPECT_DOUBLE_EQ(km.pmf(1), 0.25);
   EXPECT_DOUBLE_EQ(km.pmf(2), 0.0);
   EXPECT_DOUBLE_EQ(km.pmf(3), 0.75);
   EXPECT_NEAR(km.never(), 0.0, 1e-15);
   // Nobody at risk after the last cut-off: the log says nothing about that mass, so "never".
-  const Distribution unknown = estimate_planning({{1}, {2}}, 5);
+  const Distribution unknown = estimate_planning({{1}, {2}, {}, {}}, 5);
   EXPECT_DOUBLE_EQ(unknown.pmf(1), 0.5);
   EXPECT_DOUBLE_EQ(unknown.never(), 0.5);
   // Found after the deadline, or cut off after more steps than it: only survival is known.
-  const Distribution late = estimate_planning({{2, 9}, {30}}, 3);
+  const Distribution late = estimate_planning({{2, 9}, {30}, {}, {}}, 3);
   EXPECT_NEAR(late.pmf(2), 1.0 / 3.0, 1e-15);
   EXPECT_NEAR(late.never(), 2.0 / 3.0, 1e-15);
   // An attempt cut off before its first step ended carries no information.
-  const Distribution early = estimate_planning({{1, 2}, {0, 0, 0}}, 2);
+  const Distribution early = estimate_planning({{1, 2}, {0, 0, 0}, {}, {}}, 2);
   EXPECT_DOUBLE_EQ(early.pmf(1), 0.5);
   EXPECT_DOUBLE_EQ(early.pmf(2), 0.5);
 }
 
+// Competing risks (SPEC §7): found at 1, backtracked at 1 (blaming "a"), found at 2, cut off after
+// 1. At step 1 four are at risk: h = g = 1/4, so p(1) = q(1) = 1/4 and S(1) = 1/2; one is left at
+// step 2 and is found: p(2) = 1/2. Without backtracks the estimate is Kaplan-Meier's, bit for bit.
+TEST(Fitting, BacktracksAreASecondKindOfEventNotACutOff) {
+  PlanningSample sample;
+  sample.found = {1, 2};
+  sample.censored = {1};
+  sample.backtracked = {1};
+  sample.blamed = {"a"};
+  const AttemptEstimate estimate = estimate_attempts(sample, 3);
+  EXPECT_DOUBLE_EQ(estimate.planning.pmf(1), 0.25);
+  EXPECT_DOUBLE_EQ(estimate.planning.pmf(2), 0.5);
+  EXPECT_DOUBLE_EQ(estimate.backtrack.pmf(1), 0.25);
+  EXPECT_DOUBLE_EQ(estimate.backtrack.never(), 0.75);
+  EXPECT_DOUBLE_EQ(estimate.planning.never() + (1 - estimate.backtrack.never()), 0.25 + 0.25);
+  ASSERT_EQ(estimate.culprits.size(), 1U);
+  EXPECT_EQ(estimate.culprits[0].id, "a");
+  EXPECT_DOUBLE_EQ(estimate.culprits[0].probability, 1.0);
+  PlanningSample plain;
+  plain.found = {1, 2, 2, 5};
+  plain.censored = {0, 3};
+  EXPECT_EQ(estimate_attempts(plain, 6, 0.5).planning, estimate_planning(plain, 6, 0.5));
+  EXPECT_EQ(estimate_attempts(plain, 6).backtrack.never(), 1.0);
+  sample.blamed.clear();
+  EXPECT_THROW(estimate_attempts(sample, 3), UsageError);
+}
+
+// A log with backtrack records fits an instance that backtracks; a record blaming an action that
+// is not before it on the skeletons' path is refused naming the log.
+TEST(Fitting, FitsBacktrackingFromTheLog) {
+  const std::vector<RefinementAttempt> log{attempt("a", 1, true, 1), attempt("b", 2, false, 0, "a"),
+                                           attempt("b", 1, false, 0, "a"), attempt("b", 3, true, 1),
+                                           attempt("b", 1, true, 2)};
+  const SkeletonList skeletons{"skeletons.json", {{"a", "b"}}};
+  FitOptions options;
+  options.deadline = 5;
+  const FitResult fit = fit_problem(log, "log.jsonl", skeletons, options);
+  ASSERT_TRUE(fit.problem.has_backtracking());
+  const Action& b = fit.problem.action(1);
+  EXPECT_DOUBLE_EQ(b.backtrack.pmf(1), 0.25);  // at step 1: 4 at risk, one backtracks, one is found
+  EXPECT_DOUBLE_EQ(b.planning.pmf(1), 0.25);
+  EXPECT_DOUBLE_EQ(b.backtrack.pmf(2), 0.25);  // at step 2: 2 at risk, one backtracks
+  EXPECT_DOUBLE_EQ(b.planning.pmf(3), 0.25);
+  EXPECT_EQ(fit.actions[1].backtracked, 2U);
+  EXPECT_EQ(fit.actions[1].censored, 0U);
+  EXPECT_FALSE(fit.problem.action(0).backtrack.never() < 1.0);
+
+  const std::vector<RefinementAttempt> wrong{attempt("a", 1, false, 0, "b"), attempt("b", 1, true, 1)};
+  try {
+    fit_problem(wrong, "log.jsonl", skeletons, options);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& error) {
+    EXPECT_NE(
+        std::string(error.what()).find("log.jsonl: action 'a': blames 'b': the culprit comes after the failing action"),
+        std::string::npos)
+        << error.what();
+  }
+}
+
+// A log drawn from an instance that backtracks fits back to it: the planning and backtrack masses
+// and the culprits' shares within a few standard errors of 20,000 attempts, and the optimum near.
+TEST(Fitting, SampledBacktrackingLogsFitBack) {
+  const Distribution one = Distribution::from_pmf({0.0, 1.0});
+  std::vector<Action> actions{
+      {"a", one, one},
+      {"b", Distribution::from_pmf({0.0, 0.2, 0.2}), one, Distribution::from_pmf({0.0, 0.3, 0.1}),
+       std::vector<Culprit>{{"a", 1.0}}},
+      {"c", Distribution::from_pmf({0.0, 0.3, 0.3}), one, Distribution::from_pmf({0.0, 0.0, 0.4}),
+       std::vector<Culprit>{{"a", 0.25}, {"b", 0.75}}}};
+  const Problem original("bt", 8, 1.0, std::move(actions), {{0, 1, 2}, {0, 1}});
+  LogSamplingOptions sampling;
+  sampling.attempts_per_action = 20'000;
+  sampling.seed = 3;
+  const std::vector<RefinementAttempt> log = sample_planner_log(original, sampling);
+  FitOptions options;
+  options.deadline = 8;
+  const FitResult fit = fit_problem(log, "log", SkeletonList{"s", {{"a", "b", "c"}, {"a", "b"}}}, options);
+  const double error = 4 * std::sqrt(0.25 / 20'000.0);  // four standard errors of a proportion
+  for (int a = 1; a <= 2; ++a) {
+    for (Steps t = 1; t <= 2; ++t) {
+      EXPECT_NEAR(fit.problem.action(a).planning.pmf(t), original.action(a).planning.pmf(t), error) << a << " " << t;
+      EXPECT_NEAR(fit.problem.action(a).backtrack.pmf(t), original.action(a).backtrack.pmf(t), error) << a << " " << t;
+    }
+  }
+  ASSERT_EQ(fit.problem.culprits(2).size(), 2U);
+  for (const Problem::CulpritIndex& culprit : fit.problem.culprits(2)) {
+    EXPECT_NEAR(culprit.probability, culprit.action == 0 ? 0.25 : 0.75, 4 * std::sqrt(0.25 / 8'000.0));
+  }
+  // Coupling: an episode starts at most D attempts, and each of action a's differs between the two
+  // instances with probability at most the total variation of its outcome laws (found at t,
+  // backtracked at t blaming c, never); the executions are fitted exactly here.
+  double largest_tv = 0;
+  for (int a = 0; a < 3; ++a) {
+    const Action& x = original.action(a);
+    const Action& y = fit.problem.action(a);
+    double tv = std::abs(x.planning.never() - x.backtrack.pmf(1) - x.backtrack.pmf(2) -
+                         (y.planning.never() - y.backtrack.pmf(1) - y.backtrack.pmf(2)));
+    for (Steps t = 1; t <= 8; ++t) {
+      tv += std::abs(x.planning.pmf(t) - y.planning.pmf(t));
+      for (int c = 0; c < 2; ++c) {
+        const auto weight = [c](const Problem& p, int action) {
+          for (const Problem::CulpritIndex& culprit : p.culprits(action)) {
+            if (culprit.action == c) return culprit.probability;
+          }
+          return 0.0;
+        };
+        tv += std::abs(x.backtrack.pmf(t) * weight(original, a) - y.backtrack.pmf(t) * weight(fit.problem, a));
+      }
+    }
+    ASSERT_EQ(x.execution, y.execution);
+    largest_tv = std::max(largest_tv, tv / 2);
+  }
+  const Mdp original_mdp(original), fitted_mdp(fit.problem);
+  OptimalSolver exact(original_mdp), fitted(fitted_mdp);
+  EXPECT_NEAR(fitted.solve(fitted_mdp.start()), exact.solve(original_mdp.start()), 8 * largest_tv);
+}
+
 TEST(Fitting, LaplaceSmoothingIsAddAlphaOverTheCategories) {
   // Uncensored: exactly (count + alpha) / (n + alpha (D + 1)) over 1..D and "never".
-  const Distribution plain = estimate_planning({{1, 1, 2}, {}}, 2, 1.0);
+  const Distribution plain = estimate_planning({{1, 1, 2}, {}, {}, {}}, 2, 1.0);
   EXPECT_NEAR(plain.pmf(1), 3.0 / 6.0, 1e-15);
   EXPECT_NEAR(plain.pmf(2), 2.0 / 6.0, 1e-15);
   EXPECT_NEAR(plain.never(), 1.0 / 6.0, 1e-15);
   // With a cut-off attempt: h(1) = (1 + 1) / (2 + 3), h(2) = (0 + 1) / (0 + 2).
-  const Distribution censored = estimate_planning({{1}, {1}}, 2, 1.0);
+  const Distribution censored = estimate_planning({{1}, {1}, {}, {}}, 2, 1.0);
   EXPECT_NEAR(censored.pmf(1), 0.4, 1e-15);
   EXPECT_NEAR(censored.pmf(2), 0.3, 1e-15);
   EXPECT_NEAR(censored.never(), 0.3, 1e-15);
@@ -153,7 +287,7 @@ TEST(Fitting, RecoversAKnownDistributionFromCensoredData) {
   double at_risk = static_cast<double>(n) - leaving_at[0];
   double greenwood_sum = 0;
   double largest_naive_error = 0, largest_bound = 0;
-  PlanningSample naive{found_only, {}};
+  PlanningSample naive{found_only, {}, {}, {}};
   const Distribution dropped = estimate_planning(naive, deadline);
   for (Steps t = 1; t <= deadline; ++t) {
     if (at_risk > found_at[t]) greenwood_sum += found_at[t] / (at_risk * (at_risk - found_at[t]));
@@ -183,9 +317,9 @@ TEST(Fitting, RecoversAKnownExecutionDistributionWithinTheDkwBound) {
 }
 
 TEST(Fitting, RejectsBadEstimationOptions) {
-  EXPECT_THROW(estimate_planning({{1}, {}}, 0), UsageError);
-  EXPECT_THROW(estimate_planning({{1}, {}}, 5, -1.0), UsageError);
-  EXPECT_THROW(estimate_planning({{0}, {}}, 5), UsageError);
+  EXPECT_THROW(estimate_planning({{1}, {}, {}, {}}, 0), UsageError);
+  EXPECT_THROW(estimate_planning({{1}, {}, {}, {}}, 5, -1.0), UsageError);
+  EXPECT_THROW(estimate_planning({{0}, {}, {}, {}}, 5), UsageError);
   EXPECT_THROW(estimate_execution(std::vector<Steps>{-1}, 5), UsageError);
 }
 
@@ -195,11 +329,11 @@ SkeletonList skeletons(std::vector<std::vector<std::string>> list) {
 
 TEST(Fitting, FitsAProblemForTheSkeletons) {
   const std::vector<RefinementAttempt> log{
-      {"a", 0.4, true, 1.5, std::nullopt, std::nullopt, std::nullopt, {}},   // 1 step, executes in 2
-      {"a", 1.6, true, 0.0, std::nullopt, std::nullopt, std::nullopt, {}},   // 2 steps, executes in 0
-      {"a", 3.0, false, 0.0, std::nullopt, std::nullopt, std::nullopt, {}},  // cut off after 3 steps
-      {"b", 0.9, true, 9.0, std::nullopt, std::nullopt, std::nullopt, {}},   // executes in 9 > D: never
-      {"unused", 1.0, true, 1.0, std::nullopt, std::nullopt, std::nullopt, {}},
+      {"a", 0.4, true, 1.5, std::nullopt, std::nullopt, std::nullopt, {}, std::nullopt},   // 1 step, executes in 2
+      {"a", 1.6, true, 0.0, std::nullopt, std::nullopt, std::nullopt, {}, std::nullopt},   // 2 steps, executes in 0
+      {"a", 3.0, false, 0.0, std::nullopt, std::nullopt, std::nullopt, {}, std::nullopt},  // cut off after 3 steps
+      {"b", 0.9, true, 9.0, std::nullopt, std::nullopt, std::nullopt, {}, std::nullopt},   // executes in 9 > D: never
+      {"unused", 1.0, true, 1.0, std::nullopt, std::nullopt, std::nullopt, {}, std::nullopt},
   };
   FitOptions options;
   options.step_seconds = 1.0;
@@ -228,7 +362,8 @@ TEST(Fitting, FitsAProblemForTheSkeletons) {
 }
 
 TEST(Fitting, NamesTheSkeletonWhoseActionTheLogLacks) {
-  const std::vector<RefinementAttempt> log{{"a", 0.4, true, 1.5, std::nullopt, std::nullopt, std::nullopt, {}}};
+  const std::vector<RefinementAttempt> log{
+      {"a", 0.4, true, 1.5, std::nullopt, std::nullopt, std::nullopt, {}, std::nullopt}};
   FitOptions options;
   options.deadline = 3;
   try {

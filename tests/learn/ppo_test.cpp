@@ -11,6 +11,7 @@
 #include "ontime/learn/ppo_training.hpp"
 #include "ontime/model/instance_io.hpp"
 #include "ontime/run/evaluation.hpp"
+#include "ontime/solve/optimal_solver.hpp"
 #include "ontime/util/error.hpp"
 #include "support/paper.hpp"
 
@@ -122,6 +123,28 @@ TEST(Ppo, LearnsTheBetterSkeletonOfInstanceFour) {
   ASSERT_FALSE(training.curve.empty());
   EXPECT_EQ(training.curve.back().episodes, 3'000U);
   EXPECT_GE(training.curve.front().steps, 4'000U);  // whole episodes until an epoch holds 4,000 steps
+}
+
+// Under backtracking (SPEC §7) a trained policy decides in states that hold restore values: its
+// exact value is below the optimum and the simulated episodes agree with it.
+TEST(Ppo, DecidesUnderBacktracking) {
+  const Problem problem = load_problem(testing::source_path("data/instances/backtracking/grasp-and-place.json"));
+  ASSERT_TRUE(problem.has_backtracking());
+  const Mdp mdp(problem);
+  OptimalSolver solver(mdp);
+  const double optimum = solver.solve(mdp.start());
+  const auto policy = std::make_shared<const PpoPolicy>(train_ppo(mdp, 200, 3).policy);
+  PpoAllocator allocator(mdp, policy);
+  const double exact = evaluate_exactly(mdp, allocator).success_probability;
+  EXPECT_LE(exact, optimum + 1e-12);
+  MonteCarloOptions options;
+  options.episodes = 4'000;
+  options.seed = 5;
+  options.threads = 1;
+  const double rate = run_monte_carlo(
+                          mdp, [&] { return std::make_unique<PpoAllocator>(mdp, policy); }, options)
+                          .success_rate;
+  EXPECT_NEAR(rate, exact, 4 * std::sqrt(exact * (1 - exact) / static_cast<double>(options.episodes)));
 }
 
 TEST(Ppo, SameSeedSamePolicyByteForByte) {

@@ -18,10 +18,10 @@ namespace {
 std::filesystem::path kitchen() { return testing::source_path("tests/data/ompl_logs/kitchen.log"); }
 
 RefinementAttempt found(std::string action, double planning, double execution) {
-  return {std::move(action), planning, true, execution, std::nullopt, std::nullopt, std::nullopt, {}};
+  return {std::move(action), planning, true, execution, std::nullopt, std::nullopt, std::nullopt, {}, std::nullopt};
 }
 RefinementAttempt cut_off(std::string action, double planning) {
-  return {std::move(action), planning, false, 0.0, std::nullopt, std::nullopt, std::nullopt, {}};
+  return {std::move(action), planning, false, 0.0, std::nullopt, std::nullopt, std::nullopt, {}, std::nullopt};
 }
 
 TEST(OmplBenchmarkLog, ReadsEveryRunOfEveryPlannerAndCensorsAtTheTimeLimit) {
@@ -127,10 +127,11 @@ TEST(OmplBenchmarkLog, ASpeedThatIsNotPositiveIsAUsageError) {
 
 TEST(OmplBenchmarkLog, WhatItWritesReadsBackAsTheSameAttempts) {
   const std::vector<RefinementAttempt> attempts{
-      {"move(R1,R2)", 0.1 + 0.2, true, 1.0 / 3.0, 0, 1234, std::nullopt, {}},
-      {"move(R2,R3)", 6.0, false, 0.0, 0, 5000, std::nullopt, {}},
-      {"move(R1,R2)", 6.0, false, 0.0, 1, std::nullopt, std::nullopt, {}},
-      {"move(R2,R3)", 6.0, true, 2.5e-7, std::nullopt, 77, std::nullopt, {}},  // found at exactly the limit: within it
+      {"move(R1,R2)", 0.1 + 0.2, true, 1.0 / 3.0, 0, 1234, std::nullopt, {}, std::nullopt},
+      {"move(R2,R3)", 6.0, false, 0.0, 0, 5000, std::nullopt, {}, std::nullopt},
+      {"move(R1,R2)", 6.0, false, 0.0, 1, std::nullopt, std::nullopt, {}, std::nullopt},
+      {"move(R2,R3)", 6.0, true, 2.5e-7, std::nullopt, 77, std::nullopt, {}, std::nullopt},  // found at exactly the
+                                                                                             // limit: within it
   };
   OmplLogWriteOptions options;
   options.experiment = "navigation";
@@ -154,12 +155,12 @@ TEST(OmplBenchmarkLog, WhatItWritesReadsBackAsTheSameAttempts) {
 // censored at exactly the cut-off, which fits the same instance.
 TEST(OmplBenchmarkLog, ACollectionLogReadBackFitsTheSameInstance) {
   const std::vector<RefinementAttempt> attempts{
-      {"a", 1.5, true, 4.0, 0, std::nullopt, std::nullopt, {}},
-      {"a", 5.000013, false, 0.0, 1, std::nullopt, std::nullopt, {}},
-      {"a", 2.9, true, 3.1, 2, std::nullopt, std::nullopt, {}},
-      {"b", 5.2, false, 0.0, 0, std::nullopt, std::nullopt, {}},
-      {"b", 0.25, true, 7.5, 1, std::nullopt, std::nullopt, {}},
-      {"b", 4.0, true, 1.0, 2, std::nullopt, std::nullopt, {}},
+      {"a", 1.5, true, 4.0, 0, std::nullopt, std::nullopt, {}, std::nullopt},
+      {"a", 5.000013, false, 0.0, 1, std::nullopt, std::nullopt, {}, std::nullopt},
+      {"a", 2.9, true, 3.1, 2, std::nullopt, std::nullopt, {}, std::nullopt},
+      {"b", 5.2, false, 0.0, 0, std::nullopt, std::nullopt, {}, std::nullopt},
+      {"b", 0.25, true, 7.5, 1, std::nullopt, std::nullopt, {}, std::nullopt},
+      {"b", 4.0, true, 1.0, 2, std::nullopt, std::nullopt, {}, std::nullopt},
   };
   OmplLogWriteOptions write;
   write.time_limit_seconds = 5.0;

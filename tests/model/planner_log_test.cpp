@@ -31,8 +31,8 @@ TEST(PlannerLog, ReadsEveryFieldAndSkipsBlankLines) {
 }
 
 TEST(PlannerLog, WritesWhatItReads) {
-  RefinementAttempt found{"a", 0.1 + 0.2, true, 1.0 / 3.0, 12, 3456, std::nullopt, {}};
-  RefinementAttempt cut_off{"b(x,y)", 44.0, false, 0.0, std::nullopt, std::nullopt, std::nullopt, {}};
+  RefinementAttempt found{"a", 0.1 + 0.2, true, 1.0 / 3.0, 12, 3456, std::nullopt, {}, std::nullopt};
+  RefinementAttempt cut_off{"b(x,y)", 44.0, false, 0.0, std::nullopt, std::nullopt, std::nullopt, {}, std::nullopt};
   const std::string text = planner_log_line(found) + planner_log_line(cut_off);
   const std::vector<RefinementAttempt> back = parse_planner_log(text, "log");
   ASSERT_EQ(back.size(), 2u);
@@ -43,7 +43,8 @@ TEST(PlannerLog, WritesWhatItReads) {
 // A corpus across worlds: records name their world and carry the action's features there; a
 // log without them (every log before) reads as before.
 TEST(PlannerLog, WorldAndFeaturesAreReadAndWrittenBack) {
-  const RefinementAttempt found{"move(R1,R2)", 3.5, true, 6.25, 4, std::nullopt, "building-s7", {0.92, -0.125, 16.0}};
+  const RefinementAttempt found{"move(R1,R2)",        3.5,         true, 6.25, 4, std::nullopt, "building-s7",
+                                {0.92, -0.125, 16.0}, std::nullopt};
   const std::string line = planner_log_line(found);
   EXPECT_EQ(line, R"x({"action":"move(R1,R2)","trial":4,"planning_seconds":3.5,"found":true,"execution_seconds":6.25,)x"
                   R"x("world":"building-s7","features":[0.92,-0.125,16.0]})x"

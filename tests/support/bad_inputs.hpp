@@ -61,6 +61,13 @@ inline const std::array kBadInputs{
     BadInput{"sharing_other_position.json", "skeletons[1][1]", "at another position"},
     BadInput{"sharing_other_prefix.json", "skeletons[1][1]", "the actions before it differ"},
     BadInput{"skeleton_too_long.json", "skeletons[0]", "at most 255 actions"},
+    // Backtracking (SPEC §7).
+    BadInput{"culprit_after_failing_action.json", "actions.a.culprits.b", "the culprit comes after the failing action"},
+    BadInput{"culprit_on_another_skeleton.json", "actions.b.culprits.c",
+             "not before the action on its skeletons' path"},
+    BadInput{"culprit_probability_above_one.json", "actions.b.culprits.a", "a probability must be within [0, 1]"},
+    BadInput{"culprits_sum_above_one.json", "actions.c", "the culprits' probabilities sum to 1.250000, not 1"},
+    BadInput{"backtrack_and_planning_above_one.json", "actions.b", "planning and backtrack probabilities sum above 1"},
 };
 
 }  // namespace ontime::testing

@@ -30,6 +30,9 @@ inline const std::array kBadLogs{
     BadInput{"features_empty.jsonl", "line 1: features", "non-empty array of numbers"},
     BadInput{"features_length.jsonl", "line 2: features", "has 1 numbers, but earlier records have 2"},
     BadInput{"world_empty.jsonl", "line 1: world", "non-empty string naming the world"},
+    BadInput{"backtrack_found.jsonl", "line 1: backtrack", "found no motion ('found' must be false)"},
+    BadInput{"backtrack_self.jsonl", "line 1: backtrack", "an action cannot blame itself"},
+    BadInput{"backtrack_not_string.jsonl", "line 1: backtrack", "non-empty string naming the earlier action"},
 };
 
 }  // namespace ontime::testing

@@ -1,8 +1,9 @@
 #pragma once
 // `dp` (the paper's DP, SPEC §3): the best linear contiguous policy over single skeletons.
 //
-// Computes PS(k, 0, 0, 0) of Eq. (1) with aggregation `self` for every skeleton, picks the
-// largest once (ties: lowest index) and refines only that skeleton for the whole episode.
+// Computes PS(k, 0, 0, 0) of Eq. (1) with aggregation `self` for every skeleton (with
+// backtracking, SPEC §7, its extension: backtracking_success.hpp), picks the largest once (ties:
+// lowest index) and refines only that skeleton for the whole episode.
 // No guarantee beyond optimality among "one skeleton, refined contiguously" policies.
 // Cost: one ContiguousSuccessTable build at construction; O(1) per decision.
 

@@ -9,12 +9,15 @@
 // Cost: the Eq. (1) tables are built once per problem and shared. A decision reads PS from a
 // table for every skeleton with nothing spent on its current action, and computes the dot
 // product (at most D - CT - ET_k terms) only for the others whose table bound could beat the
-// best so far: O(K) with a few dot products, no allocation (see docs/performance.md).
+// best so far: O(K) with a few dot products, no allocation (see docs/performance.md). With
+// backtracking (SPEC §7) PS is its extension (backtracking_success.hpp), memoised per allocator:
+// O(K) hash lookups once the values an episode needs are known.
 
 #include <memory>
 #include <vector>
 
 #include "ontime/allocators/allocator.hpp"
+#include "ontime/solve/backtracking_success.hpp"
 #include "ontime/solve/contiguous_success.hpp"
 
 namespace ontime {
@@ -24,14 +27,21 @@ class DpRerunAllocator final : public Allocator {
   DpRerunAllocator(const Mdp& mdp, Aggregation aggregation = Aggregation::sum);
   DpRerunAllocator(const Mdp& mdp, std::shared_ptr<const ContiguousSuccessTable> table);
 
+  // With backtracking (SPEC §7): Eq. (1)'s extension, memoised by this allocator as it decides.
+  DpRerunAllocator(const Mdp& mdp, std::unique_ptr<BacktrackingSuccess> backtracking);
+
   std::string_view name() const noexcept override { return "dp-rerun"; }
   int choose(const State& state) override;
 
+  // Eq. (1)'s tables (problems without backtracking).
   const ContiguousSuccessTable& table() const noexcept { return *table_; }
 
  private:
+  int choose_with_backtracking(const State& state);
+
   const Mdp* mdp_;
   std::shared_ptr<const ContiguousSuccessTable> table_;
+  std::unique_ptr<BacktrackingSuccess> backtracking_;
   std::vector<int> worked_on_;  // skeletons with steps spent on their current action (scratch)
 };
 

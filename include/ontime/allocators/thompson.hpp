@@ -18,6 +18,12 @@
 // Cost per decision: one inverse-CDF draw (a binary search over D + 1 steps) per remaining
 // action of the live skeletons, O(sum of remaining actions * log D); no allocation (the
 // per-action draws live in arrays sized once).
+//
+// With backtracking (SPEC §7) a world is drawn skeleton by skeleton as its refinement would go:
+// each attempt's outcome (a motion at t with its execution, or a backtrack at t to a culprit,
+// after which the refinement goes on from the culprit with the execution before it restored),
+// until the skeleton is refined or the deadline passes; the step goes to the skeleton finishing
+// soonest in its draw. O(D) draws per skeleton at most.
 
 #include <cstdint>
 #include <vector>
@@ -42,12 +48,16 @@ class ThompsonAllocator final : public Allocator {
   // Planning plus execution steps of `action` in this decision's draw (kNever: never), the
   // planning time conditioned on `spent` steps already spent on it.
   std::int64_t drawn_time(int action, Steps spent);
+  // With backtracking: when skeleton k would finish in one draw of its refinement (kNever-like
+  // maximum when past the deadline).
+  std::int64_t drawn_finish_with_backtracking(const State& state, int k);
 
   const Mdp* mdp_;
   SplitMix64 generator_{0};
-  std::uint64_t decision_ = 0;            // numbers the draws: an action is drawn once per decision
-  std::vector<std::uint64_t> drawn_at_;   // per action: the decision of its last draw
-  std::vector<std::int64_t> drawn_time_;  // per action: its draw in that decision
+  std::uint64_t decision_ = 0;                  // numbers the draws: an action is drawn once per decision
+  std::vector<std::uint64_t> drawn_at_;         // per action: the decision of its last draw
+  std::vector<std::int64_t> drawn_time_;        // per action: its draw in that decision
+  std::vector<std::int64_t> execution_before_;  // backtracking: ET before each position (scratch)
 };
 
 }  // namespace ontime

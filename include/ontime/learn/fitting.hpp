@@ -19,6 +19,9 @@
 //
 // Execution time (never censored): the empirical PMF over 0..D, times beyond D counting as
 // "never", with add-alpha smoothing over the D + 2 categories.
+//
+// Backtracking (SPEC §7): a record that says which earlier action it blamed ended its attempt
+// then, without a motion: an event of the second kind (estimate_attempts below), not a cut-off.
 
 #include <cstddef>
 #include <span>
@@ -41,11 +44,29 @@ Steps whole_steps_within(double seconds, double step_seconds);
 struct PlanningSample {
   std::vector<Steps> found;     // planning time of each attempt that found a motion, >= 1
   std::vector<Steps> censored;  // steps survived by each attempt cut off without a motion, >= 0
+  // Backtracking (SPEC §7): the step at which each attempt that gave up did so (>= 1), and the
+  // action it blamed.
+  std::vector<Steps> backtracked;
+  std::vector<std::string> blamed;
 };
 
 // The estimators described above. Throws UsageError for a deadline out of range,
 // a negative alpha, or observations out of range.
 Distribution estimate_planning(const PlanningSample& sample, Steps deadline, double laplace = 0);
+
+// With backtracking (SPEC §7) an attempt ends in one of two ways, found or backtracked, or is cut
+// off: competing risks. At step t, with n_t attempts at risk, d_t found and b_t backtracked there,
+// the hazards are h(t) = (d_t + alpha) / (n_t + alpha (D - t + 2)) and g(t) = b_t / (the same
+// denominator), and p(t) = h(t) S(t - 1), q(t) = g(t) S(t - 1), S(t) = prod_{u<=t} (1 - h(u) - g(u))
+// (the Aalen-Johansen estimator of the two cumulative incidences; with no backtrack it is the
+// Kaplan-Meier estimate above, and then it is that function's result bit for bit). The culprits
+// are the blamed actions' shares of the backtracks, in the order each was first blamed.
+struct AttemptEstimate {
+  Distribution planning;
+  Distribution backtrack;         // all "never" without backtracks
+  std::vector<Culprit> culprits;  // empty without backtracks
+};
+AttemptEstimate estimate_attempts(const PlanningSample& sample, Steps deadline, double laplace = 0);
 Distribution estimate_execution(std::span<const Steps> execution_steps, Steps deadline, double laplace = 0);
 
 struct FitOptions {
@@ -59,9 +80,10 @@ struct FitOptions {
 // What the log said about one action.
 struct ActionFit {
   std::string id;
-  std::size_t attempts = 0;  // records of the action
-  std::size_t found = 0;     // of which found a motion
-  std::size_t censored = 0;  // of which were cut off
+  std::size_t attempts = 0;     // records of the action
+  std::size_t found = 0;        // of which found a motion
+  std::size_t censored = 0;     // of which were cut off
+  std::size_t backtracked = 0;  // of which gave up and blamed an earlier action
 };
 
 struct FitResult {

@@ -55,9 +55,22 @@ class ChoiceList {
 struct Observation {
   bool refined = false;  // a motion was found in this step
   Steps execution = 0;   // its execution time (may be kNever); only when refined
+  // Backtracking (SPEC §7): the attempt gave up and blames this earlier action (its index), whose
+  // motion and everything refined after it are discarded; -1: no backtrack. Never with `refined`.
+  int culprit = -1;
 
   static constexpr Observation not_yet() noexcept { return {}; }
-  static constexpr Observation found(Steps execution_steps) noexcept { return {true, execution_steps}; }
+  static constexpr Observation found(Steps execution_steps) noexcept { return {true, execution_steps, -1}; }
+  static constexpr Observation backtracked(int culprit_action) noexcept { return {false, 0, culprit_action}; }
+  bool is_backtrack() const noexcept { return culprit >= 0; }
+};
+
+// Whether a state type holds the restore values of backtracking (State does; the exact solvers'
+// compact copy only in its backtracking form). The Mdp's functions read and write them only then;
+// a problem with backtracking needs such a state type.
+template <class S>
+inline constexpr bool kHoldsRestore = requires(S& state) {
+  state.restore[0];
 };
 
 class Mdp {
@@ -76,7 +89,11 @@ class Mdp {
   int skeleton_count() const noexcept { return skeleton_count_; }
   Steps deadline() const noexcept { return deadline_; }
 
-  State start() const { return State(static_cast<std::size_t>(skeleton_count_)); }
+  State start() const {
+    return State(static_cast<std::size_t>(skeleton_count_), static_cast<std::size_t>(problem_->culprit_slot_count()));
+  }
+  // Whether some action may backtrack (SPEC §7).
+  bool has_backtracking() const noexcept { return problem_->has_backtracking(); }
 
   // The action skeleton k refines next, or -1 when it is fully refined (choosing it idles).
   template <class S>
@@ -125,7 +142,9 @@ class Mdp {
 
   // Whether skeleton k can still succeed from this state: it has actions left and the
   // least time it can still need (earliest completion of the current action given the
-  // steps spent, plus the fastest planning and execution of the rest) fits the deadline.
+  // steps spent, plus the fastest planning and execution of the rest; with backtracking, or a
+  // backtrack to an earlier action of its path that restores that action's execution before it)
+  // fits the deadline.
   template <class S>
   bool can_succeed(const S& state, int k) const noexcept;
   template <class S>
@@ -140,12 +159,22 @@ class Mdp {
   template <class S>
   std::int64_t least_need(const S& state, int k) const noexcept {
     const auto slot = static_cast<std::size_t>(k);
-    return least_need(k, state.refined[slot], state.spent[slot], state.execution[slot]);
+    const std::int64_t need = least_need(k, state.refined[slot], state.spent[slot], state.execution[slot]);
+    if constexpr (kHoldsRestore<S>) {
+      if (has_backtracking()) return std::min(need, least_need_after_backtrack(state, k));
+    }
+    return need;
   }
+  // With backtracking: the least need of skeleton k through a backtrack to an action c refined on
+  // its path that some action may blame: at least one step to trigger it, then B_c and the
+  // fastest planning and execution from c's position on (kUnreachableNeed without such c).
+  template <class S>
+  std::int64_t least_need_after_backtrack(const S& state, int k) const noexcept;
 
   // The least number of steps after CT before some skeleton whose next action is `action` (they
   // share its PT and ET) can succeed: the least least_need over them. can_succeed holds for
-  // one of them exactly when CT + group_need <= D.
+  // one of them exactly when CT + group_need <= D. Without backtracking only (the layered
+  // solver's).
   std::int64_t group_need(int action, std::uint16_t spent, std::uint16_t execution) const noexcept {
     const auto a = static_cast<std::size_t>(action);
     if (spent > deadline_) return kUnreachableNeed;
@@ -165,11 +194,19 @@ class Mdp {
   template <class S>
   int first_with_work_left(const S& state) const noexcept;
 
-  // P(the next step of effort on `action` finds a motion | `spent` steps did not).
+  // P(the next step of effort on `action` finds a motion | `spent` steps of this attempt neither
+  // found one nor backtracked).
   double hazard(int action, Steps spent) const noexcept {
     return spent < deadline_ ? hazards_[static_cast<std::size_t>(action) * static_cast<std::size_t>(deadline_) +
                                         static_cast<std::size_t>(spent)]
                              : 0.0;
+  }
+  // P(the next step of effort on `action` backtracks | the same): 0 without backtracking.
+  double backtrack_hazard(int action, Steps spent) const noexcept {
+    return spent < deadline_ && !backtrack_hazards_.empty()
+               ? backtrack_hazards_[static_cast<std::size_t>(action) * static_cast<std::size_t>(deadline_) +
+                                    static_cast<std::size_t>(spent)]
+               : 0.0;
   }
 
  private:
@@ -177,6 +214,14 @@ class Mdp {
   [[noreturn]] void reject_choice(int choice) const;
   [[noreturn]] static void reject_idle_refinement(int choice);
   [[noreturn]] static void reject_execution(Steps execution);
+  [[noreturn]] void reject_culprit(int action, int culprit) const;
+  // The backtracking tables (SPEC §7): hazards, culprit slots along the paths and below each one.
+  void index_backtracking(const Problem& problem);
+
+  // Backtracking to `culprit` (SPEC §7): every skeleton through it goes back to its position
+  // with the execution recorded before it; the restore values at and below it are cleared.
+  template <class S>
+  void backtrack(S& state, int culprit) const noexcept;
 
   std::uint16_t saturate_execution(std::int64_t steps) const noexcept {
     return static_cast<std::uint16_t>(steps > deadline_ ? deadline_ + 1 : steps);
@@ -194,6 +239,13 @@ class Mdp {
   std::vector<Steps> next_finish_;        // [action][spent]: least t >= 1 with p(spent + t) > 0, or kNever
   std::vector<std::vector<ExecutionOutcome>> execution_outcomes_;  // per action
   std::vector<Steps> min_execution_;                               // per action, kNever if none
+  // Backtracking only (empty otherwise).
+  std::vector<double> backtrack_hazards_;  // [action][spent], spent < deadline
+  // Per skeleton and position (offsets_ + k + l, as rest_): the culprit slot of the action there
+  // that some action may blame, else -1.
+  std::vector<int> slot_at_;
+  // Per culprit slot: the slots of the actions at or below it in the prefix tree (itself first).
+  std::vector<std::vector<int>> slots_below_;
 };
 
 template <class S, class Visitor>
@@ -203,11 +255,22 @@ void Mdp::for_each_observation(const S& state, int choice, Visitor&& visit) cons
     visit(1.0, Observation::not_yet());
     return;
   }
-  const double found = hazard(action, state.spent[static_cast<std::size_t>(choice)]);
-  if (found < 1.0) visit(1.0 - found, Observation::not_yet());
+  const Steps spent = state.spent[static_cast<std::size_t>(choice)];
+  const double found = hazard(action, spent);
+  const double back = backtrack_hazard(action, spent);
+  if (back <= 0.0) {
+    if (found < 1.0) visit(1.0 - found, Observation::not_yet());
+  } else if (found + back < 1.0) {
+    visit(1.0 - found - back, Observation::not_yet());
+  }
   if (found > 0.0) {
     for (const ExecutionOutcome& outcome : execution_outcomes_[static_cast<std::size_t>(action)]) {
       visit(found * outcome.probability, Observation::found(outcome.steps));
+    }
+  }
+  if (back > 0.0) {
+    for (const Problem::CulpritIndex& culprit : problem_->culprits(action)) {
+      if (culprit.probability > 0) visit(back * culprit.probability, Observation::backtracked(culprit.action));
     }
   }
 }
@@ -225,8 +288,18 @@ template <class S, class Generator>
 Observation Mdp::sample_observation(const S& state, int choice, Generator& generator) const {
   const int action = next_action(state, choice);
   if (action < 0) return Observation::not_yet();
-  const double found = hazard(action, state.spent[static_cast<std::size_t>(choice)]);
-  if (!(uniform01(generator) < found)) return Observation::not_yet();
+  const Steps spent = state.spent[static_cast<std::size_t>(choice)];
+  const double found = hazard(action, spent);
+  const double u = uniform01(generator);
+  if (!(u < found)) {
+    // (Without backtracking this is the only draw of a step that finds nothing.)
+    const double back = backtrack_hazard(action, spent);
+    if (!(u < found + back)) return Observation::not_yet();
+    const auto culprits = problem_->culprits(action);
+    const std::size_t blamed = sample_index(
+        culprits.size(), [&culprits](std::size_t i) { return culprits[i].probability; }, generator);
+    return Observation::backtracked(culprits[blamed].action);
+  }
   const auto& outcomes = execution_outcomes_[static_cast<std::size_t>(action)];
   const std::size_t drawn = sample_index(
       outcomes.size(), [&outcomes](std::size_t i) { return outcomes[i].probability; }, generator);
@@ -242,6 +315,21 @@ inline std::int64_t Mdp::least_need(int k, int refined, std::uint16_t spent, std
   if (finish == kNever || fastest == kNever) return kUnreachableNeed;
   return std::int64_t{execution} + finish + fastest +
          rest_[offsets_[slot] + slot + static_cast<std::size_t>(refined) + 1];
+}
+
+template <class S>
+std::int64_t Mdp::least_need_after_backtrack(const S& state, int k) const noexcept {
+  const auto slot = static_cast<std::size_t>(k);
+  const std::size_t base = offsets_[slot] + slot;
+  std::int64_t least = kUnreachableNeed;
+  // The refined actions of k's path (positions 0 .. refined - 1) that some action may blame.
+  for (int l = 0; l < state.refined[slot]; ++l) {
+    const int culprit_slot = slot_at_[base + static_cast<std::size_t>(l)];
+    if (culprit_slot < 0) continue;
+    least = std::min(least, 1 + std::int64_t{state.restore[static_cast<std::size_t>(culprit_slot)]} +
+                                rest_[base + static_cast<std::size_t>(l)]);
+  }
+  return least;
 }
 
 template <class S>
@@ -276,10 +364,13 @@ bool Mdp::group_can_succeed(const S& state, int action) const noexcept {
 template <class S>
 ChoiceList Mdp::useful_choices(const S& state) const {
   ChoiceList choices;
+  const bool backtracking = has_backtracking();
   for (int k = 0; k < skeleton_count_; ++k) {
     const int action = next_action(state, k);
     if (action < 0 || problem_->members(action).front() != k) continue;
-    if (group_can_succeed(state, action)) choices.push_back(k);
+    // With backtracking a step on a group that cannot succeed may still backtrack and restore an
+    // action that other skeletons share: every group with work left is worth considering.
+    if (backtracking || group_can_succeed(state, action)) choices.push_back(k);
   }
   return choices;
 }
@@ -297,6 +388,23 @@ Status Mdp::apply(S& state, int choice, const Observation& observation) const {
   if (observation.refined && observation.execution < 0) {
     reject_execution(observation.execution);
   }
+  if (observation.culprit >= 0) {
+    // A backtrack: only on an action step, blaming one of that action's culprits.
+    bool listed = false;
+    if (action >= 0 && !observation.refined) {
+      for (const Problem::CulpritIndex& culprit : problem_->culprits(action))
+        listed |= culprit.action == observation.culprit;
+    }
+    if (!listed) reject_culprit(action, observation.culprit);
+    if constexpr (kHoldsRestore<S>) {
+      ++state.time;
+      backtrack(state, observation.culprit);
+      if (state.time >= deadline_ || !any_can_succeed(state)) return Status::failure;
+      return Status::running;
+    } else {
+      reject_culprit(action, observation.culprit);  // (a state type without restore values)
+    }
+  }
   ++state.time;
   // An idle step (action < 0) only spends time.
   if (action >= 0 && !observation.refined) {
@@ -310,6 +418,14 @@ Status Mdp::apply(S& state, int choice, const Observation& observation) const {
             ? std::int64_t{deadline_} + 1
             : std::int64_t{state.execution[static_cast<std::size_t>(choice)]} + observation.execution;
     const std::uint16_t execution = saturate_execution(total);
+    if constexpr (kHoldsRestore<S>) {
+      if (has_backtracking()) {
+        const int culprit_slot = problem_->culprit_slot(action);
+        if (culprit_slot >= 0) {
+          state.restore[static_cast<std::size_t>(culprit_slot)] = state.execution[static_cast<std::size_t>(choice)];
+        }
+      }
+    }
     for (const int member : problem_->members(action)) {
       const auto slot = static_cast<std::size_t>(member);
       ++state.refined[slot];
@@ -322,6 +438,22 @@ Status Mdp::apply(S& state, int choice, const Observation& observation) const {
   }
   if (state.time >= deadline_ || !any_can_succeed(state)) return Status::failure;
   return Status::running;
+}
+
+template <class S>
+void Mdp::backtrack(S& state, int culprit) const noexcept {
+  static_assert(kHoldsRestore<S>, "a problem with backtracking needs a state type that holds its restore values");
+  const int position = problem_->position(culprit);
+  const auto culprit_slot = static_cast<std::size_t>(problem_->culprit_slot(culprit));  // a culprit has one
+  const std::uint16_t restored = state.restore[culprit_slot];
+  for (const int member : problem_->members(culprit)) {
+    const auto slot = static_cast<std::size_t>(member);
+    if (state.refined[slot] <= position) continue;
+    state.refined[slot] = static_cast<std::uint8_t>(position);
+    state.spent[slot] = 0;
+    state.execution[slot] = restored;
+  }
+  for (const int below : slots_below_[culprit_slot]) state.restore[static_cast<std::size_t>(below)] = 0;
 }
 
 template <class S>

@@ -1,6 +1,7 @@
 #pragma once
 // The MDP state of SPEC §2: the steps used and, per skeleton, the actions refined, the steps
-// spent on the current action and the execution time of the refined ones.
+// spent on the current action and the execution time of the refined ones; with backtracking
+// (SPEC §7), the execution before each action that may be blamed.
 //
 // Up to kInlineSkeletons skeletons the per-skeleton values live inside the object, so that
 // the hot paths (transitions, searches, exact solving) copy a state without allocating;
@@ -117,9 +118,10 @@ class PerSkeleton {
 
 struct State {
   State() noexcept = default;
-  // The start state of a problem with `skeleton_count` skeletons (Mdp::start() makes it).
-  explicit State(std::size_t skeleton_count)
-      : refined(skeleton_count), spent(skeleton_count), execution(skeleton_count) {}
+  // The start state of a problem with `skeleton_count` skeletons and `culprit_slots` actions
+  // that backtracking may blame (Mdp::start() makes it).
+  explicit State(std::size_t skeleton_count, std::size_t culprit_slots = 0)
+      : refined(skeleton_count), spent(skeleton_count), execution(skeleton_count), restore(culprit_slots) {}
 
   std::uint16_t time = 0;             // CT: steps used
   PerSkeleton<std::uint8_t> refined;  // l_k: actions refined
@@ -127,6 +129,10 @@ struct State {
   // ET_k: execution steps of the refined actions, saturated at deadline + 1 (any larger
   // value is equally too slow, and saturation keeps equivalent states equal).
   PerSkeleton<std::uint16_t> execution;
+  // Backtracking (SPEC §7): B_c for every action c some action may blame (by
+  // Problem::culprit_slot): the execution steps before c on its path, recorded when c was
+  // refined, 0 while it is not. All zero, and unused, in a problem without backtracking.
+  PerSkeleton<std::uint16_t> restore;
 
   friend bool operator==(const State&, const State&) = default;
 };

@@ -11,7 +11,8 @@
 // across worlds for conditional time models): "world": "building-s7", "features": [0.92, ...].
 //
 // `found: false` means the attempt was cut off after `planning_seconds` of effort without a
-// motion (right-censored: its planning time is known only to exceed that). Reading checks
+// motion (right-censored: its planning time is known only to exceed that), unless the record says
+// "backtrack": "ACTION ID": the refiner gave up then and blamed that earlier action (SPEC §7). Reading checks
 // every rule and raises InputError naming the file, the line (and key) and the rule.
 
 #include <cstdint>
@@ -36,6 +37,9 @@ struct RefinementAttempt {
   // a log that has them).
   std::optional<std::string> world;
   std::vector<double> features;
+  // Optional, backtracking (SPEC §7): the attempt gave up after `planning_seconds` and blamed
+  // this earlier action (found is false; an event, not a cut-off).
+  std::optional<std::string> backtrack;
 
   friend bool operator==(const RefinementAttempt&, const RefinementAttempt&) = default;
 };

@@ -4,7 +4,9 @@
 //
 // Skeletons that list the same action id share that action: it is refined once for all of
 // them. Sharing follows a common prefix, so the skeletons form a prefix tree (trie) whose
-// nodes are the used actions. A Problem is immutable once built and validated.
+// nodes are the used actions. An action may backtrack (SPEC §7): an attempt that gives up
+// blames an action before it on its path, whose motion and everything refined after it are
+// discarded. A Problem is immutable once built and validated.
 
 #include <cstddef>
 #include <span>
@@ -14,13 +16,56 @@
 #include <vector>
 
 #include "ontime/model/distribution.hpp"
+#include "ontime/util/error.hpp"
 
 namespace ontime {
 
+// An earlier action an attempt that backtracks blames (SPEC §7), with its probability.
+struct Culprit {
+  std::string id;
+  double probability = 0;
+};
+
 struct Action {
+  Action() = default;
+  // (A constructor rather than an aggregate, so that the many actions built without backtracking
+  // name just their id and distributions.)
+  Action(std::string action_id, Distribution planning_time, Distribution execution_time,
+         Distribution backtrack_time = {}, std::vector<Culprit> blamed = {})
+      : id(std::move(action_id)),
+        planning(std::move(planning_time)),
+        execution(std::move(execution_time)),
+        backtrack(std::move(backtrack_time)),
+        culprits(std::move(blamed)) {}
+
   std::string id;          // e.g. "move(R1,R5)"
   Distribution planning;   // steps of effort until refined, t >= 1
   Distribution execution;  // steps to execute the refined motion, x >= 0
+  // Backtracking (SPEC §7), optional: backtrack(t) is the probability that an attempt gives up
+  // after t steps and blames an earlier choice (its mass is the chance of backtracking at all;
+  // planning and backtrack masses sum to at most 1), and `culprits` which action on the path
+  // before it is blamed (probabilities summing to 1). All "never" and no culprits: the attempt
+  // never backtracks, as in SPEC §2.
+  Distribution backtrack;
+  std::vector<Culprit> culprits;
+};
+
+// A broken backtracking rule of SPEC §7 in a Problem being built: the action, the culprit named
+// (empty when the rule is about the action's backtrack distribution) and the rule. A UsageError,
+// so that code building problems catches it as any; instance files map it to its JSON place.
+class BacktrackingError : public UsageError {
+ public:
+  BacktrackingError(std::string action, std::string culprit, const std::string& rule)
+      : UsageError("action '" + action + "'" + (culprit.empty() ? "" : ", culprit '" + culprit + "'") + ": " + rule),
+        action_(std::move(action)),
+        culprit_(std::move(culprit)),
+        rule_(rule) {}
+  const std::string& action() const noexcept { return action_; }
+  const std::string& culprit() const noexcept { return culprit_; }
+  const std::string& rule() const noexcept { return rule_; }
+
+ private:
+  std::string action_, culprit_, rule_;
 };
 
 class Problem {
@@ -33,7 +78,10 @@ class Problem {
 
   // skeletons[k] lists indices into `actions`. Throws UsageError when a rule of
   // SPEC §1 is broken (bad deadline, empty or repeating skeleton, duplicate skeleton, sharing
-  // that does not follow a common prefix, planning mass at step 0, too many skeletons).
+  // that does not follow a common prefix, planning mass at step 0, too many skeletons), and
+  // BacktrackingError for a broken rule of SPEC §7 (backtrack mass at step 0 or with planning
+  // above 1, culprits that are not before the action on its path, probabilities outside [0, 1]
+  // or not summing to 1, culprits without backtracking or backtracking without culprits).
   Problem(std::string name, Steps deadline, double step_seconds, std::vector<Action> actions,
           std::vector<std::vector<int>> skeletons, std::string description = {});
 
@@ -64,6 +112,20 @@ class Problem {
   // True when some skeleton ends with this action (refining it may complete a plan).
   bool completes_a_skeleton(int action) const { return completes_.at(static_cast<std::size_t>(action)) != 0; }
 
+  // Backtracking (SPEC §7). Whether some action may backtrack; an action's culprits as action
+  // indices with their probabilities; the slot of an action that is some action's culprit
+  // (State::restore holds the execution before it there), or -1; how many such slots.
+  struct CulpritIndex {
+    int action;
+    double probability;
+  };
+  bool has_backtracking() const noexcept { return culprit_slots_ > 0; }
+  std::span<const CulpritIndex> culprits(int action) const {
+    return culprit_indices_.at(static_cast<std::size_t>(action));
+  }
+  int culprit_slot(int action) const { return culprit_slot_.at(static_cast<std::size_t>(action)); }
+  int culprit_slot_count() const noexcept { return culprit_slots_; }
+
   // The skeletons as lists of action indices (a copy, e.g. to build a changed problem).
   std::vector<std::vector<int>> skeleton_lists() const { return skeletons_; }
   // This problem (name, deadline, step, skeletons, description) with other actions, in the same
@@ -83,6 +145,11 @@ class Problem {
   std::vector<int> position_;
   std::vector<int> parent_;
   std::vector<char> completes_;
+  std::vector<std::vector<CulpritIndex>> culprit_indices_;
+  std::vector<int> culprit_slot_;
+  int culprit_slots_ = 0;
+
+  void index_culprits();
 };
 
 // The action an id names in the world: the id without a trailing "#n" (one or more digits). A

@@ -40,9 +40,11 @@ class World {
   // episode does not depend on which thread ran the episodes before it.
   virtual void begin_episode(std::uint64_t seed) = 0;
 
-  // One step of effort on `action`, which has already had `spent` steps in this episode: not
-  // yet, or refined with its execution time in steps (kNever: the motion cannot be executed).
-  // The action is one whose parent action, if any, is already refined in this episode.
+  // One step of effort on `action`, which has already had `spent` steps in this attempt: not
+  // yet, or refined with its execution time in steps (kNever: the motion cannot be executed), or,
+  // with backtracking (SPEC §7), a backtrack blaming one of the action's culprits (whose motion
+  // and everything after it are discarded: their next steps are new attempts). The action is one
+  // whose parent action, if any, is refined in this episode.
   virtual Observation step(int action, Steps spent) = 0;
 
   // Adds this world's counters (work done since it was made, e.g. refinements started) to
