@@ -346,7 +346,7 @@ Problem predict_problem(const ConditionalTimeModel& model, std::span<const Actio
   const std::vector<PredictedTimes> times = model.predict_rows(rows, distinct.size());
   std::vector<Action> predicted;
   for (std::size_t a = 0; a < distinct.size(); ++a) {
-    predicted.push_back(Action{distinct[a]->id, truncated(times[a].planning), truncated(times[a].execution)});
+    predicted.emplace_back(distinct[a]->id, truncated(times[a].planning), truncated(times[a].execution));
   }
   std::vector<std::vector<int>> indices;
   if (skeletons.empty()) {

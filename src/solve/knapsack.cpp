@@ -102,8 +102,7 @@ Problem reduce_knapsack(const Knapsack& knapsack, std::string name) {
     planning[static_cast<std::size_t>(knapsack.capacity) + 1] += 1.0 - early;
     std::string id = "item";
     id += std::to_string(k + 1);
-    actions.push_back(
-        Action{std::move(id), Distribution::from_pmf(std::move(planning)), Distribution::from_pmf({1.0})});
+    actions.emplace_back(std::move(id), Distribution::from_pmf(std::move(planning)), Distribution::from_pmf({1.0}));
     skeletons.push_back({static_cast<int>(k)});
   }
   return Problem(std::move(name), deadline, 1.0, std::move(actions), std::move(skeletons),
