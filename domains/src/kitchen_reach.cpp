@@ -12,7 +12,7 @@
 namespace ontime::domains::detail {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using std::numbers::pi;
 
 // Some draw reaches the object at `pose` with one of its grasps; `held`: whether the robot holds
 // it (a place) or it stands there (a pick). `alone` holds the object as its only movable one.
@@ -33,12 +33,12 @@ bool reachable(const ManipulationWorld& alone, const ObjectPose& pose, bool held
     back.translation().x() = -planner.approach_distance;
     const Transform backed = tool * back;
     const double distance = uniform(planner.base_distance[0], planner.base_distance[1]);
-    const double around = uniform(-kPi, kPi);
+    const double around = uniform(-pi, pi);
     const double x = tool.translation().x() + distance * std::cos(around);
     const double y = tool.translation().y() + distance * std::sin(around);
     const double heading = std::atan2(tool.translation().y() - y, tool.translation().x() - x) +
                            uniform(-planner.base_heading_spread, planner.base_heading_spread);
-    const Pose base{x, y, std::remainder(heading, 2 * kPi)};
+    const Pose base{x, y, std::remainder(heading, 2 * pi)};
     ArmJoints guess{};
     for (std::size_t j = 0; j < kArmJointCount; ++j)
       guess[j] = uniform(pr2_left_arm_joints()[j].lower, pr2_left_arm_joints()[j].upper);

@@ -19,7 +19,7 @@ namespace ontime::domains {
 namespace {
 
 using detail::Point;
-constexpr double kPi = std::numbers::pi;
+using std::numbers::pi;
 
 // The paper kitchen's room (data/domains/manipulation.json): floor, walls, start.
 constexpr double kFloorX = 6.0, kFloorY = 3.6;
@@ -190,7 +190,7 @@ class KitchenGenerator {
     const double side = mm(uniform(random, kind.side_min, kind.side_max));
     item.size = {side, kind.square ? side : mm(uniform(random, kind.side_min, kind.side_max)),
                  mm(uniform(random, kind.height_min, kind.height_max))};
-    item.yaw = cm(uniform(random, -kPi, kPi));
+    item.yaw = cm(uniform(random, -pi, pi));
     return item;
   }
 
@@ -257,7 +257,7 @@ class KitchenGenerator {
       item.table = target.table;
       bool placed = false;
       for (int attempt = 0; attempt < kPlacementTries && !placed; ++attempt) {
-        const double angle = uniform(random, -kPi, 0.0);
+        const double angle = uniform(random, -pi, 0.0);
         const double distance = uniform(random, kClutterGapMin, kClutterGapMax) + target.radius() + item.radius();
         item.x = mm(target.x + distance * std::cos(angle));
         item.y = mm(target.y + distance * std::sin(angle));

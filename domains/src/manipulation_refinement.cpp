@@ -18,7 +18,7 @@ namespace ontime::domains {
 namespace {
 
 namespace ob = ompl::base;
-constexpr double kPi = std::numbers::pi;
+using std::numbers::pi;
 
 ArmJoints joints_of(const ob::State* state) {
   const auto* values = state->as<ob::RealVectorStateSpace::StateType>();
@@ -60,7 +60,7 @@ class ArmJointSpace final : public ob::RealVectorStateSpace {
   double getMaximumExtent() const override {
     double sum = 0;
     for (const ArmJointSpec& joint : pr2_left_arm_joints()) {
-      sum += joint.continuous ? kPi * kPi : std::pow(joint.upper - joint.lower, 2);
+      sum += joint.continuous ? pi * pi : std::pow(joint.upper - joint.lower, 2);
     }
     return std::sqrt(sum);
   }
@@ -299,12 +299,12 @@ class ManipulationRefinement final : public detail::PhasedRefinement {
       after_->set_object_pose(object_, placement_);
     }
     const double distance = uniform(world_.planner.base_distance[0], world_.planner.base_distance[1]);
-    const double around = uniform(-kPi, kPi);
+    const double around = uniform(-pi, pi);
     const double x = tool.translation().x() + distance * std::cos(around);
     const double y = tool.translation().y() + distance * std::sin(around);
     const double heading = std::atan2(tool.translation().y() - y, tool.translation().x() - x) +
                            uniform(-world_.planner.base_heading_spread, world_.planner.base_heading_spread);
-    const Pose base{x, y, std::remainder(heading, 2 * kPi)};
+    const Pose base{x, y, std::remainder(heading, 2 * pi)};
     ArmJoints guess{};
     for (std::size_t j = 0; j < kArmJointCount; ++j)
       guess[j] = uniform(pr2_left_arm_joints()[j].lower, pr2_left_arm_joints()[j].upper);

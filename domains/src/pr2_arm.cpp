@@ -13,7 +13,7 @@
 namespace ontime::domains {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using std::numbers::pi;
 constexpr double kTorsoHeight = 0.790675;  // base_footprint -> torso_lift_link at zero lift
 constexpr double kTorsoBack = -0.05;
 constexpr double kMaxTorsoLift = 0.33;
@@ -29,9 +29,9 @@ const std::array<ArmJointSpec, kArmJointCount> kJoints{{
     {"l_shoulder_lift_joint", 'y', -0.5236, 1.3963, false, 2.082},
     {"l_upper_arm_roll_joint", 'x', -0.8, 3.9, false, 3.27},
     {"l_elbow_flex_joint", 'y', -2.3213, 0.0, false, 3.3},
-    {"l_forearm_roll_joint", 'x', -kPi, kPi, true, 3.6},
+    {"l_forearm_roll_joint", 'x', -pi, pi, true, 3.6},
     {"l_wrist_flex_joint", 'y', -2.18, 0.0, false, 3.078},
-    {"l_wrist_roll_joint", 'x', -kPi, kPi, true, 3.6},
+    {"l_wrist_roll_joint", 'x', -pi, pi, true, 3.6},
 }};
 
 KDL::Joint::JointType joint_type(char axis) {
@@ -67,7 +67,7 @@ const std::array<ArmJointSpec, kArmJointCount>& pr2_left_arm_joints() { return k
 
 double joint_difference(std::size_t joint, double from, double to) {
   const double difference = to - from;
-  return kJoints.at(joint).continuous ? std::remainder(difference, 2 * kPi) : difference;
+  return kJoints.at(joint).continuous ? std::remainder(difference, 2 * pi) : difference;
 }
 
 double joint_distance(const ArmJoints& a, const ArmJoints& b) {
@@ -80,7 +80,7 @@ ArmJoints interpolate_joints(const ArmJoints& a, const ArmJoints& b, double t) {
   ArmJoints result{};
   for (std::size_t j = 0; j < kArmJointCount; ++j) {
     result[j] = a[j] + t * joint_difference(j, a[j], b[j]);
-    if (kJoints[j].continuous) result[j] = std::remainder(result[j], 2 * kPi);
+    if (kJoints[j].continuous) result[j] = std::remainder(result[j], 2 * pi);
   }
   return result;
 }
@@ -166,7 +166,7 @@ std::optional<ArmJoints> Pr2Arm::inverse(const Transform& target, const ArmJoint
   ArmJoints joints{};
   for (std::size_t j = 0; j < kArmJointCount; ++j) {
     double value = solution(static_cast<unsigned>(j));
-    if (kJoints[j].continuous) value = std::remainder(value, 2 * kPi);
+    if (kJoints[j].continuous) value = std::remainder(value, 2 * pi);
     joints[j] = value;
   }
   if (!within_limits(joints)) return std::nullopt;

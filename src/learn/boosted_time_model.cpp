@@ -186,14 +186,12 @@ Law law_of(const std::string& name) {
   return Law::normal;
 }
 
-double logistic(double x) { return x >= 0 ? 1 / (1 + portable_exp(-x)) : portable_exp(x) / (1 + portable_exp(x)); }
-
 // P(e > z) for the standard law (XGBoost's survival:aft's: the normal, the logistic, the Gumbel
 // minimum with P(e <= z) = 1 - exp(-exp(z))).
 double survival(Law law, double z) {
   switch (law) {
     case Law::logistic:
-      return logistic(-z);
+      return portable_logistic(-z);
     case Law::extreme:
       return portable_exp(-portable_exp(z));
     case Law::normal:
@@ -211,7 +209,7 @@ double planning_survival(const BoostedParameters& p, Law law, double steps, doub
 // The planning PMF over 1..H from the two margins (the rest "never").
 std::vector<double> planning_pmf(const BoostedParameters& p, Law law, Steps horizon, double never_margin,
                                  double planning_margin) {
-  const double finds = 1 - logistic(never_margin);
+  const double finds = 1 - portable_logistic(never_margin);
   std::vector<double> masses(static_cast<std::size_t>(horizon) + 1, 0.0);
   double above = 1;  // S(t - 1)
   for (Steps t = 1; t <= horizon; ++t) {
@@ -246,7 +244,7 @@ struct PlanningRow {
 // at least log of the smallest normal double.
 double log_likelihood(const BoostedParameters& p, Law law, const PlanningRow& row, double never_margin,
                       double planning_margin) {
-  const double pi = logistic(never_margin);
+  const double pi = portable_logistic(never_margin);
   const double s = planning_survival(p, law, static_cast<double>(row.steps), planning_margin);
   const double value =
       row.found ? (1 - pi) * (planning_survival(p, law, static_cast<double>(row.steps - 1), planning_margin) - s)
@@ -422,7 +420,7 @@ std::unique_ptr<BoostedTimeModel> BoostedTimeModel::fit(const ConditionalData& d
       // booster's gradient and hessian are the logistic loss's at label w (0 for a found row);
       // the planning booster weighs a cut-off row 1 - w.
       for (std::size_t i = 0; i < N; ++i) {
-        const double pi = logistic(never_margin[i]);
+        const double pi = portable_logistic(never_margin[i]);
         double w = 0;
         if (!rows[i].found) {
           const double s = planning_survival(out, law, static_cast<double>(rows[i].steps), planning_margin[i]);

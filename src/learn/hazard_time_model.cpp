@@ -21,7 +21,6 @@ namespace {
 
 // log(1 + e^x) without overflow.
 double softplus(double x) { return std::max(x, 0.0) + portable_log1p(portable_exp(-std::abs(x))); }
-double logistic(double x) { return x >= 0 ? 1 / (1 + portable_exp(-x)) : portable_exp(x) / (1 + portable_exp(x)); }
 // log(e^a + e^b).
 double log_add(double a, double b) {
   const double high = std::max(a, b);
@@ -85,12 +84,12 @@ double objective(unsigned n, const double* theta, double* gradient, void* data) 
       linear += b[f] * group.z[f];
       kappa += g[f] * group.z[f];
     }
-    const double cure = logistic(kappa);
+    const double cure = portable_logistic(kappa);
     const double log_cure = -softplus(-kappa), log_not_cure = -softplus(kappa);
     log_survival[0] = 0;
     for (std::size_t t = 1; t <= H; ++t) {
       const double eta = a[p.bin_of[t]] + linear;
-      h[t] = logistic(eta);
+      h[t] = portable_logistic(eta);
       log_survival[t] = log_survival[t - 1] - softplus(eta);
     }
     double d_kappa = 0;
@@ -298,11 +297,11 @@ PredictedTimes HazardTimeModel::predict_checked(std::span<const double> features
   }
   const auto H = static_cast<std::size_t>(horizon());
   std::vector<double> planning(H + 1, 0.0), execution(H + 1, 0.0);
-  double alive = 1 - logistic(kappa);
+  double alive = 1 - portable_logistic(kappa);
   std::size_t bin = 0;
   for (std::size_t t = 1; t <= H; ++t) {
     if (static_cast<int>(t) > p.bin_end[bin]) ++bin;
-    const double h = logistic(p.baseline[bin] + linear);
+    const double h = portable_logistic(p.baseline[bin] + linear);
     planning[t] = alive * h;
     alive -= planning[t];
   }

@@ -23,5 +23,9 @@ inline double portable_pow(double x, double y) noexcept { return Sleef_cinz_powd
 inline double portable_log1p(double x) noexcept { return Sleef_cinz_log1pd1_u10purec(x); }
 // (At most 1.5 ulp.)
 inline double portable_erfc(double x) noexcept { return Sleef_cinz_erfcd1_u15purec(x); }
+// 1 / (1 + e^-x), with no overflow of e^-x for large negative x.
+inline double portable_logistic(double x) noexcept {
+  return x >= 0 ? 1 / (1 + portable_exp(-x)) : portable_exp(x) / (1 + portable_exp(x));
+}
 
 }  // namespace ontime

@@ -18,7 +18,7 @@ namespace {
 using nlohmann::ordered_json;
 
 // Index of a feature by name, so that a reordering shows as a failure here and nowhere else.
-std::size_t at(const std::string& name) {
+std::size_t manipulation_feature(const std::string& name) {
   const auto& names = manipulation_feature_names();
   const auto found = std::find(names.begin(), names.end(), name);
   EXPECT_NE(found, names.end()) << name;
@@ -79,35 +79,36 @@ ManipulationWorld mini() { return parse_manipulation_world(kMiniKitchen, "mini-k
 TEST(ManipulationFeatures, PickAmongNeighbours) {
   const std::vector<double> f = manipulation_action_features(mini(), "move+pick(A)");
   ASSERT_EQ(f.size(), manipulation_feature_names().size());
-  EXPECT_EQ(f[at("is_place")], 0.0);
-  EXPECT_DOUBLE_EQ(f[at("object_short")], 0.04);
-  EXPECT_DOUBLE_EQ(f[at("object_long")], 0.06);
-  EXPECT_DOUBLE_EQ(f[at("object_height")], 0.2);
-  EXPECT_DOUBLE_EQ(f[at("surface_height")], 0.74);
+  EXPECT_EQ(f[manipulation_feature("is_place")], 0.0);
+  EXPECT_DOUBLE_EQ(f[manipulation_feature("object_short")], 0.04);
+  EXPECT_DOUBLE_EQ(f[manipulation_feature("object_long")], 0.06);
+  EXPECT_DOUBLE_EQ(f[manipulation_feature("object_height")], 0.2);
+  EXPECT_DOUBLE_EQ(f[manipulation_feature("surface_height")], 0.74);
   // The front edge (y 2.3) is open: the base fits on the floor in front of it. The back edge
   // is against the wall; the left (0.5 m) and right (0.9 m) edges are farther.
-  EXPECT_NEAR(f[at("reach")], 0.3, 1e-12);
+  EXPECT_NEAR(f[manipulation_feature("reach")], 0.3, 1e-12);
   // N1: 4 cm apart in x, 5 cm in y, corner to corner; N2 14 cm to the left; F and G farther.
-  EXPECT_NEAR(f[at("nearest_gap")], std::hypot(0.04, 0.05), 1e-12);
-  EXPECT_EQ(f[at("neighbours")], 2.0);
+  EXPECT_NEAR(f[manipulation_feature("nearest_gap")], std::hypot(0.04, 0.05), 1e-12);
+  EXPECT_EQ(f[manipulation_feature("neighbours")], 2.0);
   // The strip x 1.35-1.65, y 2.3-2.6 (0.3 x 0.3 m) holds all of N1 (0.06 x 0.06) and nothing of N2.
-  EXPECT_NEAR(f[at("approach_occupied")], 0.0036 / 0.09, 1e-12);
-  EXPECT_EQ(f[at("region_area")], 0.0);
-  EXPECT_EQ(f[at("region_occupied")], 0.0);
+  EXPECT_NEAR(f[manipulation_feature("approach_occupied")], 0.0036 / 0.09, 1e-12);
+  EXPECT_EQ(f[manipulation_feature("region_area")], 0.0);
+  EXPECT_EQ(f[manipulation_feature("region_occupied")], 0.0);
 }
 
 TEST(ManipulationFeatures, PlaceInAPartlyOccupiedRegion) {
   const std::vector<double> f = manipulation_action_features(mini(), "move+place(A,R)");
-  EXPECT_EQ(f[at("is_place")], 1.0);
-  EXPECT_DOUBLE_EQ(f[at("object_short")], 0.04);  // the held object's
-  EXPECT_DOUBLE_EQ(f[at("object_height")], 0.2);
-  EXPECT_DOUBLE_EQ(f[at("surface_height")], 0.74);
-  EXPECT_NEAR(f[at("reach")], 0.2, 1e-12);     // R's centre (2.0, 2.5) to the front edge
-  EXPECT_EQ(f[at("nearest_gap")], 0.0);        // G stands partly in the rectangle
-  EXPECT_EQ(f[at("neighbours")], 2.0);         // G, and F 7.5 cm right of it
-  EXPECT_EQ(f[at("approach_occupied")], 0.0);  // x 1.85-2.15, y 2.3-2.5: G starts at 2.555, F at 2.175
-  EXPECT_NEAR(f[at("region_area")], 0.04, 1e-12);
-  EXPECT_NEAR(f[at("region_occupied")], 0.05 * 0.045 / 0.04, 1e-12);  // G's part: y 2.555-2.6
+  EXPECT_EQ(f[manipulation_feature("is_place")], 1.0);
+  EXPECT_DOUBLE_EQ(f[manipulation_feature("object_short")], 0.04);  // the held object's
+  EXPECT_DOUBLE_EQ(f[manipulation_feature("object_height")], 0.2);
+  EXPECT_DOUBLE_EQ(f[manipulation_feature("surface_height")], 0.74);
+  EXPECT_NEAR(f[manipulation_feature("reach")], 0.2, 1e-12);  // R's centre (2.0, 2.5) to the front edge
+  EXPECT_EQ(f[manipulation_feature("nearest_gap")], 0.0);     // G stands partly in the rectangle
+  EXPECT_EQ(f[manipulation_feature("neighbours")], 2.0);      // G, and F 7.5 cm right of it
+  EXPECT_EQ(f[manipulation_feature("approach_occupied")],
+            0.0);  // x 1.85-2.15, y 2.3-2.5: G starts at 2.555, F at 2.175
+  EXPECT_NEAR(f[manipulation_feature("region_area")], 0.04, 1e-12);
+  EXPECT_NEAR(f[manipulation_feature("region_occupied")], 0.05 * 0.045 / 0.04, 1e-12);  // G's part: y 2.555-2.6
 }
 
 // Objects moved before the action no longer stand where they started; those placed in the
@@ -115,18 +116,18 @@ TEST(ManipulationFeatures, PlaceInAPartlyOccupiedRegion) {
 TEST(ManipulationFeatures, TheContextMovesObjects) {
   const ManipulationWorld world = mini();
   const std::vector<double> pick = manipulation_action_features(world, "move+pick(A)[N1]");
-  EXPECT_NEAR(pick[at("nearest_gap")], 0.14, 1e-12);  // N2
-  EXPECT_EQ(pick[at("neighbours")], 1.0);
-  EXPECT_EQ(pick[at("approach_occupied")], 0.0);
+  EXPECT_NEAR(pick[manipulation_feature("nearest_gap")], 0.14, 1e-12);  // N2
+  EXPECT_EQ(pick[manipulation_feature("neighbours")], 1.0);
+  EXPECT_EQ(pick[manipulation_feature("approach_occupied")], 0.0);
   const std::vector<double> place = manipulation_action_features(world, "move+place(A,R)[N1]");
-  EXPECT_NEAR(place[at("region_occupied")], (0.05 * 0.045 + 0.06 * 0.06) / 0.04, 1e-12);
+  EXPECT_NEAR(place[manipulation_feature("region_occupied")], (0.05 * 0.045 + 0.06 * 0.06) / 0.04, 1e-12);
   // After N1 went to R and on to P, it counts in neither; it is picked at R's centre.
   const std::vector<double> again = manipulation_action_features(world, "move+pick(N1)[N1]");
-  EXPECT_NEAR(again[at("nearest_gap")], 0.025, 1e-12);  // N1 at y 2.47-2.53 under G from 2.555
-  EXPECT_EQ(again[at("neighbours")], 2.0);              // G, and F 14.5 cm to the right
-  EXPECT_NEAR(again[at("reach")], 0.2, 1e-12);
-  EXPECT_NEAR(manipulation_action_features(world, "move+place(A,R)[N1,N1]")[at("region_occupied")], 0.05 * 0.045 / 0.04,
-              1e-12);
+  EXPECT_NEAR(again[manipulation_feature("nearest_gap")], 0.025, 1e-12);  // N1 at y 2.47-2.53 under G from 2.555
+  EXPECT_EQ(again[manipulation_feature("neighbours")], 2.0);              // G, and F 14.5 cm to the right
+  EXPECT_NEAR(again[manipulation_feature("reach")], 0.2, 1e-12);
+  EXPECT_NEAR(manipulation_action_features(world, "move+place(A,R)[N1,N1]")[manipulation_feature("region_occupied")],
+              0.05 * 0.045 / 0.04, 1e-12);
 }
 
 // A low box in front of the table closes its front edge: the reach is to the left edge, and the
@@ -136,20 +137,20 @@ TEST(ManipulationFeatures, TheReachIsToAnEdgeTheBaseCanStandAt) {
   ordered_json json = ordered_json::parse(kMiniKitchen);
   json["fixed"]["bench"] = ordered_json::array({{{"min", {1.2, 1.9, 0}}, {"max", {1.8, 2.3, 0.3}}}});
   const std::vector<double> left = manipulation_action_features(mini(json), "move+pick(A)");
-  EXPECT_NEAR(left[at("reach")], 0.5, 1e-12);
+  EXPECT_NEAR(left[manipulation_feature("reach")], 0.5, 1e-12);
   // The strip x 1.0-1.5, y 2.45-2.75 holds all of N2: 0.0036 of 0.15 m².
-  EXPECT_NEAR(left[at("approach_occupied")], 0.0036 / 0.15, 1e-12);
+  EXPECT_NEAR(left[manipulation_feature("approach_occupied")], 0.0036 / 0.15, 1e-12);
 
   json["fixed"]["bench"][0]["min"][2] = 0.4;
   json["fixed"]["bench"][0]["max"][2] = 0.6;
-  EXPECT_NEAR(manipulation_action_features(mini(json), "move+pick(A)")[at("reach")], 0.3, 1e-12);
+  EXPECT_NEAR(manipulation_action_features(mini(json), "move+pick(A)")[manipulation_feature("reach")], 0.3, 1e-12);
 
   json["fixed"]["bench"][0]["min"][2] = 0.0;
   json["fixed"]["bench"][0]["max"][2] = 0.3;
   json["fixed"]["stool"] = ordered_json::array({{{"min", {0.5, 2.3, 0}}, {"max", {1.0, 2.9, 0.3}}}});
   json["floor"]["max"][0] = 2.6;  // no room for the base right of the table
   json["start"]["base"][0] = 1.5;
-  EXPECT_NEAR(manipulation_action_features(mini(json), "move+pick(A)")[at("reach")], 0.3, 1e-12);
+  EXPECT_NEAR(manipulation_action_features(mini(json), "move+pick(A)")[manipulation_feature("reach")], 0.3, 1e-12);
 }
 
 TEST(ManipulationFeatures, TheCommittedKitchen) {
@@ -157,17 +158,18 @@ TEST(ManipulationFeatures, TheCommittedKitchen) {
   // B1 at the back of the shelf board (front edge y 3.2), B3 and B4 in front of it 16 cm apart:
   // the strip x 0.70-1.00, y 3.2-3.4 holds both whole (y 3.22-3.28).
   const std::vector<double> b1 = manipulation_action_features(kitchen, "move+pick(B1)");
-  EXPECT_NEAR(b1[at("reach")], 0.2, 1e-12);
-  EXPECT_DOUBLE_EQ(b1[at("surface_height")], 0.85);
-  EXPECT_EQ(b1[at("neighbours")], 2.0);
-  EXPECT_NEAR(b1[at("nearest_gap")], std::hypot(0.05, 0.09), 1e-12);  // B1 x 0.82-0.88, y 3.37-3.43; B3's corner
-  EXPECT_NEAR(b1[at("approach_occupied")], 2 * 0.0036 / 0.06, 1e-12);
+  EXPECT_NEAR(b1[manipulation_feature("reach")], 0.2, 1e-12);
+  EXPECT_DOUBLE_EQ(b1[manipulation_feature("surface_height")], 0.85);
+  EXPECT_EQ(b1[manipulation_feature("neighbours")], 2.0);
+  EXPECT_NEAR(b1[manipulation_feature("nearest_gap")], std::hypot(0.05, 0.09),
+              1e-12);  // B1 x 0.82-0.88, y 3.37-3.43; B3's corner
+  EXPECT_NEAR(b1[manipulation_feature("approach_occupied")], 2 * 0.0036 / 0.06, 1e-12);
   const std::vector<double> freed = manipulation_action_features(kitchen, "move+pick(B1)[B3,B4]");
-  EXPECT_EQ(freed[at("neighbours")], 0.0);
-  EXPECT_EQ(freed[at("nearest_gap")], kManipulationGapCap);
-  EXPECT_EQ(freed[at("approach_occupied")], 0.0);
+  EXPECT_EQ(freed[manipulation_feature("neighbours")], 0.0);
+  EXPECT_EQ(freed[manipulation_feature("nearest_gap")], kManipulationGapCap);
+  EXPECT_EQ(freed[manipulation_feature("approach_occupied")], 0.0);
   // B4 placed in C1 (0.45 m x 0.26 m) after B3 was: B3's footprint counts there.
-  EXPECT_NEAR(manipulation_action_features(kitchen, "move+place(B4,C1)[B3]")[at("region_occupied")],
+  EXPECT_NEAR(manipulation_action_features(kitchen, "move+place(B4,C1)[B3]")[manipulation_feature("region_occupied")],
               0.0036 / (0.45 * 0.26), 1e-12);
 }
 
@@ -178,7 +180,8 @@ TEST(ManipulationFeatures, RefusesWhatTheWorldDoesNotHave) {
   EXPECT_THROW(manipulation_action_features(world, "move(R1,R2)"), std::invalid_argument);       // another domain's
   EXPECT_THROW(manipulation_action_features(world, "move+pick(A)[N2]"), std::invalid_argument);  // context unknown
   // Without a context, an action in no skeleton starts from the world as it is.
-  EXPECT_EQ(manipulation_action_features(world, "move+pick(N2)")[at("neighbours")], 1.0);  // A, 14 cm away
+  EXPECT_EQ(manipulation_action_features(world, "move+pick(N2)")[manipulation_feature("neighbours")],
+            1.0);  // A, 14 cm away
 }
 
 TEST(ManipulationFeatures, TheDomainGivesTheSameFeatures) {

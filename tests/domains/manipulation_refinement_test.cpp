@@ -10,14 +10,14 @@
 namespace ontime::domains {
 namespace {
 
-const ManipulationDomain& kitchen() {
+const ManipulationDomain& kitchen_domain() {
   static const ManipulationDomain domain(
       load_manipulation_world(testing::source_path("data/domains/manipulation.json")));
   return domain;
 }
 
 const Pr2Arm& kitchen_arm() {
-  static const Pr2Arm arm(kitchen().world().robot.torso_lift);
+  static const Pr2Arm arm(kitchen_domain().world().robot.torso_lift);
   return arm;
 }
 
@@ -26,7 +26,7 @@ const Pr2Arm& kitchen_arm() {
 std::unique_ptr<Refinement> refined(const std::string& action, const Configuration& start, std::uint64_t seed,
                                     int steps = 40) {
   const EffortSettings effort{EffortUnit::collision_checks, 1000};
-  auto refinement = kitchen().refine(action, start, seed, effort);
+  auto refinement = kitchen_domain().refine(action, start, seed, effort);
   for (int step = 1; step <= steps; ++step) {
     if (refinement->advance(2.0 * step) == RefinementStatus::found) return refinement;
   }
@@ -37,7 +37,7 @@ std::unique_ptr<Refinement> refined(const std::string& action, const Configurati
 // The world of a configuration with the bare geometry (no clearance); a held object is attached
 // with the grasp it has in `grasped` (the configuration in which it was picked up).
 std::unique_ptr<ManipulationCollision> bare_world(const Configuration& at, const Configuration& grasped) {
-  const ManipulationDomain& domain = kitchen();
+  const ManipulationDomain& domain = kitchen_domain();
   const Pr2Arm& arm = kitchen_arm();
   const KitchenState state = domain.state(at), then = domain.state(grasped);
   Transform grasp = Transform::Identity();
@@ -53,7 +53,7 @@ std::unique_ptr<ManipulationCollision> bare_world(const Configuration& at, const
 // world after the action (an object picked up or put down where the robot stands): checked on
 // its own.
 void expect_collision_free(const std::vector<Configuration>& motion) {
-  const ManipulationDomain& domain = kitchen();
+  const ManipulationDomain& domain = kitchen_domain();
   const ManipulationWorld& world = domain.world();
   const auto during = bare_world(motion.front(), motion.front());
   const double arm_step = world.planner.arm_resolution / 4, base_step = world.planner.base_resolution / 4;
@@ -81,7 +81,7 @@ void expect_collision_free(const std::vector<Configuration>& motion) {
 }
 
 TEST(ManipulationRefinement, PickingAndPlacingGivesCollisionFreeMotionsAndMovesTheObject) {
-  const ManipulationDomain& domain = kitchen();
+  const ManipulationDomain& domain = kitchen_domain();
   const ManipulationWorld& world = domain.world();
   const auto b3 = static_cast<std::size_t>(world.object_index("B3"));
   const KitchenState start = domain.state(domain.initial_configuration());
@@ -123,7 +123,7 @@ TEST(ManipulationRefinement, PickingAndPlacingGivesCollisionFreeMotionsAndMovesT
 }
 
 TEST(ManipulationRefinement, IsResumableAndDependsOnItsSeedOnly) {
-  const ManipulationDomain& domain = kitchen();
+  const ManipulationDomain& domain = kitchen_domain();
   const EffortSettings effort{EffortUnit::collision_checks, 1000};
   // Slices of one step against the same steps in a second refinement with the same seed.
   auto one = domain.refine("move+pick(B5)", domain.initial_configuration(), 3, effort);
@@ -143,7 +143,7 @@ TEST(ManipulationRefinement, IsResumableAndDependsOnItsSeedOnly) {
 }
 
 TEST(ManipulationRefinement, RejectsStartsThatDoNotSuitTheAction) {
-  const ManipulationDomain& domain = kitchen();
+  const ManipulationDomain& domain = kitchen_domain();
   const EffortSettings effort{EffortUnit::collision_checks, 1000};
   EXPECT_THROW(domain.refine("move+place(B1,R1)", domain.initial_configuration(), 1, effort), std::invalid_argument);
   EXPECT_THROW(domain.refine("move+pick(B9)", domain.initial_configuration(), 1, effort), std::invalid_argument);
@@ -154,7 +154,7 @@ TEST(ManipulationRefinement, RejectsStartsThatDoNotSuitTheAction) {
 }
 
 TEST(ManipulationDomain, ConfigurationsCarryTheWorld) {
-  const ManipulationDomain& domain = kitchen();
+  const ManipulationDomain& domain = kitchen_domain();
   const KitchenState start = domain.state(domain.initial_configuration());
   EXPECT_EQ(ManipulationDomain::configuration(start), domain.initial_configuration());
   EXPECT_EQ(domain.initial_configuration().size(), 3u + 7u + 1u + 4u * 6u);
@@ -163,7 +163,7 @@ TEST(ManipulationDomain, ConfigurationsCarryTheWorld) {
 }
 
 TEST(ManipulationDomain, AFallbackStartRebuildsTheWorldOfTheSkeletonPrefix) {
-  const ManipulationDomain& domain = kitchen();
+  const ManipulationDomain& domain = kitchen_domain();
   const ManipulationWorld& world = domain.world();
   const KitchenState state = domain.state(domain.fallback_start("move+place(B1,R1)[B3,B4]", 9));
   EXPECT_EQ(state.held, world.object_index("B1"));
@@ -180,7 +180,7 @@ TEST(ManipulationDomain, AFallbackStartRebuildsTheWorldOfTheSkeletonPrefix) {
 }
 
 TEST(ManipulationDomain, ExecutionTimesFollowTheSlowestJointAndTheBase) {
-  const ManipulationDomain& domain = kitchen();
+  const ManipulationDomain& domain = kitchen_domain();
   const double speed = domain.world().robot.arm_speed;
   const ArmJoints a{0, 0, 0, -1, 3.0, -1, 0};
   ArmJoints b = a;

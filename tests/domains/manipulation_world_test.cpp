@@ -21,7 +21,9 @@ std::string kitchen_text() {
   return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
-ManipulationWorld kitchen() { return load_manipulation_world(testing::source_path("data/domains/manipulation.json")); }
+ManipulationWorld kitchen_world() {
+  return load_manipulation_world(testing::source_path("data/domains/manipulation.json"));
+}
 
 std::vector<std::string> abstract(const std::vector<std::string>& skeleton) {
   std::vector<std::string> result;
@@ -30,7 +32,7 @@ std::vector<std::string> abstract(const std::vector<std::string>& skeleton) {
 }
 
 TEST(ManipulationWorld, LoadsTheKitchen) {
-  const ManipulationWorld world = kitchen();
+  const ManipulationWorld world = kitchen_world();
   EXPECT_EQ(world.objects.size(), 6u);
   EXPECT_EQ(world.regions.size(), 4u);
   EXPECT_EQ(world.collection.deadline, 40);
@@ -44,7 +46,7 @@ TEST(ManipulationWorld, LoadsTheKitchen) {
 TEST(ManipulationWorld, TheSkeletonsAreThoseOfAppendixA) {
   std::ifstream in(testing::source_path("data/domains/paper-skeletons.json"));
   const ordered_json paper = ordered_json::parse(in)["manipulation"];
-  const ManipulationWorld world = kitchen();
+  const ManipulationWorld world = kitchen_world();
   ASSERT_EQ(world.skeletons.size(), paper["skeletons"].size());
   for (std::size_t k = 0; k < world.skeletons.size(); ++k) {
     EXPECT_EQ(abstract(world.skeletons[k]), paper["skeletons"][k].get<std::vector<std::string>>()) << "sigma" << k + 1;
@@ -88,7 +90,7 @@ TEST(ManipulationWorld, ReadsActionIds) {
   }
 }
 
-struct BadWorld {
+struct BadKitchenWorld {
   std::string what;
   std::function<void(ordered_json&)> edit;
   std::string place;
@@ -96,7 +98,7 @@ struct BadWorld {
 };
 
 TEST(ManipulationWorld, EveryBrokenRuleIsReportedWithItsPlace) {
-  const std::vector<BadWorld> cases{
+  const std::vector<BadKitchenWorld> cases{
       {"unknown key", [](ordered_json& w) { w["colour"] = "red"; }, "colour", "unknown key"},
       {"no objects", [](ordered_json& w) { w.erase("objects"); }, "top level", "missing required key 'objects'"},
       {"floor",
@@ -187,7 +189,7 @@ TEST(ManipulationWorld, EveryBrokenRuleIsReportedWithItsPlace) {
       {"skeleton rule", [](ordered_json& w) { w["skeletons"][1] = w["skeletons"][0]; }, "skeletons[1]",
        "the same skeleton as skeletons[0]"},
   };
-  for (const BadWorld& bad : cases) {
+  for (const BadKitchenWorld& bad : cases) {
     ordered_json world = ordered_json::parse(kitchen_text());
     bad.edit(world);
     try {

@@ -15,7 +15,7 @@ namespace {
 using nlohmann::ordered_json;
 
 // Index of a feature by name, so that a reordering shows as a failure here and nowhere else.
-std::size_t at(const std::string& name) {
+std::size_t navigation_feature(const std::string& name) {
   const auto& names = navigation_feature_names();
   const auto found = std::find(names.begin(), names.end(), name);
   EXPECT_NE(found, names.end()) << name;
@@ -28,35 +28,35 @@ TEST(NavigationFeatures, MoveIntoAFurnishedRoom) {
   const NavigationWorld world = parse_navigation_world(testing::kMiniWorld, "mini.json");
   const std::vector<double> f = navigation_action_features(world, "move(B,C)");
   ASSERT_EQ(f.size(), navigation_feature_names().size());
-  EXPECT_DOUBLE_EQ(f[at("door_width")], 1.0);
-  EXPECT_NEAR(f[at("door_slack")], 0.292, 1e-12);  // 1.0 - (0.668 + 2 x 0.02)
+  EXPECT_DOUBLE_EQ(f[navigation_feature("door_width")], 1.0);
+  EXPECT_NEAR(f[navigation_feature("door_slack")], 0.292, 1e-12);  // 1.0 - (0.668 + 2 x 0.02)
   // The door's centre (6, 1.5) in the box's frame: (-1.7285, 0.5121) against half sizes (0.5,
   // 0.25): 1.2285 along and 0.2621 across, so sqrt(1.2285² + 0.2621²).
-  EXPECT_NEAR(f[at("door_furniture")], 1.2561635920864183, 1e-12);
-  EXPECT_DOUBLE_EQ(f[at("source_area")], 9.0);
-  EXPECT_DOUBLE_EQ(f[at("target_area")], 9.0);
-  EXPECT_DOUBLE_EQ(f[at("source_pieces")], 0.0);
-  EXPECT_DOUBLE_EQ(f[at("target_pieces")], 1.0);
-  EXPECT_DOUBLE_EQ(f[at("source_occupied")], 0.0);
-  EXPECT_NEAR(f[at("target_occupied")], 0.5 / 9, 1e-15);
-  EXPECT_DOUBLE_EQ(f[at("route_length")], 3.0);    // (4.5, 1.5) to (6, 1.5) to (7.5, 1.5)
-  EXPECT_DOUBLE_EQ(f[at("sampling_area")], 18.0);  // x 3..9, y 0..3
+  EXPECT_NEAR(f[navigation_feature("door_furniture")], 1.2561635920864183, 1e-12);
+  EXPECT_DOUBLE_EQ(f[navigation_feature("source_area")], 9.0);
+  EXPECT_DOUBLE_EQ(f[navigation_feature("target_area")], 9.0);
+  EXPECT_DOUBLE_EQ(f[navigation_feature("source_pieces")], 0.0);
+  EXPECT_DOUBLE_EQ(f[navigation_feature("target_pieces")], 1.0);
+  EXPECT_DOUBLE_EQ(f[navigation_feature("source_occupied")], 0.0);
+  EXPECT_NEAR(f[navigation_feature("target_occupied")], 0.5 / 9, 1e-15);
+  EXPECT_DOUBLE_EQ(f[navigation_feature("route_length")], 3.0);    // (4.5, 1.5) to (6, 1.5) to (7.5, 1.5)
+  EXPECT_DOUBLE_EQ(f[navigation_feature("sampling_area")], 18.0);  // x 3..9, y 0..3
 
   // The other direction swaps the rooms' features and keeps the door's.
   const std::vector<double> back = navigation_action_features(world, "move(C,B)");
-  EXPECT_DOUBLE_EQ(back[at("source_pieces")], 1.0);
-  EXPECT_DOUBLE_EQ(back[at("target_pieces")], 0.0);
-  EXPECT_NEAR(back[at("source_occupied")], 0.5 / 9, 1e-15);
-  EXPECT_DOUBLE_EQ(back[at("door_furniture")], f[at("door_furniture")]);
-  EXPECT_DOUBLE_EQ(back[at("route_length")], 3.0);
+  EXPECT_DOUBLE_EQ(back[navigation_feature("source_pieces")], 1.0);
+  EXPECT_DOUBLE_EQ(back[navigation_feature("target_pieces")], 0.0);
+  EXPECT_NEAR(back[navigation_feature("source_occupied")], 0.5 / 9, 1e-15);
+  EXPECT_DOUBLE_EQ(back[navigation_feature("door_furniture")], f[navigation_feature("door_furniture")]);
+  EXPECT_DOUBLE_EQ(back[navigation_feature("route_length")], 3.0);
 }
 
 TEST(NavigationFeatures, NoFurnitureNearTheDoorIsTheCap) {
   const NavigationWorld world = parse_navigation_world(testing::kMiniWorld, "mini.json");
   const std::vector<double> f = navigation_action_features(world, "move(B,D)");
-  EXPECT_DOUBLE_EQ(f[at("door_furniture")], kFeatureDistanceCap);
-  EXPECT_DOUBLE_EQ(f[at("sampling_area")], 18.0);  // x 3..6, y 0..6
-  EXPECT_DOUBLE_EQ(f[at("route_length")], 3.0);
+  EXPECT_DOUBLE_EQ(f[navigation_feature("door_furniture")], kFeatureDistanceCap);
+  EXPECT_DOUBLE_EQ(f[navigation_feature("sampling_area")], 18.0);  // x 3..6, y 0..6
+  EXPECT_DOUBLE_EQ(f[navigation_feature("route_length")], 3.0);
 }
 
 // Two doors between the same rooms: the wider one counts (the planner finds the easier passage).
@@ -65,7 +65,7 @@ TEST(NavigationFeatures, TheWiderOfTwoDoorsAndEachChangeItsOwnFeature) {
   ordered_json json = ordered_json::parse(testing::kMiniWorld);
   json["doors"].push_back({{"rooms", {"A", "B"}}, {"center", {3, 2.4}}, {"width", 0.8}});
   const NavigationWorld two = parse_navigation_world(json.dump(), "two.json");
-  EXPECT_DOUBLE_EQ(navigation_action_features(two, "move(A,B)")[at("door_width")], 1.0);
+  EXPECT_DOUBLE_EQ(navigation_action_features(two, "move(A,B)")[navigation_feature("door_width")], 1.0);
 
   json = ordered_json::parse(testing::kMiniWorld);
   json["doors"][0]["width"] = 0.8;
@@ -74,12 +74,13 @@ TEST(NavigationFeatures, TheWiderOfTwoDoorsAndEachChangeItsOwnFeature) {
   const NavigationWorld mini = parse_navigation_world(testing::kMiniWorld, "mini.json");
   const std::vector<double> before = navigation_action_features(mini, "move(A,B)");
   const std::vector<double> after = navigation_action_features(narrow, "move(A,B)");
-  EXPECT_NEAR(after[at("door_slack")], 0.092, 1e-12);
-  EXPECT_DOUBLE_EQ(after[at("source_area")], 12.0);
-  EXPECT_DOUBLE_EQ(after[at("sampling_area")], 21.0);
-  EXPECT_DOUBLE_EQ(after[at("route_length")], before[at("route_length")] + 0.5);  // A's centre moved 0.5 m
-  EXPECT_EQ(after[at("target_area")], before[at("target_area")]);
-  EXPECT_EQ(after[at("target_pieces")], before[at("target_pieces")]);
+  EXPECT_NEAR(after[navigation_feature("door_slack")], 0.092, 1e-12);
+  EXPECT_DOUBLE_EQ(after[navigation_feature("source_area")], 12.0);
+  EXPECT_DOUBLE_EQ(after[navigation_feature("sampling_area")], 21.0);
+  EXPECT_DOUBLE_EQ(after[navigation_feature("route_length")],
+                   before[navigation_feature("route_length")] + 0.5);  // A's centre moved 0.5 m
+  EXPECT_EQ(after[navigation_feature("target_area")], before[navigation_feature("target_area")]);
+  EXPECT_EQ(after[navigation_feature("target_pieces")], before[navigation_feature("target_pieces")]);
 }
 
 TEST(NavigationFeatures, RefusesWhatTheWorldDoesNotHave) {

@@ -10,7 +10,7 @@
 namespace ontime::domains {
 namespace {
 
-const NavigationDomain& office() {
+const NavigationDomain& office_domain() {
   static const NavigationDomain domain(load_navigation_world(testing::source_path("data/domains/navigation.json")));
   return domain;
 }
@@ -30,7 +30,7 @@ Pose pose(const Configuration& configuration) {
 }
 
 TEST(NavigationRefinement, FindsACollisionFreeMotionThatConnectsItsEndpoints) {
-  const NavigationDomain& domain = office();
+  const NavigationDomain& domain = office_domain();
   const NavigationWorld& world = domain.world();
   // The bare footprint (no clearance), checked every 5 mm and 0.005 rad along each segment:
   // four times finer than the planner's checks, which also kept a 2 cm clearance.
@@ -67,7 +67,7 @@ TEST(NavigationRefinement, FindsACollisionFreeMotionThatConnectsItsEndpoints) {
 }
 
 TEST(NavigationRefinement, ExecutionTimeIsLengthOverSpeedPlusRotationOverAngularSpeed) {
-  const NavigationDomain& domain = office();
+  const NavigationDomain& domain = office_domain();
   // 3 m straight, then a quarter turn on the spot, then 4 m with a half turn (shortest way).
   const std::vector<Pose> poses{{0, 0, 0}, {3, 0, 0}, {3, 0, std::numbers::pi / 2}, {3, 4, -std::numbers::pi / 2}};
   const double length = 7.0, rotation = std::numbers::pi / 2 + std::numbers::pi;
@@ -76,7 +76,7 @@ TEST(NavigationRefinement, ExecutionTimeIsLengthOverSpeedPlusRotationOverAngular
 }
 
 TEST(NavigationRefinement, ResumesTheSamePlannerSliceBySlice) {
-  const NavigationDomain& domain = office();
+  const NavigationDomain& domain = office_domain();
   const auto refinement = domain.refine("move(R1,R2)", domain.initial_configuration(), 3, checks());
   const double step = 3.0;
   std::uint64_t previous = 0;
@@ -102,7 +102,7 @@ TEST(NavigationRefinement, ResumesTheSamePlannerSliceBySlice) {
 }
 
 TEST(NavigationRefinement, SameSeedSameMotionAndEffort) {
-  const NavigationDomain& domain = office();
+  const NavigationDomain& domain = office_domain();
   const auto first = domain.refine("move(R5,R8)", domain.fallback_start("move(R5,R8)", 4), 11, checks());
   const auto second = domain.refine("move(R5,R8)", domain.fallback_start("move(R5,R8)", 4), 11, checks());
   ASSERT_TRUE(run(*first, 3.0, 100));
@@ -115,7 +115,7 @@ TEST(NavigationRefinement, SameSeedSameMotionAndEffort) {
 }
 
 TEST(NavigationRefinement, WallClockEffortCountsSeconds) {
-  const NavigationDomain& domain = office();
+  const NavigationDomain& domain = office_domain();
   const auto refinement = domain.refine("move(R2,R3)", domain.fallback_start("move(R2,R3)", 1), 5,
                                         EffortSettings{EffortUnit::wall_clock, 1200.0});
   ASSERT_TRUE(run(*refinement, 1.0, 10));
@@ -125,7 +125,7 @@ TEST(NavigationRefinement, WallClockEffortCountsSeconds) {
 }
 
 TEST(NavigationRefinement, RejectsBadRequests) {
-  const NavigationDomain& domain = office();
+  const NavigationDomain& domain = office_domain();
   EXPECT_THROW(domain.refine("move(R1,R99)", domain.initial_configuration(), 1, checks()), std::invalid_argument);
   EXPECT_THROW(domain.refine("jump(R1,R2)", domain.initial_configuration(), 1, checks()), std::invalid_argument);
   // The start must lie in the room the move leaves, and be free.

@@ -16,10 +16,10 @@ namespace {
 
 using nlohmann::ordered_json;
 
-NavigationWorld office() { return load_navigation_world(testing::source_path("data/domains/navigation.json")); }
+NavigationWorld office_world() { return load_navigation_world(testing::source_path("data/domains/navigation.json")); }
 
 TEST(NavigationWorld, LoadsTheOfficeFloor) {
-  const NavigationWorld world = office();
+  const NavigationWorld world = office_world();
   EXPECT_EQ(world.rooms.size(), 13u);
   EXPECT_EQ(world.doors.size(), 15u);
   EXPECT_EQ(world.start_room, "R1");
@@ -32,7 +32,7 @@ TEST(NavigationWorld, LoadsTheOfficeFloor) {
 }
 
 TEST(NavigationWorld, TheFourSkeletonsAreExactlyTheRoomPathsFromStartToGoal) {
-  const NavigationWorld world = office();
+  const NavigationWorld world = office_world();
   std::set<std::vector<std::string>> from_doors;
   for (const auto& path : world.room_paths(world.start_room, world.goal_room)) from_doors.insert(path);
   std::set<std::vector<std::string>> from_skeletons;
@@ -51,7 +51,7 @@ TEST(NavigationWorld, TheFourSkeletonsAreExactlyTheRoomPathsFromStartToGoal) {
 }
 
 TEST(NavigationWorld, WallsCloseEveryRoomExceptAtDoors) {
-  const NavigationWorld world = office();
+  const NavigationWorld world = office_world();
   const NavigationCollision bare(world, 0.0);
   // A thin probe robot cannot cross a wall between two rooms that share no door (R2 above R5)
   // but passes the centre of every door.
@@ -76,7 +76,7 @@ TEST(NavigationWorld, ReadsMoveActions) {
   EXPECT_TRUE(move_rooms("move(R1, R2)").empty());
 }
 
-struct BadWorld {
+struct BadNavigationWorld {
   std::string what;
   std::function<void(ordered_json&)> edit;
   std::string place;
@@ -84,7 +84,7 @@ struct BadWorld {
 };
 
 TEST(NavigationWorld, EveryBrokenRuleIsReportedWithItsPlace) {
-  const std::vector<BadWorld> cases{
+  const std::vector<BadNavigationWorld> cases{
       {"negative wall", [](ordered_json& w) { w["wall_thickness"] = -1; }, "wall_thickness", "positive number"},
       {"unknown key", [](ordered_json& w) { w["colour"] = "red"; }, "colour", "unknown key"},
       {"no rooms", [](ordered_json& w) { w.erase("rooms"); }, "top level", "missing required key 'rooms'"},
@@ -196,7 +196,7 @@ TEST(NavigationWorld, EveryBrokenRuleIsReportedWithItsPlace) {
       {"skeleton rule", [](ordered_json& w) { w["skeletons"] = ordered_json::array(); }, "skeletons",
        "at least one skeleton"},
   };
-  for (const BadWorld& bad : cases) {
+  for (const BadNavigationWorld& bad : cases) {
     ordered_json world = ordered_json::parse(testing::kMiniWorld);
     bad.edit(world);
     try {

@@ -12,15 +12,15 @@
 namespace ontime::domains {
 namespace {
 
-struct Fixture {
+struct OnlineFixture {
   NavigationDomain domain{load_navigation_world(testing::source_path("data/domains/navigation.json"))};
   Problem problem{load_problem(testing::source_path("data/instances/navigation.json"))};
   Mdp mdp{problem};
   PlannerWorldOptions options{EffortSettings{EffortUnit::collision_checks, 1200.0}, false, std::nullopt};
 };
 
-const Fixture& fixture() {
-  static const Fixture instance;
+const OnlineFixture& online_fixture() {
+  static const OnlineFixture instance;
   return instance;
 }
 
@@ -30,7 +30,7 @@ struct PlannerEpisode {
   double started = 0, found = 0;
 };
 
-PlannerEpisode run_planner_episode(const Fixture& f, Allocator& allocator, std::uint64_t seed) {
+PlannerEpisode run_planner_episode(const OnlineFixture& f, Allocator& allocator, std::uint64_t seed) {
   PlannerWorld world(f.domain, f.problem, f.options);
   PlannerEpisode episode{run_episode(f.mdp, allocator, world, seed)};
   Statistics statistics;
@@ -41,7 +41,7 @@ PlannerEpisode run_planner_episode(const Fixture& f, Allocator& allocator, std::
 }
 
 TEST(Online, AnAllocatorInterleavesRealRefinementsStepByStep) {
-  const Fixture& f = fixture();
+  const OnlineFixture& f = online_fixture();
   // Round-robin gives each skeleton a step in turn: several refinements are under way at once,
   // each resumed where it stopped.
   const auto allocator = make_allocator_factory("round-robin", f.mdp)();
@@ -58,7 +58,7 @@ TEST(Online, AnAllocatorInterleavesRealRefinementsStepByStep) {
 }
 
 TEST(Online, ASuccessRefinedEveryActionOfTheSolution) {
-  const Fixture& f = fixture();
+  const OnlineFixture& f = online_fixture();
   const auto allocator = make_allocator_factory("dp", f.mdp)();
   int successes = 0;
   for (std::uint64_t seed = 0; seed < 10; ++seed) {
@@ -73,7 +73,7 @@ TEST(Online, ASuccessRefinedEveryActionOfTheSolution) {
 }
 
 TEST(Online, SameSeedSameEpisodesWhateverTheThreads) {
-  const Fixture& f = fixture();
+  const OnlineFixture& f = online_fixture();
   const AllocatorFactory factory = make_allocator_factory("dp-rerun", f.mdp);
   const WorldFactory worlds = planner_worlds(f.domain, f.problem, f.options);
   MonteCarloOptions options;
@@ -111,7 +111,7 @@ class SeedRecorder final : public Allocator {
 // Against the real planner, as against hidden worlds, every episode's allocator draws from its
 // own stream (they once all began from seed 0, so mcts repeated one stream in every episode).
 TEST(Online, EveryEpisodeGetsItsOwnRandomStream) {
-  const Fixture& f = fixture();
+  const OnlineFixture& f = online_fixture();
   const AllocatorFactory inner = make_allocator_factory("mcts", f.mdp);
   std::vector<std::uint64_t> seeds;
   const AllocatorFactory recording = [&] { return std::make_unique<SeedRecorder>(inner(), seeds); };

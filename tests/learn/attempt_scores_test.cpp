@@ -18,7 +18,7 @@ Problem one_action(Steps deadline = 3) {
   return {"one", deadline, 1.0, {action}, {{0}}};
 }
 
-RefinementAttempt attempt(std::string action, double planning, bool found, double execution) {
+RefinementAttempt scored_attempt(std::string action, double planning, bool found, double execution) {
   RefinementAttempt record;
   record.action = std::move(action);
   record.planning_seconds = planning;
@@ -26,8 +26,8 @@ RefinementAttempt attempt(std::string action, double planning, bool found, doubl
   record.execution_seconds = execution;
   return record;
 }
-RefinementAttempt found(double planning, double execution) { return attempt("a", planning, true, execution); }
-RefinementAttempt cut_off(double planning) { return attempt("a", planning, false, 0); }
+RefinementAttempt found(double planning, double execution) { return scored_attempt("a", planning, true, execution); }
+RefinementAttempt cut_off(double planning) { return scored_attempt("a", planning, false, 0); }
 
 TEST(AttemptScores, HandComputedLogAndBrierScores) {
   // Found at 1 and at 2; cut off after 1 (1.5 s); found at 5, past the horizon 3: T > 3.
@@ -68,14 +68,14 @@ TEST(AttemptScores, ImpossibleOutcomesAtTheFloorAndAShorterHorizon) {
 }
 
 TEST(AttemptScores, UnknownActionsAndBadOptions) {
-  std::vector<RefinementAttempt> log = {found(1.0, 0.0), attempt("b", 1.0, false, 0)};
+  std::vector<RefinementAttempt> log = {found(1.0, 0.0), scored_attempt("b", 1.0, false, 0)};
   EXPECT_THROW(score_attempts(log, one_action(), "log"), UsageError);
   const AttemptScores scores = score_attempts(log, one_action(), "log", {.skip_unknown = true});
   EXPECT_EQ(scores.attempts, 1U);
   EXPECT_EQ(scores.skipped, 1U);
   EXPECT_THROW(score_attempts(log, one_action(), "log", {.horizon = 4}), UsageError);
   EXPECT_THROW(score_attempts(log, one_action(), "log", {.floor = 0}), UsageError);
-  const std::vector<RefinementAttempt> none = {attempt("b", 1.0, false, 0)};
+  const std::vector<RefinementAttempt> none = {scored_attempt("b", 1.0, false, 0)};
   EXPECT_THROW(score_attempts(none, one_action(), "log", {.skip_unknown = true}), UsageError);
 }
 

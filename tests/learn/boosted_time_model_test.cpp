@@ -18,7 +18,7 @@ namespace {
 // with probability never[x], else found at step t with the geometric law of hazard hazard[x]
 // (P(T = t) = h (1 - h)^(t - 1)); cut off after cutoff[i % cutoff.size()] steps. Execution
 // seconds are log-normal, log-mean 1 + 0.5 x, sd 0.3.
-struct Truth {
+struct GroupTruth {
   std::vector<double> never, hazard;
   std::vector<Steps> cutoff;
 
@@ -40,7 +40,7 @@ struct Truth {
   }
 };
 
-ConditionalData sample(const Truth& truth, std::size_t per_group, std::uint64_t seed) {
+ConditionalData sample_groups(const GroupTruth& truth, std::size_t per_group, std::uint64_t seed) {
   SplitMix64 random(seed);
   std::vector<RefinementAttempt> rows;
   for (std::size_t i = 0; i < per_group; ++i) {
@@ -94,8 +94,8 @@ double found_mean(const Distribution& planning, Steps horizon) {
 // sqrt(p (1 - p) / 5000) <= 0.0071, a mean of the found steps sd / sqrt(found rows) (sd 1.4 and
 // 8.2, about 4,500 and 2,750 found: 0.021 and 0.16); each bound is four of them.
 TEST(BoostedTimeModel, PredictsEachGroupsLawWithinSamplingError) {
-  const Truth truth{{0.1, 0.3}, {0.5, 0.05}, {30}};
-  const ConditionalData data = sample(truth, 5000, 1);
+  const GroupTruth truth{{0.1, 0.3}, {0.5, 0.05}, {30}};
+  const ConditionalData data = sample_groups(truth, 5000, 1);
   const auto model = fit_conditional_model(data, boosted("extreme"));
   ASSERT_EQ(model->horizon(), 30);
   const double mean_bound[] = {4 * 0.021, 4 * 0.16};
@@ -132,8 +132,8 @@ TEST(BoostedTimeModel, PredictsEachGroupsLawWithinSamplingError) {
 // group whatever the law of the found time: the default normal law, not the truth's, predicts
 // the "never" mass within sampling error too (bounds as above).
 TEST(BoostedTimeModel, TheNeverMassNeedsNoRightLaw) {
-  const Truth truth{{0.1, 0.3}, {0.5, 0.05}, {30}};
-  const auto model = fit_conditional_model(sample(truth, 5000, 2), boosted("normal"));
+  const GroupTruth truth{{0.1, 0.3}, {0.5, 0.05}, {30}};
+  const auto model = fit_conditional_model(sample_groups(truth, 5000, 2), boosted("normal"));
   for (std::size_t x = 0; x < 2; ++x) {
     const double never = truth.never_within(x, 30);
     EXPECT_NEAR(model->predict(std::vector<double>{static_cast<double>(x), 7.0}).planning.never(), never,
@@ -148,8 +148,8 @@ TEST(BoostedTimeModel, TheNeverMassNeedsNoRightLaw) {
 // sqrt(0.3 x 0.7 / 4000) = 0.0072); the mean found step (sd 5.2) on about 2,800 of them (0.1);
 // four of each.
 TEST(BoostedTimeModel, CensoringDoesNotBiasTheFoundTimeDown) {
-  const Truth truth{{0.2}, {0.1}, {4, 20}};
-  const ConditionalData data = sample(truth, 8000, 3);
+  const GroupTruth truth{{0.2}, {0.1}, {4, 20}};
+  const ConditionalData data = sample_groups(truth, 8000, 3);
   const auto model = fit_conditional_model(data, boosted("extreme"));
   ASSERT_EQ(model->horizon(), 20);
   const Distribution planning = model->predict(std::vector<double>{0.0, 7.0}).planning;
@@ -173,8 +173,8 @@ TEST(BoostedTimeModel, CensoringDoesNotBiasTheFoundTimeDown) {
 // The model file: the same bytes from two fits, the same bytes back from the file, the same
 // predictions bit for bit (at the training rows' features and between them), by one row or many.
 TEST(BoostedTimeModel, TheModelFileReadsBackToTheSameBytesAndPredictions) {
-  const Truth truth{{0.1, 0.4}, {0.4, 0.1}, {12}};
-  const ConditionalData data = sample(truth, 400, 4);
+  const GroupTruth truth{{0.1, 0.4}, {0.4, 0.1}, {12}};
+  const ConditionalData data = sample_groups(truth, 400, 4);
   ConditionalFitOptions options = boosted("logistic", 40);
   options.depth = 2;
   options.learning_rate = 0.3;
@@ -207,8 +207,8 @@ TEST(BoostedTimeModel, TheModelFileReadsBackToTheSameBytesAndPredictions) {
 
 // Fits side by side in threads give the file of a fit alone (XGBoost runs one thread a booster).
 TEST(BoostedTimeModel, FitsInThreadsGiveTheSameFile) {
-  const Truth truth{{0.1, 0.4}, {0.4, 0.1}, {12}};
-  const ConditionalData data = sample(truth, 300, 5);
+  const GroupTruth truth{{0.1, 0.4}, {0.4, 0.1}, {12}};
+  const ConditionalData data = sample_groups(truth, 300, 5);
   const std::string alone = fit_conditional_model(data, boosted("normal", 30))->to_json();
   std::vector<std::string> texts(2);
   std::vector<std::thread> threads;
@@ -221,8 +221,8 @@ TEST(BoostedTimeModel, FitsInThreadsGiveTheSameFile) {
 }
 
 TEST(BoostedTimeModel, RefusesBadSettingsAndBadFiles) {
-  const Truth truth{{0.1, 0.4}, {0.4, 0.1}, {6}};
-  const ConditionalData data = sample(truth, 100, 6);
+  const GroupTruth truth{{0.1, 0.4}, {0.4, 0.1}, {6}};
+  const ConditionalData data = sample_groups(truth, 100, 6);
   const auto refused_fit = [&](auto change) {
     ConditionalFitOptions options = boosted("normal", 5);
     change(options);
@@ -290,8 +290,8 @@ TEST(BoostedTimeModel, RefusesBadSettingsAndBadFiles) {
 }
 
 TEST(BoostedTimeModel, PredictsALibraryInOneCall) {
-  const Truth truth{{0.1, 0.4}, {0.4, 0.1}, {8}};
-  const auto model = fit_conditional_model(sample(truth, 200, 7), boosted("normal", 20));
+  const GroupTruth truth{{0.1, 0.4}, {0.4, 0.1}, {8}};
+  const auto model = fit_conditional_model(sample_groups(truth, 200, 7), boosted("normal", 20));
   const std::vector<ActionFeatures> actions{
       {"move(A,B)", {0.0, 7.0}}, {"move(B,C)", {1.0, 7.0}}, {"move(A,B)", {5.0, 7.0}}};
   const Problem library = predict_problem(*model, actions, {}, 6, "predicted");

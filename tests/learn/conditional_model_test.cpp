@@ -14,8 +14,8 @@
 namespace ontime {
 namespace {
 
-RefinementAttempt attempt(std::string action, double planning, bool found, double execution,
-                          std::vector<double> features, std::string world = "w") {
+RefinementAttempt featured_attempt(std::string action, double planning, bool found, double execution,
+                                   std::vector<double> features, std::string world = "w") {
   RefinementAttempt a;
   a.action = std::move(action);
   a.planning_seconds = planning;
@@ -47,7 +47,7 @@ ConditionalFitOptions options(std::string kind = "hazard", Steps horizon = 0, in
 // Rows drawn from the hazard model itself: feature x in {0, 1}; cure logit g0 + g x; hazard
 // logit a(t) + b x; execution log-normal with mean m0 + m x and sd s; cut off after `cutoff`
 // steps; step of 1 s.
-struct Truth {
+struct HazardTruth {
   std::vector<double> a;  // per step 1..cutoff
   double b, g0, g, m0, m, s;
   Steps cutoff;
@@ -61,7 +61,7 @@ struct Truth {
   }
 };
 
-std::vector<RefinementAttempt> sample(const Truth& truth, std::size_t per_group, std::uint64_t seed) {
+std::vector<RefinementAttempt> sample_hazard(const HazardTruth& truth, std::size_t per_group, std::uint64_t seed) {
   SplitMix64 random(seed);
   std::vector<RefinementAttempt> rows;
   for (const double x : {0.0, 1.0}) {
@@ -79,15 +79,17 @@ std::vector<RefinementAttempt> sample(const Truth& truth, std::size_t per_group,
       const double normal = std::sqrt(-2 * std::log(u1)) * std::cos(2 * std::numbers::pi * u2);
       const double execution = std::exp(truth.m0 + truth.m * x + truth.s * normal);
       // A planning time inside its step (t - 0.5 s), a cut-off at the end of the last step.
-      rows.push_back(found_at > 0 ? attempt("act", static_cast<double>(found_at) - 0.5, true, execution, {x, 7.0})
-                                  : attempt("act", static_cast<double>(truth.cutoff), false, 0, {x, 7.0}));
+      rows.push_back(found_at > 0
+                         ? featured_attempt("act", static_cast<double>(found_at) - 0.5, true, execution, {x, 7.0})
+                         : featured_attempt("act", static_cast<double>(truth.cutoff), false, 0, {x, 7.0}));
     }
   }
   return rows;
 }
 
 TEST(ConditionalData, StepsAsFittingCountsThemAndEveryRecordNeedsFeatures) {
-  const std::vector<RefinementAttempt> log{attempt("a", 2.5, true, 4.0, {1, 2}), attempt("a", 6.0, false, 0, {1, 2})};
+  const std::vector<RefinementAttempt> log{featured_attempt("a", 2.5, true, 4.0, {1, 2}),
+                                           featured_attempt("a", 6.0, false, 0, {1, 2})};
   const ConditionalData data = conditional_data(log, 2.0, "log");
   ASSERT_EQ(data.rows(), 2u);
   EXPECT_EQ(data.feature_count, 2u);
@@ -108,13 +110,15 @@ TEST(ConditionalData, StepsAsFittingCountsThemAndEveryRecordNeedsFeatures) {
 
 // Features ignored: exactly the one-action fit of fitting.hpp.
 TEST(PooledTimeModel, IsTheKaplanMeierFitOfThePooledLog) {
-  const std::vector<RefinementAttempt> log{attempt("a", 0.5, true, 2.5, {1}), attempt("b", 3.0, false, 0, {2}),
-                                           attempt("a", 2.2, true, 0.7, {3}), attempt("b", 1.0, false, 0, {4}),
-                                           attempt("a", 3.9, true, 4.0, {5})};
+  const std::vector<RefinementAttempt> log{
+      featured_attempt("a", 0.5, true, 2.5, {1}), featured_attempt("b", 3.0, false, 0, {2}),
+      featured_attempt("a", 2.2, true, 0.7, {3}), featured_attempt("b", 1.0, false, 0, {4}),
+      featured_attempt("a", 3.9, true, 4.0, {5})};
   const ConditionalData data = conditional_data(log, 1.0, "log");
   const auto model = fit_conditional_model(data, options("pooled", 5));
   std::vector<RefinementAttempt> one_action = log;
-  for (RefinementAttempt& a : one_action) a.action = "x";
+  for (RefinementAttempt& a : one_action)
+    a.action = std::string("x");  // (not = "x": GCC 12 warns falsely of overlapping copies, -Wrestrict)
   const FitResult fit = fit_problem(one_action, "log", {"skeletons", {{"x"}}}, fit_options());
   const PredictedTimes predicted = model->predict(std::vector<double>{42.0});
   EXPECT_EQ(predicted.planning, fit.problem.action(0).planning);
@@ -130,8 +134,8 @@ TEST(HazardTimeModel, WithoutInformativeFeaturesIsKaplanMeier) {
   for (int i = 0; i < 400; ++i) {
     const Steps found_at = 1 + static_cast<Steps>(uniform01(random) * 9);
     const Steps cut = static_cast<Steps>(uniform01(random) * 10);  // cut off after 0..9 steps
-    log.push_back(found_at <= cut ? attempt("a", static_cast<double>(found_at) - 0.5, true, 1.0, {3.0})
-                                  : attempt("a", static_cast<double>(cut), false, 0, {3.0}));
+    log.push_back(found_at <= cut ? featured_attempt("a", static_cast<double>(found_at) - 0.5, true, 1.0, {3.0})
+                                  : featured_attempt("a", static_cast<double>(cut), false, 0, {3.0}));
   }
   const ConditionalData data = conditional_data(log, 1.0, "log");
   const auto model = fit_conditional_model(data, options("hazard", 9));
@@ -148,8 +152,8 @@ TEST(HazardTimeModel, WithoutInformativeFeaturesIsKaplanMeier) {
 // Rows drawn from the model: the fit recovers the law of each group. With 20,000 rows per group
 // a PMF cell's standard error is below 0.0035; the bound is about three of them.
 TEST(HazardTimeModel, RecoversTheLawItWasDrawnFrom) {
-  Truth truth{{-1.0, -0.8, -0.9, -1.2, -1.5, -1.5, -1.8, -2.0}, -1.2, -2.0, 1.5, 1.0, 0.5, 0.3, 8};
-  const ConditionalData data = conditional_data(sample(truth, 20000, 11), 1.0, "log");
+  HazardTruth truth{{-1.0, -0.8, -0.9, -1.2, -1.5, -1.5, -1.8, -2.0}, -1.2, -2.0, 1.5, 1.0, 0.5, 0.3, 8};
+  const ConditionalData data = conditional_data(sample_hazard(truth, 20000, 11), 1.0, "log");
   ConditionalFitOptions named = options("hazard", 0, 0, 0.0);
   named.feature_names = {"x", "constant"};
   const auto model = fit_conditional_model(data, named);
@@ -179,8 +183,8 @@ TEST(HazardTimeModel, RecoversTheLawItWasDrawnFrom) {
 
 // The same data, the same model file, and back from the file the same predictions bit for bit.
 TEST(HazardTimeModel, TheModelFileReadsBackToTheSamePredictions) {
-  Truth truth{{-1.0, -1.0, -1.5, -1.5}, 0.7, -1.0, 0.8, 0.5, -0.2, 0.4, 4};
-  const ConditionalData data = conditional_data(sample(truth, 500, 3), 1.0, "log");
+  HazardTruth truth{{-1.0, -1.0, -1.5, -1.5}, 0.7, -1.0, 0.8, 0.5, -0.2, 0.4, 4};
+  const ConditionalData data = conditional_data(sample_hazard(truth, 500, 3), 1.0, "log");
   for (const std::string kind : {"hazard", "pooled"}) {
     const auto model = fit_conditional_model(data, options(kind, 0, kind == "hazard" ? 2 : 0));
     const std::string text = model->to_json();
@@ -198,8 +202,8 @@ TEST(HazardTimeModel, TheModelFileReadsBackToTheSamePredictions) {
 }
 
 TEST(ConditionalTimeModel, RefusesBadFeaturesAndBadFiles) {
-  Truth truth{{-1.0, -1.0}, 0.7, -1.0, 0.8, 0.5, -0.2, 0.4, 2};
-  const ConditionalData data = conditional_data(sample(truth, 100, 3), 1.0, "log");
+  HazardTruth truth{{-1.0, -1.0}, 0.7, -1.0, 0.8, 0.5, -0.2, 0.4, 2};
+  const ConditionalData data = conditional_data(sample_hazard(truth, 100, 3), 1.0, "log");
   const auto model = fit_conditional_model(data, options());
   EXPECT_THROW(model->predict(std::vector<double>{1.0}), UsageError);
   EXPECT_THROW(model->predict(std::vector<double>{1.0, std::nan("")}), UsageError);
@@ -231,8 +235,8 @@ TEST(ConditionalTimeModel, RefusesBadFeaturesAndBadFiles) {
 }
 
 TEST(ConditionalTimeModel, PredictsALibraryCutAtTheDeadline) {
-  Truth truth{{-1.0, -1.0, -1.0, -1.0, -1.0, -1.0}, 0.7, -1.0, 0.8, 0.5, -0.2, 0.4, 6};
-  const ConditionalData data = conditional_data(sample(truth, 300, 9), 1.0, "log");
+  HazardTruth truth{{-1.0, -1.0, -1.0, -1.0, -1.0, -1.0}, 0.7, -1.0, 0.8, 0.5, -0.2, 0.4, 6};
+  const ConditionalData data = conditional_data(sample_hazard(truth, 300, 9), 1.0, "log");
   const auto model = fit_conditional_model(data, options());
   const std::vector<ActionFeatures> actions{{"move(A,B)", {0.0, 7.0}}, {"move(B,C)", {1.0, 7.0}}};
   const Problem library = predict_problem(*model, actions, {}, 4, "predicted");

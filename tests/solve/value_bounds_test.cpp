@@ -22,7 +22,7 @@ namespace ontime {
 namespace {
 
 // Rounding slack of the inequalities and equalities below.
-constexpr double kRounding = 1e-12;
+constexpr double kBoundsRounding = 1e-12;
 
 // Refines one skeleton at every step: the commit policy of the lower bound.
 class AlwaysAllocator final : public Allocator {
@@ -163,10 +163,10 @@ TEST(ValueBounds, CommitValueIsTheExactValueOfAlwaysRefiningTheSkeleton) {
     for (int k = 0; k < mdp.skeleton_count(); ++k) {
       AlwaysAllocator always(k);
       const double value = evaluate_exactly(mdp, always).success_probability;
-      EXPECT_NEAR(bounds.commit(mdp.start(), k), value, kRounding) << "seed " << seed << " skeleton " << k;
+      EXPECT_NEAR(bounds.commit(mdp.start(), k), value, kBoundsRounding) << "seed " << seed << " skeleton " << k;
       best = std::max(best, value);
     }
-    EXPECT_NEAR(bounds.lower(mdp.start()), best, kRounding) << "seed " << seed;
+    EXPECT_NEAR(bounds.lower(mdp.start()), best, kBoundsRounding) << "seed " << seed;
     const int choice = bounds.lower_choice(mdp.start());
     if (choice < 0) {
       EXPECT_EQ(bounds.lower(mdp.start()), 0.0) << "seed " << seed;
@@ -191,8 +191,8 @@ TEST(ValueBounds, BracketTheOptimumOnTheStartAndOnReachableStates) {
       const double optimum = solver.solve(state);
       const double lower = bounds.lower(state);
       const double upper = bounds.upper(state);
-      EXPECT_LE(lower, optimum + kRounding) << "seed " << seed << " time " << state.time;
-      EXPECT_GE(upper, optimum - kRounding) << "seed " << seed << " time " << state.time;
+      EXPECT_LE(lower, optimum + kBoundsRounding) << "seed " << seed << " time " << state.time;
+      EXPECT_GE(upper, optimum - kBoundsRounding) << "seed " << seed << " time " << state.time;
       EXPECT_GE(lower, 0.0);
       EXPECT_LE(upper, 1.0);
       // The solver's keys, with blanked slots, give the same bounds.
@@ -214,7 +214,7 @@ TEST(ValueBounds, UpperIsTheClairvoyantProbabilityEnumeratedOutcomeByOutcome) {
     std::vector<State> checked = reachable_states(mdp, seed, 10);
     checked.push_back(mdp.start());
     for (const State& state : checked) {
-      EXPECT_NEAR(bounds.upper(state), clairvoyant_by_enumeration(mdp, state), kRounding)
+      EXPECT_NEAR(bounds.upper(state), clairvoyant_by_enumeration(mdp, state), kBoundsRounding)
           << "seed " << seed << " time " << state.time;
     }
   }
@@ -240,8 +240,8 @@ TEST(ValueBounds, BothBoundsAreTheOptimumWhenThePrefixTreeIsOnePath) {
       checked.push_back(mdp.start());
       for (const State& state : checked) {
         const double optimum = solver.solve(state);
-        EXPECT_NEAR(bounds.lower(state), optimum, kRounding) << "seed " << seed << " " << problem->name();
-        EXPECT_NEAR(bounds.upper(state), optimum, kRounding) << "seed " << seed << " " << problem->name();
+        EXPECT_NEAR(bounds.lower(state), optimum, kBoundsRounding) << "seed " << seed << " " << problem->name();
+        EXPECT_NEAR(bounds.upper(state), optimum, kBoundsRounding) << "seed " << seed << " " << problem->name();
       }
     }
   }
@@ -255,14 +255,14 @@ TEST(ValueBounds, FigureOneBoundsByHand) {
   // Committing to sigma1 succeeds when d1 is found at step 1 and both executions are fast:
   // 1 + 1 + 1 + 1 <= 5, probability 1/8 (sigma2 alike). Committing to sigma3 succeeds when d3
   // (found at step 3) executes fast: 1/2, the lower bound.
-  EXPECT_NEAR(bounds.commit(mdp.start(), 0), 0.125, kRounding);
-  EXPECT_NEAR(bounds.commit(mdp.start(), 1), 0.125, kRounding);
-  EXPECT_NEAR(bounds.commit(mdp.start(), 2), 0.5, kRounding);
+  EXPECT_NEAR(bounds.commit(mdp.start(), 0), 0.125, kBoundsRounding);
+  EXPECT_NEAR(bounds.commit(mdp.start(), 1), 0.125, kBoundsRounding);
+  EXPECT_NEAR(bounds.commit(mdp.start(), 2), 0.5, kBoundsRounding);
   EXPECT_EQ(bounds.lower_choice(mdp.start()), 2);
-  EXPECT_NEAR(bounds.lower(mdp.start()), 0.5, kRounding);
+  EXPECT_NEAR(bounds.lower(mdp.start()), 0.5, kBoundsRounding);
   // Clairvoyant: group d1 fits when d1 takes 1 + 1 steps (1/4) and d12 or d22 then executes
   // fast (3/4): 3/16; group d3 fits with 1/2. upper = 1 - (1 - 3/16)(1 - 1/2) = 19/32.
-  EXPECT_NEAR(bounds.upper(mdp.start()), 19.0 / 32.0, kRounding);
+  EXPECT_NEAR(bounds.upper(mdp.start()), 19.0 / 32.0, kBoundsRounding);
 }
 
 TEST(ValueBounds, RefusesTablesAboveTheCap) {
@@ -290,8 +290,8 @@ TEST(ValueBounds, RecordsTheGapsOnThePaperInstances) {
     const double optimum = OptimalSolver(mdp).solve(mdp.start());
     const double lower = bounds.lower(mdp.start());
     const double upper = bounds.upper(mdp.start());
-    EXPECT_LE(lower, optimum + kRounding) << name;
-    EXPECT_GE(upper, optimum - kRounding) << name;
+    EXPECT_LE(lower, optimum + kBoundsRounding) << name;
+    EXPECT_GE(upper, optimum - kBoundsRounding) << name;
     std::printf("%-10s lower %.9f  optimum %.9f  upper %.9f  optimum-lower %.3g  upper-optimum %.3g\n", name, lower,
                 optimum, upper, optimum - lower, upper - optimum);
   }
