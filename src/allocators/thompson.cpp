@@ -50,38 +50,19 @@ std::int64_t ThompsonAllocator::drawn_finish_with_backtracking(const State& stat
   while (position < actions.size()) {
     const Action& action = problem.action(actions[position]);
     // The attempt's end, conditioned on `spent` steps that neither found nor backtracked.
-    double ended = 0;
-    for (Steps u = 1; u <= spent; ++u) ended += action.planning.pmf(u) + action.backtrack.pmf(u);
-    const double u = ended + uniform01(generator_) * (1.0 - ended);
-    double cumulative = ended;
-    Steps end = kNever;
-    bool found = false;
-    for (Steps t = spent + 1; t + time - spent <= deadline && end == kNever; ++t) {
-      cumulative += action.planning.pmf(t);
-      if (u < cumulative) {
-        end = t;
-        found = true;
-        break;
-      }
-      cumulative += action.backtrack.pmf(t);
-      if (u < cumulative) end = t;
-    }
-    if (end == kNever) return kNeverFinishes;
-    time += end - spent;
+    const AttemptEnd end =
+        draw_attempt_end(action, uniform01(generator_), spent, static_cast<Steps>(deadline - time + spent));
+    if (end.step == kNever) return kNeverFinishes;
+    time += end.step - spent;
     spent = 0;
-    if (found) {
+    if (end.found) {
       const Steps drawn = action.execution.sample(generator_);
       if (drawn == kNever) return kNeverFinishes;
       execution_before_[position] = execution;
       execution += drawn;
       ++position;
     } else {
-      const auto culprits = problem.culprits(actions[position]);
-      const int culprit =
-          culprits[sample_index(
-                       culprits.size(), [&culprits](std::size_t i) { return culprits[i].probability; }, generator_)]
-              .action;
-      position = static_cast<std::size_t>(problem.position(culprit));
+      position = static_cast<std::size_t>(problem.position(draw_culprit(problem, actions[position], generator_)));
       execution = execution_before_[position];
     }
     if (time >= deadline) return kNeverFinishes;

@@ -55,36 +55,17 @@ void sample_planner_log(const Problem& problem, const LogSamplingOptions& option
       attempt.action = action.id;
       attempt.trial = i;
       if (action.backtrack.never() < 1.0) {
-        // Backtracking (SPEC §7): the attempt ends at the first step where the cumulative chance of
-        // a motion or a backtrack passes a uniform draw (the motion first at that step).
-        const double u = uniform01(generator);
-        double cumulative = 0;
-        Steps ended = kNever;
-        bool found = false;
-        const Steps last = std::max(action.planning.max_step() == kNever ? 0 : action.planning.max_step(),
-                                    action.backtrack.max_step() == kNever ? 0 : action.backtrack.max_step());
-        for (Steps t = 1; t <= last && ended == kNever; ++t) {
-          cumulative += action.planning.pmf(t);
-          if (u < cumulative) {
-            ended = t;
-            found = true;
-            break;
-          }
-          cumulative += action.backtrack.pmf(t);
-          if (u < cumulative) ended = t;
-        }
-        if (ended != kNever && ended <= cutoff) {
-          attempt.planning_seconds = seconds_within_step(ended, step, generator);
-          if (found) {
+        // Backtracking (SPEC §7): a motion or a backtrack, whichever ends the attempt first.
+        const AttemptEnd end = draw_attempt_end(action, uniform01(generator));
+        if (end.step != kNever && end.step <= cutoff) {
+          attempt.planning_seconds = seconds_within_step(end.step, step, generator);
+          if (end.found) {
             attempt.found = true;
             const Steps execution = action.execution.sample(generator);
             attempt.execution_seconds =
                 seconds_within_step(execution == kNever ? problem.deadline() + 1 : execution, step, generator);
           } else {
-            const auto culprits = problem.culprits(a);
-            const std::size_t blamed = sample_index(
-                culprits.size(), [&culprits](std::size_t c) { return culprits[c].probability; }, generator);
-            attempt.backtrack = problem.action(culprits[blamed].action).id;
+            attempt.backtrack = problem.action(draw_culprit(problem, a, generator)).id;
           }
         } else {
           attempt.planning_seconds = static_cast<double>(cutoff) * step;

@@ -174,4 +174,21 @@ Problem with_distributions_of(const Problem& structure, const Problem& distribut
   return structure.with_actions(std::move(actions));
 }
 
+AttemptEnd draw_attempt_end(const Action& action, double u, Steps spent, Steps last) {
+  // Beyond both distributions' last steps nothing more ends.
+  const auto last_of = [](const Distribution& d) { return d.max_step() == kNever ? Steps{0} : d.max_step(); };
+  last = std::min(last, std::max(last_of(action.planning), last_of(action.backtrack)));
+  double ended = 0;
+  for (Steps t = 1; t <= spent; ++t) ended += action.planning.pmf(t) + action.backtrack.pmf(t);
+  const double threshold = ended + u * (1.0 - ended);
+  double cumulative = ended;
+  for (Steps t = spent + 1; t <= last; ++t) {
+    cumulative += action.planning.pmf(t);
+    if (threshold < cumulative) return {t, true};
+    cumulative += action.backtrack.pmf(t);
+    if (threshold < cumulative) return {t, false};
+  }
+  return {};
+}
+
 }  // namespace ontime

@@ -35,32 +35,15 @@ void HiddenWorld::begin_episode(std::uint64_t seed) {
 void HiddenWorld::draw_attempt(std::size_t a) {
   const Action& action = problem_->actions()[a];
   SplitMix64 generator(stream_seed(stream_seed(seed_, a), attempt_[a]));
-  // The attempt ends at the first step t where the cumulative P(motion by t) + P(backtrack by t)
-  // passes a uniform draw; at that step the motion comes first.
-  const double u = uniform01(generator);
-  const auto found = action.planning.masses();
-  const auto back = action.backtrack.masses();
-  planning_[a] = kNever;
+  const AttemptEnd end = draw_attempt_end(action, uniform01(generator));
+  planning_[a] = end.step;
   execution_[a] = 0;
   culprit_[a] = -1;
-  double cumulative = 0;
-  for (std::size_t t = 1; t < std::max(found.size(), back.size()); ++t) {
-    cumulative += t < found.size() ? found[t] : 0.0;
-    if (u < cumulative) {
-      planning_[a] = static_cast<Steps>(t);
-      execution_[a] = action.execution.sample(generator);
-      return;
-    }
-    cumulative += t < back.size() ? back[t] : 0.0;
-    if (u < cumulative) {
-      planning_[a] = static_cast<Steps>(t);
-      const auto culprits = problem_->culprits(static_cast<int>(a));
-      culprit_[a] =
-          culprits[sample_index(
-                       culprits.size(), [&culprits](std::size_t i) { return culprits[i].probability; }, generator)]
-              .action;
-      return;
-    }
+  if (end.step == kNever) return;
+  if (end.found) {
+    execution_[a] = action.execution.sample(generator);
+  } else {
+    culprit_[a] = draw_culprit(*problem_, static_cast<int>(a), generator);
   }
 }
 

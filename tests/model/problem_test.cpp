@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <stdexcept>
+#include <utility>
 
 #include "ontime/util/error.hpp"
 #include "support/paper.hpp"
@@ -12,6 +13,26 @@ namespace {
 
 Action simple(const std::string& id) {
   return Action{id, Distribution::from_pmf({0.0, 1.0}), Distribution::from_pmf({1.0})};
+}
+
+// Motion and backtrack as competing risks: by step 1 a motion has mass 0.2 and a backtrack 0.1,
+// by step 2 a motion 0.3 more, by step 3 a backtrack 0.25 more; 0.15 never ends.
+TEST(Problem, AnAttemptEndsWhereTheCumulativeMassPassesTheDraw) {
+  const Action action{"a", Distribution::from_pmf({0.0, 0.2, 0.3}), Distribution::from_pmf({1.0}),
+                      Distribution::from_pmf({0.0, 0.1, 0.0, 0.25})};
+  const auto ends = [&action](double u, Steps spent = 0, Steps last = kNever) {
+    const AttemptEnd end = draw_attempt_end(action, u, spent, last);
+    return std::pair{end.step, end.found};
+  };
+  EXPECT_EQ(ends(0.1), std::pair(1, true));    // below 0.2
+  EXPECT_EQ(ends(0.25), std::pair(1, false));  // in [0.2, 0.3): the backtrack of step 1
+  EXPECT_EQ(ends(0.5), std::pair(2, true));    // in [0.3, 0.6)
+  EXPECT_EQ(ends(0.7), std::pair(3, false));   // in [0.6, 0.85)
+  EXPECT_EQ(ends(0.9), std::pair(kNever, false));
+  EXPECT_EQ(ends(0.7, 0, 2), std::pair(kNever, false));  // its end lies beyond `last`
+  // One step spent without an end: the draw covers the remaining 0.7, from 0.3 on.
+  EXPECT_EQ(ends(0.0, 1), std::pair(2, true));
+  EXPECT_EQ(ends(0.5, 1), std::pair(3, false));  // 0.3 + 0.5 x 0.7 = 0.65, in [0.6, 0.85)
 }
 
 TEST(Problem, PrefixTreeOfFigureOne) {

@@ -17,6 +17,7 @@
 
 #include "ontime/model/distribution.hpp"
 #include "ontime/util/error.hpp"
+#include "ontime/util/random.hpp"
 
 namespace ontime {
 
@@ -151,6 +152,27 @@ class Problem {
 
   void index_culprits();
 };
+
+// How one attempt to refine `action` ends (SPEC §7: a motion and a backtrack as competing risks),
+// given `spent` steps of it that ended neither way: at the first step t > spent where P(motion by
+// t) + P(backtrack by t), the motion counted first at its step, passes the mass already ended
+// plus u times the rest (u uniform in [0, 1)). {kNever, false} when no step up to `last` does.
+// The one draw of an attempt: the hidden world, sampled logs and Thompson sampling use it.
+struct AttemptEnd {
+  Steps step = kNever;
+  bool found = false;  // a motion; else the attempt backtracked
+};
+AttemptEnd draw_attempt_end(const Action& action, double u, Steps spent = 0, Steps last = kNever);
+
+// The earlier action an attempt at `action` that backtracks blames, drawn with the culprits'
+// probabilities.
+template <class Generator>
+int draw_culprit(const Problem& problem, int action, Generator& generator) {
+  const auto culprits = problem.culprits(action);
+  return culprits[sample_index(
+                      culprits.size(), [&culprits](std::size_t i) { return culprits[i].probability; }, generator)]
+      .action;
+}
 
 // The action an id names in the world: the id without a trailing "#n" (one or more digits). A
 // skeletons' prefix tree holds an action reached under another prefix as a node of its own,
