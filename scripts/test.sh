@@ -22,7 +22,7 @@ ctest --preset release --label-regex python --verbose
 # same files as one process, byte for byte, and no work lost when a rank dies.
 ./scripts/cluster/check.sh build/ontime
 # Static analysis: no finding of .clang-tidy's checks in src/, include/, apps/, domains/ (python/src/: see the script).
-./scripts/clang-tidy.sh build
+./scripts/clang-tidy.sh
 # Installing: pip install --no-build-isolation . (reusing build/), then the .deb of cpack.
 ./scripts/check-pip-install.sh build
 ./scripts/check-package.sh build

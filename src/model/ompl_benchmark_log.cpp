@@ -17,6 +17,8 @@
 namespace ontime {
 namespace {
 
+using Json = nlohmann::ordered_json;
+
 // The run properties the reader uses; every other one is skipped.
 constexpr std::string_view kTime = "time REAL";
 constexpr std::string_view kSolved = "solved BOOLEAN";
@@ -410,7 +412,6 @@ std::string number(double value) { return fmt::format("{}", value); }
 }  // namespace
 
 OmplActionMapping parse_ompl_action_mapping(std::string_view text, std::string_view source) {
-  using Json = nlohmann::ordered_json;
   const std::string name(source);
   const Json root = detail::parse_json_strict<Json>(text, name);
   if (!root.is_object()) {

@@ -9,9 +9,11 @@
 #include "ontime/util/json_input.hpp"
 
 namespace ontime {
+namespace {
+using Json = nlohmann::ordered_json;
+}  // namespace
 
 SkeletonList parse_skeleton_file(std::string_view text, std::string_view source) {
-  using Json = nlohmann::ordered_json;
   const std::string name(source);
   const Json root = detail::parse_json_strict<Json>(text, name);
   if (!root.is_object()) {
