@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include <filesystem>
+#include <optional>
 #include <vector>
 
 #include "cluster_job.hpp"
@@ -32,6 +33,7 @@ void add_run_command(CLI::App& app) {
     std::string domain;
     std::string world;
     std::string instance;
+    std::string belief;
     std::string solver;
     std::string effort = "checks";
     std::uint64_t episodes = 200;
@@ -55,6 +57,9 @@ void add_run_command(CLI::App& app) {
   command->add_option("--instance", options->instance,
                       "The allocator's model (default: data/instances/DOMAIN.json in the current directory, as collect "
                       "writes it, else the one installed with ontime)");
+  command->add_option("--belief", options->belief,
+                      "Decide with this instance's distributions, INSTANCE's skeletons and culprits kept (e.g. a "
+                      "backtracking-ignorant fit of the same log)");
   command->add_option("--world", options->world, "World file (default: data/domains/DOMAIN.json)");
   add_number_option(*command, "--episodes", options->episodes, "Episodes", std::uint64_t{1});
   add_number_option(*command, "--seed", options->seed, "Seed (episode e uses stream e)");
@@ -109,7 +114,18 @@ void add_run_command(CLI::App& app) {
     }
     const domains::LoadedDomain loaded = domains::load_domain(options->domain, world);
     const Problem problem = load_problem(instance);
+    std::optional<Problem> belief;
+    if (!options->belief.empty()) {
+      belief.emplace(load_problem(options->belief));
+      try {
+        (void)with_distributions_of(problem, *belief);
+      } catch (const UsageError& error) {
+        throw UsageError(options->belief + ": " + error.what() + " (--belief against " + instance.string() + ")");
+      }
+    }
     domains::PlannerRunOptions run;
+    run.belief = belief ? &*belief : nullptr;
+    run.belief_source = options->belief;
     run.solver = options->solver;
     run.parameters = options->allocator.values();
     run.episodes = options->episodes;

@@ -26,13 +26,16 @@ struct Outcome {
 // (With the checks unit a planning time of exactly k steps, k * step * rate checks, stays exact.)
 double round_to_microseconds(double seconds) { return std::round(seconds * 1e6) / 1e6; }
 
-Outcome attempt_once(const Domain& domain, const std::string& action, const Configuration& start, std::uint64_t seed,
-                     const CollectionOptions& options) {
+// `before`: the action before this one in the tree, blamed when the attempt gives up (SeSamE's
+// rule); null for an action without one, whose giving up is recorded as a cut-off then.
+Outcome attempt_once(const Domain& domain, const std::string& action, const std::string* before,
+                     const Configuration& start, std::uint64_t seed, const CollectionOptions& options) {
   const std::unique_ptr<Refinement> refinement = domain.refine(action, start, seed, options.effort);
   for (Steps step = 1; step <= options.budget_steps; ++step) {
-    if (refinement->advance(static_cast<double>(step) * options.step_seconds) == RefinementStatus::found) break;
+    if (refinement->advance(static_cast<double>(step) * options.step_seconds) != RefinementStatus::working) break;
   }
   Outcome outcome;
+  if (refinement->status() == RefinementStatus::backtrack && before != nullptr) outcome.attempt.backtrack = *before;
   outcome.attempt.action = action;
   outcome.attempt.planning_seconds = round_to_microseconds(refinement->effort().seconds());
   outcome.attempt.collision_checks = refinement->effort().checks();
@@ -68,6 +71,8 @@ std::uint64_t exchange_outcomes(const Ranks& ranks, const std::vector<TreeAction
     packer.put(outcome.attempt.found);
     packer.put(outcome.attempt.execution_seconds);
     packer.put(outcome.attempt.collision_checks);
+    packer.put(outcome.attempt.backtrack.has_value());
+    if (outcome.attempt.backtrack) packer.put_string(*outcome.attempt.backtrack);
     packer.put(outcome.end.has_value());
     if (outcome.end) packer.put_vector(*outcome.end);
   }
@@ -86,6 +91,7 @@ std::uint64_t exchange_outcomes(const Ranks& ranks, const std::vector<TreeAction
       outcome.attempt.found = unpacker.get<bool>();
       outcome.attempt.execution_seconds = unpacker.get<double>();
       outcome.attempt.collision_checks = unpacker.get<std::optional<std::uint64_t>>();
+      if (unpacker.get<bool>()) outcome.attempt.backtrack = unpacker.get_string();
       if (unpacker.get<bool>()) outcome.end = unpacker.get_vector<double>();
       done[a][t] = true;
       ++received;
@@ -209,7 +215,8 @@ CollectionResult collect(const Domain& domain, const CollectionOptions& options)
             start = domain.fallback_start(node.action, stream_seed(trial_seed, 1));
           }
           Outcome& outcome = outcomes[a][t];
-          outcome = attempt_once(domain, node.action, start, stream_seed(trial_seed, 0), options);
+          const std::string* before = node.parent < 0 ? nullptr : &tree[static_cast<std::size_t>(node.parent)].action;
+          outcome = attempt_once(domain, node.action, before, start, stream_seed(trial_seed, 0), options);
           outcome.attempt.trial = t;
           if (options.journal != nullptr) options.journal->record(JournalTrial{a, outcome.attempt, outcome.end});
           if (options.progress) {
@@ -262,9 +269,11 @@ std::vector<std::vector<Configuration>> refine_skeleton(const Domain& domain, co
     for (int attempt = 0; attempt < attempts && !found; ++attempt) {
       const std::uint64_t attempt_seed = stream_seed(stream_seed(seed, l), tried[l]++);
       const std::unique_ptr<Refinement> refinement = domain.refine(skeleton[l], at, attempt_seed, options.effort);
-      for (Steps step = 1; step <= options.budget_steps && !found; ++step) {
-        found = refinement->advance(static_cast<double>(step) * options.step_seconds) == RefinementStatus::found;
+      RefinementStatus status = RefinementStatus::working;
+      for (Steps step = 1; step <= options.budget_steps && status == RefinementStatus::working; ++step) {
+        status = refinement->advance(static_cast<double>(step) * options.step_seconds);
       }
+      found = status == RefinementStatus::found;
       if (found) {
         motions.push_back(refinement->motion());
         ends.push_back(refinement->final_configuration());

@@ -281,9 +281,21 @@ class ManipulationRefinement final : public detail::PhasedRefinement {
     return path;
   }
 
-  // One draw of a target: a grasp or a placement, a base pose, an IK solution. Each draw costs
-  // at least one check, so that rejections consume effort.
+  // One draw of a target; a place gives up (backtracks to the pick that chose its grasp) after
+  // `placement_draws` draws in a row without one, when the world sets that budget.
   void draw_target() {
+    if (draw_one_target()) {
+      misses_ = 0;
+    } else if (action_.kind == ManipulationKind::place && world_.planner.placement_draws > 0 &&
+               ++misses_ >= static_cast<std::uint64_t>(world_.planner.placement_draws)) {
+      give_up();
+    }
+  }
+
+  // One draw of a target: a grasp or a placement, a base pose, an IK solution; true when it is
+  // reachable and planning towards it starts. Each draw costs at least one check, so that
+  // rejections consume effort.
+  bool draw_one_target() {
     Transform tool;
     if (action_.kind == ManipulationKind::pick) {
       const Transform& grasp =
@@ -294,7 +306,7 @@ class ManipulationRefinement final : public detail::PhasedRefinement {
       placement_ = ObjectPose{uniform(region_->min_x, region_->max_x), uniform(region_->min_y, region_->max_y),
                               world_.resting_z(object_, *region_), uniform(region_->yaw_low, region_->yaw_high)};
       meter_.count_check();
-      if (collision_->held_object_collides(placement_)) return;
+      if (collision_->held_object_collides(placement_)) return false;
       tool = object_transform(placement_) * grasp_.inverse();
       after_->set_object_pose(object_, placement_);
     }
@@ -310,22 +322,22 @@ class ManipulationRefinement final : public detail::PhasedRefinement {
       guess[j] = uniform(pr2_left_arm_joints()[j].lower, pr2_left_arm_joints()[j].upper);
     meter_.count_check();
     const auto& floor = world_.floor;
-    if (!(x > floor[0] && x < floor[2] && y > floor[1] && y < floor[3])) return;
-    if (collision_->collides(base, world_.robot.carry)) return;
+    if (!(x > floor[0] && x < floor[2] && y > floor[1] && y < floor[3])) return false;
+    if (collision_->collides(base, world_.robot.carry)) return false;
     // The next action retracts to the carry configuration here, with or without the object.
     meter_.count_check();
-    if (after_->collides(base, world_.robot.carry)) return;
+    if (after_->collides(base, world_.robot.carry)) return false;
     const Transform torso = base_transform(base) * arm_.torso();
-    if (!arm_.may_reach(torso.inverse() * tool) || !arm_.may_reach(torso.inverse() * backed_off(tool))) return;
+    if (!arm_.may_reach(torso.inverse() * tool) || !arm_.may_reach(torso.inverse() * backed_off(tool))) return false;
     meter_.count_checks(static_cast<std::uint64_t>(world_.planner.ik_checks));
     const std::optional<ArmJoints> joints = arm_.inverse(torso.inverse() * tool, guess);
-    if (!joints) return;
+    if (!joints) return false;
     meter_.count_check();
-    if (collision_->collides(base, *joints)) return;
+    if (collision_->collides(base, *joints)) return false;
     // The last stretch is straight along the gripper's axis, from `approach_distance` back.
     meter_.count_checks(static_cast<std::uint64_t>(world_.planner.ik_checks));
     const std::optional<ArmJoints> before = arm_.inverse(torso.inverse() * backed_off(tool), *joints);
-    if (!before) return;
+    if (!before) return false;
     ++targets_;
     approach_ = Leg<ArmJoints>{};
     approach_.information = arm_space(base, stream_seed(seed_, 2 * targets_));
@@ -333,12 +345,13 @@ class ManipulationRefinement final : public detail::PhasedRefinement {
     set(near.get(), *before);
     set(at.get(), *joints);
     if (!approach_.information->isValid(near.get()) || !approach_.information->checkMotion(near.get(), at.get()))
-      return;
+      return false;
     target_base_ = base;
     target_arm_ = *joints;
     target_started_ = meter_.checks();
     planner_ = make_planner(approach_.information, world_.robot.carry, *before, world_.planner.arm_range);
     phase_ = Phase::approach;
+    return true;
   }
 
   // Approach, then drive, until both are found, the limit is reached, or the target has had
@@ -428,6 +441,7 @@ class ManipulationRefinement final : public detail::PhasedRefinement {
   ArmJoints target_arm_{};
   ObjectPose placement_;
   std::uint64_t targets_ = 0, target_started_ = 0;
+  std::uint64_t misses_ = 0;  // target draws in a row without a target
   bool retreated_ = false;
   Leg<ArmJoints> retract_, approach_;
   Leg<Pose> drive_;

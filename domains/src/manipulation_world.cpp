@@ -121,7 +121,7 @@ class KitchenReader : detail::WorldFields {
     object_at(value, "planner");
     check_keys(value, "planner",
                {"arm_range", "arm_resolution", "base_range", "base_resolution", "base_distance", "base_heading_spread",
-                "approach_distance", "ik_checks", "target_checks", "placement_gap"});
+                "approach_distance", "ik_checks", "target_checks", "placement_gap", "placement_draws"});
     ManipulationPlanner& planner = world.planner;
     planner.arm_range = positive(member(value, "planner", "arm_range"), "planner.arm_range");
     planner.arm_resolution = positive(member(value, "planner", "arm_resolution"), "planner.arm_resolution");
@@ -143,6 +143,9 @@ class KitchenReader : detail::WorldFields {
     planner.ik_checks = whole(member(value, "planner", "ik_checks"), "planner.ik_checks", 0, 1'000'000);
     planner.target_checks = whole(member(value, "planner", "target_checks"), "planner.target_checks", 1, 1'000'000'000);
     planner.placement_gap = positive(member(value, "planner", "placement_gap"), "planner.placement_gap");
+    if (value.contains("placement_draws")) {
+      planner.placement_draws = whole(value["placement_draws"], "planner.placement_draws", 0, 1'000'000'000);
+    }
   }
 
   Box3 read_box(const Json& value, const std::string& path, const ManipulationWorld& world) const {

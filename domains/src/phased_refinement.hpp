@@ -1,7 +1,8 @@
 #pragma once
 // Internal: what every domain's refinement shares. advance() does one bounded piece of work after
 // another (work(), which the domain defines as a step of its current phase) until the motion is
-// found or the effort reaches the limit, checked between pieces (so it may overshoot by one).
+// found, the attempt gives up, or the effort reaches the limit, checked between pieces (so it may
+// overshoot by one).
 
 #include <stdexcept>
 
@@ -15,27 +16,29 @@ class PhasedRefinement : public Refinement {
 
   RefinementStatus advance(double limit_seconds) final {
     meter_.start_working();
-    while (!found_ && !meter_.reached(limit_seconds)) work(limit_seconds);
+    while (status_ == RefinementStatus::working && !meter_.reached(limit_seconds)) work(limit_seconds);
     meter_.stop_working();
     return status();
   }
 
-  RefinementStatus status() const final { return found_ ? RefinementStatus::found : RefinementStatus::working; }
+  RefinementStatus status() const final { return status_; }
   const EffortMeter& effort() const final { return meter_; }
 
  protected:
   // One piece of work; `limit_seconds` for planners that run on by themselves until the limit.
   virtual void work(double limit_seconds) = 0;
 
-  void found() noexcept { found_ = true; }
+  void found() noexcept { status_ = RefinementStatus::found; }
+  // The attempt gives up and blames the action before (RefinementStatus::backtrack).
+  void give_up() noexcept { status_ = RefinementStatus::backtrack; }
   void require_found() const {
-    if (!found_) throw std::logic_error("the refinement has not found a motion yet");
+    if (status_ != RefinementStatus::found) throw std::logic_error("the refinement has not found a motion yet");
   }
 
   EffortMeter meter_;
 
  private:
-  bool found_ = false;
+  RefinementStatus status_ = RefinementStatus::working;
 };
 
 }  // namespace ontime::domains::detail

@@ -1,5 +1,7 @@
 #include "ontime/domains/planner_run.hpp"
 
+#include <optional>
+
 #include "episode_options.hpp"
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/domains/planner_world.hpp"
@@ -23,7 +25,11 @@ void check_planner_run_request(const Problem& problem, const std::string& source
 
 PlannerRun run_planner_episodes(const Domain& domain, const Problem& problem, const PlannerRunOptions& options) {
   const Mdp mdp(problem);
-  const AllocatorFactory factory = make_allocator_factory(options.solver, mdp, options.parameters);
+  const std::optional<Problem> planned = options.belief == nullptr
+                                             ? std::nullopt
+                                             : std::optional<Problem>(with_distributions_of(problem, *options.belief));
+  const Mdp planned_mdp(planned ? *planned : problem);
+  const AllocatorFactory factory = make_allocator_factory(options.solver, planned_mdp, options.parameters);
   PlannerWorldOptions planner;
   planner.effort = options.effort;
   planner.independent_starts = options.independent_starts;
@@ -40,6 +46,8 @@ PlannerRun run_planner_episodes(const Domain& domain, const Problem& problem, co
   run.summary = run_episodes(mdp, planner_worlds(domain, problem, planner), factory, episodes);
   run.refinements_started = run.summary.world_statistics.find("refinements_started").value_or(0.0) /
                             static_cast<double>(run.summary.episodes);
+  run.backtracks =
+      run.summary.world_statistics.find("backtracks").value_or(0.0) / static_cast<double>(run.summary.episodes);
   if (options.exact) {
     const auto allocator = factory();
     run.exact = evaluate_exactly(mdp, *allocator, max_states_of(options.parameters), options.stop);

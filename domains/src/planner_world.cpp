@@ -16,6 +16,7 @@ PlannerWorld::PlannerWorld(const Domain& domain, const Problem& problem, const P
   for (int a = 0; a < problem.action_count(); ++a)
     actions_.push_back(TreeAction{problem.action(a).id, problem.parent(a)});
   refinements_.resize(actions_.size());
+  attempts_.resize(actions_.size());
 }
 
 PlannerWorld::PlannerWorld(const Domain& domain, const StreamingWorldOptions& streaming,
@@ -36,11 +37,13 @@ void PlannerWorld::begin_episode(std::uint64_t seed) {
   // this world ran before (which depend on the thread count).
   nominal_clock_.restart();
   for (std::unique_ptr<Refinement>& refinement : refinements_) refinement.reset();
+  std::fill(attempts_.begin(), attempts_.end(), 0);
   if (task_planner_) {
     task_planner_->restart();
     actions_.clear();
     node_ids_.clear();
     refinements_.clear();
+    attempts_.clear();
   }
 }
 
@@ -73,6 +76,7 @@ std::optional<FoundSkeleton> PlannerWorld::next_skeleton() {
       actions_.push_back(TreeAction{move, parent});
       node_ids_.push_back(id);
       refinements_.emplace_back();
+      attempts_.push_back(0);
     }
     found.action_ids.push_back(node_ids_[static_cast<std::size_t>(node)]);
     parent = node;
@@ -106,7 +110,11 @@ Observation PlannerWorld::step(int action, Steps spent) {
     } else {
       start = refinements_[static_cast<std::size_t>(parent)]->final_configuration();
     }
-    refinement = domain_->refine(id, start, stream_seed(seed_, stream), options_.effort);
+    // A first attempt draws from stream 2a; attempt n > 0 (after backtracks) from sub-stream n of it.
+    const std::uint64_t attempt = attempts_[static_cast<std::size_t>(action)];
+    const std::uint64_t seed =
+        attempt == 0 ? stream_seed(seed_, stream) : stream_seed(stream_seed(seed_, stream), attempt);
+    refinement = domain_->refine(id, start, seed, options_.effort);
     ++started_;
   }
   const double step_seconds = step_seconds_;
@@ -115,9 +123,32 @@ Observation PlannerWorld::step(int action, Steps spent) {
   const RefinementStatus status = refinement->advance(static_cast<double>(spent + 1) * step_seconds);
   const double real_end = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
   nominal_clock_.count_call(real_end - real_start, refinement->effort().seconds() - effort_start);
+  if (status == RefinementStatus::backtrack) {
+    // SeSamE's rule: the action before is to blame. A first action has none; it is then stuck,
+    // as an attempt that never ends.
+    const int culprit = actions_[static_cast<std::size_t>(action)].parent;
+    if (culprit < 0) return Observation::not_yet();
+    discard_from(culprit);
+    ++backtracks_;
+    return Observation::backtracked(culprit);
+  }
   if (status != RefinementStatus::found) return Observation::not_yet();
   ++found_;
   return Observation::found(steps_to_complete(refinement->execution_seconds(), step_seconds));
+}
+
+void PlannerWorld::discard_from(int culprit) {
+  // Parents come before their children (in the instance's order and in the order nodes stream
+  // in), so one pass marks every action at or below the culprit.
+  std::vector<bool> below(actions_.size(), false);
+  for (auto a = static_cast<std::size_t>(culprit); a < actions_.size(); ++a) {
+    const int parent = actions_[a].parent;
+    below[a] = static_cast<int>(a) == culprit || (parent >= 0 && below[static_cast<std::size_t>(parent)]);
+    if (below[a] && refinements_[a]) {
+      refinements_[a].reset();
+      ++attempts_[a];
+    }
+  }
 }
 
 const Clock* PlannerWorld::clock() const noexcept {
@@ -127,6 +158,7 @@ const Clock* PlannerWorld::clock() const noexcept {
 void PlannerWorld::collect_statistics(Statistics& statistics) const {
   statistics.add("refinements_started", static_cast<double>(started_));
   statistics.add("refinements_found", static_cast<double>(found_));
+  statistics.add("backtracks", static_cast<double>(backtracks_));
 }
 
 WorldFactory streaming_planner_worlds(const Domain& domain, const StreamingWorldOptions& streaming,

@@ -225,6 +225,7 @@ std::string to_json(const Tamp& tamp) {
   out["ci95"] = summary.ci95;
   out["mean_skeletons_found"] = result.mean_skeletons_found;
   out["refinements_started"] = result.refinements_started;
+  out["backtracks"] = result.backtracks;
   out["seconds"] = summary.seconds;
   add_charges(out, summary.live_mean, "mean_");
   if (options.adaptation) {
@@ -264,6 +265,7 @@ std::string to_text(const Tamp& tamp) {
       summary.live_mean.decision, summary.live_mean.planning, summary.live_mean.overrun, summary.live_mean.outside,
       summary.live_mean.elapsed, deadline_seconds(result));
   out += fmt::format("refinements started  {:.2f} per episode\n", result.refinements_started);
+  if (result.backtracks > 0) out += fmt::format("backtracks           {:.2f} per episode\n", result.backtracks);
   if (options.adaptation) {
     const auto sequences = static_cast<double>(options.adaptation->sequences);
     out += fmt::format("online update        {} sequences of {} episodes, the library a prior of strength {}\n",
@@ -311,6 +313,8 @@ std::string to_json(const Run& run) {
   out["ci95"] = summary.ci95;
   out["independent_starts"] = options.independent_starts;
   out["refinements_started"] = result.refinements_started;
+  out["backtracks"] = result.backtracks;
+  if (options.belief != nullptr) out["belief"] = options.belief_source;
   out["seconds"] = summary.seconds;
   if (result.exact) out["model_exact_success_probability"] = result.exact->success_probability;
   out["effort"] = effort_unit_name(options.effort.unit);
@@ -331,7 +335,8 @@ std::string to_text(const Run& run) {
   const MonteCarloResult& summary = result.summary;
   const bool live = is_live(options);
   std::string out =
-      fmt::format("solver               {} on the {} domain (model {})\n", options.solver, run.domain, run.instance);
+      fmt::format("solver               {} on the {} domain (model {}{})\n", options.solver, run.domain, run.instance,
+                  options.belief == nullptr ? "" : ", deciding with the distributions of " + options.belief_source);
   out += fmt::format("real planner         {:.4f} ± {:.4f}  ({} of {} episodes, seed {}, {:.1f} s){}\n",
                      summary.success_rate, summary.ci95, summary.successes, summary.episodes, options.seed,
                      summary.seconds, live ? ", live" : "");
@@ -350,6 +355,7 @@ std::string to_text(const Run& run) {
     out += fmt::format("timeline             episode {}: {}\n", *run.timeline_episode, run.timeline_files);
   }
   out += fmt::format("refinements started  {:.2f} per episode\n", result.refinements_started);
+  if (result.backtracks > 0) out += fmt::format("backtracks           {:.2f} per episode\n", result.backtracks);
   if (result.exact) out += fmt::format("model, exact         {:.4f}\n", result.exact->success_probability);
   return out;
 }

@@ -140,6 +140,8 @@ TampResult run_tamp(const Domain& domain, const Problem& library, const TampOpti
   }
   result.refinements_started = result.summary.world_statistics.find("refinements_started").value_or(0.0) /
                                static_cast<double>(result.summary.episodes);
+  result.backtracks =
+      result.summary.world_statistics.find("backtracks").value_or(0.0) / static_cast<double>(result.summary.episodes);
 
   // The picture: the episode run again on its own, so that its world still holds its motions.
   if (options.picture_episode && is_root_rank(options.ranks)) {

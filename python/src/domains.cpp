@@ -197,11 +197,22 @@ void bind_domains(py::module_& m) {
       "run",
       [](const std::shared_ptr<DomainHandle>& domain, const py::object& problem, const std::string& solver,
          Episodes episodes, Seed seed, Threads threads, const std::string& effort, ChecksPerSecond checks_per_second,
-         bool independent_starts, bool exact, bool live, DecisionShare decision_share, const py::object& progress,
-         const py::kwargs& kwargs) {
+         bool independent_starts, bool exact, bool live, DecisionShare decision_share, const py::object& belief,
+         const py::object& progress, const py::kwargs& kwargs) {
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
         const std::string instance = instance_label(problem, *mdp->problem);
+        std::shared_ptr<MdpHandle> believed;
         domains::PlannerRunOptions options;
+        if (!belief.is_none()) {
+          believed = to_mdp(belief);
+          try {
+            (void)with_distributions_of(*mdp->problem, *believed->problem);
+          } catch (const UsageError& error) {
+            throw UsageError(std::string("belief: ") + error.what());
+          }
+          options.belief = believed->problem.get();
+          options.belief_source = instance_label(belief, *believed->problem);
+        }
         options.solver = solver;
         options.parameters = parameter_values(kwargs);
         options.episodes = episodes;
@@ -231,11 +242,12 @@ void bind_domains(py::module_& m) {
       py::arg("domain"), py::arg("problem"), py::arg("solver"), py::kw_only(), py::arg("episodes") = 200,
       py::arg("seed") = 1, py::arg("threads") = 0, py::arg("effort") = "checks", py::arg("checks_per_second") = 0.0,
       py::arg("independent_starts") = false, py::arg("exact") = false, py::arg("live") = false,
-      py::arg("decision_share") = 0.5, py::arg("progress") = py::none(),
+      py::arg("decision_share") = 0.5, py::arg("belief") = py::none(), py::arg("progress") = py::none(),
       "`ontime run`: episodes in which the allocator `solver` (parameters as keyword arguments), with `problem` "
       "as its model, drives the domain's real motion planner; live=True (always with effort 'wall') charges "
-      "its thinking and the planner's overruns on the clock. Returns the fields of `ontime run --json` (live: "
-      "every episode with its timeline).");
+      "its thinking and the planner's overruns on the clock; `belief` (a Problem or instance file): the "
+      "allocator decides with its distributions, `problem`'s skeletons and culprits kept (`ontime run "
+      "--belief`). Returns the fields of `ontime run --json` (live: every episode with its timeline).");
 
   m.def(
       "tamp",

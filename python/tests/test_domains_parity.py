@@ -16,6 +16,8 @@ NAVIGATION = str(SOURCE_DIR / "data" / "domains" / "navigation.json")
 NAVIGATION_MODEL = str(SOURCE_DIR / "data" / "instances" / "navigation.json")
 BUILDING = str(SOURCE_DIR / "data" / "domains" / "building-6x5.json")
 BUILDING_MOVES = str(SOURCE_DIR / "data" / "instances" / "building-6x5-moves.json")
+KITCHEN_GRASPS = str(SOURCE_DIR / "data" / "domains" / "kitchen-grasps.json")
+KITCHEN_GRASPS_MODEL = str(SOURCE_DIR / "data" / "instances" / "kitchen-grasps.json")
 
 
 def without(result, *keys):
@@ -148,6 +150,26 @@ def test_run_matches_the_cli(cli):
     live = ontime.domains.run(nav, NAVIGATION_MODEL, "dp-rerun", episodes=2, threads=1, live=True)
     assert list(live) == list(live_expected)
     assert len(live["episode_results"]) == 2 and all(episode["timeline"] for episode in live["episode_results"])
+
+
+def test_run_with_a_belief_in_a_world_that_backtracks_matches_the_cli(cli, tmp_path):
+    # The same log read without its backtracks: the allocator's belief; the world's places give up.
+    with open(KITCHEN_GRASPS_MODEL, encoding="utf-8") as text:
+        model = json.load(text)
+    for action in model["actions"].values():
+        action.pop("backtrack", None)
+        action.pop("culprits", None)
+    belief = tmp_path / "ignorant.json"
+    belief.write_text(json.dumps(model), encoding="utf-8")
+    expected = cli("run", "--domain", "manipulation", "--world", KITCHEN_GRASPS, "--instance", KITCHEN_GRASPS_MODEL,
+                   "--belief", belief, "--solver", "dp-rerun", "--episodes", 3, "--threads", 1, "--seed", 2, "--json")
+    kitchen = ontime.domains.load("manipulation", KITCHEN_GRASPS)
+    got = ontime.domains.run(kitchen, KITCHEN_GRASPS_MODEL, "dp-rerun", episodes=3, threads=1, seed=2,
+                             belief=str(belief))
+    assert without(got, "seconds") == without(expected, "seconds")
+    assert got["belief"] == str(belief)
+    with pytest.raises(ontime.UsageError, match="belief: the deadlines differ"):
+        ontime.domains.run(kitchen, KITCHEN_GRASPS_MODEL, "dp-rerun", episodes=1, belief=NAVIGATION_MODEL)
 
 
 def test_collect_and_fit_writes_the_clis_files(cli, tmp_path):

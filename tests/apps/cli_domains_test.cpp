@@ -153,6 +153,44 @@ TEST(Cli, CollectRunsTheManipulationDomain) {
   EXPECT_EQ(instance["skeletons"][7].size(), 12u);
 }
 
+// The kitchen whose places give up: collect writes backtrack records and fits culprits; run
+// drives the real refiner that backtracks, with the instance's distributions or a belief's (here
+// the same log read without its backtracks), and refuses a belief of other actions.
+TEST(Cli, RunDrivesARefinerThatBacktracksWithABelief) {
+  const std::filesystem::path dir = scratch("kitchen-grasps");
+  const std::string world = testing::source_path("data/domains/kitchen-grasps.json").string();
+  const auto collected = ontime({"collect", "--domain", "manipulation", "--world", world, "--trials", "2", "--log",
+                                 (dir / "g.jsonl").string(), "-o", (dir / "g.json").string(), "--json"});
+  ASSERT_EQ(collected.exit_code, 0) << collected.err;
+  const json fitted = json::parse(read_file(dir / "g.json"));
+  EXPECT_EQ(fitted["actions"]["move+place(B1,S)"]["culprits"], json({{"move+pick(B1)", 1.0}}));
+  EXPECT_NE(read_file(dir / "g.jsonl").find(R"x("backtrack":"move+pick(B1)")x"), std::string::npos);
+
+  json ignorant = json::parse(read_file(testing::source_path("data/instances/kitchen-grasps.json")));
+  for (auto& [id, action] : ignorant["actions"].items()) {
+    action.erase("backtrack");
+    action.erase("culprits");
+  }
+  std::ofstream(dir / "ignorant.json") << ignorant.dump(1);
+  const std::string instance = testing::source_path("data/instances/kitchen-grasps.json").string();
+  const auto run =
+      ontime({"run", "--domain", "manipulation", "--world", world, "--instance", instance, "--belief",
+              (dir / "ignorant.json").string(), "--solver", "dp-rerun", "--episodes", "3", "--threads", "1", "--json"});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const json out = json::parse(run.out);
+  EXPECT_EQ(out["belief"], (dir / "ignorant.json").string());
+  EXPECT_EQ(out["episodes"], 3);
+  EXPECT_GE(out["backtracks"].get<double>(), 0.0);
+
+  const std::string other = testing::source_path("data/instances/navigation.json").string();
+  const auto refused = ontime({"run", "--domain", "manipulation", "--world", world, "--instance", instance, "--belief",
+                               other, "--solver", "dp-rerun", "--episodes", "1"});
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_NE(refused.err.find(other + ": "), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("the deadlines differ (22 and 40 steps) (--belief against"), std::string::npos)
+      << refused.err;
+}
+
 TEST(Cli, MapDrawsTheWorldAndOneMotionPerSkeleton) {
   const std::filesystem::path dir = scratch("map");
   const std::string png = (dir / "map.png").string();

@@ -470,5 +470,62 @@ TEST(CollectionJournal, EveryRanksFinishedTrialsResumeUnderAnyNumberOfRanks) {
   }
 }
 
+const ManipulationDomain& grasp_kitchen() {
+  static const ManipulationDomain domain(
+      load_manipulation_world(testing::source_path("data/domains/kitchen-grasps.json")));
+  return domain;
+}
+
+// In the kitchen whose cubby takes only one pair of grasps, a place with another grasp gives up
+// after the world's placement draws and blames the pick before it (SeSamE's rule): the log names
+// it, ranks exchange the record whole, and without the budget the same attempts never end.
+TEST(Collection, APlaceThatGivesUpBlamesThePickBeforeIt) {
+  const ManipulationWorld& world = grasp_kitchen().world();
+  CollectionOptions settings = options(3, 1, 2);
+  settings.effort.checks_per_second = world.collection.checks_per_second;
+  settings.step_seconds = world.collection.step_seconds;
+  settings.budget_steps = 20;
+  const CollectionResult result = collect(grasp_kitchen(), settings);
+  ASSERT_EQ(result.log.size(), 15u);
+  std::map<std::string, int> backtracked, found;
+  for (const RefinementAttempt& attempt : result.log) {
+    if (attempt.backtrack) {
+      ++backtracked[attempt.action];
+      EXPECT_FALSE(attempt.found);
+      EXPECT_GT(attempt.planning_seconds, 0);
+      EXPECT_LT(attempt.planning_seconds, 20 * settings.step_seconds) << "gave up before the cut-off";
+      if (attempt.action == "move+place(B1,S)") {
+        EXPECT_EQ(*attempt.backtrack, "move+pick(B1)");
+      }
+      if (attempt.action == "move+place(B1,S)[B1]") {
+        EXPECT_EQ(*attempt.backtrack, "move+pick(B1)[B1]");
+      }
+    }
+    found[attempt.action] += attempt.found ? 1 : 0;
+  }
+  // The direct placement is infeasible: every attempt gives up; picks never do.
+  EXPECT_EQ(backtracked["move+place(B1,S)"], 3);
+  EXPECT_EQ(backtracked["move+pick(B1)"], 0);
+  EXPECT_EQ(found["move+pick(B1)"], 3);
+
+  testing::run_on_ranks(2, [&](const Ranks& ranks) {
+    CollectionOptions split = settings;
+    split.ranks = &ranks;
+    EXPECT_EQ(text(collect(grasp_kitchen(), split).log), text(result.log)) << "rank " << ranks.rank();
+  });
+
+  ManipulationWorld patient = world;
+  patient.planner.placement_draws = 0;
+  const ManipulationDomain never_gives_up(patient);
+  settings.budget_steps = 6;
+  for (const RefinementAttempt& attempt : collect(never_gives_up, settings).log) {
+    EXPECT_FALSE(attempt.backtrack.has_value()) << attempt.action;
+    if (attempt.action == "move+place(B1,S)") {
+      EXPECT_FALSE(attempt.found);
+      EXPECT_GE(attempt.planning_seconds, 6 * settings.step_seconds) << "cut off at the budget";
+    }
+  }
+}
+
 }  // namespace
 }  // namespace ontime::domains

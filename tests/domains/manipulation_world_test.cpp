@@ -41,6 +41,16 @@ TEST(ManipulationWorld, LoadsTheKitchen) {
   const MovableObject& b1 = world.objects[static_cast<std::size_t>(world.object_index("B1"))];
   EXPECT_DOUBLE_EQ(b1.pose.z, 0.85 + world.planner.placement_gap + 0.1);
   EXPECT_EQ(world.walls.size(), 4u);
+  EXPECT_EQ(world.planner.placement_draws, 0) << "places never give up unless the world says so";
+}
+
+TEST(ManipulationWorld, LoadsTheKitchenWhosePlacesGiveUp) {
+  const ManipulationWorld world = load_manipulation_world(testing::source_path("data/domains/kitchen-grasps.json"));
+  EXPECT_EQ(world.planner.placement_draws, 300);
+  const PlacementRegion& cubby = world.regions[static_cast<std::size_t>(world.region_index("S"))];
+  EXPECT_DOUBLE_EQ(cubby.yaw_low, -0.2);
+  EXPECT_DOUBLE_EQ(cubby.yaw_high, 0.2);
+  EXPECT_EQ(world.skeletons.size(), 2u);
 }
 
 TEST(ManipulationWorld, TheSkeletonsAreThoseOfAppendixA) {
@@ -164,6 +174,8 @@ TEST(ManipulationWorld, EveryBrokenRuleIsReportedWithItsPlace) {
        },
        "planner.base_distance", "nearest < farthest"},
       {"ik checks", [](ordered_json& w) { w["planner"]["ik_checks"] = 2.5; }, "planner.ik_checks", "whole number"},
+      {"placement draws", [](ordered_json& w) { w["planner"]["placement_draws"] = -1; }, "planner.placement_draws",
+       "whole number"},
       {"base resolution", [](ordered_json& w) { w["planner"]["base_resolution"] = 0.2; }, "planner.base_resolution",
        "below the wall thickness"},
       {"not an action", [](ordered_json& w) { w["skeletons"][0][1] = "fly(B1)"; }, "skeletons[0][1]",

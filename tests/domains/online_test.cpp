@@ -3,6 +3,7 @@
 #include <set>
 
 #include "ontime/allocators/allocator_registry.hpp"
+#include "ontime/domains/manipulation.hpp"
 #include "ontime/domains/navigation.hpp"
 #include "ontime/domains/planner_world.hpp"
 #include "ontime/model/instance_io.hpp"
@@ -123,6 +124,55 @@ TEST(Online, EveryEpisodeGetsItsOwnRandomStream) {
   ASSERT_EQ(seeds.size(), 3U);
   EXPECT_EQ(std::set<std::uint64_t>(seeds.begin(), seeds.end()).size(), 3U) << "two episodes share one random stream";
   for (std::uint64_t e = 0; e < 3; ++e) EXPECT_EQ(seeds[e], stream_seed(stream_seed(3, e), 1));
+}
+
+// A refinement that gives up (the kitchen whose cubby takes one pair of grasps): the step reports
+// the backtrack to the action before, that action and every one below it lose their motions, and
+// the next step on it starts a new attempt; episodes stay the same whatever the threads.
+TEST(Online, ARefinementThatGivesUpSendsTheEpisodeBackToTheActionBefore) {
+  const ManipulationDomain domain(load_manipulation_world(testing::source_path("data/domains/kitchen-grasps.json")));
+  const Problem problem = load_problem(testing::source_path("data/instances/kitchen-grasps.json"));
+  const Mdp mdp(problem);
+  const PlannerWorldOptions options{
+      EffortSettings{EffortUnit::collision_checks, domain.world().collection.checks_per_second}, false, std::nullopt};
+  PlannerWorld world(domain, problem, options);
+  world.begin_episode(5);
+  const int pick = problem.find_action("move+pick(B1)");
+  const int place = problem.find_action("move+place(B1,S)");
+  ASSERT_GE(pick, 0);
+  ASSERT_GE(place, 0);
+  Observation seen;
+  Steps spent = 0;
+  for (; spent < problem.deadline() && !seen.refined; ++spent) seen = world.step(pick, spent);
+  ASSERT_TRUE(seen.refined);
+  seen = Observation::not_yet();
+  for (spent = 0; spent < problem.deadline() && !seen.refined && !seen.is_backtrack(); ++spent)
+    seen = world.step(place, spent);
+  ASSERT_TRUE(seen.is_backtrack()) << "the direct placement is infeasible with the grasp the pick took";
+  EXPECT_EQ(seen.culprit, pick);
+  EXPECT_EQ(world.refinement(pick), nullptr);
+  EXPECT_EQ(world.refinement(place), nullptr);
+  EXPECT_FALSE(world.step(pick, 0).is_backtrack());
+  EXPECT_NE(world.refinement(pick), nullptr);
+  Statistics statistics;
+  world.collect_statistics(statistics);
+  EXPECT_EQ(statistics.find("backtracks").value_or(-1), 1.0);
+  EXPECT_EQ(statistics.find("refinements_started").value_or(-1), 3.0);
+
+  const AllocatorFactory factory = make_allocator_factory("dp-rerun", mdp);
+  MonteCarloOptions episodes;
+  episodes.episodes = 6;
+  episodes.seed = 2;
+  episodes.threads = 1;
+  const MonteCarloResult one = run_episodes(mdp, planner_worlds(domain, problem, options), factory, episodes);
+  episodes.threads = 2;
+  const MonteCarloResult two = run_episodes(mdp, planner_worlds(domain, problem, options), factory, episodes);
+  EXPECT_EQ(one.successes, two.successes);
+  EXPECT_GT(one.world_statistics.find("backtracks").value_or(0), 0.0);
+  EXPECT_DOUBLE_EQ(one.world_statistics.find("backtracks").value_or(-1),
+                   two.world_statistics.find("backtracks").value_or(-2));
+  EXPECT_DOUBLE_EQ(one.world_statistics.find("refinements_started").value_or(-1),
+                   two.world_statistics.find("refinements_started").value_or(-2));
 }
 
 }  // namespace

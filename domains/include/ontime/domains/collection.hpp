@@ -7,7 +7,9 @@
 // the domain's initial configuration. (If no refinement of the action before succeeded, the
 // domain draws a fallback start.) An attempt gets one step of effort at a time, exactly as an
 // allocator would give it (advance(1 step), advance(2 steps), ...), and is cut off after
-// `budget_steps` steps without a motion.
+// `budget_steps` steps without a motion. An attempt that gives up (RefinementStatus::backtrack)
+// ends there and is logged with `backtrack` naming the action before it in the tree (SeSamE's
+// rule, docs/spec.md §7); an action without one (a first action, every_action) logs it as cut off.
 //
 // With CollectionOptions::every_action, the actions are instead every action the domain can
 // refine, each on its own (every_action_list): a library that covers any skeleton.

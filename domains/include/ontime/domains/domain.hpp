@@ -26,16 +26,20 @@ namespace ontime::domains {
 // A robot configuration in the domain's own coordinates (navigation: x, y, theta).
 using Configuration = std::vector<double>;
 
-enum class RefinementStatus { working, found };
+// `backtrack`: the attempt gave up because of the motion chosen for the action before it (a
+// grasp with which no placement is reachable), SeSamE's rule (docs/spec.md §7): that action is
+// to be refined anew, and this one after it, from where its new motion ends.
+enum class RefinementStatus { working, found, backtrack };
 
 // One attempt to refine one abstract action.
 class Refinement {
  public:
   virtual ~Refinement() = default;
 
-  // Continues the attempt until a motion is found or the total effort reaches `limit_seconds`
-  // (checked between planner iterations, so it may overshoot by one iteration). Calling it
-  // again with a larger limit resumes the same planner where it stopped.
+  // Continues the attempt until a motion is found, the attempt gives up (backtrack), or the total
+  // effort reaches `limit_seconds` (checked between planner iterations, so it may overshoot by
+  // one iteration). Calling it again with a larger limit resumes the same planner where it
+  // stopped; once found or given up, it returns at once.
   virtual RefinementStatus advance(double limit_seconds) = 0;
 
   virtual RefinementStatus status() const = 0;

@@ -15,7 +15,10 @@
 //   4. drive: plans the base from its pose to the target's with the arm carried (SE(2));
 //   5. shorten: greedy shortcutting of the three paths.
 // A target whose approach and drive take more than `planner.target_checks` checks is dropped
-// for a new draw. Every collision check is effort, and so is every IK solve (`planner.ik_checks`
+// for a new draw. When the world sets `planner.placement_draws`, a place that has drawn that many
+// targets in a row without one (every placement unreachable with the grasp held) gives up and
+// blames the pick before it (RefinementStatus::backtrack, docs/spec.md §7): the pick is refined
+// anew, with another grasp. Every collision check is effort, and so is every IK solve (`planner.ik_checks`
 // checks each). Planning is resumable: advance() continues the same planners, trees kept.
 // Execution: the arm paths at `robot.arm_speed` times the PR2's joint velocity limits (each
 // segment as long as its slowest joint), the base path as navigation's, and the gripper.

@@ -82,6 +82,10 @@ struct ManipulationPlanner {
   int ik_checks = 0;                      // effort of one IK solve, in collision checks
   int target_checks = 0;                  // effort spent on one target before drawing another
   double placement_gap = 0;               // objects rest this far above their surface (m)
+  // Backtracking (docs/spec.md §7): a place gives up and blames the pick before it after this
+  // many placements in a row that the arm cannot reach with the grasp it holds (IK, collisions
+  // at the placement and along the approach); 0 (the default): it never gives up.
+  int placement_draws = 0;
 };
 
 struct ManipulationWorld {

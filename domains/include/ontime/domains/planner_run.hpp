@@ -37,7 +37,12 @@ struct PlannerRunOptions {
   // Every action after the first starts at a fresh pose in its room, not where the refinement
   // before it ended (PlannerWorldOptions::independent_starts).
   bool independent_starts = false;
-  bool exact = false;           // also the exact success the allocator expects from the instance
+  // The allocator's distributions (with_distributions_of(instance, *belief)), while the instance
+  // keeps the episodes' structure (skeletons, culprits): e.g. a backtracking-ignorant fit of the
+  // same log deciding in a world that backtracks (docs/spec.md §7). Null: the instance's own.
+  const Problem* belief = nullptr;
+  std::string belief_source;    // for reports
+  bool exact = false;           // also the exact success of the allocator with the instance as the truth
   bool live = false;            // live episodes (also whenever the effort is wall-clock time)
   double decision_share = 0.5;  // live: the share of a step an anytime allocator thinks per decision
   const Ranks* ranks = nullptr;
@@ -51,6 +56,7 @@ bool is_live(const PlannerRunOptions& options) noexcept;
 struct PlannerRun {
   MonteCarloResult summary;
   double refinements_started = 0;  // per episode
+  double backtracks = 0;           // per episode
   std::optional<ExactEvaluation> exact;
   std::vector<EpisodeResult> episodes;  // live runs: every episode with its timeline
 };

@@ -6,12 +6,16 @@
 // outcomes come from the planner itself, so the success rate measures how well the model
 // predicts the domain.
 //
-// Within an episode an action is refined once: its refinement starts, the first time the
-// allocator picks it, where the refinement of the action before it ended (a first action at
-// the domain's initial configuration), and every later pick continues it by one step.
-// The episode with seed s draws the refinement of the a-th action of the instance from
-// stream_seed(s, 2a) (and a fallback start from stream 2a + 1): same seed, same episodes,
-// whatever the thread count (in the collision-checks effort unit).
+// Within an episode an action is refined once, unless refinement backtracks: its refinement
+// starts, the first time the allocator picks it, where the refinement of the action before it
+// ended (a first action at the domain's initial configuration), and every later pick continues
+// it by one step. When a refinement gives up (RefinementStatus::backtrack, docs/spec.md §7), the
+// action before it is blamed: that action's motion and those of every action below it in the
+// prefix tree are discarded, and the step reports the backtrack; each is refined anew, in a new
+// attempt, when next picked. The episode with seed s draws attempt 0 of the a-th action of the
+// instance from stream_seed(s, 2a), attempt n > 0 from stream_seed(stream_seed(s, 2a), n) (and
+// a fallback start from stream 2a + 1): same seed, same episodes, whatever the thread count (in
+// the collision-checks effort unit).
 
 #include <cstdint>
 #include <memory>
@@ -86,8 +90,8 @@ struct StreamingWorldOptions {
   double seconds_per_skeleton = 0;
 };
 
-// Counters: "refinements_started" (interleaved ones included) and "refinements_found" (those
-// that found a motion), summed over the episodes since the world was made.
+// Counters: "refinements_started" (interleaved ones included), "refinements_found" (those
+// that found a motion) and "backtracks", summed over the episodes since the world was made.
 class PlannerWorld final : public World {
  public:
   // The domain and the problem must outlive the world. The problem's action ids must be
@@ -125,9 +129,14 @@ class PlannerWorld final : public World {
   std::vector<std::string> node_ids_;  // by action index: the id in the episode's problem
   std::uint64_t seed_ = 0;
   std::vector<std::unique_ptr<Refinement>> refinements_;  // by action, in this episode
+  std::vector<std::uint64_t> attempts_;                   // by action: attempts before the current one
+  std::uint64_t backtracks_ = 0;
   std::uint64_t started_ = 0;
   std::uint64_t found_ = 0;
   NominalPlanningClock nominal_clock_;
+
+  // Discards the refinements of `culprit` and of every action below it.
+  void discard_from(int culprit);
 };
 
 // One planner world per thread, for the episode runner; the arguments must outlive the worlds.

@@ -77,6 +77,7 @@ struct TampResult {
   MonteCarloResult summary;
   double mean_skeletons_found = 0;      // per episode
   double refinements_started = 0;       // per episode
+  double backtracks = 0;                // per episode
   std::vector<EpisodeResult> episodes;  // with keep_episodes (sequence by sequence with adaptation)
   // With adaptation: per episode index of a sequence, how many of the sequences succeeded there.
   std::vector<std::uint64_t> successes_by_episode;
