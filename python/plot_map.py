@@ -107,7 +107,9 @@ def main():
         colour = PATH_COLOURS[index % len(PATH_COLOURS)]
         axes.plot([point[0] for point in path["points"]], [point[1] for point in path["points"]], color=colour,
                   linewidth=1.8, label=label(path["label"]), zorder=3)
-        axes.add_patch(Polygon(path["end"], closed=True, facecolor=colour, edgecolor=colour, alpha=0.35, zorder=3))
+        if path["end"]:  # (none for a skeleton that could not be refined)
+            axes.add_patch(Polygon(path["end"], closed=True, facecolor=colour, edgecolor=colour, alpha=0.35,
+                                   zorder=3))
     axes.set_ylabel("y (m)")
     axes.set_title(label(drawing["title"], TITLE_CHARACTERS) + (" — seen from above" if front else ""))
     if drawing["paths"]:

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "ontime/domains/collection.hpp"
+#include "ontime/util/error.hpp"
 #include "ontime/util/random.hpp"
 
 namespace ontime::domains {
@@ -22,7 +23,15 @@ MapDrawing map_drawing(const Domain& domain, const DomainDefaults& defaults, std
       skeletons.empty() ? scene.title : fmt::format("{}: one refined motion per skeleton (seed {})", scene.title, seed);
   drawing.polygons = scene.polygons;
   for (std::size_t k = 0; k < skeletons.size(); ++k) {
-    const auto motions = refine_skeleton(domain, skeletons[k], stream_seed(seed, k), settings);
+    std::vector<std::vector<Configuration>> motions;
+    try {
+      motions = refine_skeleton(domain, skeletons[k], stream_seed(seed, k), settings);
+    } catch (const UsageError& error) {
+      // An infeasible skeleton (kitchen-grasps' direct placement): captioned with the reason, not drawn.
+      drawing.paths.push_back(
+          {fmt::format("σ{}: {} (not refined: {})", k + 1, domain.describe(skeletons[k]), error.what()), {}, {}});
+      continue;
+    }
     Polyline points;
     for (const auto& motion : motions) {
       const auto trace = domain.trace(motion);

@@ -153,9 +153,9 @@ TEST(Cli, CollectRunsTheManipulationDomain) {
   EXPECT_EQ(instance["skeletons"][7].size(), 12u);
 }
 
-// The kitchen whose places give up: collect writes backtrack records and fits culprits; run
-// drives the real refiner that backtracks, with the instance's distributions or a belief's (here
-// the same log read without its backtracks), and refuses a belief of other actions.
+// The kitchen whose places give up: collect writes backtrack records and fits culprits; map draws
+// it; run drives the real refiner that backtracks, with the instance's distributions or a
+// belief's (here the same log read without its backtracks), and refuses a belief of other actions.
 TEST(Cli, RunDrivesARefinerThatBacktracksWithABelief) {
   const std::filesystem::path dir = scratch("kitchen-grasps");
   const std::string world = testing::source_path("data/domains/kitchen-grasps.json").string();
@@ -181,6 +181,16 @@ TEST(Cli, RunDrivesARefinerThatBacktracksWithABelief) {
   EXPECT_EQ(out["belief"], (dir / "ignorant.json").string());
   EXPECT_EQ(out["episodes"], 3);
   EXPECT_GE(out["backtracks"].get<double>(), 0.0);
+
+  // The map draws the regrasp and captions the infeasible direct placement instead of failing.
+  const auto map = ontime({"map", "--domain", "manipulation", "--world", world, "-o", (dir / "map.png").string()});
+  ASSERT_EQ(map.exit_code, 0) << map.err;
+  const json drawing = json::parse(read_file(dir / "map.json"));
+  ASSERT_EQ(drawing["paths"].size(), 2u);
+  EXPECT_TRUE(drawing["paths"][0]["points"].empty());
+  EXPECT_NE(drawing["paths"][0]["label"].get<std::string>().find("not refined: no motion found for move+place(B1,S)"),
+            std::string::npos);
+  EXPECT_GT(drawing["paths"][1]["points"].size(), 2u);
 
   const std::string other = testing::source_path("data/instances/navigation.json").string();
   const auto refused = ontime({"run", "--domain", "manipulation", "--world", world, "--instance", instance, "--belief",

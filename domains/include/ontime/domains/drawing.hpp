@@ -38,8 +38,8 @@ struct MapDrawing {
 };
 
 // The domain's world and, for skeleton k, the motions refine_skeleton finds from stream k of
-// `seed` with the world file's step, deadline (as the cut-off) and checker speed. Throws
-// UsageError when a skeleton cannot be refined.
+// `seed` with the world file's step, deadline (as the cut-off) and checker speed. A skeleton that
+// cannot be refined has no points and no end, and its label says why.
 MapDrawing map_drawing(const Domain& domain, const DomainDefaults& defaults, std::uint64_t seed);
 
 // A skeleton an episode's task planner found: its planning seconds are those of its actions (an
