@@ -266,7 +266,8 @@ std::vector<std::vector<Configuration>> refine_skeleton(const Domain& domain, co
     const std::size_t l = motions.size();
     const Configuration& at = l == 0 ? domain.initial_configuration() : ends.back();
     bool found = false;
-    for (int attempt = 0; attempt < attempts && !found; ++attempt) {
+    bool gave_up = false;  // the refiner blamed the action before: back to it at once (SeSamE)
+    for (int attempt = 0; attempt < attempts && !found && !gave_up; ++attempt) {
       const std::uint64_t attempt_seed = stream_seed(stream_seed(seed, l), tried[l]++);
       const std::unique_ptr<Refinement> refinement = domain.refine(skeleton[l], at, attempt_seed, options.effort);
       RefinementStatus status = RefinementStatus::working;
@@ -274,6 +275,7 @@ std::vector<std::vector<Configuration>> refine_skeleton(const Domain& domain, co
         status = refinement->advance(static_cast<double>(step) * options.step_seconds);
       }
       found = status == RefinementStatus::found;
+      gave_up = status == RefinementStatus::backtrack && l > 0;
       if (found) {
         motions.push_back(refinement->motion());
         ends.push_back(refinement->final_configuration());
@@ -282,7 +284,8 @@ std::vector<std::vector<Configuration>> refine_skeleton(const Domain& domain, co
     if (found) continue;
     if (l == 0 || restarts[l]++ == static_cast<std::uint64_t>(attempts)) {
       throw UsageError("no motion found for " + skeleton[l] + " in " + std::to_string(tried[l]) + " attempts of " +
-                       std::to_string(options.budget_steps) + " steps each");
+                       std::to_string(options.budget_steps) + " steps each" +
+                       (gave_up ? ", the last giving up on the motion of the action before it" : ""));
     }
     motions.pop_back();  // refine the action before anew, then this one from its new end
     ends.pop_back();

@@ -101,7 +101,8 @@ CollectionResult collect(const Domain& domain, const CollectionOptions& options)
 // initial configuration (for pictures). Each action gets up to `attempts` attempts of
 // `budget_steps` steps from where the action before it ended; when all are cut off, the action
 // before it is refined anew (some ends are hard to go on from) and the action tried again from
-// there, up to `attempts` times per position. Throws ontime::UsageError when that fails too.
+// there, up to `attempts` times per position; an attempt that gives up (backtrack) goes back to
+// the action before at once. Throws ontime::UsageError when that fails too.
 std::vector<std::vector<Configuration>> refine_skeleton(const Domain& domain, const std::vector<std::string>& skeleton,
                                                         std::uint64_t seed, const CollectionOptions& options,
                                                         int attempts = 20);
