@@ -123,9 +123,9 @@ void add_solve_command(CLI::App& app) {
   command->add_option("INSTANCE", options->instance, "Instance file (JSON, SPEC §5)")->required();
   command
       ->add_option("--method", options->method,
-                   "layered (default: the whole tree; where a cap cuts it, a split follows), split (the strongest "
-                   "first-action subtree enumerated, the others bounded) or memoised (the default for an instance "
-                   "with backtracking, which the others do not take)")
+                   "layered (default: the whole tree; where a cap cuts it, a split follows, but for an instance "
+                   "with backtracking), split (the strongest first-action subtree enumerated, the others bounded; "
+                   "not with backtracking) or memoised")
       ->check(CLI::IsMember({"layered", "split", "memoised"}));
   add_number_option(*command, "--max-states", options->max_states,
                     "Cap on states: layered gives an interval past it, memoised stops with an error (default: "
@@ -156,15 +156,6 @@ void add_solve_command(CLI::App& app) {
     const Problem problem = load_problem(options->instance);
     if (problem.skeleton_count() > kMaxExactSkeletons) check_exact_work(problem, 1, options->instance);
     const Mdp mdp(problem);
-    if (problem.has_backtracking()) {
-      // The layered solver and its bounds do not take backtracking (SPEC §7) yet; the memoised
-      // solver does, and is the default for such an instance.
-      if (command->count("--method") > 0 && options->method != "memoised") {
-        throw UsageError("solve --method " + options->method +
-                         " does not take an instance with backtracking (SPEC §7): use --method memoised");
-      }
-      options->method = "memoised";
-    }
     if (options->method == "memoised") {
       if (split_over_ranks(job_ranks())) {
         throw UsageError("solve --method memoised does not split over MPI ranks: use --method layered");

@@ -46,16 +46,9 @@ void bind_solve(py::module_& m) {
          Number<std::uint64_t, "max_disk_mib", 0, (std::uint64_t{1} << 40)> max_disk_mib, const py::object& scratch,
          const py::object& policy, Number<int, "policy_layers", 1, 1'000'000> policy_layers) {
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
-        // As `ontime solve`: the memoised solver is the default (and the only method) for an
-        // instance with backtracking (SPEC §7), which the layered solver does not take yet.
-        const bool backtracking = mdp->problem->has_backtracking();
-        const std::string method = method_given.value_or(backtracking ? "memoised" : "layered");
+        const std::string method = method_given.value_or("layered");
         if (method != "layered" && method != "split" && method != "memoised") {
           throw UsageError("method must be 'layered', 'split' or 'memoised' (got '" + method + "')");
-        }
-        if (backtracking && method != "memoised") {
-          throw UsageError("solve method '" + method +
-                           "' does not take an instance with backtracking (SPEC §7): use method='memoised'");
         }
         if (method == "memoised") {
           report::Solve solve{.instance = instance_label(problem, *mdp->problem),
@@ -122,7 +115,8 @@ void bind_solve(py::module_& m) {
       "disk. policy=FILE writes the choices of the first `policy_layers` layers as `ontime solve --policy` does "
       "(JSON Lines: a state, its choice and the bounds of its value). The GIL is released; Ctrl-C stops it "
       "(KeyboardInterrupt). method='memoised' is the memoised expectimax (OptimalSolver: exact, or an error past "
-      "max_states), the default and only method for an instance with backtracking.");
+      "max_states). For an instance with backtracking neither a split nor a tolerance applies (UsageError), and "
+      "a cap's interval comes from bounds that count a give-up as a success.");
 }
 
 }  // namespace ontime::python

@@ -15,8 +15,14 @@ def test_an_instance_with_backtracking_reads_and_solves_as_the_cli_does(cli):
     place = problem.actions[1]
     assert place.id == "place(A,R1)" and place.culprits == {"pick(A)": 1.0}
     assert abs(place.backtrack.pmf[2] - 0.4) < 1e-15
-    assert ontime.solve(problem)["optimal_success_probability"] == cli("solve", EXAMPLE, "--json")[
+    solved = ontime.solve(problem)
+    assert solved["optimal_success_probability"] == cli("solve", EXAMPLE, "--json")[
         "optimal_success_probability"]
+    # The layered solver (the default) and the memoised one agree to the bit.
+    assert solved["optimal_success_probability"] == ontime.solve(problem, method="memoised")[
+        "optimal_success_probability"]
+    with pytest.raises(ontime.UsageError, match="a split does not apply to an instance with backtracking"):
+        ontime.solve(problem, method="split")
 
 
 def test_a_session_takes_a_backtrack_and_refines_the_culprit_again():

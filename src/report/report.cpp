@@ -264,6 +264,15 @@ std::string policy_lines(const Solve& solve) {
   std::string lines;
   for (const PolicyEntry& entry : solve.solution.policy) {
     Json line = state_object(entry.state, solve.problem->skeleton_count());
+    if (solve.problem->has_backtracking()) {
+      // The execution each blamable refined action would restore (SPEC §7), by its id.
+      Json restore = Json::object();
+      for (int a = 0; a < solve.problem->action_count(); ++a) {
+        const int slot = solve.problem->culprit_slot(a);
+        if (slot >= 0) restore[solve.problem->action(a).id] = entry.state.restore[static_cast<std::size_t>(slot)];
+      }
+      line["restore"] = std::move(restore);
+    }
     line["choice"] = entry.choice;
     line["lower_bound"] = entry.lower;
     line["upper_bound"] = entry.upper;

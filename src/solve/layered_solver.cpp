@@ -136,13 +136,20 @@ LayeredSolution solve_split(const Mdp& mdp, const LayeredSolveOptions& options, 
 
 LayeredSolution solve_layered(const Mdp& mdp, const LayeredSolveOptions& options) {
   detail::require_exact_size(mdp, "solve");
-  if (mdp.has_backtracking()) {
-    throw UsageError(
-        "solve: the layered solver does not take an instance with backtracking (SPEC §7); the "
-        "memoised solver (OptimalSolver, --method memoised) does");
-  }
   if (!(options.tolerance >= 0.0 && options.tolerance <= 1.0)) {
     throw UsageError("solve: the tolerance must lie in [0, 1] (got " + std::to_string(options.tolerance) + ")");
+  }
+  if (mdp.has_backtracking()) {
+    // A tolerance drops a group by its clairvoyant chance, and a split bounds whole subtrees by
+    // it: under backtracking that bound counts every backtrack as a success (docs/theory.md), too
+    // loose to drop anything by. Caps still give a certified interval at the frontier.
+    if (options.tolerance > 0) {
+      throw UsageError("solve: a tolerance does not apply to an instance with backtracking (SPEC §7)");
+    }
+    if (options.split == SplitMode::always) {
+      throw UsageError("solve: a split does not apply to an instance with backtracking (SPEC §7)");
+    }
+    return layered::search_layers(mdp, options, false, nullptr);
   }
   if (options.split == SplitMode::always) {
     const std::vector<int> kept = split_plan(mdp);

@@ -12,30 +12,49 @@ namespace {
 //   T[s][b] = h(s) * found[b - 1] + (1 - h(s)) * T[s + 1][b - 1],
 // with T = 0 once s reaches D (the hazard is 0 from there on) or b reaches 0. found[m] is the
 // value of finding the motion with m steps of budget left after the finding step.
-void fill_block(const Mdp& mdp, int action, const std::vector<double>& found, double* block) {
+//
+// With backtracking (SPEC §7), a step also gives up with probability g(s): the recursion is
+//   T[s][b] = h(s) * found[b - 1] + [win] g(s) + (1 - h(s) - g(s)) * T[s + 1][b - 1],
+// where a give-up is worth nothing to the commit bound, and everything to the relaxation of the
+// upper bound (`win` given), whose T[s][0] is then win[s] rather than 0 (a give-up needs no
+// budget).
+void fill_block(const Mdp& mdp, int action, const std::vector<double>& found, double* block, const double* win) {
   const auto deadline = static_cast<std::size_t>(mdp.deadline());
   for (std::size_t s = deadline; s-- > 0;) {
     const double hazard = mdp.hazard(action, static_cast<Steps>(s));
+    const double back = mdp.backtrack_hazard(action, static_cast<Steps>(s));
+    const double gives_up = win != nullptr ? back : 0.0;
     double* row = block + s * deadline;
     const double* next = s + 1 < deadline ? block + (s + 1) * deadline : nullptr;
     for (std::size_t b = 1; b <= deadline; ++b) {
-      const double missed = next != nullptr && b > 1 ? next[b - 2] : 0.0;
+      double missed = next != nullptr && b > 1 ? next[b - 2] : 0.0;
+      if (b == 1 && win != nullptr) missed = win[s + 1];
       // A probability: rounding must not carry it above 1.
-      row[b - 1] = std::min(1.0, hazard * found[b - 1] + (1.0 - hazard) * missed);
+      row[b - 1] = back == 0.0 ? std::min(1.0, hazard * found[b - 1] + (1.0 - hazard) * missed)
+                               : std::min(1.0, hazard * found[b - 1] + gives_up + (1.0 - hazard - back) * missed);
     }
   }
 }
 
 // found[m] = sum over execution times x <= m of P(x) * after[m - x], for m in [0, D): the
 // value of finding the motion of `action` given the value after[r] of having r >= 0 steps
-// of budget left once it is refined (slower executions leave a negative budget: value 0).
-std::vector<double> convolve_execution(const Action& action, const std::vector<double>& after) {
+// of budget left once it is refined (slower executions leave a negative budget: value
+// `too_slow`, 0 but for the upper bound under backtracking, where the actions below may still
+// give up).
+std::vector<double> convolve_execution(const Action& action, const std::vector<double>& after, double too_slow) {
   const std::size_t size = after.size();
   std::vector<double> found(size, 0.0);
   const auto masses = action.execution.masses();
   for (std::size_t x = 0; x < std::min(size, masses.size()); ++x) {
     if (masses[x] <= 0.0) continue;
     for (std::size_t m = x; m < size; ++m) found[m] += masses[x] * after[m - x];
+  }
+  if (too_slow > 0.0) {
+    double fits = 0.0;  // P(x <= m)
+    for (std::size_t m = 0; m < size; ++m) {
+      if (m < masses.size()) fits += masses[m];
+      found[m] = std::min(1.0, found[m] + std::max(0.0, 1.0 - fits) * too_slow);
+    }
   }
   return found;
 }
@@ -44,11 +63,6 @@ std::vector<double> convolve_execution(const Action& action, const std::vector<d
 
 ValueBounds::ValueBounds(const Mdp& mdp, std::size_t max_table_entries)
     : mdp_(&mdp), skeleton_count_(mdp.skeleton_count()), deadline_(mdp.deadline()) {
-  if (mdp.has_backtracking()) {
-    throw UsageError(
-        "the value bounds (commit policy, clairvoyant relaxation) do not take an instance with "
-        "backtracking (SPEC §7) yet");
-  }
   const Problem& problem = mdp.problem();
   const auto deadline = static_cast<std::size_t>(deadline_);
   const std::size_t block = deadline * deadline;
@@ -78,11 +92,31 @@ ValueBounds::ValueBounds(const Mdp& mdp, std::size_t max_table_entries)
   for (const int n : nodes) {
     if (problem.parent(n) >= 0) children[static_cast<std::size_t>(problem.parent(n))].push_back(n);
   }
+  // With backtracking, the relaxation counts a give-up as a success (docs/theory.md): W(n, s) =
+  // P(some action of n's subtree gives up | PT_n > s), whatever the budget, is its value where
+  // the budget is spent; (D + 1) doubles per node, W(n, D) = 0.
+  const bool backtracking = mdp.has_backtracking();
+  const std::size_t win_size = deadline + 1;
+  if (backtracking) win_.assign(nodes.size() * win_size, 0.0);
   std::vector<double> after(deadline);
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     const int n = nodes[i];
     const auto slot = static_cast<std::size_t>(n);
     node_block[slot] = i * block;
+    // Below n, once refined: P(some child's subtree gives up), whatever the budget.
+    double below_gives_up = 0.0;
+    if (backtracking) {
+      double none = 1.0;
+      for (const int child : children[slot])
+        none *= 1.0 - win_[node_block[static_cast<std::size_t>(child)] / block * win_size];
+      below_gives_up = 1.0 - none;
+      double* win = win_.data() + i * win_size;
+      for (std::size_t s = deadline; s-- > 0;) {
+        const double hazard = mdp.hazard(n, static_cast<Steps>(s));
+        const double back = mdp.backtrack_hazard(n, static_cast<Steps>(s));
+        win[s] = std::min(1.0, back + hazard * below_gives_up + (1.0 - hazard - back) * win[s + 1]);
+      }
+    }
     // H(n, r) for r in [0, D): 1 when n completes a skeleton, else P(some child's subtree fits r).
     for (std::size_t r = 0; r < deadline; ++r) {
       if (problem.completes_a_skeleton(n)) {
@@ -91,12 +125,14 @@ ValueBounds::ValueBounds(const Mdp& mdp, std::size_t max_table_entries)
       }
       double all_fail = 1.0;
       for (const int child : children[slot]) {
-        // G(child, 0, r), zero for r = 0 (a motion takes at least one step to find).
+        // G(child, 0, r), zero for r = 0 (a motion takes at least one step to find; a give-up
+        // too, but needs no budget).
         if (r >= 1) all_fail *= 1.0 - reach_[node_block[static_cast<std::size_t>(child)] + (r - 1)];
       }
-      after[r] = 1.0 - all_fail;
+      after[r] = r == 0 && backtracking ? below_gives_up : 1.0 - all_fail;
     }
-    fill_block(mdp, n, convolve_execution(problem.action(n), after), reach_.data() + i * block);
+    fill_block(mdp, n, convolve_execution(problem.action(n), after, below_gives_up), reach_.data() + i * block,
+               backtracking ? win_.data() + i * win_size : nullptr);
   }
 
   // Lower bound: C_k[l][s][b], the value of committing to k, one block per position.
@@ -105,6 +141,7 @@ ValueBounds::ValueBounds(const Mdp& mdp, std::size_t max_table_entries)
   path_start_.resize(static_cast<std::size_t>(skeleton_count_));
   commit_block_.assign(positions, kNoTable);
   reach_block_.assign(positions, kNoTable);
+  if (backtracking) win_block_.assign(positions, kNoTable);
   std::size_t start = 0;
   for (int k = 0; k < skeleton_count_; ++k) {
     const int length = problem.skeleton_length(k);
@@ -114,7 +151,10 @@ ValueBounds::ValueBounds(const Mdp& mdp, std::size_t max_table_entries)
       const int n = problem.action_at(k, l);
       const std::size_t position = start + static_cast<std::size_t>(l);
       commit_block_[position] = position * block;
-      if (problem.members(n).front() == k) reach_block_[position] = node_block[static_cast<std::size_t>(n)];
+      if (problem.members(n).front() == k) {
+        reach_block_[position] = node_block[static_cast<std::size_t>(n)];
+        if (backtracking) win_block_[position] = node_block[static_cast<std::size_t>(n)] / block * win_size;
+      }
       // After refining n with r >= 0 steps left: success if n completes a skeleton (every
       // skeleton ending at n shares k's execution time), else C_k[l + 1][0][r].
       for (std::size_t r = 0; r < deadline; ++r) {
@@ -124,7 +164,7 @@ ValueBounds::ValueBounds(const Mdp& mdp, std::size_t max_table_entries)
           after[r] = r >= 1 ? commit_[(position + 1) * block + (r - 1)] : 0.0;
         }
       }
-      fill_block(mdp, n, convolve_execution(problem.action(n), after), commit_.data() + position * block);
+      fill_block(mdp, n, convolve_execution(problem.action(n), after, 0.0), commit_.data() + position * block, nullptr);
     }
     start += static_cast<std::size_t>(length);
   }

@@ -19,6 +19,17 @@ namespace {
 
 using namespace cli_test;
 
+// The lines `ontime solve INSTANCE --policy FILE --policy-layers LAYERS` writes, parsed.
+std::vector<json> solve_policy(const std::string& instance, const std::string& name, int layers) {
+  const std::string policy = (scratch(name) / "policy.jsonl").string();
+  const auto written = ontime({"solve", instance, "--policy", policy, "--policy-layers", std::to_string(layers)});
+  EXPECT_EQ(written.exit_code, 0) << written.err;
+  std::ifstream in(policy);
+  std::vector<json> entries;
+  for (std::string line; std::getline(in, line);) entries.push_back(json::parse(line));
+  return entries;
+}
+
 TEST(Cli, SolveReportsTheFigureOneOptimum) {
   const auto result = ontime({"solve", paper("figure1"), "--json"});
   ASSERT_EQ(result.exit_code, 0) << result.err;
@@ -136,20 +147,13 @@ TEST(Cli, SolveGivesTheOptimumOrACertifiedIntervalWithItsLayers) {
   EXPECT_GE(bounded["split"]["upper_bound"].get<double>(), 0.942);
   EXPECT_LE(bounded["upper_bound"].get<double>(), bounded["split"]["upper_bound"].get<double>());
 
-  const auto directory = scratch("solve_policy");
-  const std::string policy = (directory / "policy.jsonl").string();
-  const auto written = ontime({"solve", paper("instance1"), "--policy", policy, "--policy-layers", "2"});
-  ASSERT_EQ(written.exit_code, 0) << written.err;
-  std::ifstream in(policy);
-  std::string line;
-  int lines = 0;
-  while (std::getline(in, line)) {
-    const json entry = json::parse(line);
+  const std::vector<json> entries = solve_policy(paper("instance1"), "solve_policy", 2);
+  for (const json& entry : entries) {
     EXPECT_LE(entry["time"].get<int>(), 1);
     EXPECT_EQ(entry["refined"].size(), 4U);
-    ++lines;
+    EXPECT_FALSE(entry.contains("restore"));
   }
-  EXPECT_EQ(lines, 1 + solved["layers"][1]["states"].get<int>());
+  EXPECT_EQ(entries.size(), 1 + solved["layers"][1]["states"].get<std::size_t>());
 }
 
 TEST(Cli, SolveNoTimingPrintsTheSameBytesForAnyThreadCount) {
@@ -168,6 +172,46 @@ TEST(Cli, SolveNoTimingPrintsTheSameBytesForAnyThreadCount) {
   EXPECT_FALSE(solved["layers"][0].contains("forward_seconds"));
   EXPECT_FALSE(solved["exact"].get<bool>());
   EXPECT_LT(solved["lower_bound"].get<double>(), solved["upper_bound"].get<double>());
+}
+
+// An instance with backtracking: the layered solver by default, the memoised solver's value to
+// the bit, a policy whose states hold what a backtrack restores, an interval under a cap; a split
+// or a tolerance exits with 2 naming the rule.
+TEST(Cli, SolveTakesAnInstanceWithBacktracking) {
+  const std::string kitchen = testing::source_path("data/instances/kitchen-grasps.json").string();
+  const auto layered = ontime({"solve", kitchen, "--json"});
+  const auto memoised = ontime({"solve", kitchen, "--json", "--method", "memoised"});
+  ASSERT_EQ(layered.exit_code, 0) << layered.err;
+  ASSERT_EQ(memoised.exit_code, 0) << memoised.err;
+  const json by_layers = json::parse(layered.out), by_memo = json::parse(memoised.out);
+  EXPECT_EQ(by_layers["optimal_success_probability"].get<double>(),
+            by_memo["optimal_success_probability"].get<double>());
+  EXPECT_NEAR(by_layers["optimal_success_probability"].get<double>(), 0.824085, 5e-7);
+  EXPECT_EQ(by_layers["states"].get<int>(), by_memo["states"].get<int>());
+  EXPECT_EQ(by_layers["first_choice"].get<int>(), by_memo["first_choice"].get<int>());
+
+  const std::vector<json> entries = solve_policy(kitchen, "solve_backtracking_policy", 4);
+  for (const json& entry : entries) {
+    // The kitchen's blamable actions: the first grasp and the regrasp.
+    ASSERT_TRUE(entry.contains("restore")) << entry.dump();
+    EXPECT_EQ(entry["restore"].size(), 2U) << entry.dump();
+  }
+  EXPECT_GT(entries.size(), 4U);
+
+  const auto capped = ontime({"solve", kitchen, "--json", "--max-states", "20000"});
+  ASSERT_EQ(capped.exit_code, 0) << capped.err;
+  const json bounded = json::parse(capped.out);
+  EXPECT_FALSE(bounded["exact"].get<bool>());
+  EXPECT_LE(bounded["lower_bound"].get<double>(), by_memo["optimal_success_probability"].get<double>());
+  EXPECT_GE(bounded["upper_bound"].get<double>(), by_memo["optimal_success_probability"].get<double>());
+  EXPECT_FALSE(bounded.contains("split"));
+
+  const auto split = ontime({"solve", kitchen, "--method", "split"});
+  EXPECT_EQ(split.exit_code, 2);
+  EXPECT_NE(split.err.find("a split does not apply to an instance with backtracking"), std::string::npos) << split.err;
+  const auto tolerance = ontime({"solve", kitchen, "--tolerance", "0.01"});
+  EXPECT_EQ(tolerance.exit_code, 2);
+  EXPECT_NE(tolerance.err.find("a tolerance does not apply"), std::string::npos) << tolerance.err;
 }
 
 }  // namespace

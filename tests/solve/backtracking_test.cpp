@@ -389,14 +389,136 @@ TEST(Backtracking, TheFormatsRulesNameThePlace) {
 
 // The exact solver takes only as many blamed actions as its keys hold; the layered solver and the
 // value bounds refuse backtracking for now.
-TEST(Backtracking, SolversThatDoNotTakeItSaySo) {
+// The layered solver walks the same outcomes in the same order as the memoised one, layer by
+// layer: the same value to the bit, the same first choice, the same states, on any thread count;
+// the policy it keeps holds the restore values (its states solve to its values).
+TEST(Backtracking, TheLayeredSolverEqualsTheMemoisedOneBitForBit) {
+  int backtracking = 0;
+  for (std::uint64_t seed = 1; seed <= 40; ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    const Problem problem = with_backtracking(testing::random_instance(seed, 3, 3, 6), seed + 1000);
+    if (!problem.has_backtracking()) continue;
+    ++backtracking;
+    const Mdp mdp(problem);
+    OptimalSolver solver(mdp);
+    const double optimum = solver.solve(mdp.start());
+    for (const unsigned threads : {1U, 2U}) {
+      LayeredSolveOptions options;
+      options.threads = threads;
+      options.policy_layers = 3;
+      const LayeredSolution layered = solve_layered(mdp, options);
+      ASSERT_TRUE(layered.exact);
+      EXPECT_EQ(layered.lower, optimum);
+      EXPECT_EQ(layered.upper, optimum);
+      EXPECT_EQ(layered.first_choice, solver.best_choice(mdp.start()).value_or(-1));
+      EXPECT_EQ(layered.states, solver.states());
+      ASSERT_FALSE(layered.policy.empty());
+      for (const PolicyEntry& entry : layered.policy) {
+        EXPECT_EQ(entry.lower, solver.solve(entry.state));
+        EXPECT_EQ(entry.choice, solver.best_choice(entry.state).value_or(-1));
+      }
+    }
+  }
+  EXPECT_GE(backtracking, 25);
+}
+
+TEST(Backtracking, TheLayeredSolverEqualsTheMemoisedOneOnTheExampleAndTheKitchen) {
+  for (const char* path : {"data/instances/backtracking/grasp-and-place.json", "data/instances/kitchen-grasps.json"}) {
+    SCOPED_TRACE(path);
+    const Problem problem = load_problem(testing::source_path(path));
+    ASSERT_TRUE(problem.has_backtracking());
+    const Mdp mdp(problem);
+    OptimalSolver solver(mdp);
+    const double optimum = solver.solve(mdp.start());
+    const LayeredSolution layered = solve_layered(mdp, LayeredSolveOptions{});
+    ASSERT_TRUE(layered.exact);
+    EXPECT_EQ(layered.lower, optimum);
+    EXPECT_EQ(layered.first_choice, solver.best_choice(mdp.start()).value_or(-1));
+    EXPECT_EQ(layered.states, solver.states());
+  }
+}
+
+// The bounds under backtracking (a give-up ends the commit bound in failure and the relaxation in
+// success) hold the optimum in every state random episodes visit; returns the states checked, and
+// counts in `informative` those where the interval is narrower than a half and its top below 1.
+int check_bounds_along_episodes(const Mdp& mdp, int episodes, std::uint64_t seed, int& informative) {
+  OptimalSolver solver(mdp);
+  const ValueBounds bounds(mdp);
+  SplitMix64 generator(seed);
+  int states = 0;
+  for (int episode = 0; episode < episodes; ++episode) {
+    State state = mdp.start();
+    for (Status status = Status::running; status == Status::running;) {
+      const double value = solver.solve(state);
+      const double lower = bounds.lower(state), upper = bounds.upper(state);
+      EXPECT_LE(lower, value + 1e-12);
+      EXPECT_GE(upper, value - 1e-12);
+      const int committed = bounds.lower_choice(state);
+      if (committed >= 0) {
+        EXPECT_EQ(bounds.commit(state, committed), lower);
+      }
+      ++states;
+      informative += upper < 1.0 && upper - lower < 0.5 ? 1 : 0;
+      const ChoiceList choices = mdp.useful_choices(state);
+      if (choices.empty()) break;
+      const int choice = choices[generator() % choices.size()];
+      status = mdp.apply(state, choice, mdp.sample_observation(state, choice, generator));
+    }
+  }
+  return states;
+}
+
+// ... and the layered solver cut by a cap gives an interval that holds the optimum.
+TEST(Backtracking, TheBoundsHoldTheOptimumInEveryStateVisited) {
+  int states = 0, informative = 0, cut_checked = 0;
+  for (std::uint64_t seed = 1; seed <= 80; ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    const Problem problem = with_backtracking(testing::random_instance(seed, 4, 4, 16), seed + 1000);
+    if (!problem.has_backtracking()) continue;
+    const Mdp mdp(problem);
+    states += check_bounds_along_episodes(mdp, 60, seed, informative);
+    OptimalSolver solver(mdp);
+    const double optimum = solver.solve(mdp.start());
+    if (solver.states() < 30) continue;  // too few layers to cut
+    ++cut_checked;
+    LayeredSolveOptions capped;
+    capped.max_states = solver.states() / 3;
+    const LayeredSolution cut = solve_layered(mdp, capped);
+    EXPECT_FALSE(cut.exact);
+    EXPECT_GE(cut.frontier_layer, 0);
+    EXPECT_LE(cut.lower, optimum + 1e-12);
+    EXPECT_GE(cut.upper, optimum - 1e-12);
+  }
+  EXPECT_GE(cut_checked, 10);
+  EXPECT_GE(states, 1000);
+  EXPECT_GE(informative, states / 4);  // the bounds say something in many of them
+  // Where backtracking is what makes success possible: the kitchen's direct place gives up on
+  // every grasp, its regrasp's last place on four in five.
+  for (const char* path : {"data/instances/backtracking/grasp-and-place.json", "data/instances/kitchen-grasps.json"}) {
+    SCOPED_TRACE(path);
+    const Problem problem = load_problem(testing::source_path(path));
+    const Mdp mdp(problem);
+    int real_informative = 0;
+    EXPECT_GE(check_bounds_along_episodes(mdp, 100, 7, real_informative), 100);
+  }
+}
+
+TEST(Backtracking, TheLayeredSolverRefusesAToleranceOrASplit) {
   std::uint64_t seed = 1;
   while (!with_backtracking(testing::random_instance(seed, 3, 3, 6), seed + 1000).has_backtracking()) ++seed;
   const Problem problem = with_backtracking(testing::random_instance(seed, 3, 3, 6), seed + 1000);
-  ASSERT_TRUE(problem.has_backtracking());
   const Mdp mdp(problem);
-  EXPECT_THROW(solve_layered(mdp, LayeredSolveOptions{}), UsageError);
-  EXPECT_THROW(ValueBounds bounds(mdp), UsageError);
+  LayeredSolveOptions tolerance;
+  tolerance.tolerance = 0.01;
+  EXPECT_THROW(solve_layered(mdp, tolerance), UsageError);
+  LayeredSolveOptions split;
+  split.split = SplitMode::always;
+  EXPECT_THROW(solve_layered(mdp, split), UsageError);
+  LayeredSolveOptions fallback;  // a fallback split does not happen: the whole tree, exactly
+  fallback.split = SplitMode::fallback;
+  const LayeredSolution whole = solve_layered(mdp, fallback);
+  EXPECT_TRUE(whole.exact);
+  EXPECT_TRUE(whole.split_kept.empty());
 }
 
 }  // namespace

@@ -32,6 +32,14 @@
 //    price of one step of delay for the enumerated part (a flagged copy of each state, one
 //    layer on), which keeps the bound near the optimum when the others are weak.
 //
+// Backtracking (SPEC §7): keys also hold the restore value of every action some action may
+// blame, nothing is blanked, and the outcomes are the MDP's own (Mdp::for_each_outcome), so the
+// value is still the memoised solver's to the bit. A cap's frontier gets ValueBounds under
+// backtracking, whose lower end is at most (not exactly) the commit policy's value, so the
+// interval's lower end is at most that of a real policy. A tolerance or `split == always` is a
+// UsageError there (their bound counts every give-up as a success and would drop nothing), and
+// `fallback` never splits.
+//
 // Ranks: states are owned by the rank their key hashes to; each rank expands its own, sends the
 // successors it finds to their owners (all_to_all, chunk by chunk) and learns their places; going
 // back, it asks the owners for those places' values. Every rank returns the same solution.

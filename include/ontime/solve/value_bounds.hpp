@@ -22,6 +22,15 @@
 // CT + ET_k >= D; in particular slots blanked with spent or execution above D + 1 (the exact
 // solver's keys of skeletons that cannot succeed) are ignored.
 //
+// With backtracking (SPEC §7) both still hold, each for a reason of its own (docs/theory.md):
+// commit(s, k) is the probability that committing to k succeeds before any of its actions gives
+// up, at most the commit policy's value (which goes on after a give-up), so still a lower bound
+// on V*; upper(s) is the clairvoyant relaxation of the problem in which a give-up ends the
+// episode in success (a give-up is worth at most 1), so a group contributes, besides its
+// completions, the chance that some action of its subtree gives up, also where its own budget
+// is spent (CT + ET_k >= D, but CT + 1 < D). The restore values are not read: the relaxation
+// never needs them, and the commit bound never gets there.
+//
 // Cost: the tables hold (nodes + sum of skeleton lengths) * D^2 doubles, built in
 // O((nodes + sum of lengths) * D^2) time; the constructor throws ResourceLimitError past
 // `max_table_entries`. Each bound is then O(K) table lookups, with no allocation. A
@@ -76,14 +85,19 @@ class ValueBounds {
   double group_upper(int k, int refined, std::uint16_t spent, std::uint16_t execution,
                      std::int64_t time) const noexcept {
     const auto slot = static_cast<std::size_t>(k);
+    if (refined >= lengths_[slot]) return 0.0;
+    const std::size_t position = path_start_[slot] + static_cast<std::size_t>(refined);
+    const std::size_t block = reach_block_[position];
+    if (block == kNoTable) return 0.0;
     const std::size_t at = cell(slot, refined, spent, execution, time);
-    if (at == kNoTable) return 0.0;
-    const std::size_t block = reach_block_[path_start_[slot] + static_cast<std::size_t>(refined)];
-    return block == kNoTable ? 0.0 : reach_[block + at];
+    if (at != kNoTable) return reach_[block + at];
+    // With backtracking, a spent budget still leaves the give-ups of the subtree.
+    if (win_.empty() || spent >= deadline_ || time + 1 >= deadline_) return 0.0;
+    return win_[win_block_[position] + spent];
   }
 
   // Doubles the tables hold.
-  std::size_t table_entries() const noexcept { return commit_.size() + reach_.size(); }
+  std::size_t table_entries() const noexcept { return commit_.size() + reach_.size() + win_.size(); }
   const Mdp& mdp() const noexcept { return *mdp_; }
 
  private:
@@ -116,6 +130,10 @@ class ValueBounds {
   std::vector<std::size_t> reach_block_;
   std::vector<double> commit_;
   std::vector<double> reach_;
+  // Backtracking only (empty otherwise): per node, W(n, s) for s in [0, D], the chance that some
+  // action of its subtree gives up; per position, where the group's W starts (as reach_block_).
+  std::vector<double> win_;
+  std::vector<std::size_t> win_block_;
 };
 
 template <class S>
@@ -142,12 +160,11 @@ int ValueBounds::lower_choice(const S& state) const noexcept {
 template <class S>
 double ValueBounds::upper(const S& state) const noexcept {
   double all_fail = 1.0;
-  for (std::size_t k = 0; k < static_cast<std::size_t>(skeleton_count_); ++k) {
-    const std::size_t at = cell(state, k);
-    if (at == kNoTable) continue;
-    const std::size_t block = reach_block_[path_start_[k] + state.refined[k]];
-    if (block == kNoTable) continue;  // another member of the group speaks for it
-    all_fail *= 1.0 - reach_[block + at];
+  for (int k = 0; k < skeleton_count_; ++k) {
+    // 0 for a skeleton that is not its group's lowest index: another member speaks for it.
+    const auto slot = static_cast<std::size_t>(k);
+    const double group = group_upper(k, state.refined[slot], state.spent[slot], state.execution[slot], state.time);
+    if (group > 0.0) all_fail *= 1.0 - group;
   }
   return 1.0 - all_fail;
 }

@@ -36,13 +36,22 @@ void LayeredSearch<W>::value_frontier(const std::vector<Key>& keys, int t, std::
   for_each_block(keys.size(), options_->threads, kBlock, [&](unsigned) {
     return [&](std::uint64_t begin, std::uint64_t end) {
       CompactState state;
-      for (std::uint64_t i = begin; i < end; ++i) {
-        layout_->decode(keys[i], t, state);
+      detail::CompactBacktrackState back_state;
+      const auto bound = [&](const auto& decoded, std::uint64_t i) {
         if (bounds != nullptr) {
-          values[i] = {bounds->lower(state), bounds->upper(state)};
-          choices[i] = bounds->lower_choice(state);
+          values[i] = {bounds->lower(decoded), bounds->upper(decoded)};
+          choices[i] = bounds->lower_choice(decoded);
         } else {
-          values[i] = {0.0, mdp_->any_can_succeed(state) ? 1.0 : 0.0};
+          values[i] = {0.0, mdp_->any_can_succeed(decoded) ? 1.0 : 0.0};
+        }
+      };
+      for (std::uint64_t i = begin; i < end; ++i) {
+        if (mdp_->has_backtracking()) {
+          layout_->decode(keys[i], t, back_state);
+          bound(back_state, i);
+        } else {
+          layout_->decode(keys[i], t, state);
+          bound(state, i);
         }
         if (weak_ != nullptr && !layout_->flagged(keys[i])) {
           // The bounded subtrees, fresh: committing to them is a policy; above, the two parts

@@ -38,9 +38,11 @@ inline constexpr std::uint32_t kExtrasCode = 0xFFFF'FFFDU;
 inline constexpr int kWeakChoice = -2;
 
 // Where each skeleton's fields sit in a key: refined in just enough bits for the skeleton's
-// length, PT and ET in just enough for 0 .. D + 1 and one more code for a blanked slot; in a
-// split, one more bit flags the copies one layer on (a step went to the bounded subtrees). A
-// skeleton's fields never straddle two words, so that rewriting them is a mask and an or.
+// length, PT and ET in just enough for 0 .. D + 1 and one more code for a blanked slot; with
+// backtracking (SPEC §7), then one field of the same width per culprit slot for its restore
+// value (an execution, 0 .. D + 1); in a split, one more bit flags the copies one layer on (a
+// step went to the bounded subtrees). A field never straddles two words, so that rewriting a
+// skeleton's is a mask and an or.
 class KeyLayout {
  public:
   KeyLayout(const Mdp& mdp, bool flag)
@@ -64,6 +66,11 @@ class KeyLayout {
       field = {word, shift, refined_bits, 0, 0};
       field.mask = ((std::uint64_t{1} << (refined_bits + 2 * counter_bits_)) - 1) << shift;
       field.blank = (blank_code_ << refined_bits | blank_code_ << (refined_bits + counter_bits_)) << shift;
+    }
+    restore_slots_ = mdp.problem().culprit_slot_count();
+    for (int c = 0; c < restore_slots_; ++c) {
+      const auto [word, shift] = place(counter_bits_);
+      restore_[static_cast<std::size_t>(c)] = {word, shift};
     }
     if (flag) {
       const auto [word, shift] = place(1);
@@ -95,19 +102,28 @@ class KeyLayout {
     word = on ? word | flag_bit_ : word & ~flag_bit_;
   }
 
-  template <std::size_t W>
-  PackedState<W> encode(const CompactState& state) const noexcept {
+  // A state's key (its time is the layer's). A CompactBacktrackState's restore values are
+  // written too; a CompactState's only for a problem without backtracking.
+  template <std::size_t W, class Compact>
+  PackedState<W> encode(const Compact& state) const noexcept {
     PackedState<W> key;
     for (int k = 0; k < skeletons_; ++k) {
       const auto slot = static_cast<std::size_t>(k);
       key.words[static_cast<std::size_t>(word(k))] |=
           value(k, state.refined[slot], state.spent[slot], state.execution[slot]);
     }
+    if constexpr (kHoldsRestore<Compact>) {
+      for (int c = 0; c < restore_slots_; ++c) {
+        const Place& place = restore_[static_cast<std::size_t>(c)];
+        key.words[static_cast<std::size_t>(place.word)] |= code(state.restore[static_cast<std::size_t>(c)])
+                                                           << place.shift;
+      }
+    }
     return key;
   }
 
-  template <std::size_t W>
-  void decode(const PackedState<W>& key, int layer, CompactState& out) const noexcept {
+  template <std::size_t W, class Compact>
+  void decode(const PackedState<W>& key, int layer, Compact& out) const noexcept {
     out.time = static_cast<std::uint16_t>(layer);
     const std::uint64_t counter_mask = (std::uint64_t{1} << counter_bits_) - 1;
     for (int k = 0; k < skeletons_; ++k) {
@@ -118,12 +134,22 @@ class KeyLayout {
       out.spent[slot] = counter(bits >> field.refined_bits & counter_mask);
       out.execution[slot] = counter(bits >> (field.refined_bits + counter_bits_) & counter_mask);
     }
+    if constexpr (kHoldsRestore<Compact>) {
+      for (int c = 0; c < restore_slots_; ++c) {
+        const Place& place = restore_[static_cast<std::size_t>(c)];
+        out.restore[static_cast<std::size_t>(c)] =
+            counter(key.words[static_cast<std::size_t>(place.word)] >> place.shift & counter_mask);
+      }
+    }
   }
 
  private:
   struct Field {
     int word, shift, refined_bits;
     std::uint64_t mask, blank;
+  };
+  struct Place {
+    int word = 0, shift = 0;
   };
   std::uint64_t code(std::uint16_t counter) const noexcept {
     return counter >= blank_code_ ? blank_code_ : std::uint64_t{counter};
@@ -139,6 +165,8 @@ class KeyLayout {
   int flag_word_ = 0;
   std::uint64_t flag_bit_ = 0;
   std::array<Field, kMaxExactSkeletons> fields_{};
+  int restore_slots_ = 0;
+  std::array<Place, detail::kMaxExactCulpritSlots> restore_{};
 };
 
 // The rank that owns a key, and the shard of a rank's layer table a key falls into: two mixes

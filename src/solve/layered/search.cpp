@@ -19,6 +19,7 @@
 
 #include "ontime/solve/value_bounds.hpp"
 #include "ontime/util/byte_packing.hpp"
+#include "ontime/util/error.hpp"
 #include "solve/expectimax.hpp"
 
 namespace ontime::layered {
@@ -79,10 +80,16 @@ void LayeredSearch<W>::finish() {
     return a.layer != b.layer ? a.layer < b.layer : a.key.words < b.key.words;
   });
   for (const PolicyRecord& record : policy) {
-    CompactState compact;
-    layout_->decode(record.key, record.layer, compact);
-    State state(static_cast<std::size_t>(mdp_->skeleton_count()));
-    detail::expanded(compact, state);
+    State state = mdp_->start();  // sized for the skeletons and the restore values
+    if (mdp_->has_backtracking()) {
+      detail::CompactBacktrackState compact;
+      layout_->decode(record.key, record.layer, compact);
+      detail::expanded(compact, state);
+    } else {
+      CompactState compact;
+      layout_->decode(record.key, record.layer, compact);
+      detail::expanded(compact, state);
+    }
     solution_.policy.push_back(
         {std::move(state), record.choice, record.value.lower, exact ? record.value.lower : record.value.upper});
   }
@@ -107,6 +114,12 @@ LayeredSolution run_search(const Mdp& mdp, const LayeredSolveOptions& options, b
 
 LayeredSolution search_layers(const Mdp& mdp, const LayeredSolveOptions& options, bool flag, const WeakCluster* weak) {
   const int words = KeyLayout(mdp, flag).words();
+  if (words > static_cast<int>(kMaxExactSkeletons) + 1) {
+    // Only backtracking's restore values, with a deadline in the tens of thousands, get here.
+    throw UsageError("solve: a state of " + mdp.problem().name() + " needs " + std::to_string(words) +
+                     " words of key, above the layered solver's " + std::to_string(kMaxExactSkeletons + 1) +
+                     "; the memoised solver (--method memoised) takes it");
+  }
   if (words <= 1) return run_search<1>(mdp, options, flag, weak);
   if (words <= 2) return run_search<2>(mdp, options, flag, weak);
   if (words <= 4) return run_search<4>(mdp, options, flag, weak);

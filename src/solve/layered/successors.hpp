@@ -90,6 +90,12 @@ class TreeTables {
 //
 // Groups are found from the skeletons that are not blanked: a blanked slot (refined 0) would
 // name the first action, shared with skeletons elsewhere in the tree that are still alive.
+//
+// With backtracking (SPEC §7) a key holds the whole state with its restore values and nothing
+// is blanked (a step on a group that cannot succeed may still backtrack and restore an action
+// others share), so the walk decodes the state and takes the MDP's own outcomes
+// (Mdp::useful_choices, Mdp::for_each_outcome), exactly the memoised solver's; neither a
+// tolerance nor a split is taken there (solve_layered refuses them).
 template <std::size_t W>
 class Successors {
  public:
@@ -115,7 +121,8 @@ class Successors {
         tolerance_(tolerance),
         split_(split),
         deadline_(mdp.deadline()),
-        skeletons_(mdp.skeleton_count()) {}
+        skeletons_(mdp.skeleton_count()),
+        backtracking_(mdp.has_backtracking()) {}
 
   // Calls sink(outcome) for every outcome, with keys (forward).
   template <class Sink>
@@ -131,6 +138,12 @@ class Successors {
 
   // The start, blanked as a successor is, and reduced by the tolerance with its own share.
   Outcome start() {
+    if (backtracking_) {
+      Outcome outcome;
+      outcome.key = layout_->encode<W>(detail::compact<detail::CompactBacktrackState>(
+          mdp_->start(), skeletons_, mdp_->problem().culprit_slot_count()));
+      return outcome;
+    }
     CompactState state = detail::compact(mdp_->start(), skeletons_);
     detail::blank_hopeless(*mdp_, state);
     Outcome outcome;
@@ -201,8 +214,39 @@ class Successors {
     }
   }
 
+  // With backtracking: the MDP's outcomes of the decoded state, in its order (the backward pass
+  // takes the observations' probabilities without applying them).
+  template <bool kKeys, class Sink>
+  void walk_backtracking(const Key& key, int t, Sink& sink) {
+    layout_->decode(key, t, back_state_);
+    for (const int choice : mdp_->useful_choices(back_state_)) {
+      if constexpr (kKeys) {
+        mdp_->for_each_outcome(back_state_, choice,
+                               [&](double probability, Status status, const detail::CompactBacktrackState& next) {
+                                 Outcome outcome;
+                                 outcome.choice = choice;
+                                 outcome.probability = probability;
+                                 outcome.status = status;
+                                 if (status == Status::running) outcome.key = layout_->encode<W>(next);
+                                 sink(static_cast<const Outcome&>(outcome));
+                               });
+      } else {
+        mdp_->for_each_observation(back_state_, choice, [&](double probability, const Observation&) {
+          Outcome outcome;
+          outcome.choice = choice;
+          outcome.probability = probability;
+          sink(static_cast<const Outcome&>(outcome));
+        });
+      }
+    }
+  }
+
   template <bool kKeys, class Sink>
   void walk(const Key& key, int t, Sink& sink) {
+    if (backtracking_) {
+      walk_backtracking<kKeys>(key, t, sink);
+      return;
+    }
     layout_->decode(key, t, state_);
     const bool flagged = layout_->flagged(key);
     find_groups(state_);
@@ -350,8 +394,10 @@ class Successors {
   bool split_;
   Steps deadline_;
   int skeletons_;
+  bool backtracking_;
   // Scratch of one walk, kept to avoid allocation per state.
   CompactState state_;
+  detail::CompactBacktrackState back_state_;
   std::vector<Group> groups_;
   std::vector<char> alive_, kept_;
 };
