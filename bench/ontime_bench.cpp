@@ -211,11 +211,18 @@ void BM_LayeredKitchenSplit(benchmark::State& bench) { time_layered(bench, "mani
 BENCHMARK(BM_LayeredKitchenSplit)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
 
 // MCTS search throughput from the start state of instance 1, one core (target >= 1e6/s).
+// range(1): 0 the paper's backups (mean, random rollouts); 1 bellman backups with the
+// clairvoyant bound as leaf value (no rollouts).
 void BM_MctsIterations(benchmark::State& bench) {
   const ontime::Problem problem = paper(1);
   const ontime::Mdp mdp(problem);
   ontime::MctsOptions options;
   options.budget = ontime::DecisionBudget::iterations(static_cast<std::uint64_t>(bench.range(0)));
+  const bool bellman = bench.range(1) != 0;
+  if (bellman) {
+    options.backup = ontime::MctsBackup::bellman;
+    options.leaf_bounds = std::make_shared<const ontime::ValueBounds>(mdp);
+  }
   ontime::MctsAllocator mcts(mdp, options);
   std::uint64_t episode = 0;
   for (auto _ : bench) {
@@ -227,9 +234,15 @@ void BM_MctsIterations(benchmark::State& bench) {
   bench.SetItemsProcessed(static_cast<std::int64_t>(statistics.find("iterations").value_or(0)));
   bench.counters["tree_MiB"] = statistics.find("peak_tree_bytes").value_or(0) / (1 << 20);
   bench.counters["tree_nodes"] = statistics.find("peak_tree_nodes").value_or(0);
-  bench.SetLabel("instance 1, root search, iterations/s");
+  bench.SetLabel(bellman ? "instance 1, root search, bellman, upper leaves, iterations/s"
+                         : "instance 1, root search, iterations/s");
 }
-BENCHMARK(BM_MctsIterations)->Arg(10'000)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MctsIterations)
+    ->Args({10'000, 0})
+    ->Args({1'000'000, 0})
+    ->Args({10'000, 1})
+    ->Args({1'000'000, 1})
+    ->Unit(benchmark::kMillisecond);
 
 // PPO training of 10,000 episodes (target <= 60 s on any paper instance).
 void BM_PpoTraining(benchmark::State& bench) {

@@ -23,6 +23,9 @@ MctsAllocator::MctsAllocator(const Mdp& mdp, MctsOptions options) : mdp_(&mdp), 
   if (!(options_.exploration >= 0.0) || !std::isfinite(options_.exploration)) {
     throw UsageError("the exploration constant of mcts must be a finite number >= 0");
   }
+  if (options_.leaf_bounds && options_.backup != MctsBackup::bellman) {
+    throw UsageError("mcts: leaf values from bounds need bellman backups (a mean counts rewards 0 or 1)");
+  }
   if (options_.rollout) {
     rollout_policy_ = options_.rollout();
     if (!rollout_policy_->is_stationary()) {
@@ -40,27 +43,35 @@ void MctsAllocator::begin_episode(std::uint64_t seed) {
 
 std::size_t MctsAllocator::tree_bytes() const noexcept {
   return nodes_.capacity() * sizeof(DecisionNode) + edges_.capacity() * sizeof(Edge) +
-         outcomes_.capacity() * sizeof(Outcome);
+         outcomes_.capacity() * sizeof(Outcome) + (node_values_.capacity() + edge_values_.capacity()) * sizeof(double);
 }
 
 bool MctsAllocator::would_exceed_memory(std::size_t nodes, std::size_t edges, std::size_t outcomes) const {
   const std::size_t projected = grown_capacity(nodes_.capacity(), nodes_.size() + nodes) * sizeof(DecisionNode) +
                                 grown_capacity(edges_.capacity(), edges_.size() + edges) * sizeof(Edge) +
                                 grown_capacity(outcomes_.capacity(), outcomes_.size() + outcomes) * sizeof(Outcome);
-  return projected > options_.max_tree_bytes;
+  const std::size_t values = bellman() ? (grown_capacity(node_values_.capacity(), node_values_.size() + nodes) +
+                                          grown_capacity(edge_values_.capacity(), edge_values_.size() + edges)) *
+                                             sizeof(double)
+                                       : 0;
+  return projected + values > options_.max_tree_bytes;
 }
 
 void MctsAllocator::reset(const State& root) {
   nodes_.clear();
   edges_.clear();
   outcomes_.clear();
+  node_values_.clear();
+  edge_values_.clear();
   nodes_.emplace_back();
+  if (bellman()) node_values_.push_back(0.0);
   root_state_ = root;
   has_tree_ = true;
 }
 
 std::uint32_t MctsAllocator::add_node() {
   nodes_.emplace_back();
+  if (bellman()) node_values_.push_back(0.0);
   return static_cast<std::uint32_t>(nodes_.size() - 1);
 }
 
@@ -74,6 +85,7 @@ bool MctsAllocator::expand(std::uint32_t node, const State& state) {
     edge.choice = static_cast<std::uint16_t>(choice);
     edges_.push_back(edge);
   }
+  if (bellman()) edge_values_.resize(edges_.size(), 0.0);
   return true;
 }
 
@@ -100,7 +112,7 @@ std::uint32_t MctsAllocator::select_edge(const DecisionNode& node) const {
     const Edge& edge = edges_[e];
     if (edge.visits == 0) return e;  // every choice once first, lowest index first
     const double visits = edge.visits;
-    const double score = estimate(edge) + options_.exploration * std::sqrt(log_visits / visits);
+    const double score = estimate(e) + options_.exploration * std::sqrt(log_visits / visits);
     if (score > best_score) {
       best_score = score;
       best = e;
@@ -150,6 +162,7 @@ bool MctsAllocator::iterate() {
     const Outcome& outcome = outcomes_[picked];
     if (outcome.status != Status::running) {
       reward = outcome.status == Status::success ? 1.0 : 0.0;
+      outcomes_[picked].child = kReached;
       break;
     }
     mdp_->apply(state, edge.choice, outcome.observation);
@@ -158,7 +171,11 @@ bool MctsAllocator::iterate() {
       const std::uint32_t child = add_node();
       outcomes_[picked].child = child;
       nodes_[child].visits = 1;
-      reward = rollout(state);
+      if (bellman()) {
+        node_values_[child] = leaf_value(state);
+      } else {
+        reward = rollout(state);
+      }
       break;
     }
     node = outcome.child;
@@ -169,7 +186,38 @@ bool MctsAllocator::iterate() {
     ++edge.visits;
     edge.successes += reward > 0.5 ? 1U : 0U;
   }
+  if (bellman()) back_up_bellman();
   return true;
+}
+
+double MctsAllocator::leaf_value(State& state) {
+  if (!options_.leaf_bounds) return rollout(state);
+  return options_.optimistic_leaves ? options_.leaf_bounds->upper(state) : options_.leaf_bounds->lower(state);
+}
+
+void MctsAllocator::back_up_bellman() {
+  // Deepest first: each edge's Q from its reached outcomes, then its node's V from its edges.
+  for (std::size_t i = path_.size(); i >= 2; i -= 2) {
+    const Edge& edge = edges_[path_[i - 1]];
+    double weight = 0.0, sum = 0.0;
+    for (std::uint32_t o = edge.first_outcome; o < edge.first_outcome + edge.outcome_count; ++o) {
+      const Outcome& outcome = outcomes_[o];
+      if (outcome.child == kNone) continue;
+      weight += outcome.probability;
+      if (outcome.status == Status::success) {
+        sum += outcome.probability;
+      } else if (outcome.status == Status::running) {
+        sum += outcome.probability * node_values_[outcome.child];
+      }
+    }
+    edge_values_[path_[i - 1]] = weight > 0.0 ? sum / weight : 0.0;
+    const DecisionNode& node = nodes_[path_[i - 2]];
+    double best = 0.0;
+    for (std::uint32_t e = node.first_edge; e < node.first_edge + node.edge_count; ++e) {
+      if (edges_[e].visits > 0) best = std::max(best, edge_values_[e]);
+    }
+    node_values_[path_[i - 2]] = best;
+  }
 }
 
 int MctsAllocator::choose(const State& state) { return choose(state, options_.budget); }
@@ -218,7 +266,7 @@ void MctsAllocator::observe(const State& before, int choice, const State& after,
     for (std::uint32_t o = edge.first_outcome; o < edge.first_outcome + edge.outcome_count; ++o) {
       State next = before;
       mdp_->apply(next, choice, outcomes_[o].observation);
-      if (next == after && outcomes_[o].child != kNone) {
+      if (next == after && outcomes_[o].child < kReached) {
         reroot(outcomes_[o].child);
         root_state_ = after;
         has_tree_ = true;
@@ -235,8 +283,10 @@ void MctsAllocator::reroot(std::uint32_t new_root) {
   std::vector<DecisionNode> nodes;
   std::vector<Edge> edges;
   std::vector<Outcome> outcomes;
+  std::vector<double> node_values, edge_values;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pending{{new_root, 0}};
   nodes.push_back(nodes_[new_root]);
+  if (bellman()) node_values.push_back(node_values_[new_root]);
   while (!pending.empty()) {
     const auto [old_index, new_index] = pending.back();
     pending.pop_back();
@@ -249,9 +299,10 @@ void MctsAllocator::reroot(std::uint32_t new_root) {
         const auto first = static_cast<std::uint32_t>(outcomes.size());
         for (std::uint32_t o = edge.first_outcome; o < edge.first_outcome + edge.outcome_count; ++o) {
           Outcome outcome = outcomes_[o];
-          if (outcome.child != kNone) {
+          if (outcome.child < kReached) {
             const auto child = static_cast<std::uint32_t>(nodes.size());
             nodes.push_back(nodes_[outcome.child]);
+            if (bellman()) node_values.push_back(node_values_[outcome.child]);
             pending.emplace_back(outcome.child, child);
             outcome.child = child;
           }
@@ -260,11 +311,14 @@ void MctsAllocator::reroot(std::uint32_t new_root) {
         edge.first_outcome = first;
       }
       edges.push_back(edge);
+      if (bellman()) edge_values.push_back(edge_values_[e]);
     }
   }
   nodes_ = std::move(nodes);
   edges_ = std::move(edges);
   outcomes_ = std::move(outcomes);
+  node_values_ = std::move(node_values);
+  edge_values_ = std::move(edge_values);
 }
 
 void MctsAllocator::collect_statistics(Statistics& statistics) const {
@@ -281,65 +335,81 @@ std::vector<MctsAllocator::RootChoice> MctsAllocator::root_choices() const {
   const DecisionNode& root = nodes_[0];
   for (std::uint32_t e = root.first_edge; e < root.first_edge + root.edge_count; ++e) {
     const Edge& edge = edges_[e];
-    result.push_back({edge.choice, edge.visits, estimate(edge)});
+    result.push_back({edge.choice, edge.visits, estimate(e)});
   }
   return result;
 }
 
 AllocatorKind mcts_kind() {
-  return {.name = "mcts",
-          .summary = "Monte Carlo tree search (UCT with chance nodes) sampling the model before every step",
-          .capabilities = {Capability::randomised, Capability::anytime},
-          .parameters = {Parameter::integer("iterations", 10'000, 1, Parameter::kNoLimit,
-                                            "search iterations per decision (no limit when only time-budget is given)"),
-                         Parameter::real("time-budget", 0, 0, Parameter::kNoLimit,
-                                         "seconds per decision, 0: none (with iterations, whichever ends first)"),
-                         Parameter::real("exploration", 0.5, 0, Parameter::kNoLimit, "exploration constant C of UCT"),
-                         Parameter::text("rollout", "random",
-                                         "rollout policy: 'random' or a stationary allocator (e.g. dp-rerun)"),
-                         Parameter::integer("max-tree-mib", 1024, 1, 1 << 24,
-                                            "memory cap of the search tree in MiB; a search stops there with its best "
-                                            "answer")},
-          .make = [](const Mdp& mdp, const ParameterReader& parameters) -> AllocatorFactory {
-            MctsOptions options;
-            options.exploration = parameters.real("exploration");
-            const double seconds = parameters.real("time-budget");
-            const std::uint64_t iterations = seconds > 0 && !parameters.given("iterations")
-                                                 ? std::numeric_limits<std::uint64_t>::max()
-                                                 : parameters.integer("iterations");
-            options.budget =
-                seconds > 0 ? DecisionBudget::either(iterations, seconds) : DecisionBudget::iterations(iterations);
-            options.max_tree_bytes = static_cast<std::size_t>(parameters.integer("max-tree-mib")) << 20;
-            const std::string rollout = parameters.text("rollout");
-            if (rollout != "random") {
-              if (!allocator_registry().find(rollout).capabilities.has(Capability::stationary)) {
-                throw UsageError("parameter 'rollout': the rollout policy of mcts must choose by the state alone; '" +
-                                 rollout + "' does not");
-              }
-              options.rollout = allocator_registry().make_factory(rollout, mdp, parameters.values());
-            }
-            MctsAllocator probe(mdp, options);  // checks the options once, before any episode
-            return [model = &mdp, options] { return std::make_unique<MctsAllocator>(*model, options); };
-          },
-          .needs = {.decision_budget = [](const ParameterReader& parameters) -> DecisionBudget {
-                      // Only what the caller gave: without it, a live session's share of a slice.
-                      const bool iterations = parameters.given("iterations");
-                      const double seconds = parameters.given("time-budget") ? parameters.real("time-budget") : 0.0;
-                      if (!iterations) return seconds > 0 ? DecisionBudget::seconds(seconds) : DecisionBudget{};
-                      return seconds > 0 ? DecisionBudget::either(parameters.integer("iterations"), seconds)
-                                         : DecisionBudget::iterations(parameters.integer("iterations"));
-                    },
-                    .memory = {.parameter = "max-tree-mib",
-                               .bytes =
-                                   [](const Problem&, const ParameterReader& parameters) {
-                                     return static_cast<double>(parameters.integer("max-tree-mib")) * 1024.0 * 1024.0;
-                                   },
-                               .per_allocator = true},
-                    .counters = {{kSearchesCounter, "decisions that ran a search"},
-                                 {kIterationsCounter, "search iterations, summed over the searches"},
-                                 {"memory_stops", "searches stopped by the tree's memory cap"},
-                                 {"peak_tree_nodes", "the most nodes a tree held"},
-                                 {"peak_tree_bytes", "the most bytes a tree held"}}}};
+  return {
+      .name = "mcts",
+      .summary = "Monte Carlo tree search (UCT with chance nodes) sampling the model before every step",
+      .capabilities = {Capability::randomised, Capability::anytime},
+      .parameters = {Parameter::integer("iterations", 10'000, 1, Parameter::kNoLimit,
+                                        "search iterations per decision (no limit when only time-budget is given)"),
+                     Parameter::real("time-budget", 0, 0, Parameter::kNoLimit,
+                                     "seconds per decision, 0: none (with iterations, whichever ends first)"),
+                     Parameter::real("exploration", 0.5, 0, Parameter::kNoLimit, "exploration constant C of UCT"),
+                     Parameter::choice("backup", "mean", {"mean", "bellman"},
+                                       "Q of a choice: the mean reward through it (the paper's), or the model's "
+                                       "expectation over the outcomes reached, V the best Q (DP-UCT)"),
+                     Parameter::choice("leaf", "rollout", {"rollout", "upper", "lower"},
+                                       "bellman: a new node's value, a rollout's reward or the clairvoyant (upper) or "
+                                       "commit (lower) bound on the optimum there"),
+                     Parameter::text("rollout", "random",
+                                     "rollout policy: 'random' or a stationary allocator (e.g. dp-rerun)"),
+                     Parameter::integer("max-tree-mib", 1024, 1, 1 << 24,
+                                        "memory cap of the search tree in MiB; a search stops there with its best "
+                                        "answer")},
+      .make = [](const Mdp& mdp, const ParameterReader& parameters) -> AllocatorFactory {
+        MctsOptions options;
+        options.exploration = parameters.real("exploration");
+        options.backup = parameters.text("backup") == "bellman" ? MctsBackup::bellman : MctsBackup::mean;
+        const std::string leaf = parameters.text("leaf");
+        if (leaf != "rollout") {
+          if (options.backup != MctsBackup::bellman) {
+            throw UsageError("parameter 'leaf': '" + leaf + "' needs backup 'bellman' (a mean counts rewards 0 or 1)");
+          }
+          options.leaf_bounds = std::make_shared<const ValueBounds>(mdp);  // ResourceLimitError past its cap
+          options.optimistic_leaves = leaf == "upper";
+        }
+        const double seconds = parameters.real("time-budget");
+        const std::uint64_t iterations = seconds > 0 && !parameters.given("iterations")
+                                             ? std::numeric_limits<std::uint64_t>::max()
+                                             : parameters.integer("iterations");
+        options.budget =
+            seconds > 0 ? DecisionBudget::either(iterations, seconds) : DecisionBudget::iterations(iterations);
+        options.max_tree_bytes = static_cast<std::size_t>(parameters.integer("max-tree-mib")) << 20;
+        const std::string rollout = parameters.text("rollout");
+        if (rollout != "random") {
+          if (!allocator_registry().find(rollout).capabilities.has(Capability::stationary)) {
+            throw UsageError("parameter 'rollout': the rollout policy of mcts must choose by the state alone; '" +
+                             rollout + "' does not");
+          }
+          options.rollout = allocator_registry().make_factory(rollout, mdp, parameters.values());
+        }
+        MctsAllocator probe(mdp, options);  // checks the options once, before any episode
+        return [model = &mdp, options] { return std::make_unique<MctsAllocator>(*model, options); };
+      },
+      .needs = {.decision_budget = [](const ParameterReader& parameters) -> DecisionBudget {
+                  // Only what the caller gave: without it, a live session's share of a slice.
+                  const bool iterations = parameters.given("iterations");
+                  const double seconds = parameters.given("time-budget") ? parameters.real("time-budget") : 0.0;
+                  if (!iterations) return seconds > 0 ? DecisionBudget::seconds(seconds) : DecisionBudget{};
+                  return seconds > 0 ? DecisionBudget::either(parameters.integer("iterations"), seconds)
+                                     : DecisionBudget::iterations(parameters.integer("iterations"));
+                },
+                .memory = {.parameter = "max-tree-mib",
+                           .bytes =
+                               [](const Problem&, const ParameterReader& parameters) {
+                                 return static_cast<double>(parameters.integer("max-tree-mib")) * 1024.0 * 1024.0;
+                               },
+                           .per_allocator = true},
+                .counters = {{kSearchesCounter, "decisions that ran a search"},
+                             {kIterationsCounter, "search iterations, summed over the searches"},
+                             {"memory_stops", "searches stopped by the tree's memory cap"},
+                             {"peak_tree_nodes", "the most nodes a tree held"},
+                             {"peak_tree_bytes", "the most bytes a tree held"}}}};
 }
 
 }  // namespace ontime

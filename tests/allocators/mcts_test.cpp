@@ -3,12 +3,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
+#include <string>
+#include <utility>
 
 #include "ontime/allocators/allocator_registry.hpp"
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/run/evaluation.hpp"
 #include "ontime/run/session.hpp"
 #include "ontime/run/simulator.hpp"
+#include "ontime/solve/value_bounds.hpp"
 #include "ontime/util/error.hpp"
 #include "support/paper.hpp"
 
@@ -112,6 +116,76 @@ TEST(Mcts, FindsTheOptimalFirstChoice) {
   }
 }
 
+// Bellman backups with the clairvoyant bound as a new node's value: the search picks a choice
+// whose exact Q is the optimum from the start of every paper instance (the mean backups miss
+// instance 1's: a2_1, whose first random rollouts fail), whatever the seed.
+MctsOptions bellman_with_upper_leaves(const Mdp& mdp, std::uint64_t iterations) {
+  MctsOptions options = with_iterations(iterations);
+  options.backup = MctsBackup::bellman;
+  options.leaf_bounds = std::make_shared<const ValueBounds>(mdp);
+  options.optimistic_leaves = true;
+  return options;
+}
+
+// Q*(s, c): the exact value of choosing c in s and then playing optimally.
+double exact_q(const Mdp& mdp, OptimalSolver& solver, const State& state, int choice) {
+  double q = 0.0;
+  mdp.for_each_outcome(state, choice, [&](double probability, Status status, const State& next) {
+    if (status == Status::success) q += probability;
+    if (status == Status::running) q += probability * solver.solve(next);
+  });
+  return q;
+}
+
+TEST(Mcts, BellmanBackupsWithOptimisticLeavesChooseOptimallyAtTheStart) {
+  for (const char* name : {"figure1", "instance1", "instance2", "instance3", "instance4", "instance5"}) {
+    const Problem problem = testing::paper_instance(name);
+    const Mdp mdp(problem);
+    OptimalSolver solver(mdp);
+    const double optimum = solver.solve(mdp.start());
+    for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+      MctsAllocator mcts(mdp, bellman_with_upper_leaves(mdp, 10'000));
+      mcts.begin_episode(seed);
+      const int choice = mcts.choose(mdp.start());
+      EXPECT_NEAR(exact_q(mdp, solver, mdp.start(), choice), optimum, 1e-12) << name << " seed " << seed;
+    }
+  }
+}
+
+// On Fig. 1 the whole tree fits in the search: once every outcome has been reached, the partial
+// Bellman backups are the full ones, and each root choice's value is its exact Q*.
+TEST(Mcts, BellmanBackupsOverTheWholeTreeAreTheExactValues) {
+  const Problem problem = testing::paper_instance("figure1");
+  const Mdp mdp(problem);
+  OptimalSolver solver(mdp);
+  solver.solve(mdp.start());
+  for (const bool optimistic : {true, false}) {
+    MctsOptions options = bellman_with_upper_leaves(mdp, 200'000);
+    options.optimistic_leaves = optimistic;
+    MctsAllocator mcts(mdp, options);
+    mcts.begin_episode(1);
+    mcts.choose(mdp.start());
+    const auto root = mcts.root_choices();
+    ASSERT_EQ(root.size(), 2U);
+    for (const auto& item : root) {
+      EXPECT_NEAR(item.value, exact_q(mdp, solver, mdp.start(), item.skeleton), 1e-12)
+          << "skeleton " << item.skeleton << (optimistic ? " (upper leaves)" : " (lower leaves)");
+    }
+  }
+}
+
+TEST(Mcts, LeafValuesFromBoundsNeedBellmanBackups) {
+  const Problem problem = testing::paper_instance("figure1");
+  const Mdp mdp(problem);
+  MctsOptions options = bellman_with_upper_leaves(mdp, 100);
+  options.backup = MctsBackup::mean;
+  EXPECT_THROW(MctsAllocator(mdp, options), UsageError);
+  EXPECT_THROW(make_allocator_factory("mcts", mdp, {{"leaf", "upper"}}), UsageError);
+  EXPECT_THROW(make_allocator_factory("mcts", mdp, {{"backup", "max"}}), UsageError);
+  EXPECT_THROW(make_allocator_factory("mcts", mdp, {{"backup", "bellman"}, {"leaf", "middle"}}), UsageError);
+  EXPECT_NO_THROW(make_allocator_factory("mcts", mdp, {{"backup", "bellman"}, {"leaf", "lower"}}));
+}
+
 TEST(Mcts, SharingSkeletonsAreOneChoice) {
   const Problem problem = testing::paper_instance("figure1");
   const Mdp mdp(problem);
@@ -128,19 +202,23 @@ TEST(Mcts, SharingSkeletonsAreOneChoice) {
 TEST(Mcts, SameSeedSameDecisionsWhateverTheThreads) {
   const Problem problem = testing::paper_instance("instance3");
   const Mdp mdp(problem);
-  const AllocatorFactory factory = make_allocator_factory("mcts", mdp, {{"iterations", "300"}});
-  MonteCarloOptions monte_carlo;
-  monte_carlo.episodes = 400;
-  monte_carlo.seed = 5;
-  monte_carlo.threads = 1;
-  const MonteCarloResult one = run_monte_carlo(mdp, factory, monte_carlo);
-  monte_carlo.threads = 2;
-  const MonteCarloResult two = run_monte_carlo(mdp, factory, monte_carlo);
-  EXPECT_EQ(one.successes, two.successes);
-  ASSERT_TRUE(one.statistics.find("iterations").has_value());
-  ASSERT_TRUE(two.statistics.find("iterations").has_value());
-  EXPECT_EQ(*one.statistics.find("iterations"), *two.statistics.find("iterations"));
-  EXPECT_EQ(*one.statistics.find("iterations"), *one.statistics.find("searches") * 300);
+  for (const auto& [backup, leaf] : {std::pair{"mean", "rollout"}, {"bellman", "rollout"}, {"bellman", "upper"}}) {
+    SCOPED_TRACE(std::string(backup) + ", " + leaf);
+    const AllocatorFactory factory =
+        make_allocator_factory("mcts", mdp, {{"iterations", "300"}, {"backup", backup}, {"leaf", leaf}});
+    MonteCarloOptions monte_carlo;
+    monte_carlo.episodes = 400;
+    monte_carlo.seed = 5;
+    monte_carlo.threads = 1;
+    const MonteCarloResult one = run_monte_carlo(mdp, factory, monte_carlo);
+    monte_carlo.threads = 2;
+    const MonteCarloResult two = run_monte_carlo(mdp, factory, monte_carlo);
+    EXPECT_EQ(one.successes, two.successes);
+    ASSERT_TRUE(one.statistics.find("iterations").has_value());
+    ASSERT_TRUE(two.statistics.find("iterations").has_value());
+    EXPECT_EQ(*one.statistics.find("iterations"), *two.statistics.find("iterations"));
+    EXPECT_EQ(*one.statistics.find("iterations"), *one.statistics.find("searches") * 300);
+  }
 }
 
 TEST(Mcts, KeepsTheObservedSubtree) {

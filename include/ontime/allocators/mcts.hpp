@@ -14,6 +14,21 @@
 // useful choices by default, or any stationary allocator such as dp-rerun) and backs up the
 // success (1) or failure (0).
 //
+// Backups: `mean` (the default, the paper's) keeps Q as the mean reward of the iterations
+// through the edge. `bellman` keeps it as the model's expectation over the outcomes met so far
+// (partial Bellman backups, DP-UCT: Keller and Helmert 2013): Q(s, c) = sum_o P(o) v(o) /
+// sum_o P(o) over the outcomes o of c reached at least once, v(o) being 1 for success, 0 for
+// failure and V of the child otherwise, and V(s) = max_c Q(s, c) over the choices tried (the
+// leaf value until the node is expanded). The chance nodes then weigh outcomes by their
+// probabilities instead of by how often the samples happened to fall on them, and a choice whose
+// first rollouts failed recovers as soon as its subtree's values do. A new node's leaf value is a
+// rollout's reward, or (`leaf_bounds`) a bound of ValueBounds on V* there: the clairvoyant upper
+// bound makes every unexplored subtree look as good as it could be, so UCT goes where the bound
+// says success may still be found (bounded search in the manner of bounded RTDP), and needs no
+// rollout; the commit bound is a pessimistic start. On the paper's instance 1 the mean with random
+// rollouts settles on a1_1 (Q* = 0.920) because a2_1's first rollouts fail; bellman with upper
+// leaves picks a2_1 (Q* = 0.942) in every seed tried (docs/experiments.md).
+//
 // It sees only the MDP state: the search samples from the model's distributions, never from
 // the hidden outcomes of the episode it decides for. After each observed transition the
 // matching subtree becomes the new root (tree reuse).
@@ -21,9 +36,11 @@
 // Guarantees: UCT's choice converges to an optimal one as iterations grow (Kocsis and
 // Szepesvári 2006); for a finite budget it is an estimate. Same seed and an iteration budget:
 // same decisions.
-// Cost: per iteration O(depth * K) in the tree plus O(D * K) for the rollout; memory about
-// 24 bytes per decision node, 24 per chance node and 24 per outcome, bounded by
-// `max_tree_bytes`: a search that would exceed it stops with its best answer so far.
+// Cost: per iteration O(depth * K) in the tree plus O(D * K) for the rollout (bellman: plus
+// O(depth * (outcomes + K)) for the backup; with bound leaves no rollout but O(K) lookups);
+// memory a few tens of bytes per decision node, chance node and outcome (bellman: 8 more per
+// node and per chance node), bounded by `max_tree_bytes`: a search that would exceed
+// it stops with its best answer so far. The bounds' tables are built once per factory.
 
 #include <cstddef>
 #include <cstdint>
@@ -33,12 +50,20 @@
 #include "ontime/allocators/allocator.hpp"
 #include "ontime/allocators/decision_budget.hpp"
 #include "ontime/mdp/mdp.hpp"
+#include "ontime/solve/value_bounds.hpp"
 #include "ontime/util/random.hpp"
 
 namespace ontime {
 
+enum class MctsBackup { mean, bellman };
+
 struct MctsOptions {
-  double exploration = 0.5;                                    // C of UCT
+  double exploration = 0.5;  // C of UCT
+  MctsBackup backup = MctsBackup::mean;
+  // Bellman backups: a new node's V from these bounds (ValueBounds; null: a rollout's reward):
+  // the clairvoyant upper bound when `optimistic_leaves`, else the commit bound below.
+  std::shared_ptr<const ValueBounds> leaf_bounds;
+  bool optimistic_leaves = true;
   DecisionBudget budget = DecisionBudget::iterations(10'000);  // default per decision
   std::size_t max_tree_bytes = std::size_t{1} << 30;           // 1 GiB
   bool reuse_tree = true;
@@ -75,6 +100,9 @@ class MctsAllocator final : public Allocator {
  private:
   static constexpr std::uint32_t kNone = 0xFFFFFFFFU;
 
+  // An outcome's `child` once a terminal outcome has been reached (bellman backups count it).
+  static constexpr std::uint32_t kReached = 0xFFFFFFFEU;
+
   struct DecisionNode {
     std::uint32_t first_edge = kNone;  // kNone until expanded
     std::uint32_t visits = 0;
@@ -90,7 +118,7 @@ class MctsAllocator final : public Allocator {
   struct Outcome {
     double probability;
     Observation observation;
-    std::uint32_t child = kNone;  // decision node, kNone until reached
+    std::uint32_t child = kNone;  // decision node, kNone until reached (kReached: a terminal one)
     Status status;
   };
 
@@ -99,9 +127,14 @@ class MctsAllocator final : public Allocator {
   bool expand(std::uint32_t node, const State& state);  // false: memory cap
   bool expand_outcomes(std::uint32_t edge, const State& state);
   std::uint32_t select_edge(const DecisionNode& node) const;
-  static double estimate(const Edge& edge) noexcept {
-    return edge.visits == 0 ? 0.0 : static_cast<double>(edge.successes) / edge.visits;
+  double estimate(std::uint32_t e) const noexcept {
+    const Edge& edge = edges_[e];
+    if (edge.visits == 0) return 0.0;
+    return bellman() ? edge_values_[e] : static_cast<double>(edge.successes) / edge.visits;
   }
+  bool bellman() const noexcept { return options_.backup == MctsBackup::bellman; }
+  double leaf_value(State& state);  // a new node's value (bellman): a rollout's reward or a bound
+  void back_up_bellman();
   bool iterate();                // false: memory cap reached
   double rollout(State& state);  // plays on from `state`, changing it
   void reroot(std::uint32_t new_root);
@@ -117,6 +150,10 @@ class MctsAllocator final : public Allocator {
   std::vector<DecisionNode> nodes_;  // nodes_[0] is the root
   std::vector<Edge> edges_;
   std::vector<Outcome> outcomes_;
+  // Bellman backups only (empty otherwise, so that the mean's tree stays as small): V per
+  // decision node (the leaf value until expanded), Q per edge (over the outcomes reached).
+  std::vector<double> node_values_;
+  std::vector<double> edge_values_;
   std::vector<std::uint32_t> path_;  // edges visited by the current iteration
   struct Counters {
     std::uint64_t searches = 0;       // decisions that ran a search
