@@ -1,7 +1,6 @@
 #include "ontime/run/episode_runner.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <bit>
 #include <chrono>
 #include <cmath>
@@ -379,7 +378,7 @@ MonteCarloResult run_many(const WorldFactory& worlds, const AllocatorFactory* al
   std::vector<ThreadRun> runs(worker_count(count, options.threads));
   const std::uint64_t block =
       std::clamp<std::uint64_t>(count / (8 * runs.size()), 1, std::max<std::uint64_t>(1, 256 / length));
-  std::atomic<std::uint64_t> done{0};
+  std::uint64_t done = 0;  // episodes finished, guarded by progress_mutex
   std::mutex progress_mutex;
   // Split runs: this rank's episode results, packed for the other ranks' on_episode.
   std::string packed_episodes;
@@ -412,10 +411,11 @@ MonteCarloResult run_many(const WorldFactory& worlds, const AllocatorFactory* al
         if (options.time_decisions) run.timer.end_episode();
       }
       const std::uint64_t episodes_done = (end - begin) * length;
-      const std::uint64_t finished = done.fetch_add(episodes_done) + episodes_done;
       if (options.progress) {
+        // Counted under the lock that orders the reports, so that they never go backwards.
         const std::lock_guard lock(progress_mutex);
-        options.progress(finished, count * length);
+        done += episodes_done;
+        options.progress(done, count * length);
       }
     };
   });

@@ -207,7 +207,7 @@ TEST(Mcts, SameSeedSameDecisionsWhateverTheThreads) {
     const AllocatorFactory factory =
         make_allocator_factory("mcts", mdp, {{"iterations", "300"}, {"backup", backup}, {"leaf", leaf}});
     MonteCarloOptions monte_carlo;
-    monte_carlo.episodes = 400;
+    monte_carlo.episodes = 200;
     monte_carlo.seed = 5;
     monte_carlo.threads = 1;
     const MonteCarloResult one = run_monte_carlo(mdp, factory, monte_carlo);

@@ -55,32 +55,41 @@ TEST(Cli, UsageErrorsExitWithTwo) {
 }
 
 // Standard error is not a terminal here (a pipe, as in a log or CI): progress comes as plain
-// lines, here one per update (ONTIME_PROGRESS_SECONDS=0), and --quiet silences them.
+// lines, here one per update (ONTIME_PROGRESS_SECONDS=0), and --quiet silences them. The lines'
+// form and order on a Monte Carlo run (one line per 256 episodes), and on training (one line per
+// epoch of at least 4,000 steps: instance 4's episodes are one or two steps long, so 300 episodes
+// are one epoch; 3,000 took two minutes under the sanitizers).
+std::vector<std::uint64_t> progress_counts(const std::string& err, const std::string& what, std::uint64_t total) {
+  // Durations as the bar writes them: 42s, 1m07s, 1h21m (a slow build passes a minute).
+  const std::regex line("ontime " + what + R"(: (\d+)/)" + std::to_string(total) +
+                        R"( \((\d+)%\), \d+[hms](\d+[ms])? elapsed, about \d+[hms](\d+[ms])? left)");
+  std::istringstream in(err);
+  std::vector<std::uint64_t> done;
+  for (std::string text; std::getline(in, text);) {
+    std::smatch match;
+    EXPECT_TRUE(std::regex_match(text, match, line)) << text;
+    if (match.empty()) continue;
+    done.push_back(std::stoull(match[1]));
+    EXPECT_EQ(std::stoull(match[2]), done.back() * 100 / total);
+  }
+  return done;
+}
+
 TEST(Cli, ProgressLinesInALogAndNoneWhenQuiet) {
   const auto directory = scratch("progress");
   const std::string policy = (directory / "policy.json").string();
-  const std::vector<std::string> train = {ONTIME_CLI, "train", paper("instance4"), "--episodes", "3000",
-                                          "--out",    policy,  "--no-plot"};
-  std::vector<std::string> logged = {"/usr/bin/env", "ONTIME_PROGRESS_SECONDS=0"};
-  logged.insert(logged.end(), train.begin(), train.end());
-  const auto result = testing::run_process(logged);
-  ASSERT_EQ(result.exit_code, 0) << result.err;
-  // Durations as the bar writes them: 42s, 1m07s, 1h21m (a slow build, e.g. under the sanitizers,
-  // passes a minute).
-  const std::regex line(
-      R"(ontime train ppo: (\d+)/3000 \((\d+)%\), \d+[hms](\d+[ms])? elapsed, about \d+[hms](\d+[ms])? left)");
-  std::istringstream err(result.err);
-  std::vector<std::uint64_t> done;
-  for (std::string text; std::getline(err, text);) {
-    std::smatch match;
-    ASSERT_TRUE(std::regex_match(text, match, line)) << text;
-    done.push_back(std::stoull(match[1]));
-    EXPECT_EQ(std::stoull(match[2]), done.back() * 100 / 3000);
-  }
-  // One line per epoch of at least 4,000 steps (instance 4's episodes are one or two steps long).
-  ASSERT_GE(done.size(), 2U);
-  EXPECT_TRUE(std::is_sorted(done.begin(), done.end()));
-  EXPECT_EQ(done.back(), 3000U);
+  const auto evaluated = testing::run_process({"/usr/bin/env", "ONTIME_PROGRESS_SECONDS=0", ONTIME_CLI, "evaluate",
+                                               paper("instance4"), "--solver", "dp-rerun", "--episodes", "3000"});
+  ASSERT_EQ(evaluated.exit_code, 0) << evaluated.err;
+  const std::vector<std::uint64_t> episodes = progress_counts(evaluated.err, "evaluate dp-rerun", 3000);
+  ASSERT_GE(episodes.size(), 11U);  // 256, 512, ..., 2816, 3000
+  EXPECT_TRUE(std::is_sorted(episodes.begin(), episodes.end()));
+  EXPECT_EQ(episodes.back(), 3000U);
+
+  const auto trained = testing::run_process({"/usr/bin/env", "ONTIME_PROGRESS_SECONDS=0", ONTIME_CLI, "train",
+                                             paper("instance4"), "--episodes", "300", "--out", policy, "--no-plot"});
+  ASSERT_EQ(trained.exit_code, 0) << trained.err;
+  EXPECT_EQ(progress_counts(trained.err, "train ppo", 300), std::vector<std::uint64_t>{300});
 
   // Quiet: nothing at all. 30 episodes suffice to show it: the same run without --quiet writes a
   // progress line (its one epoch), and training 3,000 twice took minutes under the sanitizers.
