@@ -1,4 +1,4 @@
-// `ontime solve INSTANCE`: the exact optimum (layered or memoised expectimax), or a certified
+// `ontime solve INSTANCE`: the exact optimum (layered, memoised or branch-and-bound), or a certified
 // interval around it when a cap stops the layered solver, a tolerance drops hopeless groups or
 // a split bounds the weaker subtrees.
 
@@ -16,6 +16,7 @@
 #include "ontime/model/instance_io.hpp"
 #include "ontime/report/report.hpp"
 #include "ontime/solve/layered_solver.hpp"
+#include "ontime/solve/search_solver.hpp"
 #include "ontime/util/atomic_file.hpp"
 #include "ontime/util/error.hpp"
 
@@ -53,6 +54,23 @@ void run_memoised(const SolveOptions& options, const Problem& problem, const Mdp
   solve.solution.states = solver.states();
   solve.solution.first_choice = solver.best_choice(mdp.start()).value_or(-1);
   solve.seconds = seconds;
+  fmt::print("{}", options.json ? report::to_json(solve) + "\n" : report::to_text(solve));
+}
+
+void run_search(const SolveOptions& options, const Problem& problem, const Mdp& mdp) {
+  const std::size_t max_states = options.max_states != 0 ? options.max_states : OptimalSolver::kDefaultMaxStates;
+  check_exact_work(problem, max_states, options.instance, flag_spelling());
+  SearchSolveOptions settings;
+  settings.max_states = max_states;
+  const auto started = std::chrono::steady_clock::now();
+  if (options.max_seconds > 0) {
+    const auto deadline = started + std::chrono::duration<double>(options.max_seconds);
+    settings.stop = [deadline] { return std::chrono::steady_clock::now() >= deadline; };
+  }
+  report::Solve solve{.instance = options.instance, .problem = &problem, .mdp = &mdp, .method = "search"};
+  solve.search = solve_search(mdp, settings);
+  solve.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  solve.timing = !options.no_timing;
   fmt::print("{}", options.json ? report::to_json(solve) + "\n" : report::to_text(solve));
 }
 
@@ -125,11 +143,12 @@ void add_solve_command(CLI::App& app) {
       ->add_option("--method", options->method,
                    "layered (default: the whole tree; where a cap cuts it, a split follows, but for an instance "
                    "with backtracking), split (the strongest first-action subtree enumerated, the others bounded; "
-                   "not with backtracking) or memoised")
-      ->check(CLI::IsMember({"layered", "split", "memoised"}));
+                   "not with backtracking), memoised, or search (branch and bound: exact, solving only the states the "
+                   "bounds cannot settle)")
+      ->check(CLI::IsMember({"layered", "split", "memoised", "search"}));
   add_number_option(*command, "--max-states", options->max_states,
-                    "Cap on states: layered gives an interval past it, memoised stops with an error (default: "
-                    "none for layered, 10000000 for memoised)",
+                    "Cap on states: layered and search give an interval past it, memoised stops with an error "
+                    "(default: none for layered, 10000000 for memoised and search)",
                     std::size_t{1});
   add_number_option(*command, "--max-memory-mib", options->max_memory_mib,
                     "Layered: tables one rank may hold (default: 80% of the available memory)", std::uint64_t{1});
@@ -137,7 +156,7 @@ void add_solve_command(CLI::App& app) {
                     "Layered: scratch one rank may write (default: 90% of the free space)", std::uint64_t{1});
   add_number_option(*command, "--max-seconds", options->max_seconds,
                     "Layered: end the forward pass after this long and give an interval (the backward pass still "
-                    "runs)",
+                    "runs); search: end the search and give an interval",
                     0.0);
   add_number_option(*command, "--tolerance", options->tolerance,
                     "Layered, split: drop groups whose clairvoyant chance alone is below this, with their share in "
@@ -161,6 +180,11 @@ void add_solve_command(CLI::App& app) {
         throw UsageError("solve --method memoised does not split over MPI ranks: use --method layered");
       }
       run_memoised(*options, problem, mdp);
+    } else if (options->method == "search") {
+      if (split_over_ranks(job_ranks())) {
+        throw UsageError("solve --method search does not split over MPI ranks: use --method layered");
+      }
+      run_search(*options, problem, mdp);
     } else {
       run_layered(*options, problem, mdp);
     }

@@ -12,6 +12,7 @@
 #include "ontime/solve/knapsack.hpp"
 #include "ontime/solve/layered_solver.hpp"
 #include "ontime/solve/optimal_solver.hpp"
+#include "ontime/solve/search_solver.hpp"
 #include "ontime/util/atomic_file.hpp"
 #include "ontime/util/error.hpp"
 #include "ontime/util/memory.hpp"
@@ -47,8 +48,23 @@ void bind_solve(py::module_& m) {
          const py::object& policy, Number<int, "policy_layers", 1, 1'000'000> policy_layers) {
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
         const std::string method = method_given.value_or("layered");
-        if (method != "layered" && method != "split" && method != "memoised") {
-          throw UsageError("method must be 'layered', 'split' or 'memoised' (got '" + method + "')");
+        if (method != "layered" && method != "split" && method != "memoised" && method != "search") {
+          throw UsageError("method must be 'layered', 'split', 'memoised' or 'search' (got '" + method + "')");
+        }
+        if (method == "search") {
+          report::Solve solve{.instance = instance_label(problem, *mdp->problem),
+                              .problem = mdp->problem.get(),
+                              .mdp = &mdp->mdp,
+                              .method = method};
+          run_interruptibly([&](const std::function<bool()>& stop, Progress&) {
+            const auto started = std::chrono::steady_clock::now();
+            SearchSolveOptions options;
+            options.max_states = max_states;
+            options.stop = stop;
+            solve.search = solve_search(mdp->mdp, options);
+            solve.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+          });
+          return json_object(report::to_json(solve));
         }
         if (method == "memoised") {
           report::Solve solve{.instance = instance_label(problem, *mdp->problem),
@@ -115,7 +131,9 @@ void bind_solve(py::module_& m) {
       "disk. policy=FILE writes the choices of the first `policy_layers` layers as `ontime solve --policy` does "
       "(JSON Lines: a state, its choice and the bounds of its value). The GIL is released; Ctrl-C stops it "
       "(KeyboardInterrupt). method='memoised' is the memoised expectimax (OptimalSolver: exact, or an error past "
-      "max_states). For an instance with backtracking neither a split nor a tolerance applies (UsageError), and "
+      "max_states). method='search' is the branch-and-bound search (exact as the others, touching fewer states; past "
+      "max_states a certified interval, as `ontime solve --method search`). For an instance with backtracking neither "
+      "a split nor a tolerance applies (UsageError), and "
       "a cap's interval comes from bounds that count a give-up as a success.");
 }
 

@@ -20,6 +20,18 @@ def test_solve_matches_the_cli(path, cli):
 
 
 @pytest.mark.parametrize("path", PAPER_INSTANCES, ids=lambda p: p.stem)
+def test_the_search_matches_the_cli_and_the_layered_bits(path, cli):
+    expected = cli("solve", path, "--json", "--method", "search", "--no-timing")
+    got = ontime.solve(str(path), method="search")
+    assert set(got) == set(expected) | {"seconds"}
+    for key in ("optimal_success_probability", "states", "upper_tests", "first_choice", "first_action"):
+        assert got[key] == expected[key]
+    assert got["optimal_success_probability"] == ontime.solve(str(path))["optimal_success_probability"]
+    capped = ontime.solve(str(path), method="search", max_states=1)
+    assert capped["lower_bound"] <= got["optimal_success_probability"] <= capped["upper_bound"]
+
+
+@pytest.mark.parametrize("path", PAPER_INSTANCES, ids=lambda p: p.stem)
 @pytest.mark.parametrize("solver", EXACT_SOLVERS)
 def test_exact_evaluation_matches_the_cli(path, solver, cli):
     expected = cli("evaluate", path, "--solver", solver, "--episodes", 2000, "--seed", 7, "--exact", "--json")

@@ -36,7 +36,7 @@ Json statistics_object(const Statistics& statistics) {
 }
 
 std::string first_action_of(const Solve& solve) {
-  const int first = solve.solution.first_choice;
+  const int first = solve.search ? solve.search->first_choice : solve.solution.first_choice;
   return first >= 0 ? solve.problem->action(solve.mdp->next_action(solve.mdp->start(), first)).id : "";
 }
 
@@ -128,16 +128,59 @@ std::string to_text(const Evaluation& evaluation) {
   return out;
 }
 
-std::string to_json(const Solve& solve) {
-  const LayeredSolution& solution = solve.solution;
+namespace {
+
+// The keys every method's JSON starts with.
+Json solve_head(const Solve& solve, double lower, double upper, bool exact) {
   Json out;
   out["instance"] = solve.instance;
   out["name"] = solve.problem->name();
   out["method"] = solve.method;
-  out["optimal_success_probability"] = solution.exact ? Json(solution.lower) : Json(nullptr);
-  out["lower_bound"] = solution.lower;
-  out["upper_bound"] = solution.upper;
-  out["exact"] = solution.exact;
+  out["optimal_success_probability"] = exact ? Json(lower) : Json(nullptr);
+  out["lower_bound"] = lower;
+  out["upper_bound"] = upper;
+  out["exact"] = exact;
+  return out;
+}
+
+Json search_json(const Solve& solve) {
+  const SearchSolution& solution = *solve.search;
+  Json out = solve_head(solve, solution.lower, solution.upper, solution.exact);
+  if (!solution.exact) out["stopped_by"] = solution.stopped_by;
+  out["states"] = solution.states;
+  out["bounded_successors"] = solution.bounded;
+  out["choices_cut"] = solution.choices_cut;
+  out["upper_tests"] = solution.tested;
+  out["refined_states"] = solution.refined;
+  if (solve.timing) out["seconds"] = solve.seconds;
+  out["first_choice"] = solution.first_choice;
+  out["first_action"] = first_action_of(solve);
+  return out;
+}
+
+std::string search_text(const Solve& solve, std::string out) {
+  const SearchSolution& solution = *solve.search;
+  if (!solution.exact) out += fmt::format("search cut                   at {}\n", solution.stopped_by);
+  if (solution.first_choice >= 0) {
+    out += fmt::format("first choice                 skeleton {} (refine {}){}\n", solution.first_choice,
+                       first_action_of(solve), solution.exact ? "" : ", the best lower end's");
+  } else {
+    out += "first choice                 none (no skeleton can meet the deadline)\n";
+  }
+  out += fmt::format("states                       {} solved, {} successors valued by their bounds, {} choices cut\n",
+                     solution.states, solution.bounded, solution.choices_cut);
+  out += fmt::format("upper tests                  {} states expanded, {} with a refined upper bound\n",
+                     solution.tested, solution.refined);
+  if (solve.timing) out += fmt::format("time                         {:.4f} s\n", solve.seconds);
+  return out;
+}
+
+}  // namespace
+
+std::string to_json(const Solve& solve) {
+  if (solve.search) return dump(search_json(solve));
+  const LayeredSolution& solution = solve.solution;
+  Json out = solve_head(solve, solution.lower, solution.upper, solution.exact);
   if (solve.memoised) {
     out["states"] = solution.states;
     if (solve.timing) out["seconds"] = solve.seconds;
@@ -198,6 +241,16 @@ std::string to_text(const Solve& solve) {
   const std::string first_action = first_action_of(solve);
   std::string out = fmt::format("instance                     {} ({}), deadline {}, {} skeletons\n", solve.instance,
                                 problem.name(), problem.deadline(), problem.skeleton_count());
+  if (solve.search) {
+    const SearchSolution& search = *solve.search;
+    if (search.exact) {
+      out += fmt::format("optimal success probability  {:.6f}\n", search.lower);
+    } else {
+      out += fmt::format("optimal success probability  in [{:.6f}, {:.6f}] (width {:.6f})\n", search.lower,
+                         search.upper, search.upper - search.lower);
+    }
+    return search_text(solve, std::move(out));
+  }
   if (solution.exact) {
     out += fmt::format("optimal success probability  {:.6f}\n", solution.lower);
   } else {

@@ -337,4 +337,48 @@ class Expectimax {
   std::vector<int> choices_;
 };
 
+// Choices and state keys of the optimal solver; Words > 0 packs keys into that many 64-bit
+// words (detail::pack), 0 keys by the whole state (detail::compact).
+template <std::size_t Words>
+class OptimalPolicy {
+ public:
+  using Compact = CompactState;
+  explicit OptimalPolicy(const Mdp& mdp) : mdp_(&mdp) {}
+
+  void choices(const Compact& state, std::vector<int>& out) const {
+    for (const int choice : mdp_->useful_choices(state)) out.push_back(choice);
+  }
+
+  // Skeletons in a group that can no longer succeed influence nothing: blank_hopeless
+  // blanks their slots so that states differing only there share one memo entry.
+  auto key(const CompactState& state) const {
+    CompactState key = state;
+    blank_hopeless(*mdp_, key);
+    if constexpr (Words > 0) {
+      return pack<Words>(key, mdp_->skeleton_count());
+    } else {
+      return key;
+    }
+  }
+
+ private:
+  const Mdp* mdp_;
+};
+
+// With backtracking (SPEC §7): states with their restore values, keyed whole. No slot is blanked:
+// a step on a group that cannot succeed may still backtrack and restore an action others share.
+class OptimalBacktrackPolicy {
+ public:
+  using Compact = CompactBacktrackState;
+  explicit OptimalBacktrackPolicy(const Mdp& mdp) : mdp_(&mdp) {}
+
+  void choices(const Compact& state, std::vector<int>& out) const {
+    for (const int choice : mdp_->useful_choices(state)) out.push_back(choice);
+  }
+  static const Compact& key(const Compact& state) { return state; }
+
+ private:
+  const Mdp* mdp_;
+};
+
 }  // namespace ontime::detail

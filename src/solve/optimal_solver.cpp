@@ -9,52 +9,9 @@
 namespace ontime {
 namespace {
 
-// Choices and state keys of the optimal solver; Words > 0 packs keys into that many 64-bit
-// words (detail::pack), 0 keys by the whole state (detail::compact).
-template <std::size_t Words>
-class OptimalPolicy {
- public:
-  using Compact = detail::CompactState;
-  explicit OptimalPolicy(const Mdp& mdp) : mdp_(&mdp) {}
-
-  void choices(const Compact& state, std::vector<int>& out) const {
-    for (const int choice : mdp_->useful_choices(state)) out.push_back(choice);
-  }
-
-  // Skeletons in a group that can no longer succeed influence nothing: detail::blank_hopeless
-  // blanks their slots so that states differing only there share one memo entry.
-  auto key(const detail::CompactState& state) const {
-    detail::CompactState key = state;
-    detail::blank_hopeless(*mdp_, key);
-    if constexpr (Words > 0) {
-      return detail::pack<Words>(key, mdp_->skeleton_count());
-    } else {
-      return key;
-    }
-  }
-
- private:
-  const Mdp* mdp_;
-};
-
-// With backtracking (SPEC §7): states with their restore values, keyed whole. No slot is blanked:
-// a step on a group that cannot succeed may still backtrack and restore an action others share.
-class OptimalBacktrackPolicy {
- public:
-  using Compact = detail::CompactBacktrackState;
-  explicit OptimalBacktrackPolicy(const Mdp& mdp) : mdp_(&mdp) {}
-
-  void choices(const Compact& state, std::vector<int>& out) const {
-    for (const int choice : mdp_->useful_choices(state)) out.push_back(choice);
-  }
-  static const Compact& key(const Compact& state) { return state; }
-
- private:
-  const Mdp* mdp_;
-};
-
-using Search = std::variant<detail::Expectimax<OptimalPolicy<2>>, detail::Expectimax<OptimalPolicy<4>>,
-                            detail::Expectimax<OptimalPolicy<0>>, detail::Expectimax<OptimalBacktrackPolicy>>;
+using Search =
+    std::variant<detail::Expectimax<detail::OptimalPolicy<2>>, detail::Expectimax<detail::OptimalPolicy<4>>,
+                 detail::Expectimax<detail::OptimalPolicy<0>>, detail::Expectimax<detail::OptimalBacktrackPolicy>>;
 
 }  // namespace
 
@@ -63,12 +20,12 @@ struct OptimalSolver::Impl {
 
   static Search make(const Mdp& mdp, std::size_t max_states) {
     const auto build = [&]<std::size_t Words>() -> Search {
-      return detail::Expectimax<OptimalPolicy<Words>>(mdp, OptimalPolicy<Words>(mdp), max_states,
-                                                      OptimalSolver::kTieTolerance, "optimal");
+      return detail::Expectimax<detail::OptimalPolicy<Words>>(mdp, detail::OptimalPolicy<Words>(mdp), max_states,
+                                                              OptimalSolver::kTieTolerance, "optimal");
     };
     if (mdp.has_backtracking()) {
-      return detail::Expectimax<OptimalBacktrackPolicy>(mdp, OptimalBacktrackPolicy(mdp), max_states,
-                                                        OptimalSolver::kTieTolerance, "optimal");
+      return detail::Expectimax<detail::OptimalBacktrackPolicy>(mdp, detail::OptimalBacktrackPolicy(mdp), max_states,
+                                                                OptimalSolver::kTieTolerance, "optimal");
     }
     switch (detail::packed_words(mdp)) {
       case 2:

@@ -174,6 +174,30 @@ TEST(Cli, SolveNoTimingPrintsTheSameBytesForAnyThreadCount) {
   EXPECT_LT(solved["lower_bound"].get<double>(), solved["upper_bound"].get<double>());
 }
 
+// The branch-and-bound search: the layered solver's value to the bit with fewer states solved; a
+// cap gives an interval around it; over MPI ranks it is refused.
+TEST(Cli, SolveBySearchGivesTheLayeredBits) {
+  const auto layered = ontime({"solve", paper("instance1"), "--json"});
+  const auto search = ontime({"solve", paper("instance1"), "--json", "--method", "search", "--no-timing"});
+  const auto capped = ontime({"solve", paper("instance1"), "--json", "--method", "search", "--max-states", "10"});
+  ASSERT_EQ(layered.exit_code, 0) << layered.err;
+  ASSERT_EQ(search.exit_code, 0) << search.err;
+  ASSERT_EQ(capped.exit_code, 0) << capped.err;
+  const json by_layers = json::parse(layered.out), by_search = json::parse(search.out), cut = json::parse(capped.out);
+  EXPECT_EQ(by_search["method"], "search");
+  EXPECT_EQ(by_search["optimal_success_probability"].get<double>(),
+            by_layers["optimal_success_probability"].get<double>());
+  EXPECT_EQ(by_search["first_choice"].get<int>(), by_layers["first_choice"].get<int>());
+  EXPECT_LT(by_search["states"].get<int>(), by_layers["states"].get<int>());
+  EXPECT_FALSE(by_search.contains("seconds"));
+  EXPECT_FALSE(cut["exact"].get<bool>());
+  EXPECT_TRUE(cut["optimal_success_probability"].is_null());
+  EXPECT_EQ(cut["stopped_by"], "the cap of 10 states");
+  EXPECT_LE(cut["lower_bound"].get<double>(), by_layers["optimal_success_probability"].get<double>());
+  EXPECT_GE(cut["upper_bound"].get<double>(), by_layers["optimal_success_probability"].get<double>());
+  EXPECT_EQ(cut["states"].get<int>(), 10);
+}
+
 // An instance with backtracking: the layered solver by default, the memoised solver's value to
 // the bit, a policy whose states hold what a backtrack restores, an interval under a cap; a split
 // or a tolerance exits with 2 naming the rule.

@@ -20,6 +20,7 @@
 #include "ontime/solve/backtracking_success.hpp"
 #include "ontime/solve/layered_solver.hpp"
 #include "ontime/solve/optimal_solver.hpp"
+#include "ontime/solve/search_solver.hpp"
 #include "ontime/solve/value_bounds.hpp"
 #include "ontime/util/error.hpp"
 #include "ontime/util/random.hpp"
@@ -418,6 +419,32 @@ TEST(Backtracking, TheLayeredSolverEqualsTheMemoisedOneBitForBit) {
         EXPECT_EQ(entry.choice, solver.best_choice(entry.state).value_or(-1));
       }
     }
+  }
+  EXPECT_GE(backtracking, 25);
+}
+
+// The search takes the memoised solver's keys and outcomes, and the bounds hold under
+// backtracking: the same value to the bit and the same first choice.
+TEST(Backtracking, TheSearchEqualsTheMemoisedSolverBitForBit) {
+  int backtracking = 0;
+  for (std::uint64_t seed = 1; seed <= 40; ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    const Problem problem = with_backtracking(testing::random_instance(seed, 3, 3, 6), seed + 1000);
+    if (!problem.has_backtracking()) continue;
+    ++backtracking;
+    const Mdp mdp(problem);
+    OptimalSolver solver(mdp);
+    const double optimum = solver.solve(mdp.start());
+    const SearchSolution search = solve_search(mdp);
+    ASSERT_TRUE(search.exact);
+    EXPECT_EQ(search.lower, optimum);
+    EXPECT_EQ(search.first_choice, solver.best_choice(mdp.start()).value_or(-1));
+    EXPECT_LE(search.states, solver.states());
+    SearchSolveOptions capped;
+    capped.max_states = search.states / 2 + 1;
+    const SearchSolution cut = solve_search(mdp, capped);
+    EXPECT_LE(cut.lower, optimum + 1e-15);
+    EXPECT_GE(cut.upper, optimum - 1e-15);
   }
   EXPECT_GE(backtracking, 25);
 }

@@ -22,6 +22,7 @@
 #include "ontime/run/experiments.hpp"
 #include "ontime/run/table.hpp"
 #include "ontime/solve/layered_solver.hpp"
+#include "ontime/solve/search_solver.hpp"
 
 namespace ontime::report {
 
@@ -52,6 +53,8 @@ struct Solve {
   std::string method = "layered";
   LayeredSolution solution = {};
   bool memoised = false;
+  // The branch-and-bound search's solution (method "search"), in place of `solution`.
+  std::optional<SearchSolution> search = std::nullopt;
   double tolerance = 0;
   double seconds = 0;
   bool timing = true;

@@ -1,0 +1,67 @@
+#pragma once
+// `solve_search`: the optimal success probability V* of the start state by branch and bound
+// over the reachable MDP, touching only the states whose exact value can still decide a choice;
+// a certified interval around V* when a cap or the stop condition ends it first.
+//
+// What it computes. Depth first from the start, as the memoised solver (optimal_solver.hpp)
+// does, but a state's choices are not all solved: each choice c gets an interval
+// [lo_c, hi_c] around its value Q(c) = sum_o P(o | s, c) V*(o), from the exact values of the
+// successors already solved and, for the others, the certified bounds of ValueBounds (commit
+// policy below, clairvoyant relaxation above, each widened by kBoundSlack against rounding).
+// The most promising choice (largest hi) is solved first, exactly; then the choices are
+// replayed in index order under the exact solver's tie rule (a choice replaces the best so far
+// when its value exceeds it by more than kTieTolerance). A choice whose interval settles its
+// comparison (below the best so far plus the tolerance: never the answer; above it: replaces
+// it) is not solved; the first comparison the intervals cannot settle solves the one of its two
+// choices not yet exact with the larger hi, and the replay starts again. The answer is the last
+// choice the replay keeps, solved exactly.
+//
+// Guarantees. Every exact value is summed over the same outcomes in the same order from the
+// same successor values as the memoised solver's, and a choice is left unsolved only where its
+// interval proves the tie rule's verdict on it, so the value and the choice of every state
+// solved are the memoised (and layered) solver's to the bit. Under a cap or a stop, the start
+// state's interval comes from one step of lookahead over what was solved: lower is at most V*
+// (a certified bound, not the value of a policy as the layered solver's is), upper at least V*.
+// Deterministic: one thread, the same order every run. Backtracking (SPEC §7) is taken as the
+// memoised solver takes it (whole states with their restore values as keys).
+//
+// Cost: time and memory linear in the states solved (each a memo slot of the memoised
+// solver's size) times their outcomes, with two table lookups of O(K) per unsolved successor;
+// the ValueBounds tables ((nodes + sum of lengths) * D^2 doubles). The recursion goes one level
+// per step of CT, so at most D deep (D <= 10,000 by the instance format: well within a thread's
+// stack).
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "ontime/mdp/mdp.hpp"
+
+namespace ontime {
+
+struct SearchSolveOptions {
+  std::uint64_t max_states = 0;  // states solved exactly; 0: no cap
+  // Checked every few thousand states: once it returns true the search ends as at a cap.
+  std::function<bool()> stop;
+};
+
+struct SearchSolution {
+  double lower = 0;  // V* when exact
+  double upper = 0;  // equal to lower when exact
+  bool exact = true;
+  int first_choice = -1;          // the optimal first choice (cut: the choice of the best lower end), -1 if none
+  std::uint64_t states = 0;       // states solved exactly
+  std::uint64_t bounded = 0;      // successors valued by their bounds alone (with repetitions)
+  std::uint64_t choices_cut = 0;  // choices left unsolved because their interval settled them
+  std::uint64_t tested = 0;       // upper tests run (states expanded to refine their upper bound)
+  std::uint64_t refined = 0;      // states holding a refined upper bound at the end
+  std::string stopped_by;         // cut: the cap or stop that ended the search
+};
+
+// Solves from mdp.start(). Throws UsageError for more than kMaxExactSkeletons skeletons (or more
+// blamable actions than the exact solvers' keys hold); ResourceLimitError when ValueBounds'
+// tables are too large.
+SearchSolution solve_search(const Mdp& mdp, const SearchSolveOptions& options = {});
+
+}  // namespace ontime

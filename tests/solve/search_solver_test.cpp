@@ -1,0 +1,116 @@
+#include "ontime/solve/search_solver.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <string>
+
+#include "ontime/allocators/optimal.hpp"
+#include "ontime/util/error.hpp"
+#include "support/paper.hpp"
+#include "support/random_instances.hpp"
+
+namespace ontime {
+namespace {
+
+// The search solves a choice exactly wherever the bounds cannot settle the tie rule's verdict, and
+// sums it as the memoised solver does: the same value to the bit and the same first choice, with
+// at most the memoised solver's states solved.
+void expect_search_equals_memoised(const Mdp& mdp, const std::string& name) {
+  OptimalSolver memoised(mdp);
+  const double optimum = memoised.solve(mdp.start());
+  const SearchSolution search = solve_search(mdp);
+  ASSERT_TRUE(search.exact) << name;
+  EXPECT_EQ(search.lower, optimum) << name;
+  EXPECT_EQ(search.upper, optimum) << name;
+  EXPECT_EQ(search.first_choice, memoised.best_choice(mdp.start()).value_or(-1)) << name;
+  EXPECT_LE(search.states, memoised.states()) << name;
+  EXPECT_TRUE(search.stopped_by.empty()) << name;
+}
+
+TEST(SearchSolver, EqualsTheMemoisedSolverBitForBitOnThePaperInstances) {
+  std::uint64_t searched = 0;
+  std::uint64_t enumerated = 0;
+  for (const char* name : {"figure1", "instance1", "instance2", "instance3", "instance4", "instance5"}) {
+    const Problem problem = testing::paper_instance(name);
+    const Mdp mdp(problem);
+    expect_search_equals_memoised(mdp, name);
+    searched += solve_search(mdp).states;
+    OptimalSolver memoised(mdp);
+    memoised.solve(mdp.start());
+    enumerated += memoised.states();
+  }
+  // Instance 1 alone: 872 states reachable; the bounds leave fewer than 600 to solve.
+  EXPECT_LT(searched, enumerated);
+}
+
+TEST(SearchSolver, EqualsTheMemoisedSolverBitForBitOnRandomInstances) {
+  for (std::uint64_t seed = 1; seed <= 300; ++seed) {
+    const Problem problem = testing::random_instance(seed, 5, 4, 14);
+    const Mdp mdp(problem);
+    expect_search_equals_memoised(mdp, "seed " + std::to_string(seed));
+  }
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    const Problem problem = testing::random_instance(1000 + seed, 7, 5, 18);
+    const Mdp mdp(problem);
+    expect_search_equals_memoised(mdp, "deeper, seed " + std::to_string(seed));
+  }
+}
+
+// Wherever a state cap or the stop condition ends the search, the start's interval holds the
+// optimum, and its first choice is one of the start's useful choices.
+TEST(SearchSolver, EveryCapGivesAnIntervalHoldingTheOptimum) {
+  int cut = 0;
+  for (std::uint64_t seed = 1; seed <= 120; ++seed) {
+    const Problem problem = testing::random_instance(seed, 5, 4, 14);
+    const Mdp mdp(problem);
+    OptimalSolver memoised(mdp);
+    const double optimum = memoised.solve(mdp.start());
+    const SearchSolution whole = solve_search(mdp);
+    for (const std::uint64_t cap : {std::uint64_t{1}, whole.states / 3 + 1, whole.states / 2 + 1, whole.states}) {
+      SCOPED_TRACE("seed " + std::to_string(seed) + ", cap " + std::to_string(cap));
+      SearchSolveOptions options;
+      options.max_states = cap;
+      const SearchSolution capped = solve_search(mdp, options);
+      EXPECT_LE(capped.lower, optimum + 1e-15);
+      EXPECT_GE(capped.upper, optimum - 1e-15);
+      EXPECT_LE(capped.upper, 1.0);
+      EXPECT_GE(capped.lower, 0.0);
+      if (capped.exact) {
+        EXPECT_EQ(capped.lower, optimum);
+        continue;
+      }
+      ++cut;
+      EXPECT_LE(capped.states, cap);
+      EXPECT_NE(capped.stopped_by.find("cap of " + std::to_string(cap) + " states"), std::string::npos);
+      bool useful = false;
+      for (const int choice : mdp.useful_choices(mdp.start())) useful = useful || choice == capped.first_choice;
+      EXPECT_TRUE(useful) << capped.first_choice;
+    }
+  }
+  EXPECT_GE(cut, 100);
+}
+
+TEST(SearchSolver, TheStopConditionEndsItWithAnInterval) {
+  const Problem problem = testing::paper_instance("instance1");
+  const Mdp mdp(problem);
+  SearchSolveOptions options;
+  options.stop = [] { return true; };
+  const SearchSolution stopped = solve_search(mdp, options);
+  OptimalSolver memoised(mdp);
+  const double optimum = memoised.solve(mdp.start());
+  EXPECT_FALSE(stopped.exact);
+  EXPECT_EQ(stopped.stopped_by, "the stop condition");
+  EXPECT_LE(stopped.lower, optimum);
+  EXPECT_GE(stopped.upper, optimum);
+  EXPECT_LT(stopped.lower, stopped.upper);
+}
+
+TEST(SearchSolver, RefusesMoreSkeletonsThanItsKeysHold) {
+  const Problem wide = testing::wide_instance(7, kMaxExactSkeletons + 1, 2, 12);
+  const Mdp wide_mdp(wide);
+  EXPECT_THROW(solve_search(wide_mdp), UsageError);
+}
+
+}  // namespace
+}  // namespace ontime
