@@ -210,6 +210,21 @@ BENCHMARK(BM_LayeredNavigationOptimum)->Iterations(1)->Unit(benchmark::kSecond)-
 void BM_LayeredKitchenSplit(benchmark::State& bench) { time_layered(bench, "manipulation", ontime::SplitMode::always); }
 BENCHMARK(BM_LayeredKitchenSplit)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
 
+// The branch-and-bound search (solve/search_solver.hpp) on the navigation optimum, one thread:
+// against BM_LayeredNavigationOptimum (target: five times faster, the same value).
+void BM_SearchNavigationOptimum(benchmark::State& bench) {
+  const ontime::Problem problem =
+      ontime::load_problem(std::string(ONTIME_SOURCE_DIR) + "/data/instances/navigation.json");
+  const ontime::Mdp mdp(problem);
+  ontime::SearchSolution solution;
+  for (auto _ : bench) solution = ontime::solve_search(mdp);
+  bench.counters["states"] = static_cast<double>(solution.states);
+  bench.counters["upper_tests"] = static_cast<double>(solution.tested);
+  bench.counters["value"] = solution.lower;
+  bench.SetLabel(problem.name());
+}
+BENCHMARK(BM_SearchNavigationOptimum)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+
 // MCTS search throughput from the start state of instance 1, one core (target >= 1e6/s).
 // range(1): 0 the paper's backups (mean, random rollouts); 1 bellman backups with the
 // clairvoyant bound as leaf value (no rollouts).

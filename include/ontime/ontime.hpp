@@ -38,6 +38,7 @@
 #include "ontime/solve/contiguous_success.hpp"
 #include "ontime/solve/knapsack.hpp"
 #include "ontime/solve/layered_solver.hpp"
+#include "ontime/solve/search_solver.hpp"
 #include "ontime/solve/value_bounds.hpp"
 #include "ontime/util/byte_packing.hpp"
 #include "ontime/util/error.hpp"

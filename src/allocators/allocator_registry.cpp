@@ -13,8 +13,8 @@
 namespace ontime {
 namespace {
 
-constexpr Capability kAllCapabilities[] = {Capability::stationary, Capability::randomised, Capability::anytime,
-                                           Capability::needs_policy, Capability::optimal};
+constexpr Capability kAllCapabilities[] = {Capability::stationary,   Capability::randomised, Capability::anytime,
+                                           Capability::needs_policy, Capability::optimal,    Capability::certified};
 
 // The whole text as a number of the parameter's type, or nothing.
 std::optional<double> parse_number(const Parameter& parameter, std::string_view text) {
@@ -54,6 +54,8 @@ std::string_view to_string(Capability capability) noexcept {
       return "needs-policy";
     case Capability::optimal:
       return "optimal";
+    case Capability::certified:
+      return "certified";
   }
   return "?";
 }

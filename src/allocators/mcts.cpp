@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <utility>
 
+#include "allocators/detail/anytime_budget.hpp"
 #include "ontime/allocators/allocator_registry.hpp"
 #include "ontime/util/error.hpp"
 #include "util/portable_math.hpp"
@@ -373,12 +373,7 @@ AllocatorKind mcts_kind() {
           options.leaf_bounds = std::make_shared<const ValueBounds>(mdp);  // ResourceLimitError past its cap
           options.optimistic_leaves = leaf == "upper";
         }
-        const double seconds = parameters.real("time-budget");
-        const std::uint64_t iterations = seconds > 0 && !parameters.given("iterations")
-                                             ? std::numeric_limits<std::uint64_t>::max()
-                                             : parameters.integer("iterations");
-        options.budget =
-            seconds > 0 ? DecisionBudget::either(iterations, seconds) : DecisionBudget::iterations(iterations);
+        options.budget = detail::default_budget(parameters);
         options.max_tree_bytes = static_cast<std::size_t>(parameters.integer("max-tree-mib")) << 20;
         const std::string rollout = parameters.text("rollout");
         if (rollout != "random") {
@@ -391,14 +386,7 @@ AllocatorKind mcts_kind() {
         MctsAllocator probe(mdp, options);  // checks the options once, before any episode
         return [model = &mdp, options] { return std::make_unique<MctsAllocator>(*model, options); };
       },
-      .needs = {.decision_budget = [](const ParameterReader& parameters) -> DecisionBudget {
-                  // Only what the caller gave: without it, a live session's share of a slice.
-                  const bool iterations = parameters.given("iterations");
-                  const double seconds = parameters.given("time-budget") ? parameters.real("time-budget") : 0.0;
-                  if (!iterations) return seconds > 0 ? DecisionBudget::seconds(seconds) : DecisionBudget{};
-                  return seconds > 0 ? DecisionBudget::either(parameters.integer("iterations"), seconds)
-                                     : DecisionBudget::iterations(parameters.integer("iterations"));
-                },
+      .needs = {.decision_budget = detail::given_budget,
                 .memory = {.parameter = "max-tree-mib",
                            .bytes =
                                [](const Problem&, const ParameterReader& parameters) {

@@ -65,17 +65,17 @@ struct MatrixFree {
 struct BoosterFree {
   void operator()(void* handle) const noexcept { static_cast<void>(XGBoosterFree(handle)); }
 };
-using Matrix = std::unique_ptr<void, MatrixFree>;
+using DMatrix = std::unique_ptr<void, MatrixFree>;
 using Booster = std::unique_ptr<void, BoosterFree>;
 
-Matrix dense_matrix(const std::vector<float>& values, std::size_t rows, std::size_t columns) {
+DMatrix dense_matrix(const std::vector<float>& values, std::size_t rows, std::size_t columns) {
   DMatrixHandle handle = nullptr;
   check(XGDMatrixCreateFromMat(values.data(), rows, columns, std::numeric_limits<float>::quiet_NaN(), &handle),
         "to make a matrix");
-  return Matrix(handle);
+  return DMatrix(handle);
 }
 
-void set_info(const Matrix& matrix, const char* field, const std::vector<float>& values) {
+void set_info(const DMatrix& matrix, const char* field, const std::vector<float>& values) {
   check(XGDMatrixSetFloatInfo(matrix.get(), field, values.data(), values.size()),
         (std::string("to set the training rows' ") + field).c_str());
 }
@@ -88,7 +88,7 @@ void set_parameters(const Booster& booster, const Settings& settings) {
   }
 }
 
-Booster training_booster(const Matrix& matrix, const Settings& settings) {
+Booster training_booster(const DMatrix& matrix, const Settings& settings) {
   DMatrixHandle matrices[] = {matrix.get()};
   BoosterHandle handle = nullptr;
   check(XGBoosterCreate(matrices, 1, &handle), "to make a booster");
@@ -114,7 +114,7 @@ std::vector<double> margins(int status, const bst_ulong* shape, bst_ulong dimens
 }
 
 // Margins of the training rows (XGBoost's prediction cache makes each call O(rows)).
-std::vector<double> training_margins(const Booster& booster, const Matrix& matrix, std::size_t rows) {
+std::vector<double> training_margins(const Booster& booster, const DMatrix& matrix, std::size_t rows) {
   const bst_ulong* shape = nullptr;
   bst_ulong dimensions = 0;
   const float* values = nullptr;
@@ -283,7 +283,7 @@ constexpr const char* kPlanningObjective = "survival:aft";
 constexpr const char* kExecutionObjective = "reg:squarederror";
 
 // The execution booster: XGBoost's reg:squarederror on the log seconds, from their mean.
-Booster execution_booster(const Matrix& matrix, const std::vector<float>& log_seconds,
+Booster execution_booster(const DMatrix& matrix, const std::vector<float>& log_seconds,
                           const BoostedSettings& settings) {
   set_info(matrix, "label", log_seconds);
   double sum = 0;
@@ -305,7 +305,7 @@ Booster execution_booster(const Matrix& matrix, const std::vector<float>& log_se
 // prediction for an action the trees have not seen, which the training residuals understate by
 // what the trees fit of the noise. (One row: its training residual, 0.) At least 1e-3.
 double execution_sigma(const std::vector<float>& features, const std::vector<float>& log_seconds, std::size_t F,
-                       const BoostedSettings& settings, const Booster& booster, const Matrix& matrix) {
+                       const BoostedSettings& settings, const Booster& booster, const DMatrix& matrix) {
   const std::size_t rows = log_seconds.size();
   if (rows == 0) return 1;
   std::vector<double> predicted(rows);
@@ -326,7 +326,7 @@ double execution_sigma(const std::vector<float>& features, const std::vector<flo
         kept_features.insert(kept_features.end(), begin, begin + static_cast<std::ptrdiff_t>(F));
       }
     }
-    const Matrix kept = dense_matrix(kept_features, kept_labels.size(), F);
+    const DMatrix kept = dense_matrix(kept_features, kept_labels.size(), F);
     const Booster without = execution_booster(kept, kept_labels, settings);
     const std::vector<double> margin =
         training_margins(without, dense_matrix(held_features, held.size(), F), held.size());
@@ -401,7 +401,7 @@ std::unique_ptr<BoostedTimeModel> BoostedTimeModel::fit(const ConditionalData& d
       lower[i] = static_cast<float>((rows[i].found ? steps - 1 : steps) / u);
       upper[i] = rows[i].found ? static_cast<float>(steps / u) : std::numeric_limits<float>::infinity();
     }
-    const Matrix matrix = dense_matrix(features, N, F);
+    const DMatrix matrix = dense_matrix(features, N, F);
     set_info(matrix, "label_lower_bound", lower);
     set_info(matrix, "label_upper_bound", upper);
     Settings never_settings = tree_settings(settings), planning_settings = tree_settings(settings);
@@ -452,7 +452,7 @@ std::unique_ptr<BoostedTimeModel> BoostedTimeModel::fit(const ConditionalData& d
           static_cast<float>(portable_log(std::max(data.execution_seconds[i], 1e-6 * data.step_seconds))));
     }
     const std::size_t found = log_seconds.size();
-    const Matrix execution_matrix = dense_matrix(found_features, found, F);
+    const DMatrix execution_matrix = dense_matrix(found_features, found, F);
     const Booster execution = execution_booster(execution_matrix, log_seconds, settings);
     out.execution_sigma = execution_sigma(found_features, log_seconds, F, settings, execution, execution_matrix);
     // The model predicts from the boosters read back from their text, as a model file's are; they

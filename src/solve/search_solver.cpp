@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <cmath>
 #include <cstddef>
 #include <exception>
 #include <functional>
@@ -12,6 +13,7 @@
 #include <string>
 #include <type_traits>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include "ontime/solve/optimal_solver.hpp"
@@ -37,6 +39,8 @@ constexpr double kShareMargin = 1.1;
 // larger frames.
 constexpr std::size_t kStackBase = std::size_t{1} << 20;
 constexpr std::size_t kStackPerStep = std::size_t{4} << 10;
+// Searches whose deadline needs at most this much run on the caller's stack (D <= 64).
+constexpr std::size_t kInlineStack = std::size_t{256} << 10;
 
 // Unwinds the search at a cap or a stop; the memo keeps what was solved.
 struct CutShort {
@@ -50,12 +54,17 @@ class BranchAndBound {
   using Key = std::remove_cvref_t<decltype(std::declval<const Policy&>().key(std::declval<const Compact&>()))>;
   using Hash = std::conditional_t<std::is_same_v<Key, Compact>, detail::CompactStateHash, detail::PackedStateHash>;
 
-  BranchAndBound(const Mdp& mdp, Policy policy, const ValueBounds& bounds, const SearchSolveOptions& options)
-      : mdp_(&mdp), policy_(std::move(policy)), bounds_(&bounds), options_(&options) {}
+  BranchAndBound(const Mdp& mdp, Policy policy, const ValueBounds& bounds, std::uint64_t max_states)
+      : mdp_(&mdp), policy_(std::move(policy)), bounds_(&bounds), max_states_(max_states) {}
 
-  SearchSolution run() {
-    const Compact start =
-        detail::compact<Compact>(mdp_->start(), mdp_->skeleton_count(), mdp_->problem().culprit_slot_count());
+  // Searches from `from` until its value is exact, the cap is reached or `stop(work)` returns
+  // true (checked after every `check_interval` units of work: a state solved or expanded by an
+  // upper test, counted from this call's start). What was solved and refined is kept.
+  SearchSolution run(const State& from, const std::function<bool(std::uint64_t)>& stop, std::uint64_t check_interval) {
+    const auto start = detail::compact<Compact>(from, mdp_->skeleton_count(), mdp_->problem().culprit_slot_count());
+    stop_ = &stop;
+    check_interval_ = check_interval;
+    work_start_ = work_;
     SearchSolution out;
     try {
       const detail::ExpectimaxEntry entry = solve(start, policy_.key(start));
@@ -64,18 +73,27 @@ class BranchAndBound {
     } catch (const CutShort& cut) {
       out = cut_short(start, cut.why);
     }
-    out.states = memo_.size();
+    stop_ = nullptr;
+    out.states = solved_;
     out.bounded = bounded_;
     out.tested = tested_;
-    out.refined = refined_.size();
+    out.refined = table_.size() - solved_;
     out.choices_cut = choices_cut_;
     return out;
   }
 
+  // Forgets every state solved or refined.
+  void clear() {
+    table_.clear();
+    solved_ = 0;
+  }
+  // States in the table (solved or refined).
+  std::uint64_t size() const noexcept { return table_.size(); }
+
  private:
   struct Item {
-    double probability;
-    Status status;
+    double probability = 0.0;
+    Status status = Status::running;
     Compact next;
     Key key;  // of `next`, when running
     // When running: the interval around V*(next) last looked up (lo < 0: not yet), and whether
@@ -86,16 +104,22 @@ class BranchAndBound {
   // One choice of a state on the search's path: its outcomes items_[begin, end) and the interval
   // around its value (lo == hi once solved).
   struct Choice {
-    int choice;
-    std::size_t begin, end;
+    int choice = -1;
+    std::size_t begin = 0, end = 0;
     double lo = 0, hi = 0;
     bool exact = false;
     bool tested = false;  // an upper test against the best so far was tried
   };
   static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
 
+  // (solve, solve_choice, prove_below and test recurse one level per step of CT, at most D deep:
+  // solve_search gives deep deadlines a stack of their own. An explicit stack would hold the same
+  // frames with far less clear code.)
+  // NOLINTNEXTLINE(misc-no-recursion)
   detail::ExpectimaxEntry solve(const Compact& state, const Key& key) {
-    if (const auto found = memo_.find(key); found != memo_.end()) return found->second;
+    if (const auto found = table_.find(key); found != table_.end() && found->second.exact) {
+      return {found->second.value, found->second.choice};
+    }
     const std::size_t item_begin = items_.size();
     const std::size_t choice_begin = choices_.size();
     expand(state);
@@ -122,14 +146,27 @@ class BranchAndBound {
     items_.resize(item_begin);
     choices_.resize(choice_begin);
 
-    if (options_->max_states != 0 && memo_.size() >= options_->max_states) {
-      throw CutShort{"the cap of " + std::to_string(options_->max_states) + " states"};
+    check_cap();
+    table_.insert_or_assign(key, Entry{entry.value, -1.0F, static_cast<std::int16_t>(entry.choice), true});
+    ++solved_;
+    count_work();
+    return entry;
+  }
+
+  // Throws CutShort when the table holds the cap's states (solved and refined: what memory holds).
+  void check_cap() const {
+    if (max_states_ != 0 && table_.size() >= max_states_) {
+      throw CutShort{"the cap of " + std::to_string(max_states_) + " states"};
     }
-    if (options_->stop && (memo_.size() & (kStopCheckInterval - 1)) == 0 && options_->stop()) {
+  }
+
+  // One unit of work done: throws CutShort when the stop condition says so.
+  void count_work() {
+    ++work_;
+    const std::uint64_t done = work_ - work_start_;
+    if (stop_ != nullptr && *stop_ && (done == 1 || done % check_interval_ == 0) && (*stop_)(done)) {
       throw CutShort{"the stop condition"};
     }
-    memo_.emplace(key, entry);
-    return entry;
   }
 
   // Pushes every useful choice of `state` and its outcomes (in the MDP's order) on the stacks.
@@ -150,13 +187,14 @@ class BranchAndBound {
   // it; else the upper test's refined bound or ValueBounds' upper end, and (with `lower`)
   // ValueBounds' lower end, each widened by kBoundSlack.
   void look_up(Item& item, bool lower) {
-    if (const auto found = memo_.find(item.key); found != memo_.end()) {
+    const auto found = table_.find(item.key);
+    if (found != table_.end() && found->second.exact) {
       item.lo = item.hi = found->second.value;
       item.exact = true;
       return;
     }
     ++bounded_;
-    item.hi = upper_of(item.next, item.key);
+    item.hi = found != table_.end() ? found->second.value : static_upper(item.next);
     if (lower && item.lo < 0.0) item.lo = std::max(0.0, bounds_->lower(item.next) - kBoundSlack);
   }
 
@@ -179,24 +217,25 @@ class BranchAndBound {
     choices_[c].hi = hi;
   }
 
-  // Looks up choice c's successors and sums its interval.
+  // Looks up choice c's successors and sums its interval. The table is far larger than the
+  // caches: every lookup is prefetched first.
   void bound(std::size_t c, bool lower = true) {
+    for (std::size_t i = choices_[c].begin; i < choices_[c].end; ++i) {
+      if (items_[i].status == Status::running && !items_[i].exact) table_.prefetch(items_[i].key);
+    }
     for (std::size_t i = choices_[c].begin; i < choices_[c].end; ++i) {
       if (items_[i].status == Status::running && !items_[i].exact) look_up(items_[i], lower);
     }
     sum_up(c, lower);
   }
 
-  // An upper bound on V*(next): refined by an upper test where one ran, else ValueBounds'.
-  double upper_of(const Compact& next, const Key& key) const {
-    if (const auto found = refined_.find(key); found != refined_.end()) return found->second.upper;
-    return std::min(1.0, bounds_->upper(next) + kBoundSlack);
-  }
+  // ValueBounds' upper bound on V*(next), widened by kBoundSlack.
+  double static_upper(const Compact& next) const { return std::min(1.0, bounds_->upper(next) + kBoundSlack); }
 
   // Tries to bring choice c's upper end to `threshold` or below by upper tests of its running
   // successors: each is asked for a share of the excess in proportion to its gap (probability
   // times the width of its interval); its upper end is then summed again.
-  void prove_below(std::size_t c, double threshold) {
+  void prove_below(std::size_t c, double threshold) {  // NOLINT(misc-no-recursion): see solve
     choices_[c].tested = true;
     const std::size_t begin = choices_[c].begin;
     const std::size_t end = choices_[c].end;
@@ -225,13 +264,14 @@ class BranchAndBound {
 
   // An upper test: a bound u >= V*(state), refined by expanding the state (and, recursively, its
   // successors) until u <= target or the expansion shows it cannot get there. Each expanded
-  // state's bound is kept (refined_).
-  double test(const Compact& state, const Key& key, double target) {
-    if (const auto found = memo_.find(key); found != memo_.end()) return found->second.value;
-    const double known = upper_of(state, key);
+  // state's bound is kept (table_).
+  double test(const Compact& state, const Key& key, double target) {  // NOLINT(misc-no-recursion): see solve
+    const auto found = table_.find(key);
+    if (found != table_.end() && found->second.exact) return found->second.value;
+    const double known = found != table_.end() ? found->second.value : static_upper(state);
     if (known <= target || target < 0.0) return known;
-    const auto tried = refined_.find(key);
-    if (tried != refined_.end() && target <= tried->second.failed_at) return known;
+    if (found != table_.end() && target <= found->second.failed_at) return known;
+    const bool held = found != table_.end();
     const std::size_t item_begin = items_.size();
     const std::size_t choice_begin = choices_.size();
     expand(state);
@@ -250,14 +290,22 @@ class BranchAndBound {
     items_.resize(item_begin);
     choices_.resize(choice_begin);
     result = std::min(result, known);
-    Refined& refined = refined_[key];
-    refined.upper = result;
-    if (result > target) refined.failed_at = std::max(refined.failed_at, target);
+    if (!held) check_cap();
+    // (Looked up again: the recursion may have moved the table's slots.)
+    Entry& refined = table_.try_emplace(key, Entry{1.0, -1.0F, -1, false}).first->second;
+    refined.value = result;
+    if (result > target) {
+      // Rounded up, so that a test to the same target is not run again.
+      auto missed = static_cast<float>(target);
+      if (static_cast<double>(missed) < target) missed = std::nextafter(missed, 2.0F);
+      refined.failed_at = std::max(refined.failed_at, missed);
+    }
+    count_work();
     return result;
   }
 
   // Solves choice c exactly: the memoised solver's sum, in its order.
-  void solve_choice(std::size_t c) {
+  void solve_choice(std::size_t c) {  // NOLINT(misc-no-recursion): see solve
     double value = 0.0;
     const std::size_t begin = choices_[c].begin;
     const std::size_t end = choices_[c].end;
@@ -285,12 +333,12 @@ class BranchAndBound {
     threshold = 2.0;
     if (begin == end) return kNone;
     bool any_exact = false;
-    std::size_t widest = begin;
+    std::size_t first = begin;
     for (std::size_t c = begin; c < end; ++c) {
       any_exact = any_exact || choices_[c].exact;
-      if (choices_[c].lo > choices_[widest].lo) widest = c;
+      if (choices_[c].lo > choices_[first].lo) first = c;
     }
-    if (!any_exact) return widest;
+    if (!any_exact) return first;  // the largest lower end
     // The exact solver's replay: the best so far starts below every value.
     double best_lo = -1.0;
     double best_hi = -1.0;
@@ -341,28 +389,30 @@ class BranchAndBound {
   const Mdp* mdp_;
   Policy policy_;
   const ValueBounds* bounds_;
-  const SearchSolveOptions* options_;
-  absl::flat_hash_map<Key, detail::ExpectimaxEntry, Hash> memo_;
+  std::uint64_t max_states_;
+  const std::function<bool(std::uint64_t)>* stop_ = nullptr;
+  std::uint64_t check_interval_ = 1;
+  std::uint64_t work_ = 0, work_start_ = 0;
   std::vector<Item> items_;
   std::vector<Choice> choices_;
   std::vector<int> choice_list_;
-  // A state's upper bound as upper tests refined it, and the highest target a test of it missed:
-  // a test to that target or below is not run again (it would most likely miss again; when the
-  // bounds below have moved since, the exact solve that follows a miss is only slower).
-  struct Refined {
-    double upper = 1.0;
-    double failed_at = -1.0;
+  // One table for the states solved (exact) and those whose upper bound an upper test refined
+  // (value: that bound), so that a successor costs one probe. failed_at: the highest target a
+  // test of the state missed; a test to that target or below is not run again (it would most
+  // likely miss again; where the bounds below have moved since, the exact solve that follows a
+  // miss is only slower). A float: it only steers the search.
+  struct Entry {
+    double value;
+    float failed_at;
+    std::int16_t choice;
+    bool exact;
   };
-  absl::flat_hash_map<Key, Refined, Hash> refined_;
+  absl::flat_hash_map<Key, Entry, Hash> table_;
+  std::uint64_t solved_ = 0;
   std::uint64_t tested_ = 0;
   std::uint64_t bounded_ = 0;
   std::uint64_t choices_cut_ = 0;
 };
-
-template <class Policy>
-SearchSolution run(const Mdp& mdp, Policy policy, const ValueBounds& bounds, const SearchSolveOptions& options) {
-  return BranchAndBound<Policy>(mdp, std::move(policy), bounds, options).run();
-}
 
 // Runs `work` on a thread of its own whose stack holds `stack_bytes`, and waits for it; rethrows
 // what it threw. The search recurses one level per step of the deadline, and the caller's thread
@@ -376,7 +426,7 @@ void run_on_own_stack(std::size_t stack_bytes, const std::function<void()>& work
   pthread_attr_t attributes;
   if (pthread_attr_init(&attributes) != 0) throw std::runtime_error("search: cannot set up its thread");
   pthread_attr_setstacksize(&attributes, std::max<std::size_t>(stack_bytes, PTHREAD_STACK_MIN));
-  pthread_t thread;
+  pthread_t thread{};
   const int created = pthread_create(
       &thread, &attributes,
       [](void* argument) -> void* {
@@ -397,29 +447,76 @@ void run_on_own_stack(std::size_t stack_bytes, const std::function<void()>& work
   if (job.error) std::rethrow_exception(job.error);
 }
 
+using Engine = std::variant<BranchAndBound<detail::OptimalPolicy<2>>, BranchAndBound<detail::OptimalPolicy<4>>,
+                            BranchAndBound<detail::OptimalPolicy<0>>, BranchAndBound<detail::OptimalBacktrackPolicy>>;
+
+Engine make_engine(const Mdp& mdp, const ValueBounds& bounds, std::uint64_t max_states) {
+  if (mdp.has_backtracking()) {
+    return BranchAndBound<detail::OptimalBacktrackPolicy>(mdp, detail::OptimalBacktrackPolicy(mdp), bounds, max_states);
+  }
+  switch (detail::packed_words(mdp)) {
+    case 2:
+      return BranchAndBound<detail::OptimalPolicy<2>>(mdp, detail::OptimalPolicy<2>(mdp), bounds, max_states);
+    case 4:
+      return BranchAndBound<detail::OptimalPolicy<4>>(mdp, detail::OptimalPolicy<4>(mdp), bounds, max_states);
+    default:
+      return BranchAndBound<detail::OptimalPolicy<0>>(mdp, detail::OptimalPolicy<0>(mdp), bounds, max_states);
+  }
+}
+
 }  // namespace
 
-SearchSolution solve_search(const Mdp& mdp, const SearchSolveOptions& options) {
+struct BranchAndBoundSearch::Impl {
+  Impl(const Mdp& mdp, std::uint64_t max_states)
+      : bounds(mdp), engine(make_engine(mdp, bounds, max_states)), deadline(mdp.deadline()) {}
+  ValueBounds bounds;
+  Engine engine;
+  Steps deadline;
+
+  SearchSolution run(const State& from, const std::function<bool(std::uint64_t)>& stop, std::uint64_t check_interval) {
+    SearchSolution solution;
+    const auto work = [&] {
+      solution = std::visit([&](auto& search) { return search.run(from, stop, check_interval); }, engine);
+    };
+    // Shallow searches run on the caller's stack; deeper ones on a stack of their own.
+    const std::size_t stack = static_cast<std::size_t>(deadline) * kStackPerStep;
+    if (stack <= kInlineStack) {
+      work();
+    } else {
+      run_on_own_stack(kStackBase + stack, work);
+    }
+    return solution;
+  }
+};
+
+BranchAndBoundSearch::BranchAndBoundSearch(const Mdp& mdp, std::uint64_t max_states) {
   detail::require_exact_size(mdp, "search");
-  const ValueBounds bounds(mdp);
-  SearchSolution solution;
-  run_on_own_stack(kStackBase + kStackPerStep * static_cast<std::size_t>(mdp.deadline()), [&] {
-    if (mdp.has_backtracking()) {
-      solution = run(mdp, detail::OptimalBacktrackPolicy(mdp), bounds, options);
-      return;
-    }
-    switch (detail::packed_words(mdp)) {
-      case 2:
-        solution = run(mdp, detail::OptimalPolicy<2>(mdp), bounds, options);
-        break;
-      case 4:
-        solution = run(mdp, detail::OptimalPolicy<4>(mdp), bounds, options);
-        break;
-      default:
-        solution = run(mdp, detail::OptimalPolicy<0>(mdp), bounds, options);
-    }
-  });
-  return solution;
+  impl_ = std::make_unique<Impl>(mdp, max_states);
+}
+BranchAndBoundSearch::~BranchAndBoundSearch() = default;
+BranchAndBoundSearch::BranchAndBoundSearch(BranchAndBoundSearch&&) noexcept = default;
+BranchAndBoundSearch& BranchAndBoundSearch::operator=(BranchAndBoundSearch&&) noexcept = default;
+
+SearchSolution BranchAndBoundSearch::search(const State& from, const std::function<bool(std::uint64_t)>& stop,
+                                            std::uint64_t check_interval) {
+  return impl_->run(from, stop, std::max<std::uint64_t>(check_interval, 1));
+}
+
+void BranchAndBoundSearch::clear() {
+  std::visit([](auto& search) { search.clear(); }, impl_->engine);
+}
+
+// (std::visit throws only for a valueless variant, which the engine, never reassigned, cannot be.)
+// NOLINTNEXTLINE(bugprone-exception-escape)
+std::uint64_t BranchAndBoundSearch::size() const noexcept {
+  return std::visit([](const auto& search) { return search.size(); }, impl_->engine);
+}
+
+SearchSolution solve_search(const Mdp& mdp, const SearchSolveOptions& options) {
+  BranchAndBoundSearch search(mdp, options.max_states);
+  std::function<bool(std::uint64_t)> stop;
+  if (options.stop) stop = [&options](std::uint64_t) { return options.stop(); };
+  return search.search(mdp.start(), stop, kStopCheckInterval);
 }
 
 }  // namespace ontime

@@ -14,6 +14,7 @@
 #include "ontime/run/simulator.hpp"
 #include "ontime/solve/value_bounds.hpp"
 #include "ontime/util/error.hpp"
+#include "support/exact_q.hpp"
 #include "support/paper.hpp"
 
 namespace ontime {
@@ -127,16 +128,6 @@ MctsOptions bellman_with_upper_leaves(const Mdp& mdp, std::uint64_t iterations) 
   return options;
 }
 
-// Q*(s, c): the exact value of choosing c in s and then playing optimally.
-double exact_q(const Mdp& mdp, OptimalSolver& solver, const State& state, int choice) {
-  double q = 0.0;
-  mdp.for_each_outcome(state, choice, [&](double probability, Status status, const State& next) {
-    if (status == Status::success) q += probability;
-    if (status == Status::running) q += probability * solver.solve(next);
-  });
-  return q;
-}
-
 TEST(Mcts, BellmanBackupsWithOptimisticLeavesChooseOptimallyAtTheStart) {
   for (const char* name : {"figure1", "instance1", "instance2", "instance3", "instance4", "instance5"}) {
     const Problem problem = testing::paper_instance(name);
@@ -147,7 +138,7 @@ TEST(Mcts, BellmanBackupsWithOptimisticLeavesChooseOptimallyAtTheStart) {
       MctsAllocator mcts(mdp, bellman_with_upper_leaves(mdp, 10'000));
       mcts.begin_episode(seed);
       const int choice = mcts.choose(mdp.start());
-      EXPECT_NEAR(exact_q(mdp, solver, mdp.start(), choice), optimum, 1e-12) << name << " seed " << seed;
+      EXPECT_NEAR(testing::exact_q(mdp, solver, mdp.start(), choice), optimum, 1e-12) << name << " seed " << seed;
     }
   }
 }
@@ -168,7 +159,7 @@ TEST(Mcts, BellmanBackupsOverTheWholeTreeAreTheExactValues) {
     const auto root = mcts.root_choices();
     ASSERT_EQ(root.size(), 2U);
     for (const auto& item : root) {
-      EXPECT_NEAR(item.value, exact_q(mdp, solver, mdp.start(), item.skeleton), 1e-12)
+      EXPECT_NEAR(item.value, testing::exact_q(mdp, solver, mdp.start(), item.skeleton), 1e-12)
           << "skeleton " << item.skeleton << (optimistic ? " (upper leaves)" : " (lower leaves)");
     }
   }

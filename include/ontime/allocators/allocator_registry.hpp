@@ -37,6 +37,7 @@ enum class Capability : std::uint32_t {
   anytime = 1U << 2,       // uses the budget passed with each decision
   needs_policy = 1U << 3,  // needs a trained policy (a file), not just the instance
   optimal = 1U << 4,       // attains the optimum: the reference column, not a competitor
+  certified = 1U << 5,     // each decision carries a certified bound on its loss (a yardstick, like optimal)
 };
 
 class Capabilities {

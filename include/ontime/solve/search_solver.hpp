@@ -8,13 +8,16 @@
 // [lo_c, hi_c] around its value Q(c) = sum_o P(o | s, c) V*(o), from the exact values of the
 // successors already solved and, for the others, the certified bounds of ValueBounds (commit
 // policy below, clairvoyant relaxation above, each widened by kBoundSlack against rounding).
-// The most promising choice (largest hi) is solved first, exactly; then the choices are
+// The choice with the largest lower end is solved first, exactly; then the choices are
 // replayed in index order under the exact solver's tie rule (a choice replaces the best so far
 // when its value exceeds it by more than kTieTolerance). A choice whose interval settles its
 // comparison (below the best so far plus the tolerance: never the answer; above it: replaces
-// it) is not solved; the first comparison the intervals cannot settle solves the one of its two
-// choices not yet exact with the larger hi, and the replay starts again. The answer is the last
-// choice the replay keeps, solved exactly.
+// it) is not solved. Where the intervals cannot settle a comparison with an exact best so far,
+// an upper test first tries to push the choice's upper end below it: the excess is spread over
+// its unsolved successors in proportion to their gaps, and each is expanded (not solved) just far
+// enough, recursively, to meet its share; the upper bounds it finds are kept. A comparison still
+// unsettled solves the one of its two choices not yet exact with the larger hi, and the replay
+// starts again. The answer is the last choice the replay keeps, solved exactly.
 //
 // Guarantees. Every exact value is summed over the same outcomes in the same order from the
 // same successor values as the memoised solver's, and a choice is left unsolved only where its
@@ -25,15 +28,17 @@
 // Deterministic: one thread, the same order every run. Backtracking (SPEC §7) is taken as the
 // memoised solver takes it (whole states with their restore values as keys).
 //
-// Cost: time and memory linear in the states solved (each a memo slot of the memoised
-// solver's size) times their outcomes, with two table lookups of O(K) per unsolved successor;
-// the ValueBounds tables ((nodes + sum of lengths) * D^2 doubles). The recursion goes one level
-// per step of CT, so at most D deep (D <= 10,000 by the instance format: well within a thread's
-// stack).
+// Cost: time and memory linear in the states solved or expanded by upper tests (one table of
+// both, a slot of the packed key and 16 bytes each) times their outcomes, with a table lookup
+// and ValueBounds' O(K) per unsolved successor; the ValueBounds tables ((nodes + sum of
+// lengths) * D^2 doubles). The recursion goes one level per step of CT, so at most D deep: a
+// deadline above 64 steps runs it on a thread of its own whose stack is sized for D, whatever
+// the caller's stack.
 
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 
 #include "ontime/mdp/mdp.hpp"
@@ -41,7 +46,7 @@
 namespace ontime {
 
 struct SearchSolveOptions {
-  std::uint64_t max_states = 0;  // states solved exactly; 0: no cap
+  std::uint64_t max_states = 0;  // states held: solved, or with an upper bound refined by a test; 0: no cap
   // Checked every few thousand states: once it returns true the search ends as at a cap.
   std::function<bool()> stop;
 };
@@ -57,6 +62,37 @@ struct SearchSolution {
   std::uint64_t tested = 0;       // upper tests run (states expanded to refine their upper bound)
   std::uint64_t refined = 0;      // states holding a refined upper bound at the end
   std::string stopped_by;         // cut: the cap or stop that ended the search
+};
+
+// The search kept between calls, for deciding step by step (the `branch-and-bound` allocator):
+// the values it solved and the upper bounds it refined hold for any state, so a later search
+// from a successor starts from them.
+class BranchAndBoundSearch {
+ public:
+  // Builds ValueBounds' tables. Throws as solve_search does.
+  explicit BranchAndBoundSearch(const Mdp& mdp, std::uint64_t max_states = 0);
+  ~BranchAndBoundSearch();
+  BranchAndBoundSearch(const BranchAndBoundSearch&) = delete;
+  BranchAndBoundSearch& operator=(const BranchAndBoundSearch&) = delete;
+  BranchAndBoundSearch(BranchAndBoundSearch&&) noexcept;
+  BranchAndBoundSearch& operator=(BranchAndBoundSearch&&) noexcept;
+
+  // Searches from `from` until its value is exact, the state cap is reached (states held: solved
+  // or refined since made or cleared) or `stop(work)` returns true, checked every `check_interval` units of
+  // work (a state solved, or expanded by an upper test) with the units done in this call. Cut
+  // short, the solution is `from`'s interval and the choice of the best lower end: `lower` is at
+  // most that choice's value, `upper` at least V*(from), so upper - lower bounds its loss. The
+  // counters are cumulative.
+  SearchSolution search(const State& from, const std::function<bool(std::uint64_t work)>& stop = nullptr,
+                        std::uint64_t check_interval = 1);
+  // Forgets what was solved and refined.
+  void clear();
+  // States held (solved or refined).
+  std::uint64_t size() const noexcept;  // NOLINT(bugprone-exception-escape): see its definition
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 // Solves from mdp.start(). Throws UsageError for more than kMaxExactSkeletons skeletons (or more

@@ -1,0 +1,101 @@
+#include "ontime/allocators/branch_and_bound.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <string>
+
+#include "ontime/allocators/allocator_registry.hpp"
+#include "ontime/run/evaluation.hpp"
+#include "ontime/solve/optimal_solver.hpp"
+#include "ontime/util/random.hpp"
+#include "support/exact_q.hpp"
+#include "support/paper.hpp"
+#include "support/random_instances.hpp"
+
+namespace ontime {
+namespace {
+
+// Along episodes drawn from the model, every decision's certified gap is at least its true loss
+// V*(s) - Q*(s, choice), whatever the budget; with a budget the search finishes in, the gap is 0
+// and the choice attains V*.
+void expect_sound_gaps(const Mdp& mdp, std::uint64_t iterations, std::uint64_t seed, int& cut_decisions) {
+  OptimalSolver solver(mdp);
+  BranchAndBoundOptions options;
+  options.budget = DecisionBudget::iterations(iterations);
+  BranchAndBoundAllocator allocator(mdp, options);
+  SplitMix64 generator(seed);
+  for (int episode = 0; episode < 20; ++episode) {
+    allocator.begin_episode(seed + static_cast<std::uint64_t>(episode));
+    State state = mdp.start();
+    for (;;) {
+      if (mdp.useful_choices(state).empty()) break;
+      const int choice = allocator.choose(state);
+      const double optimum = solver.solve(state);
+      const double loss = optimum - testing::exact_q(mdp, solver, state, choice);
+      EXPECT_GE(allocator.last_gap(), loss - 1e-12) << "iterations " << iterations;
+      if (allocator.last_gap() == 0.0) {
+        EXPECT_NEAR(loss, 0.0, 1e-12) << "iterations " << iterations;
+      } else {
+        ++cut_decisions;
+      }
+      if (mdp.apply(state, choice, mdp.sample_observation(state, choice, generator)) != Status::running) break;
+    }
+  }
+}
+
+TEST(BranchAndBound, TheCertifiedGapIsNeverBelowTheTrueLoss) {
+  int cut_decisions = 0;
+  for (std::uint64_t seed = 1; seed <= 30; ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    const Problem problem = testing::random_instance(seed, 5, 4, 14);
+    const Mdp mdp(problem);
+    for (const std::uint64_t iterations : {1U, 5U, 50U}) expect_sound_gaps(mdp, iterations, seed, cut_decisions);
+  }
+  for (const char* name : {"instance1", "instance3"}) {
+    const Problem problem = testing::paper_instance(name);
+    const Mdp mdp(problem);
+    for (const std::uint64_t iterations : {1U, 10U, 100U}) expect_sound_gaps(mdp, iterations, 7, cut_decisions);
+  }
+  EXPECT_GE(cut_decisions, 200);  // the small budgets do cut searches short
+}
+
+// With the default budget the paper's instances are solved exactly at every decision: the
+// choices are the optimal allocator's, and the success rate over the same episodes is its rate.
+TEST(BranchAndBound, ItsDefaultBudgetIsTheOptimumOnThePaperInstances) {
+  for (const char* name : {"figure1", "instance1", "instance2", "instance3", "instance4", "instance5"}) {
+    const Problem problem = testing::paper_instance(name);
+    const Mdp mdp(problem);
+    MonteCarloOptions monte_carlo;
+    monte_carlo.episodes = 2000;
+    monte_carlo.seed = 11;
+    monte_carlo.threads = 1;
+    const MonteCarloResult searched =
+        run_monte_carlo(mdp, make_allocator_factory("branch-and-bound", mdp, {}), monte_carlo);
+    const MonteCarloResult optimal = run_monte_carlo(mdp, make_allocator_factory("optimal", mdp, {}), monte_carlo);
+    EXPECT_EQ(searched.successes, optimal.successes) << name;
+    EXPECT_EQ(searched.statistics.find("exact_decisions"), searched.statistics.find(kSearchesCounter)) << name;
+    EXPECT_EQ(searched.statistics.find("max_gap").value_or(-1.0), 0.0) << name;
+  }
+}
+
+TEST(BranchAndBound, SameSeedSameDecisionsWhateverTheThreads) {
+  const Problem problem = testing::random_instance(21, 5, 4, 14);
+  const Mdp mdp(problem);
+  const AllocatorFactory factory = make_allocator_factory("branch-and-bound", mdp, {{"iterations", "2"}});
+  MonteCarloOptions monte_carlo;
+  monte_carlo.episodes = 400;
+  monte_carlo.seed = 5;
+  monte_carlo.threads = 1;
+  const MonteCarloResult one = run_monte_carlo(mdp, factory, monte_carlo);
+  monte_carlo.threads = 2;
+  const MonteCarloResult two = run_monte_carlo(mdp, factory, monte_carlo);
+  EXPECT_EQ(one.successes, two.successes);
+  EXPECT_EQ(one.statistics.find(kIterationsCounter), two.statistics.find(kIterationsCounter));
+  // (A sum of doubles over two threads' shares: equal up to the order of the additions.)
+  EXPECT_NEAR(one.statistics.find("gap_sum").value_or(-1.0), two.statistics.find("gap_sum").value_or(1.0), 1e-9);
+  EXPECT_GT(one.statistics.find("gap_sum").value_or(0.0), 0.0);
+}
+
+}  // namespace
+}  // namespace ontime
