@@ -105,6 +105,14 @@ std::string to_json(const Evaluation& evaluation) {
     out["exact_success_probability"] = evaluation.exact->success_probability;
     out["exact_states"] = evaluation.exact->states;
   }
+  if (evaluation.regret) {
+    Json regret;
+    regret["optimum"] = evaluation.regret->optimum;
+    regret["mean"] = evaluation.regret->mean;
+    regret["ci95"] = evaluation.regret->ci95;
+    regret["episodes"] = evaluation.regret->episodes;
+    out["regret"] = regret;
+  }
   return dump(out);
 }
 
@@ -119,6 +127,12 @@ std::string to_text(const Evaluation& evaluation) {
   if (evaluation.exact) {
     out += fmt::format("exact           {:.6f}  ({} states)\n", evaluation.exact->success_probability,
                        evaluation.exact->states);
+  }
+  if (evaluation.regret) {
+    const RegretEstimate& regret = *evaluation.regret;
+    out += fmt::format("regret          {:.6f} ± {:.6f}  (optimum {:.6f}: success probability {:.6f}, {:.2f}% of it)\n",
+                       regret.mean, regret.ci95, regret.optimum, regret.optimum - regret.mean,
+                       regret.optimum > 0 ? 100.0 * (regret.optimum - regret.mean) / regret.optimum : 100.0);
   }
   if (!evaluation.timing) return out;
   out +=

@@ -33,6 +33,10 @@ constexpr std::size_t kStopCheckInterval = 4096;
 // An upper test asks each successor for this much more than its share of the excess, so that
 // one round usually suffices.
 constexpr double kShareMargin = 1.1;
+// A trial ends where its choice's outcomes hold less than this fraction of the start's gap
+// (bounded RTDP's tau); the trials end when the start's gap is below kTrialsDone.
+constexpr double kTrialRatio = 32.0;
+constexpr double kTrialsDone = 1e-9;
 
 // The search's stack: a base, and per step of the deadline (a level of solve and one of an upper
 // test, under 0.5 KiB together in a release build, measured at D = 4,096) room for the sanitizers'
@@ -74,6 +78,37 @@ class BranchAndBound {
       out = cut_short(start, cut.why);
     }
     stop_ = nullptr;
+    return with_counters(out);
+  }
+
+  // Trials from `from` (bounded RTDP, McMahan, Likhachev and Gordon 2005) until `stop(work)`
+  // returns true (checked after every `check_interval` states expanded), the cap is reached or
+  // from's interval is narrower than kTrialsDone. Each trial walks down from `from`: at every
+  // state it takes the choice of the largest upper end and the outcome of the largest
+  // probability times gap, and ends where the choice's outcomes hold less than 1/kTrialRatio of
+  // from's gap; the states walked are then backed up deepest first, both ends (a state's lower
+  // end is its best choice's lower end less kTieTolerance, which keeps it at most the exact
+  // solver's value whatever choice its tie rule takes). The bounds are kept, so a search after
+  // them starts from them. Returns from's interval and the choice of the best lower end.
+  SearchSolution trials(const State& from, const std::function<bool(std::uint64_t)>& stop,
+                        std::uint64_t check_interval) {
+    const auto start = detail::compact<Compact>(from, mdp_->skeleton_count(), mdp_->problem().culprit_slot_count());
+    const Key key = policy_.key(start);
+    work_start_ = work_;
+    bool go_on = true;
+    while (go_on) go_on = trial(start, key, stop, check_interval);
+    SearchSolution out;
+    if (const auto found = table_.find(key); found != table_.end() && found->second.exact) {
+      out.lower = out.upper = found->second.value;
+      out.first_choice = found->second.choice;
+    } else {
+      out = cut_short(start, "the trials' budget");
+    }
+    return with_counters(out);
+  }
+
+  // `out` with the cumulative counters.
+  SearchSolution with_counters(SearchSolution out) const {
     out.states = solved_;
     out.bounded = bounded_;
     out.tested = tested_;
@@ -85,6 +120,7 @@ class BranchAndBound {
   // Forgets every state solved or refined.
   void clear() {
     table_.clear();
+    lower_.clear();
     solved_ = 0;
   }
   // States in the table (solved or refined).
@@ -111,6 +147,12 @@ class BranchAndBound {
     bool tested = false;  // an upper test against the best so far was tried
   };
   static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+  // A state on a trial's path: its key and its choices choices_[choice_begin, choice_end), whose
+  // outcomes start at items_[item_begin].
+  struct TrialLevel {
+    Key key;
+    std::size_t item_begin = 0, choice_begin = 0, choice_end = 0;
+  };
 
   // (solve, solve_choice, prove_below and test recurse one level per step of CT, at most D deep:
   // solve_search gives deep deadlines a stack of their own. An explicit stack would hold the same
@@ -151,6 +193,103 @@ class BranchAndBound {
     ++solved_;
     count_work();
     return entry;
+  }
+
+  // One trial (see trials()); false when the trials should end.
+  bool trial(const Compact& start, const Key& start_key, const std::function<bool(std::uint64_t)>& stop,
+             std::uint64_t check_interval) {
+    path_.clear();
+    Compact state = start;
+    Key key = start_key;
+    double start_gap = -1.0;
+    bool go_on = true;
+    for (;;) {
+      if (const auto found = table_.find(key); found != table_.end() && found->second.exact) {
+        go_on = !path_.empty();  // the start solved: nothing left to narrow
+        break;
+      }
+      if (max_states_ != 0 && table_.size() >= max_states_ && !table_.contains(key)) {
+        go_on = false;
+        break;
+      }
+      TrialLevel level{key, items_.size(), choices_.size(), 0};
+      expand(state);
+      level.choice_end = choices_.size();
+      path_.push_back(level);
+      const auto [lo, hi] = back_up(path_.back());
+      ++work_;
+      const std::uint64_t done = work_ - work_start_;
+      if (stop && (done == 1 || done % check_interval == 0) && stop(done)) go_on = false;
+      if (start_gap < 0.0) {
+        start_gap = hi - lo;
+        if (start_gap <= kTrialsDone) go_on = false;
+      }
+      if (!go_on || hi - lo <= start_gap / kTrialRatio) break;
+      // The choice of the largest upper end (the lowest index on ties), then its outcome of the
+      // largest probability times gap.
+      std::size_t choice = kNone;
+      for (std::size_t c = path_.back().choice_begin; c < path_.back().choice_end; ++c) {
+        if (choice == kNone || choices_[c].hi > choices_[choice].hi) choice = c;
+      }
+      std::size_t next = kNone;
+      double mass = 0.0;
+      double largest = 0.0;
+      for (std::size_t i = choices_[choice].begin; i < choices_[choice].end; ++i) {
+        const Item& item = items_[i];
+        if (item.status != Status::running || item.exact) continue;
+        const double weight = item.probability * (item.hi - item.lo);
+        mass += weight;
+        if (weight > largest) {
+          largest = weight;
+          next = i;
+        }
+      }
+      if (next == kNone || mass <= start_gap / kTrialRatio) break;
+      state = items_[next].next;
+      key = items_[next].key;
+    }
+    // Deepest first; the deepest level was just backed up.
+    for (std::size_t level = path_.size(); level-- > 1;) {
+      (void)back_up(path_[level - 1]);
+    }
+    if (!path_.empty()) {
+      items_.resize(path_.front().item_begin);
+      choices_.resize(path_.front().choice_begin);
+    }
+    return go_on;
+  }
+
+  // Bounds a trial level's choices from what the table and the trials hold, and keeps the
+  // state's interval: its upper end in the table (as an upper test does), its lower end in
+  // lower_. A state without choices is solved (0, as solve() would find).
+  std::pair<double, double> back_up(const TrialLevel& level) {
+    const Key& key = level.key;
+    if (level.choice_begin == level.choice_end) {
+      table_.insert_or_assign(key, Entry{0.0, -1.0F, -1, true});
+      ++solved_;
+      return {0.0, 0.0};
+    }
+    double lo = 0.0;
+    double hi = 0.0;
+    for (std::size_t c = level.choice_begin; c < level.choice_end; ++c) {
+      for (std::size_t i = choices_[c].begin; i < choices_[c].end; ++i) {
+        if (items_[i].status == Status::running && !items_[i].exact) table_.prefetch(items_[i].key);
+      }
+      for (std::size_t i = choices_[c].begin; i < choices_[c].end; ++i) {
+        Item& item = items_[i];
+        if (item.status != Status::running || item.exact) continue;
+        look_up(item, true);
+      }
+      sum_up(c, true);
+      lo = std::max(lo, choices_[c].lo);
+      hi = std::max(hi, choices_[c].hi);
+    }
+    lo = std::max(0.0, lo - OptimalSolver::kTieTolerance);
+    Entry& entry = table_.try_emplace(key, Entry{hi, -1.0F, -1, false}).first->second;
+    if (!entry.exact) entry.value = std::min(entry.value, hi);
+    double& held = lower_[key];
+    held = std::max(held, lo);
+    return {held, entry.exact ? entry.value : std::min(entry.value, 1.0)};
   }
 
   // Throws CutShort when the table holds the cap's states (solved and refined: what memory holds).
@@ -195,7 +334,11 @@ class BranchAndBound {
     }
     ++bounded_;
     item.hi = found != table_.end() ? found->second.value : static_upper(item.next);
-    if (lower && item.lo < 0.0) item.lo = std::max(0.0, bounds_->lower(item.next) - kBoundSlack);
+    if (!lower) return;
+    if (item.lo < 0.0) item.lo = std::max(0.0, bounds_->lower(item.next) - kBoundSlack);
+    if (!lower_.empty()) {
+      if (const auto held = lower_.find(item.key); held != lower_.end()) item.lo = std::max(item.lo, held->second);
+    }
   }
 
   // Choice c's interval from its items' (`lower`: both ends, else the upper end only). Summed in
@@ -396,6 +539,9 @@ class BranchAndBound {
   std::vector<Item> items_;
   std::vector<Choice> choices_;
   std::vector<int> choice_list_;
+  std::vector<TrialLevel> path_;
+  // Lower ends backed up by trials (certified: at most the exact solver's value of the state).
+  absl::flat_hash_map<Key, double, Hash> lower_;
   // One table for the states solved (exact) and those whose upper bound an upper test refined
   // (value: that bound), so that a successor costs one probe. failed_at: the highest target a
   // test of the state missed; a test to that target or below is not run again (it would most
@@ -500,6 +646,13 @@ BranchAndBoundSearch& BranchAndBoundSearch::operator=(BranchAndBoundSearch&&) no
 SearchSolution BranchAndBoundSearch::search(const State& from, const std::function<bool(std::uint64_t)>& stop,
                                             std::uint64_t check_interval) {
   return impl_->run(from, stop, std::max<std::uint64_t>(check_interval, 1));
+}
+
+SearchSolution BranchAndBoundSearch::trials(const State& from, const std::function<bool(std::uint64_t)>& stop,
+                                            std::uint64_t check_interval) {
+  // (Trials walk down a path without recursion: the caller's stack suffices.)
+  return std::visit([&](auto& search) { return search.trials(from, stop, std::max<std::uint64_t>(check_interval, 1)); },
+                    impl_->engine);
 }
 
 void BranchAndBoundSearch::clear() {

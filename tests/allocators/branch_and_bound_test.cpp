@@ -19,10 +19,12 @@ namespace {
 // Along episodes drawn from the model, every decision's certified gap is at least its true loss
 // V*(s) - Q*(s, choice), whatever the budget; with a budget the search finishes in, the gap is 0
 // and the choice attains V*.
-void expect_sound_gaps(const Mdp& mdp, std::uint64_t iterations, std::uint64_t seed, int& cut_decisions) {
+void expect_sound_gaps(const Mdp& mdp, std::uint64_t iterations, std::uint64_t seed, int& cut_decisions,
+                       double trial_share) {
   OptimalSolver solver(mdp);
   BranchAndBoundOptions options;
   options.budget = DecisionBudget::iterations(iterations);
+  options.trial_share = trial_share;
   BranchAndBoundAllocator allocator(mdp, options);
   SplitMix64 generator(seed);
   for (int episode = 0; episode < 20; ++episode) {
@@ -50,14 +52,19 @@ TEST(BranchAndBound, TheCertifiedGapIsNeverBelowTheTrueLoss) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     const Problem problem = testing::random_instance(seed, 5, 4, 14);
     const Mdp mdp(problem);
-    for (const std::uint64_t iterations : {1U, 5U, 50U}) expect_sound_gaps(mdp, iterations, seed, cut_decisions);
+    // Search alone, trials then search, trials alone.
+    for (const std::uint64_t iterations : {1U, 5U, 50U}) {
+      for (const double share : {0.0, 0.5, 1.0}) expect_sound_gaps(mdp, iterations, seed, cut_decisions, share);
+    }
   }
   for (const char* name : {"instance1", "instance3"}) {
     const Problem problem = testing::paper_instance(name);
     const Mdp mdp(problem);
-    for (const std::uint64_t iterations : {1U, 10U, 100U}) expect_sound_gaps(mdp, iterations, 7, cut_decisions);
+    for (const std::uint64_t iterations : {1U, 10U, 100U}) {
+      for (const double share : {0.0, 0.5, 1.0}) expect_sound_gaps(mdp, iterations, 7, cut_decisions, share);
+    }
   }
-  EXPECT_GE(cut_decisions, 200);  // the small budgets do cut searches short
+  EXPECT_GE(cut_decisions, 600);  // the small budgets do cut searches short
 }
 
 // With the default budget the paper's instances are solved exactly at every decision: the

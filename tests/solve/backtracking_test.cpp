@@ -424,7 +424,7 @@ TEST(Backtracking, TheLayeredSolverEqualsTheMemoisedOneBitForBit) {
 }
 
 // The search takes the memoised solver's keys and outcomes, and the bounds hold under
-// backtracking: the same value to the bit and the same first choice.
+// backtracking: the same value to the bit and the same first choice, after trials too.
 TEST(Backtracking, TheSearchEqualsTheMemoisedSolverBitForBit) {
   int backtracking = 0;
   for (std::uint64_t seed = 1; seed <= 40; ++seed) {
@@ -440,6 +440,16 @@ TEST(Backtracking, TheSearchEqualsTheMemoisedSolverBitForBit) {
     EXPECT_EQ(search.lower, optimum);
     EXPECT_EQ(search.first_choice, solver.best_choice(mdp.start()).value_or(-1));
     EXPECT_LE(search.states, solver.states());
+    for (const std::uint64_t budget : {2U, 20U}) {
+      // Trials' bounds hold under backtracking, and the search after them keeps the bits.
+      BranchAndBoundSearch trialled(mdp);
+      const SearchSolution trials = trialled.trials(mdp.start(), [&](std::uint64_t work) { return work >= budget; });
+      EXPECT_LE(trials.lower, optimum + OptimalSolver::kTieTolerance);  // as SearchSolver.Trials* says
+      EXPECT_GE(trials.upper, optimum);
+      const SearchSolution after = trialled.search(mdp.start());
+      EXPECT_EQ(after.lower, optimum);
+      EXPECT_EQ(after.first_choice, search.first_choice);
+    }
     SearchSolveOptions capped;
     capped.max_states = search.states / 2 + 1;
     const SearchSolution cut = solve_search(mdp, capped);

@@ -91,6 +91,62 @@ TEST(SearchSolver, EveryCapGivesAnIntervalHoldingTheOptimum) {
   EXPECT_GE(cut, 100);
 }
 
+// Q*(start, choice) from the memoised solver's values.
+double exact_q_at_start(const Mdp& mdp, OptimalSolver& memoised, int choice) {
+  double q = 0.0;
+  mdp.for_each_outcome(mdp.start(), choice, [&](double p, Status status, const State& next) {
+    if (status == Status::success) q += p;
+    if (status == Status::running) q += p * memoised.solve(next);
+  });
+  return q;
+}
+
+// Trials back lower and upper ends up along their paths: after any number of them the start's
+// interval holds the optimum (its lower end within the tie rule's tolerance: it is the lower end
+// of one choice, whose value may pass the optimum by that much where the rule kept an earlier
+// choice), its choice's lower end is at most that choice's exact value, and a search after them
+// (which settles choices by the trials' lower ends) still gives the memoised solver's bits
+// (with backtracking: Backtracking.TheSearchEqualsTheMemoisedSolverBitForBit). On the paper
+// instances 300 units of trials close the interval.
+void expect_certified_trials(const Mdp& mdp, std::uint64_t budget, const std::string& name) {
+  OptimalSolver memoised(mdp);
+  const double optimum = memoised.solve(mdp.start());
+  BranchAndBoundSearch search(mdp);
+  const SearchSolution trials = search.trials(mdp.start(), [&](std::uint64_t work) { return work >= budget; });
+  EXPECT_LE(trials.lower, optimum + OptimalSolver::kTieTolerance) << name;
+  EXPECT_GE(trials.upper, optimum) << name;
+  if (trials.first_choice >= 0) {
+    EXPECT_LE(trials.lower, exact_q_at_start(mdp, memoised, trials.first_choice)) << name;
+  }
+  const SearchSolution after = search.search(mdp.start());
+  ASSERT_TRUE(after.exact) << name;
+  EXPECT_EQ(after.lower, optimum) << name;
+  EXPECT_EQ(after.first_choice, memoised.best_choice(mdp.start()).value_or(-1)) << name;
+}
+
+TEST(SearchSolver, TrialsGiveCertifiedBoundsAndTheSearchAfterThemKeepsTheBits) {
+  for (std::uint64_t seed = 1; seed <= 60; ++seed) {
+    const Problem problem = testing::random_instance(seed, 5, 4, 14);
+    const Mdp mdp(problem);
+    for (const std::uint64_t budget : {1U, 4U, 30U, 300U}) {
+      expect_certified_trials(mdp, budget, "seed " + std::to_string(seed) + ", " + std::to_string(budget) + " units");
+    }
+  }
+  for (const char* name : {"figure1", "instance1", "instance2", "instance3", "instance4", "instance5"}) {
+    const Problem problem = testing::paper_instance(name);
+    const Mdp mdp(problem);
+    for (const std::uint64_t budget : {1U, 10U, 30U, 300U}) expect_certified_trials(mdp, budget, name);
+    OptimalSolver memoised(mdp);
+    const double optimum = memoised.solve(mdp.start());
+    BranchAndBoundSearch search(mdp);
+    const SearchSolution one = search.trials(mdp.start(), [](std::uint64_t) { return true; });
+    EXPECT_GT(one.upper - one.lower, 0.01) << name;  // the static bounds leave a gap
+    const SearchSolution closed = search.trials(mdp.start(), [](std::uint64_t work) { return work >= 300; });
+    EXPECT_LE(closed.upper - closed.lower, 1e-9) << name;
+    EXPECT_NEAR(exact_q_at_start(mdp, memoised, closed.first_choice), optimum, 1e-9) << name;
+  }
+}
+
 TEST(SearchSolver, TheStopConditionEndsItWithAnInterval) {
   const Problem problem = testing::paper_instance("instance1");
   const Mdp mdp(problem);

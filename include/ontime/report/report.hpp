@@ -20,6 +20,7 @@
 #include "ontime/model/problem.hpp"
 #include "ontime/run/evaluation.hpp"
 #include "ontime/run/experiments.hpp"
+#include "ontime/run/regret.hpp"
 #include "ontime/run/table.hpp"
 #include "ontime/solve/layered_solver.hpp"
 #include "ontime/solve/search_solver.hpp"
@@ -39,7 +40,8 @@ struct Evaluation {
   std::uint64_t seed = 0;
   MonteCarloResult result = {};
   std::optional<ExactEvaluation> exact = {};
-  bool timing = true;  // decision times and run time
+  std::optional<RegretEstimate> regret = {};  // with_regret's estimate of V* - V^pi
+  bool timing = true;                         // decision times and run time
 };
 std::string to_json(const Evaluation& evaluation);
 std::string to_text(const Evaluation& evaluation);

@@ -85,6 +85,17 @@ class BranchAndBoundSearch {
   // counters are cumulative.
   SearchSolution search(const State& from, const std::function<bool(std::uint64_t work)>& stop = nullptr,
                         std::uint64_t check_interval = 1);
+  // Trials of bounded RTDP (McMahan, Likhachev and Gordon 2005) from `from`, each expanded state
+  // one unit of work, until `stop(work)` returns true (checked every `check_interval` units), the
+  // state cap is reached or from's interval is narrower than 1e-9. A trial walks down by the
+  // choice of the largest upper end and the outcome of the largest probability times gap, and
+  // backs both ends up along its path: where the depth-first search spends its work deep in one
+  // choice, trials spread it over the choices that may still be best, so that their lower ends
+  // rise. The lower ends are certified (at most the exact solver's values) and kept like the
+  // upper ones; a search() after trials settles choices by them. Returns from's interval and
+  // the choice of the best lower end (exact when `from` was solved before).
+  SearchSolution trials(const State& from, const std::function<bool(std::uint64_t work)>& stop,
+                        std::uint64_t check_interval = 1);
   // Forgets what was solved and refined.
   void clear();
   // States held (solved or refined).

@@ -1,0 +1,58 @@
+#pragma once
+// The regret of an allocator, V*(s0) - V^pi(s0), estimated along its own episodes with far less
+// variance than the difference of two success rates.
+//
+// What it computes. For any allocator, stationary or not, and episodes drawn from the model,
+//   V*(s0) - V^pi(s0) = E[ sum over the decisions t of (V*(s_t) - Q*(s_t, a_t)) ]
+// (the performance-difference identity: the terms telescope, since V^pi's episodes move by the
+// model's outcome probabilities). Each term is a decision's exact loss, 0 wherever the allocator
+// chose optimally, so an allocator that is optimal at nearly every state has an estimate near 0
+// with a narrow interval, where its sampled success rate would need millions of episodes to be
+// told apart from the optimum. `with_regret` wraps an allocator: after each decision, in
+// observe() and so outside the decision's timing, it adds the decision's loss, computed by the
+// exact search (search_solver.hpp) whose table is kept across the episodes of its thread. Each
+// episode's sum, and its square, go into the statistics (kRegretSum, kRegretSquares,
+// kRegretEpisodes) in fixed point, whole multiples of kRegretUnit held exactly in a double, so
+// that the runner's merge over threads sums them exactly and the totals do not depend on the
+// thread count; `regret_estimate` turns them into a mean and a 95% interval.
+//
+// Guarantees: the mean is unbiased for episodes drawn from the Mdp given (a hidden sampled world
+// of the same instance; an allocator planning with another belief is judged under this Mdp);
+// each loss is exact to the solver's rounding. Cost: per decision, the exact values of the state
+// and the chosen successors (a search from each, fast once the table holds them); memory: the
+// search's table per thread, capped by `max_states` (ResourceLimitError past it).
+
+#include <cstdint>
+#include <optional>
+
+#include "ontime/allocators/allocator.hpp"
+#include "ontime/mdp/mdp.hpp"
+#include "ontime/util/statistics.hpp"
+
+namespace ontime {
+
+inline constexpr const char* kRegretSum = "regret_units";
+inline constexpr const char* kRegretSquares = "regret_square_units";
+inline constexpr const char* kRegretEpisodes = "regret_episodes";
+// The fixed point's unit, 2^-32 (2.3e-10): an episode's sum is rounded to it. Totals stay exact
+// up to 2^53 units (2^21 in all).
+inline constexpr double kRegretUnit = 0x1p-32;
+
+// Allocators of `allocators`, each measuring its losses against `mdp`'s optimum (see above).
+AllocatorFactory with_regret(const Mdp& mdp, AllocatorFactory allocators, std::uint64_t max_states);
+
+struct RegretEstimate {
+  double optimum = 0;  // V*(s0)
+  double mean = 0;     // estimated V*(s0) - V^pi(s0)
+  double ci95 = 0;     // half-width: 1.96 times the standard error over the episodes
+  std::uint64_t episodes = 0;
+};
+
+// V*(s0), the optimum the losses are measured against, by the exact search; ResourceLimitError
+// when it needs more than `max_states` states.
+double regret_optimum(const Mdp& mdp, std::uint64_t max_states);
+
+// The estimate from a run's merged statistics; nullopt when they hold no regret counters.
+std::optional<RegretEstimate> regret_estimate(const Statistics& statistics, double optimum);
+
+}  // namespace ontime
