@@ -34,6 +34,7 @@ struct SolveOptions {
   int policy_layers = 1;
   double max_seconds = 0;
   double tolerance = 0;
+  double gap = 0;
   unsigned threads = 0;
   bool stats = false;
   bool json = false;
@@ -62,6 +63,7 @@ void run_search(const SolveOptions& options, const Problem& problem, const Mdp& 
   check_exact_work(problem, max_states, options.instance, flag_spelling());
   SearchSolveOptions settings;
   settings.max_states = max_states;
+  settings.gap = options.gap;
   const auto started = std::chrono::steady_clock::now();
   if (options.max_seconds > 0) {
     const auto deadline = started + std::chrono::duration<double>(options.max_seconds);
@@ -158,6 +160,10 @@ void add_solve_command(CLI::App& app) {
                     "Layered: end the forward pass after this long and give an interval (the backward pass still "
                     "runs); search: end the search and give an interval",
                     0.0);
+  add_number_option(*command, "--gap", options->gap,
+                    "Search: no exact solve, but trials of bounded RTDP until the certified interval is at most this "
+                    "wide (or --max-states, --max-seconds end them; default 0: the exact search)",
+                    0.0, 1.0);
   add_number_option(*command, "--tolerance", options->tolerance,
                     "Layered, split: drop groups whose clairvoyant chance alone is below this, with their share in "
                     "the interval (default 0: none)",
@@ -172,6 +178,7 @@ void add_solve_command(CLI::App& app) {
   command->add_flag("--no-timing", options->no_timing,
                     "Layered: leave out measured times and memory, so that outputs can be compared byte for byte");
   command->callback([options, command] {
+    if (options->gap > 0 && options->method != "search") throw UsageError("--gap is for --method search");
     const Problem problem = load_problem(options->instance);
     if (problem.skeleton_count() > kMaxExactSkeletons) check_exact_work(problem, 1, options->instance);
     const Mdp mdp(problem);

@@ -45,9 +45,11 @@ void bind_solve(py::module_& m) {
          const std::optional<std::string>& method_given, Number<double, "tolerance", 0.0, 1.0> tolerance,
          Number<std::uint64_t, "max_memory_mib", 0, (std::uint64_t{1} << 40)> max_memory_mib,
          Number<std::uint64_t, "max_disk_mib", 0, (std::uint64_t{1} << 40)> max_disk_mib, const py::object& scratch,
-         const py::object& policy, Number<int, "policy_layers", 1, 1'000'000> policy_layers) {
+         const py::object& policy, Number<int, "policy_layers", 1, 1'000'000> policy_layers,
+         Number<double, "gap", 0.0, 1.0> gap) {
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
         const std::string method = method_given.value_or("layered");
+        if (gap > 0 && method != "search") throw UsageError("gap is for method='search'");
         if (method != "layered" && method != "split" && method != "memoised" && method != "search") {
           throw UsageError("method must be 'layered', 'split', 'memoised' or 'search' (got '" + method + "')");
         }
@@ -61,6 +63,7 @@ void bind_solve(py::module_& m) {
             SearchSolveOptions options;
             options.max_states = max_states;
             options.stop = stop;
+            options.gap = gap;
             solve.search = solve_search(mdp->mdp, options);
             solve.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
           });
@@ -120,7 +123,7 @@ void bind_solve(py::module_& m) {
       py::arg("problem"), py::arg("max_states") = OptimalSolver::kDefaultMaxStates, py::arg("threads") = 0,
       py::kw_only(), py::arg("method") = py::none(), py::arg("tolerance") = 0.0, py::arg("max_memory_mib") = 0,
       py::arg("max_disk_mib") = 0, py::arg("scratch") = py::none(), py::arg("policy") = py::none(),
-      py::arg("policy_layers") = 1,
+      py::arg("policy_layers") = 1, py::arg("gap") = 0.0,
       "The exact optimal success probability and first choice (the layered solver), as `ontime solve --json` "
       "reports them; where a cap cuts the whole tree, a certified interval [lower_bound, upper_bound] "
       "instead (optimal_success_probability None), tightened by a split when the skeletons' first actions "
@@ -132,7 +135,9 @@ void bind_solve(py::module_& m) {
       "(JSON Lines: a state, its choice and the bounds of its value). The GIL is released; Ctrl-C stops it "
       "(KeyboardInterrupt). method='memoised' is the memoised expectimax (OptimalSolver: exact, or an error past "
       "max_states). method='search' is the branch-and-bound search (exact as the others, touching fewer states; past "
-      "max_states a certified interval, as `ontime solve --method search`). For an instance with backtracking neither "
+      "max_states a certified interval, as `ontime solve --method search`); with gap > 0 it solves nothing exactly but "
+      "runs trials of bounded RTDP until the certified interval is at most `gap` wide (`ontime solve --gap`). For an "
+      "instance with backtracking neither "
       "a split nor a tolerance applies (UsageError), and "
       "a cap's interval comes from bounds that count a give-up as a success.");
 }

@@ -29,6 +29,15 @@ def test_the_search_matches_the_cli_and_the_layered_bits(path, cli):
     assert got["optimal_success_probability"] == ontime.solve(str(path))["optimal_success_probability"]
     capped = ontime.solve(str(path), method="search", max_states=1)
     assert capped["lower_bound"] <= got["optimal_success_probability"] <= capped["upper_bound"]
+    narrow = ontime.solve(str(path), method="search", gap=0.001)
+    expected_narrow = cli("solve", path, "--json", "--method", "search", "--gap", 0.001, "--no-timing")
+    if not narrow["exact"]:
+        assert narrow["stopped_by"] == "the gap"
+        assert narrow["upper_bound"] - narrow["lower_bound"] <= 0.001
+    for key in ("lower_bound", "upper_bound", "first_choice", "refined_states"):
+        assert narrow[key] == expected_narrow[key]
+    with pytest.raises(ontime.UsageError, match="gap is for method='search'"):
+        ontime.solve(str(path), gap=0.001)
 
 
 @pytest.mark.parametrize("path", PAPER_INSTANCES, ids=lambda p: p.stem)

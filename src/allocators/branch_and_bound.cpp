@@ -38,8 +38,7 @@ DecisionBudget share_of(const DecisionBudget& budget, double share) {
 }  // namespace
 
 void BranchAndBoundAllocator::begin_episode(std::uint64_t seed) {
-  (void)seed;
-  search_.clear();
+  search_.clear(seed);
   last_gap_ = 0.0;
 }
 

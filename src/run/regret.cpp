@@ -15,8 +15,7 @@ namespace {
 double exact_value(BranchAndBoundSearch& search, const State& state, std::uint64_t max_states) {
   const SearchSolution solution = search.search(state);
   if (!solution.exact) {
-    throw ResourceLimitError("regret: the exact values need more than " + std::to_string(max_states) +
-                             " states");
+    throw ResourceLimitError("regret: the exact values need more than " + std::to_string(max_states) + " states");
   }
   return solution.lower;
 }

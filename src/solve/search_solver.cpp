@@ -19,6 +19,7 @@
 #include "ontime/solve/optimal_solver.hpp"
 #include "ontime/solve/value_bounds.hpp"
 #include "ontime/util/error.hpp"
+#include "ontime/util/random.hpp"
 #include "solve/expectimax.hpp"
 
 namespace ontime {
@@ -33,10 +34,13 @@ constexpr std::size_t kStopCheckInterval = 4096;
 // An upper test asks each successor for this much more than its share of the excess, so that
 // one round usually suffices.
 constexpr double kShareMargin = 1.1;
-// A trial ends where its choice's outcomes hold less than this fraction of the start's gap
-// (bounded RTDP's tau); the trials end when the start's gap is below kTrialsDone.
+// A trial ends where its choice's outcomes hold less than this fraction of the start's gap, in
+// probability times gap (bounded RTDP's tau); the trials end when the start's gap is below
+// kTrialsDone.
 constexpr double kTrialRatio = 32.0;
 constexpr double kTrialsDone = 1e-9;
+// The trials' draws until clear(seed) gives others.
+constexpr std::uint64_t kDefaultTrialSeed = 1;
 
 // The search's stack: a base, and per step of the deadline (a level of solve and one of an upper
 // test, under 0.5 KiB together in a release build, measured at D = 4,096) room for the sanitizers'
@@ -84,25 +88,26 @@ class BranchAndBound {
   // Trials from `from` (bounded RTDP, McMahan, Likhachev and Gordon 2005) until `stop(work)`
   // returns true (checked after every `check_interval` states expanded), the cap is reached or
   // from's interval is narrower than kTrialsDone. Each trial walks down from `from`: at every
-  // state it takes the choice of the largest upper end and the outcome of the largest
-  // probability times gap, and ends where the choice's outcomes hold less than 1/kTrialRatio of
-  // from's gap; the states walked are then backed up deepest first, both ends (a state's lower
+  // state it takes the choice of the largest upper end and draws one of its outcomes in
+  // proportion to probability times gap, and ends where the choice's outcomes hold less than
+  // 1/kTrialRatio of from's gap in all; the states walked are then backed up deepest first, both ends (a state's lower
   // end is its best choice's lower end less kTieTolerance, which keeps it at most the exact
   // solver's value whatever choice its tie rule takes). The bounds are kept, so a search after
   // them starts from them. Returns from's interval and the choice of the best lower end.
-  SearchSolution trials(const State& from, const std::function<bool(std::uint64_t)>& stop,
-                        std::uint64_t check_interval) {
+  SearchSolution trials(const State& from, const std::function<bool(std::uint64_t)>& stop, std::uint64_t check_interval,
+                        double gap) {
     const auto start = detail::compact<Compact>(from, mdp_->skeleton_count(), mdp_->problem().culprit_slot_count());
     const Key key = policy_.key(start);
     work_start_ = work_;
-    bool go_on = true;
-    while (go_on) go_on = trial(start, key, stop, check_interval);
+    trials_end_.clear();
+    while (trial(start, key, stop, check_interval, std::max(gap, kTrialsDone))) {
+    }
     SearchSolution out;
     if (const auto found = table_.find(key); found != table_.end() && found->second.exact) {
       out.lower = out.upper = found->second.value;
       out.first_choice = found->second.choice;
     } else {
-      out = cut_short(start, "the trials' budget");
+      out = cut_short(start, trials_end_);
     }
     return with_counters(out);
   }
@@ -117,11 +122,12 @@ class BranchAndBound {
     return out;
   }
 
-  // Forgets every state solved or refined.
-  void clear() {
+  // Forgets every state solved or refined; the trials draw from `seed` on.
+  void clear(std::uint64_t seed) {
     table_.clear();
     lower_.clear();
     solved_ = 0;
+    generator_ = SplitMix64(seed);
   }
   // States in the table (solved or refined).
   std::uint64_t size() const noexcept { return table_.size(); }
@@ -150,6 +156,7 @@ class BranchAndBound {
   // A state on a trial's path: its key and its choices choices_[choice_begin, choice_end), whose
   // outcomes start at items_[item_begin].
   struct TrialLevel {
+    Compact state;
     Key key;
     std::size_t item_begin = 0, choice_begin = 0, choice_end = 0;
   };
@@ -196,8 +203,9 @@ class BranchAndBound {
   }
 
   // One trial (see trials()); false when the trials should end.
+  // Sets trials_end_ to what ended them.
   bool trial(const Compact& start, const Key& start_key, const std::function<bool(std::uint64_t)>& stop,
-             std::uint64_t check_interval) {
+             std::uint64_t check_interval, double gap) {
     path_.clear();
     Compact state = start;
     Key key = start_key;
@@ -209,42 +217,54 @@ class BranchAndBound {
         break;
       }
       if (max_states_ != 0 && table_.size() >= max_states_ && !table_.contains(key)) {
+        trials_end_ = "the cap of " + std::to_string(max_states_) + " states";
         go_on = false;
         break;
       }
-      TrialLevel level{key, items_.size(), choices_.size(), 0};
+      TrialLevel level{state, key, items_.size(), choices_.size(), 0};
       expand(state);
       level.choice_end = choices_.size();
       path_.push_back(level);
       const auto [lo, hi] = back_up(path_.back());
       ++work_;
       const std::uint64_t done = work_ - work_start_;
-      if (stop && (done == 1 || done % check_interval == 0) && stop(done)) go_on = false;
+      if (stop && (done == 1 || done % check_interval == 0) && stop(done)) {
+        trials_end_ = "the stop condition";
+        go_on = false;
+      }
       if (start_gap < 0.0) {
         start_gap = hi - lo;
-        if (start_gap <= kTrialsDone) go_on = false;
+        if (start_gap <= gap) {
+          trials_end_ = "the gap";
+          go_on = false;
+        }
       }
-      if (!go_on || hi - lo <= start_gap / kTrialRatio) break;
-      // The choice of the largest upper end (the lowest index on ties), then its outcome of the
-      // largest probability times gap.
+      if (!go_on) break;
+      // The choice of the largest upper end (the lowest index on ties), then one of its outcomes
+      // drawn in proportion to probability times gap. (Always the largest would walk the same
+      // path again and again where the backups no longer move its bounds.)
       std::size_t choice = kNone;
       for (std::size_t c = path_.back().choice_begin; c < path_.back().choice_end; ++c) {
         if (choice == kNone || choices_[c].hi > choices_[choice].hi) choice = c;
       }
-      std::size_t next = kNone;
       double mass = 0.0;
-      double largest = 0.0;
+      for (std::size_t i = choices_[choice].begin; i < choices_[choice].end; ++i) {
+        const Item& item = items_[i];
+        if (item.status == Status::running && !item.exact) mass += item.probability * std::max(0.0, item.hi - item.lo);
+      }
+      if (mass <= start_gap / kTrialRatio) break;
+      double draw = uniform01(generator_) * mass;
+      std::size_t next = kNone;
       for (std::size_t i = choices_[choice].begin; i < choices_[choice].end; ++i) {
         const Item& item = items_[i];
         if (item.status != Status::running || item.exact) continue;
-        const double weight = item.probability * (item.hi - item.lo);
-        mass += weight;
-        if (weight > largest) {
-          largest = weight;
-          next = i;
-        }
+        const double weight = item.probability * std::max(0.0, item.hi - item.lo);
+        if (weight <= 0.0) continue;
+        next = i;
+        draw -= weight;
+        if (draw < 0.0) break;
       }
-      if (next == kNone || mass <= start_gap / kTrialRatio) break;
+      if (next == kNone) break;
       state = items_[next].next;
       key = items_[next].key;
     }
@@ -285,9 +305,12 @@ class BranchAndBound {
       hi = std::max(hi, choices_[c].hi);
     }
     lo = std::max(0.0, lo - OptimalSolver::kTieTolerance);
-    Entry& entry = table_.try_emplace(key, Entry{hi, -1.0F, -1, false}).first->second;
+    // Never above what was known: the state's own bounds can be tighter than one step of
+    // lookahead over its successors' (the clairvoyant bound of a state is not the largest of its
+    // choices' sums of their successors' bounds).
+    Entry& entry = table_.try_emplace(key, Entry{static_upper(level.state), -1.0F, -1, false}).first->second;
     if (!entry.exact) entry.value = std::min(entry.value, hi);
-    double& held = lower_[key];
+    double& held = lower_.try_emplace(key, std::max(0.0, bounds_->lower(level.state) - kBoundSlack)).first->second;
     held = std::max(held, lo);
     return {held, entry.exact ? entry.value : std::min(entry.value, 1.0)};
   }
@@ -540,6 +563,8 @@ class BranchAndBound {
   std::vector<Choice> choices_;
   std::vector<int> choice_list_;
   std::vector<TrialLevel> path_;
+  std::string trials_end_;
+  SplitMix64 generator_{kDefaultTrialSeed};
   // Lower ends backed up by trials (certified: at most the exact solver's value of the state).
   absl::flat_hash_map<Key, double, Hash> lower_;
   // One table for the states solved (exact) and those whose upper bound an upper test refined
@@ -649,14 +674,15 @@ SearchSolution BranchAndBoundSearch::search(const State& from, const std::functi
 }
 
 SearchSolution BranchAndBoundSearch::trials(const State& from, const std::function<bool(std::uint64_t)>& stop,
-                                            std::uint64_t check_interval) {
+                                            std::uint64_t check_interval, double gap) {
   // (Trials walk down a path without recursion: the caller's stack suffices.)
-  return std::visit([&](auto& search) { return search.trials(from, stop, std::max<std::uint64_t>(check_interval, 1)); },
-                    impl_->engine);
+  return std::visit(
+      [&](auto& search) { return search.trials(from, stop, std::max<std::uint64_t>(check_interval, 1), gap); },
+      impl_->engine);
 }
 
-void BranchAndBoundSearch::clear() {
-  std::visit([](auto& search) { search.clear(); }, impl_->engine);
+void BranchAndBoundSearch::clear(std::uint64_t seed) {
+  std::visit([seed](auto& search) { search.clear(seed); }, impl_->engine);
 }
 
 // (std::visit throws only for a valueless variant, which the engine, never reassigned, cannot be.)
@@ -669,6 +695,7 @@ SearchSolution solve_search(const Mdp& mdp, const SearchSolveOptions& options) {
   BranchAndBoundSearch search(mdp, options.max_states);
   std::function<bool(std::uint64_t)> stop;
   if (options.stop) stop = [&options](std::uint64_t) { return options.stop(); };
+  if (options.gap > 0.0) return search.trials(mdp.start(), stop, kStopCheckInterval, options.gap);
   return search.search(mdp.start(), stop, kStopCheckInterval);
 }
 

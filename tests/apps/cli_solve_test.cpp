@@ -199,6 +199,22 @@ TEST(Cli, SolveBySearchGivesTheLayeredBits) {
   EXPECT_EQ(cut["states"].get<int>() + cut["refined_states"].get<int>(), 10);
 }
 
+// --gap: trials until the certified interval is that narrow, no exact solve; only with search.
+TEST(Cli, SolveBySearchWithAGapGivesANarrowInterval) {
+  const auto narrow = ontime({"solve", paper("instance1"), "--json", "--method", "search", "--gap", "0.001"});
+  ASSERT_EQ(narrow.exit_code, 0) << narrow.err;
+  const json out = json::parse(narrow.out);
+  EXPECT_FALSE(out["exact"].get<bool>());
+  EXPECT_EQ(out["stopped_by"], "the gap");
+  EXPECT_LE(out["upper_bound"].get<double>() - out["lower_bound"].get<double>(), 0.001);
+  EXPECT_LE(out["lower_bound"].get<double>(), 0.942 + 1e-12);
+  EXPECT_GE(out["upper_bound"].get<double>(), 0.942);
+  EXPECT_EQ(out["states"], 0);
+  const auto layered = ontime({"solve", paper("instance1"), "--gap", "0.001"});
+  EXPECT_EQ(layered.exit_code, 2);
+  EXPECT_NE(layered.err.find("--gap is for --method search"), std::string::npos) << layered.err;
+}
+
 // An instance with backtracking: the layered solver by default, the memoised solver's value to
 // the bit, a policy whose states hold what a backtrack restores, an interval under a cap; a split
 // or a tolerance exits with 2 naming the rule.

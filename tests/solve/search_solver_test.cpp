@@ -144,6 +144,16 @@ TEST(SearchSolver, TrialsGiveCertifiedBoundsAndTheSearchAfterThemKeepsTheBits) {
     const SearchSolution closed = search.trials(mdp.start(), [](std::uint64_t work) { return work >= 300; });
     EXPECT_LE(closed.upper - closed.lower, 1e-9) << name;
     EXPECT_NEAR(exact_q_at_start(mdp, memoised, closed.first_choice), optimum, 1e-9) << name;
+    // solve_search with a gap: trials only, until the interval is that narrow.
+    SearchSolveOptions narrow;
+    narrow.gap = 0.01;
+    const SearchSolution within = solve_search(mdp, narrow);
+    if (within.exact) continue;  // figure 1's start has one useful choice: solved at once
+    EXPECT_EQ(within.stopped_by, "the gap") << name;
+    EXPECT_LE(within.upper - within.lower, 0.01) << name;
+    EXPECT_LE(within.lower, optimum + OptimalSolver::kTieTolerance) << name;
+    EXPECT_GE(within.upper, optimum) << name;
+    EXPECT_EQ(within.states, 0U) << name;  // nothing solved exactly
   }
 }
 

@@ -15,8 +15,9 @@
 // upper end of V*(state) minus that lower end, never below the choice's true loss
 // V*(state) - Q*(state, choice).
 //
-// Deterministic: the search is cleared at the start of every episode, so an episode's decisions
-// depend on its own history only, and with a work budget on no property of the machine. Not
+// Deterministic: the search is cleared at the start of every episode and its trials draw from
+// the episode's seed, so an episode's decisions depend on its seed and its own history only, and
+// with a work budget on no property of the machine. Not
 // stationary (a decision depends on what the episode solved before it). Cost per decision: its
 // budget; memory: the search's table, cleared when it holds `max-states` states.
 

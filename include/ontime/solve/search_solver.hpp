@@ -49,6 +49,9 @@ struct SearchSolveOptions {
   std::uint64_t max_states = 0;  // states held: solved, or with an upper bound refined by a test; 0: no cap
   // Checked every few thousand states: once it returns true the search ends as at a cap.
   std::function<bool()> stop;
+  // Above 0: no exact search, but trials (BranchAndBoundSearch::trials) until the start's
+  // certified interval is at most this wide, or a cap or the stop ends them.
+  double gap = 0.0;
 };
 
 struct SearchSolution {
@@ -61,7 +64,7 @@ struct SearchSolution {
   std::uint64_t choices_cut = 0;  // choices left unsolved because their interval settled them
   std::uint64_t tested = 0;       // upper tests run (states expanded to refine their upper bound)
   std::uint64_t refined = 0;      // states holding a refined upper bound at the end
-  std::string stopped_by;         // cut: the cap or stop that ended the search
+  std::string stopped_by;         // cut: the cap or stop that ended the search (trials: or "the gap")
 };
 
 // The search kept between calls, for deciding step by step (the `branch-and-bound` allocator):
@@ -87,17 +90,17 @@ class BranchAndBoundSearch {
                         std::uint64_t check_interval = 1);
   // Trials of bounded RTDP (McMahan, Likhachev and Gordon 2005) from `from`, each expanded state
   // one unit of work, until `stop(work)` returns true (checked every `check_interval` units), the
-  // state cap is reached or from's interval is narrower than 1e-9. A trial walks down by the
-  // choice of the largest upper end and the outcome of the largest probability times gap, and
-  // backs both ends up along its path: where the depth-first search spends its work deep in one
-  // choice, trials spread it over the choices that may still be best, so that their lower ends
-  // rise. The lower ends are certified (at most the exact solver's values) and kept like the
-  // upper ones; a search() after trials settles choices by them. Returns from's interval and
-  // the choice of the best lower end (exact when `from` was solved before).
+  // state cap is reached or from's interval is at most `gap` (at least 1e-9) wide. A trial walks down by the
+  // choice of the largest upper end and an outcome drawn in proportion to probability times gap
+  // (from the seed of the last clear(), 1 before any), and backs both ends up along its path:
+  // where the depth-first search spends its work deep in one choice, trials spread it over the
+  // choices that may still be best, so that their lower ends rise. The lower ends are certified
+  // (at most the exact solver's values) and kept like the upper ones; a search() after trials settles choices by them.
+  // Returns from's interval and the choice of the best lower end (exact when `from` was solved before).
   SearchSolution trials(const State& from, const std::function<bool(std::uint64_t work)>& stop,
-                        std::uint64_t check_interval = 1);
-  // Forgets what was solved and refined.
-  void clear();
+                        std::uint64_t check_interval = 1, double gap = 0.0);
+  // Forgets what was solved and refined; the trials draw from `seed` on.
+  void clear(std::uint64_t seed = 1);
   // States held (solved or refined).
   std::uint64_t size() const noexcept;  // NOLINT(bugprone-exception-escape): see its definition
 
