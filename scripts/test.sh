@@ -10,36 +10,42 @@
 # Each build folder is a preset of CMakePresets.json (release, core, sanitize).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-./scripts/setup.sh
-./scripts/check-format.sh
+# Each step's wall time goes to stderr, so that a slow run shows where its time went.
+step() {
+  local start=$SECONDS
+  "$@"
+  echo "[test.sh] $((SECONDS - start)) s (at $SECONDS s): $*" >&2
+}
+step ./scripts/setup.sh
+step ./scripts/check-format.sh
 # Ninja when it is installed (CMake reads CMAKE_GENERATOR only for a new build folder).
 if [ -z "${CMAKE_GENERATOR:-}" ] && command -v ninja >/dev/null 2>&1; then export CMAKE_GENERATOR=Ninja; fi
-./scripts/build.sh -DONTIME_WARNINGS_AS_ERRORS=ON
-ctest --preset release --parallel "$(nproc)" --label-exclude python
+step ./scripts/build.sh -DONTIME_WARNINGS_AS_ERRORS=ON
+step ctest --preset release --parallel "$(nproc)" --label-exclude python
 # The Python package's pytest suite, verbose so that its closing line shows.
-ctest --preset release --label-regex python --verbose
+step ctest --preset release --label-regex python --verbose
 # Split over MPI ranks (mpirun, and srun on a single-node SLURM cluster brought up for it): the
 # same files as one process, byte for byte, and no work lost when a rank dies.
-./scripts/cluster/check.sh build/ontime
+step ./scripts/cluster/check.sh build/ontime
 # Static analysis: no finding of .clang-tidy's checks in src/, include/, apps/, domains/ (python/src/: see the script).
-./scripts/clang-tidy.sh
+step ./scripts/clang-tidy.sh
 # Installing: pip install --no-build-isolation . (reusing build/), then the .deb of cpack.
-./scripts/check-pip-install.sh build
-./scripts/check-package.sh build
+step ./scripts/check-pip-install.sh build
+step ./scripts/check-package.sh build
 
 # The core without the domains: configured with OMPL, FCL and KDL hidden from find_package, the
 # library and the tool build, the tool refuses the domain commands, the install works and an
 # outside project builds against it (install_and_consume, core component only, with Eigen hidden
 # from the consumer). Its unit tests are those of build/ (and of build-sanitize/ below), the same
 # sources with the same flags: they are not built a third time.
-cmake --preset core -DONTIME_WARNINGS_AS_ERRORS=ON
-cmake --build --preset core --parallel "$(nproc)" --target ontime ontime_cli
-ctest --preset core --parallel "$(nproc)" \
+step cmake --preset core -DONTIME_WARNINGS_AS_ERRORS=ON
+step cmake --build --preset core --parallel "$(nproc)" --target ontime ontime_cli
+step ctest --preset core --parallel "$(nproc)" \
   --tests-regex '^(install_and_consume|cli_refuses_domain_commands_without_the_domains|layers_.*)$'
 
 # (No Python package: an instrumented extension cannot be loaded by the uninstrumented
 # interpreter. The install test, which builds an uninstrumented consumer against the library, is
 # left out by the preset; it sets ASAN_OPTIONS and UBSAN_OPTIONS.)
-cmake --preset sanitize
-cmake --build --preset sanitize --parallel "$(nproc)"
-ctest --preset sanitize --parallel "$(nproc)"
+step cmake --preset sanitize
+step cmake --build --preset sanitize --parallel "$(nproc)"
+step ctest --preset sanitize --parallel "$(nproc)"
