@@ -67,15 +67,13 @@ void add_evaluate_command(CLI::App& app) {
       check_exact_work(problem, max_states_of(parameters), options->instance, flag_spelling());
     }
     const AllocatorFactory factory = make_allocator_factory(options->solver, planned_mdp, parameters);
-    std::optional<double> optimum;
-    if (options->regret) optimum = regret_optimum(mdp, max_states_of(parameters));
 
     MonteCarloOptions monte_carlo = options->monte_carlo.options();
     monte_carlo.time_decisions = !options->no_timing;
     ProgressBar bar("evaluate " + options->solver);
     monte_carlo.progress = [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); };
-    const MonteCarloResult result =
-        run_monte_carlo(mdp, optimum ? with_regret(mdp, factory, max_states_of(parameters)) : factory, monte_carlo);
+    const MonteCarloResult result = run_monte_carlo(
+        mdp, options->regret ? with_regret(mdp, factory, max_states_of(parameters)) : factory, monte_carlo);
 
     std::optional<ExactEvaluation> exact;
     if (options->exact) {
@@ -90,7 +88,7 @@ void add_evaluate_command(CLI::App& app) {
                                   .seed = options->monte_carlo.seed,
                                   .result = result,
                                   .exact = exact,
-                                  .regret = optimum ? regret_estimate(result.statistics, *optimum) : std::nullopt,
+                                  .regret = options->regret ? regret_estimate(result.statistics) : std::nullopt,
                                   .timing = !options->no_timing};
     fmt::print("{}", options->json ? report::to_json(evaluation) + "\n" : report::to_text(evaluation));
   });

@@ -68,6 +68,22 @@ def test_monte_carlo_counts_match_the_cli_for_the_same_seed(solver, params, flag
     assert got["decision_time_us"]["decisions"] == expected["decision_time_us"]["decisions"]
 
 
+def test_the_regret_estimate_matches_the_cli(cli):
+    # dp-rerun on instance 1 (V* - V about 0.002): the estimate's bits are the CLI's
+    # (fixed point: whatever the thread counts).
+    path = PAPER_INSTANCES[0]
+    expected = cli("evaluate", path, "--solver", "dp-rerun", "--episodes", 2000, "--seed", 5, "--threads", 2,
+                   "--regret", "--json")
+    got = ontime.evaluate(str(path), "dp-rerun", episodes=2000, seed=5, threads=1, regret=True)
+    assert got["regret"] == expected["regret"]
+    assert got["regret"]["optimum"] == ontime.solve(str(path))["optimal_success_probability"]
+    exact = ontime.evaluate(str(path), "dp-rerun", episodes=1, exact=True)["exact_success_probability"]
+    truth = got["regret"]["optimum"] - exact
+    assert abs(got["regret"]["mean"] - truth) <= 2 * got["regret"]["ci95"]
+    assert got["regret"]["ci95"] < got["ci95"]
+    assert "regret" not in ontime.evaluate(str(path), "dp-rerun", episodes=10)
+
+
 def test_the_registry_is_listed_as_the_cli_lists_it(cli):
     assert ontime.allocators() == cli("allocators", "--json")
 

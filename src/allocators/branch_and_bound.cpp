@@ -7,6 +7,7 @@
 #include "allocators/detail/anytime_budget.hpp"
 #include "ontime/allocators/allocator_registry.hpp"
 #include "ontime/solve/optimal_solver.hpp"
+#include "ontime/util/random.hpp"
 
 namespace ontime {
 
@@ -38,6 +39,8 @@ DecisionBudget share_of(const DecisionBudget& budget, double share) {
 }  // namespace
 
 void BranchAndBoundAllocator::begin_episode(std::uint64_t seed) {
+  episode_seed_ = seed;
+  restarts_ = 0;
   search_.clear(seed);
   last_gap_ = 0.0;
 }
@@ -49,30 +52,20 @@ int BranchAndBoundAllocator::choose(const State& state, const DecisionBudget& bu
   const ChoiceList choices = mdp_->useful_choices(state);
   if (choices.empty()) return mdp_->first_with_work_left(state);
   if (choices.size() == 1) return choices[0];
-  // A table at its cap starts again (the cap counts the states of the episode so far).
-  if (search_.size() >= options_.max_states) search_.clear();
+  // A table at its cap starts again (the cap counts the states of the episode so far), its trials
+  // drawing from a stream of the episode's seed.
+  if (search_.size() >= options_.max_states) search_.clear(stream_seed(episode_seed_, ++restarts_));
   const DecisionBudget& decision = budget.is_set() ? budget : options_.budget;
   const BudgetMonitor monitor(decision);
   std::uint64_t work = 0;
-  SearchSolution found;
-  bool settled = false;  // the trials found the state solved
-  if (options_.trial_share > 0.0) {
-    const BudgetMonitor share(share_of(decision, options_.trial_share));
-    found = search_.trials(state, [&](std::uint64_t done) {
-      work = done;
-      return share.exhausted(done) || monitor.exhausted(done);
-    });
-    settled = found.exact;
-  }
-  const std::uint64_t trial_work = work;
-  if (!settled && (trial_work == 0 || !monitor.exhausted(trial_work))) {
-    found = search_.search(state, [&](std::uint64_t done) {
-      work = trial_work + done;
-      return monitor.exhausted(work);
-    });
-  }
+  std::uint64_t trial_work = 0;
+  const bool open_ended = !decision.max_iterations() && !decision.max_seconds();
+  const SearchSolution found = open_ended && options_.trial_share > 0.0 && options_.trial_share < 1.0
+                                   ? in_rounds(state, monitor, work, trial_work)
+                                   : in_two_parts(state, decision, monitor, work, trial_work);
   ++counters_.searches;
   counters_.work += work;
+  counters_.trial_work += trial_work;
   if (found.exact) ++counters_.exact;
   last_gap_ = std::max(0.0, found.upper - found.lower);
   counters_.gap_sum += last_gap_;
@@ -80,9 +73,63 @@ int BranchAndBoundAllocator::choose(const State& state, const DecisionBudget& bu
   return found.first_choice >= 0 ? found.first_choice : choices[0];
 }
 
+SearchSolution BranchAndBoundAllocator::in_two_parts(const State& state, const DecisionBudget& decision,
+                                                     const BudgetMonitor& monitor, std::uint64_t& work,
+                                                     std::uint64_t& trial_work) {
+  SearchSolution found;
+  if (options_.trial_share > 0.0) {
+    const BudgetMonitor share(share_of(decision, options_.trial_share));
+    found = search_.trials(state, [&](std::uint64_t done) {
+      work = done;
+      return share.exhausted(done) || monitor.exhausted(done);
+    });
+    if (found.exact) {
+      trial_work = work;
+      return found;
+    }
+  }
+  trial_work = work;
+  if (trial_work == 0 || !monitor.exhausted(trial_work)) {
+    found = search_.search(state, [&](std::uint64_t done) {
+      work = trial_work + done;
+      return monitor.exhausted(work);
+    });
+  }
+  return found;
+}
+
+SearchSolution BranchAndBoundAllocator::in_rounds(const State& state, const BudgetMonitor& monitor, std::uint64_t& work,
+                                                  std::uint64_t& trial_work) {
+  SearchSolution found;
+  for (std::uint64_t round = kFirstRound;; round *= 2) {
+    const auto trial_quota =
+        std::max<std::uint64_t>(1, static_cast<std::uint64_t>(options_.trial_share * static_cast<double>(round)));
+    const auto search_quota = std::max<std::uint64_t>(1, round - std::min(round, trial_quota));
+    bool stopped = false;
+    bool quota_spent = false;
+    const std::uint64_t before_trials = work;
+    found = search_.trials(state, [&](std::uint64_t done) {
+      work = before_trials + done;
+      stopped = monitor.exhausted(work);
+      return stopped || done >= trial_quota;
+    });
+    trial_work += work - before_trials;
+    if (found.exact || stopped) return found;
+    const std::uint64_t before_search = work;
+    found = search_.search(state, [&](std::uint64_t done) {
+      work = before_search + done;
+      stopped = monitor.exhausted(work);
+      quota_spent = done >= search_quota;
+      return stopped || quota_spent;
+    });
+    // Ended by neither the budget nor its quota: by the state cap, which the next round would hit at once.
+    if (found.exact || stopped || !quota_spent) return found;
+  }
+}
 void BranchAndBoundAllocator::collect_statistics(Statistics& statistics) const {
   statistics.add(kSearchesCounter, static_cast<double>(counters_.searches));
   statistics.add(kIterationsCounter, static_cast<double>(counters_.work));
+  statistics.add("trial_work", static_cast<double>(counters_.trial_work));
   statistics.add("exact_decisions", static_cast<double>(counters_.exact));
   statistics.add("gap_sum", counters_.gap_sum);
   statistics.add("max_gap", counters_.max_gap, Statistics::Merge::max);
@@ -122,6 +169,7 @@ AllocatorKind branch_and_bound_kind() {
                     .counters = {{kSearchesCounter, "decisions that ran a search"},
                                  {kIterationsCounter,
                                   "work of the decisions: states expanded by trials or upper tests, or solved"},
+                                 {"trial_work", "the part of that work spent on trials"},
                                  {"exact_decisions", "decisions whose search finished (the optimal choice)"},
                                  {"gap_sum", "certified gaps, summed over the decisions"},
                                  {"max_gap", "the largest certified gap of a decision"}}}};

@@ -22,8 +22,13 @@ double exact_value(BranchAndBoundSearch& search, const State& state, std::uint64
 
 class RegretMeter final : public Allocator {
  public:
+  // Solves V*(s0) first: the losses of the first decisions need its subtree anyway.
   RegretMeter(const Mdp& mdp, std::unique_ptr<Allocator> inner, std::uint64_t max_states)
-      : mdp_(&mdp), inner_(std::move(inner)), exact_(mdp, max_states), max_states_(max_states) {}
+      : mdp_(&mdp),
+        inner_(std::move(inner)),
+        exact_(mdp, max_states),
+        max_states_(max_states),
+        optimum_(value(mdp.start())) {}
 
   std::string_view name() const noexcept override { return inner_->name(); }
   void begin_episode(std::uint64_t seed) override {
@@ -51,6 +56,7 @@ class RegretMeter final : public Allocator {
     statistics.add(kRegretSum, sum_ + units(last));
     statistics.add(kRegretSquares, squares_ + units(last * last));
     statistics.add(kRegretEpisodes, static_cast<double>(episodes_ + (in_episode_ ? 1 : 0)));
+    statistics.add(kRegretOptimum, optimum_, Statistics::Merge::max);
   }
 
  private:
@@ -72,6 +78,7 @@ class RegretMeter final : public Allocator {
   std::unique_ptr<Allocator> inner_;
   BranchAndBoundSearch exact_;
   std::uint64_t max_states_;
+  double optimum_;
   double episode_loss_ = 0.0, sum_ = 0.0, squares_ = 0.0;
   std::uint64_t episodes_ = 0;
   bool in_episode_ = false;
@@ -85,18 +92,14 @@ AllocatorFactory with_regret(const Mdp& mdp, AllocatorFactory allocators, std::u
   };
 }
 
-double regret_optimum(const Mdp& mdp, std::uint64_t max_states) {
-  BranchAndBoundSearch search(mdp, max_states);
-  return exact_value(search, mdp.start(), max_states);
-}
-
-std::optional<RegretEstimate> regret_estimate(const Statistics& statistics, double optimum) {
+std::optional<RegretEstimate> regret_estimate(const Statistics& statistics) {
   const auto sum = statistics.find(kRegretSum);
   const auto squares = statistics.find(kRegretSquares);
   const auto episodes = statistics.find(kRegretEpisodes);
-  if (!sum || !squares || !episodes || *episodes < 1) return std::nullopt;
+  const auto optimum = statistics.find(kRegretOptimum);
+  if (!sum || !squares || !episodes || !optimum || *episodes < 1) return std::nullopt;
   RegretEstimate estimate;
-  estimate.optimum = optimum;
+  estimate.optimum = *optimum;
   estimate.episodes = static_cast<std::uint64_t>(*episodes);
   estimate.mean = *sum * kRegretUnit / *episodes;
   const double variance = std::max(0.0, *squares * kRegretUnit / *episodes - estimate.mean * estimate.mean);

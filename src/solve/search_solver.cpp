@@ -112,6 +112,18 @@ class BranchAndBound {
     return with_counters(out);
   }
 
+  // Forgets every state solved or refined; the trials draw from `seed` on.
+  void clear(std::uint64_t seed) {
+    table_.clear();
+    lower_.clear();
+    solved_ = 0;
+    generator_ = SplitMix64(seed);
+  }
+  // Records held, what the cap counts: a state solved or refined is one, a lower end kept by the
+  // trials another (a smaller one: counting it whole keeps the memory estimate an upper bound).
+  std::uint64_t size() const noexcept { return table_.size() + lower_.size(); }
+
+ private:
   // `out` with the cumulative counters.
   SearchSolution with_counters(SearchSolution out) const {
     out.states = solved_;
@@ -122,17 +134,6 @@ class BranchAndBound {
     return out;
   }
 
-  // Forgets every state solved or refined; the trials draw from `seed` on.
-  void clear(std::uint64_t seed) {
-    table_.clear();
-    lower_.clear();
-    solved_ = 0;
-    generator_ = SplitMix64(seed);
-  }
-  // States in the table (solved or refined).
-  std::uint64_t size() const noexcept { return table_.size(); }
-
- private:
   struct Item {
     double probability = 0.0;
     Status status = Status::running;
@@ -216,7 +217,7 @@ class BranchAndBound {
         go_on = !path_.empty();  // the start solved: nothing left to narrow
         break;
       }
-      if (max_states_ != 0 && table_.size() >= max_states_ && !table_.contains(key)) {
+      if (max_states_ != 0 && size() >= max_states_ && !table_.contains(key)) {
         trials_end_ = "the cap of " + std::to_string(max_states_) + " states";
         go_on = false;
         break;
@@ -315,9 +316,9 @@ class BranchAndBound {
     return {held, entry.exact ? entry.value : std::min(entry.value, 1.0)};
   }
 
-  // Throws CutShort when the table holds the cap's states (solved and refined: what memory holds).
+  // Throws CutShort when the cap's records are held (what memory holds).
   void check_cap() const {
-    if (max_states_ != 0 && table_.size() >= max_states_) {
+    if (max_states_ != 0 && size() >= max_states_) {
       throw CutShort{"the cap of " + std::to_string(max_states_) + " states"};
     }
   }

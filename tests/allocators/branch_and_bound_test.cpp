@@ -2,10 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 
 #include "ontime/allocators/allocator_registry.hpp"
+#include "ontime/model/instance_io.hpp"
 #include "ontime/run/evaluation.hpp"
 #include "ontime/solve/optimal_solver.hpp"
 #include "ontime/util/random.hpp"
@@ -84,6 +86,30 @@ TEST(BranchAndBound, ItsDefaultBudgetIsTheOptimumOnThePaperInstances) {
     EXPECT_EQ(searched.statistics.find("exact_decisions"), searched.statistics.find(kSearchesCounter)) << name;
     EXPECT_EQ(searched.statistics.find("max_gap").value_or(-1.0), 0.0) << name;
   }
+}
+
+// A budget of a stop condition alone (the caller's clock) has no size to share: trials and
+// search take turns in rounds, so the search runs however soon it trips (a share of it would
+// give the trials all). On navigation neither finishes in 5,000 units.
+TEST(BranchAndBound, AStopConditionAloneStillRunsTheSearch) {
+  const Problem problem = load_problem(testing::source_path("data/instances/navigation.json"));
+  const Mdp mdp(problem);
+  BranchAndBoundAllocator allocator(mdp, {});
+  allocator.begin_episode(1);
+  std::uint64_t calls = 0;
+  const int choice = allocator.choose(mdp.start(), DecisionBudget::until([&calls] { return ++calls >= 5'000; }));
+  Statistics statistics;
+  allocator.collect_statistics(statistics);
+  const double work = statistics.find(kIterationsCounter).value_or(0.0);
+  const double trial_work = statistics.find("trial_work").value_or(-1.0);
+  EXPECT_EQ(work, 5'000.0);  // the condition is asked after every unit
+  EXPECT_GT(trial_work, 0.0);
+  // At least the first round's search share.
+  EXPECT_GE(work - trial_work, static_cast<double>(BranchAndBoundAllocator::kFirstRound) / 2.0);
+  EXPECT_EQ(statistics.find("exact_decisions").value_or(-1.0), 0.0);
+  EXPECT_GT(allocator.last_gap(), 0.0);
+  const ChoiceList useful = mdp.useful_choices(mdp.start());
+  EXPECT_NE(std::find(useful.begin(), useful.end(), choice), useful.end());
 }
 
 TEST(BranchAndBound, SameSeedSameDecisionsWhateverTheThreads) {

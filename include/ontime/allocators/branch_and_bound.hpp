@@ -6,25 +6,28 @@
 // test, or solved; or seconds; or the caller's stop condition) from the current state in two
 // parts: first `trial_share` of it on trials of bounded RTDP (BranchAndBoundSearch::trials),
 // which raise the certified lower ends of every choice that may still be best, then the rest on
-// the search, which settles choices by those ends too. It keeps what it solved and bounded for
-// the rest of the episode, so that later decisions start from it. (The search alone, cut short,
-// has gone deep into the first choice it solves while the others keep their static lower ends:
-// on navigation at 10 ms per decision that loses 1.5% of the optimum, the trials nothing;
-// docs/experiments.md.) Where the search finishes, the choice is the optimal one (the memoised solver's).
-// Cut short, it takes the choice with the best certified lower end and reports the gap: the
-// upper end of V*(state) minus that lower end, never below the choice's true loss
-// V*(state) - Q*(state, choice).
+// the search, which settles choices by those ends too. A budget of a stop condition alone (the
+// caller's clock) has no size to share: trials and search then take turns in rounds of doubling
+// work (kFirstRound units, then twice as many, ...), each its share of the round, until the search
+// finishes or the condition trips, so that the search runs however soon it trips. It keeps what it solved and bounded
+// for the rest of the episode, so that later decisions start from it. (The search alone, cut short, has gone deep into
+// the first choice it solves while the others keep their static lower ends: on navigation at 10 ms per decision that
+// loses 1.5% of the optimum, the trials nothing; docs/experiments.md.) Where the search finishes, the choice is the
+// optimal one (the memoised solver's). Cut short, it takes the choice with the best certified lower end and reports the
+// gap: the upper end of V*(state) minus that lower end, never below the choice's true loss V*(state) - Q*(state,
+// choice).
 //
 // Deterministic: the search is cleared at the start of every episode and its trials draw from
-// the episode's seed, so an episode's decisions depend on its seed and its own history only, and
-// with a work budget on no property of the machine. Not
-// stationary (a decision depends on what the episode solved before it). Cost per decision: its
-// budget; memory: the search's table, cleared when it holds `max-states` states.
+// the episode's seed (after a restart at the cap, from a stream of it), so an episode's decisions depend on its seed
+// and its own history only, and with a work budget on no property of the machine. Not stationary (a decision depends on
+// what the episode solved before it). Cost per decision: its budget; memory: the search's table, cleared when it holds
+// `max-states` states.
 
 #include <cstdint>
 #include <string_view>
 
 #include "ontime/allocators/allocator.hpp"
+#include "ontime/allocators/decision_budget.hpp"
 #include "ontime/mdp/mdp.hpp"
 #include "ontime/solve/search_solver.hpp"
 
@@ -53,13 +56,24 @@ class BranchAndBoundAllocator final : public Allocator {
   // was useful).
   double last_gap() const noexcept { return last_gap_; }
 
+  // The first round's work under a budget of a stop condition alone.
+  static constexpr std::uint64_t kFirstRound = 256;
+
  private:
+  // Trials on the first trial_share of the budget, then the search on the rest.
+  SearchSolution in_two_parts(const State& state, const DecisionBudget& decision, const BudgetMonitor& monitor,
+                              std::uint64_t& work, std::uint64_t& trial_work);
+  // Trials and search in turns (a budget of a stop condition alone).
+  SearchSolution in_rounds(const State& state, const BudgetMonitor& monitor, std::uint64_t& work,
+                           std::uint64_t& trial_work);
+
   const Mdp* mdp_;
   BranchAndBoundOptions options_;
   BranchAndBoundSearch search_;
   double last_gap_ = 0.0;
+  std::uint64_t episode_seed_ = 1, restarts_ = 0;
   struct Counters {
-    std::uint64_t searches = 0, work = 0, exact = 0;
+    std::uint64_t searches = 0, work = 0, trial_work = 0, exact = 0;
     double gap_sum = 0.0, max_gap = 0.0;
   } counters_;
 };

@@ -14,7 +14,8 @@
 // episode's sum, and its square, go into the statistics (kRegretSum, kRegretSquares,
 // kRegretEpisodes) in fixed point, whole multiples of kRegretUnit held exactly in a double, so
 // that the runner's merge over threads sums them exactly and the totals do not depend on the
-// thread count; `regret_estimate` turns them into a mean and a 95% interval.
+// thread count; with V*(s0) (kRegretOptimum, solved first by each thread's meter),
+// `regret_estimate` turns them into a mean and a 95% interval.
 //
 // Guarantees: the mean is unbiased for episodes drawn from the Mdp given (a hidden sampled world
 // of the same instance; an allocator planning with another belief is judged under this Mdp);
@@ -34,11 +35,13 @@ namespace ontime {
 inline constexpr const char* kRegretSum = "regret_units";
 inline constexpr const char* kRegretSquares = "regret_square_units";
 inline constexpr const char* kRegretEpisodes = "regret_episodes";
+inline constexpr const char* kRegretOptimum = "regret_optimum";
 // The fixed point's unit, 2^-32 (2.3e-10): an episode's sum is rounded to it. Totals stay exact
 // up to 2^53 units (2^21 in all).
 inline constexpr double kRegretUnit = 0x1p-32;
 
-// Allocators of `allocators`, each measuring its losses against `mdp`'s optimum (see above).
+// Allocators of `allocators`, each measuring its losses against `mdp`'s optimum (see above). Each
+// solves V*(s0) when made: ResourceLimitError when that needs more than `max_states` states.
 AllocatorFactory with_regret(const Mdp& mdp, AllocatorFactory allocators, std::uint64_t max_states);
 
 struct RegretEstimate {
@@ -48,11 +51,7 @@ struct RegretEstimate {
   std::uint64_t episodes = 0;
 };
 
-// V*(s0), the optimum the losses are measured against, by the exact search; ResourceLimitError
-// when it needs more than `max_states` states.
-double regret_optimum(const Mdp& mdp, std::uint64_t max_states);
-
 // The estimate from a run's merged statistics; nullopt when they hold no regret counters.
-std::optional<RegretEstimate> regret_estimate(const Statistics& statistics, double optimum);
+std::optional<RegretEstimate> regret_estimate(const Statistics& statistics);
 
 }  // namespace ontime

@@ -46,7 +46,9 @@
 namespace ontime {
 
 struct SearchSolveOptions {
-  std::uint64_t max_states = 0;  // states held: solved, or with an upper bound refined by a test; 0: no cap
+  // Records held: a state solved or with an upper bound refined by a test is one, a lower end kept
+  // by trials another; 0: no cap.
+  std::uint64_t max_states = 0;
   // Checked every few thousand states: once it returns true the search ends as at a cap.
   std::function<bool()> stop;
   // Above 0: no exact search, but trials (BranchAndBoundSearch::trials) until the start's
@@ -80,8 +82,8 @@ class BranchAndBoundSearch {
   BranchAndBoundSearch(BranchAndBoundSearch&&) noexcept;
   BranchAndBoundSearch& operator=(BranchAndBoundSearch&&) noexcept;
 
-  // Searches from `from` until its value is exact, the state cap is reached (states held: solved
-  // or refined since made or cleared) or `stop(work)` returns true, checked every `check_interval` units of
+  // Searches from `from` until its value is exact, the state cap is reached (records held since
+  // made or cleared: see size()) or `stop(work)` returns true, checked every `check_interval` units of
   // work (a state solved, or expanded by an upper test) with the units done in this call. Cut
   // short, the solution is `from`'s interval and the choice of the best lower end: `lower` is at
   // most that choice's value, `upper` at least V*(from), so upper - lower bounds its loss. The
@@ -101,7 +103,8 @@ class BranchAndBoundSearch {
                         std::uint64_t check_interval = 1, double gap = 0.0);
   // Forgets what was solved and refined; the trials draw from `seed` on.
   void clear(std::uint64_t seed = 1);
-  // States held (solved or refined).
+  // Records held, what the cap counts: a state solved or refined is one, a lower end kept by the
+  // trials another.
   std::uint64_t size() const noexcept;  // NOLINT(bugprone-exception-escape): see its definition
 
  private:
