@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Checks that OnTime split over MPI ranks gives the numbers of one process, to the byte, and
 # loses no work when a rank dies:
-#  1. a navigation collection of 100 trials per action (with features: a corpus's records) and an
+#  1. a navigation collection of 50 trials per action (with features: a corpus's records) and an
 #     evaluation of the fitted instance, as one process, under `mpirun -np 2`, and under SLURM (`sbatch` of the scripts here, whose
 #     `srun --mpi=pmix` starts 2 tasks) on a single-node cluster brought up for the check
 #     (slurm-up.sh); the logs, the fitted instances and the evaluations must be identical;
@@ -30,7 +30,7 @@ if [ "$(id -u)" -eq 0 ]; then mpirun+=(--allow-run-as-root); fi
 world="$root/data/domains/navigation.json"
 # With --features: the records of a corpus for conditional models (docs/learning.md) come out of
 # the ranks as out of one process.
-job_collect=(--domain navigation --world "$world" --trials 100 --seed 1 --features --log nav.jsonl
+job_collect=(--domain navigation --world "$world" --trials 50 --seed 1 --features --log nav.jsonl
   --instance nav.json)
 collect=(collect "${job_collect[@]}" --threads 1)
 evaluate=(evaluate nav.json --solver dp-rerun --episodes 20000 --seed 1 --threads 1 --json --no-timing)

@@ -172,7 +172,7 @@ TEST(Cli, InterruptedTrainingLeavesTheOldSetOrTheNewSetNeverAMix) {
     if (!plot) arguments.push_back("--no-plot");
     return arguments;
   };
-  ASSERT_EQ(testing::run_process(train("100", true)).exit_code, 0);
+  ASSERT_EQ(testing::run_process(train("50", true)).exit_code, 0);
   const std::vector<std::string> old_set{read_file(policy), read_file(csv), read_file(png)};
   const auto entries = [&directory] {
     std::vector<std::string> names;
@@ -186,7 +186,7 @@ TEST(Cli, InterruptedTrainingLeavesTheOldSetOrTheNewSetNeverAMix) {
   ASSERT_EQ(entries(), expected_names);
 
   // Cut off while the new files are being written (the plot is drawn last).
-  const auto staging = testing::run_process(train("200", true), [&] {
+  const auto staging = testing::run_process(train("100", true), [&] {
     for (const std::string& name : entries()) {
       if (name.rfind(".ontime-output-", 0) == 0) return true;
     }
@@ -208,7 +208,7 @@ TEST(Cli, InterruptedTrainingLeavesTheOldSetOrTheNewSetNeverAMix) {
 
   // Cut off as soon as a new policy shows: the curve beside it is new too.
   const std::vector<std::string> before{read_file(policy), read_file(csv), read_file(png)};
-  testing::run_process(train("300", true), [&] { return read_file(policy) != before[0]; });
+  testing::run_process(train("150", true), [&] { return read_file(policy) != before[0]; });
   EXPECT_EQ(entries(), expected_names);
   const std::vector<std::string> now{read_file(policy), read_file(csv), read_file(png)};
   if (now[0] == before[0]) {
@@ -218,7 +218,7 @@ TEST(Cli, InterruptedTrainingLeavesTheOldSetOrTheNewSetNeverAMix) {
     EXPECT_TRUE(now[2] != before[2]) << "a new policy beside the old curve PNG";
   }
 
-  ASSERT_EQ(testing::run_process(train("400", false)).exit_code, 0);
+  ASSERT_EQ(testing::run_process(train("200", false)).exit_code, 0);
   EXPECT_EQ(entries(), (std::vector<std::string>{"policy.curve.csv", "policy.json"}));
 }
 

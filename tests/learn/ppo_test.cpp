@@ -152,10 +152,10 @@ TEST(Ppo, SameSeedSamePolicyByteForByte) {
   const Mdp mdp(problem);
   PpoHyperparameters small;
   small.steps_per_epoch = 500;
-  const std::string first = ppo_policy_to_json(train_ppo(mdp, 300, 9, small).policy);
-  const std::string second = ppo_policy_to_json(train_ppo(mdp, 300, 9, small).policy);
+  const std::string first = ppo_policy_to_json(train_ppo(mdp, 150, 9, small).policy);
+  const std::string second = ppo_policy_to_json(train_ppo(mdp, 150, 9, small).policy);
   EXPECT_EQ(first, second);
-  EXPECT_NE(first, ppo_policy_to_json(train_ppo(mdp, 300, 10, small).policy));
+  EXPECT_NE(first, ppo_policy_to_json(train_ppo(mdp, 150, 10, small).policy));
 }
 
 // Eigen chooses the blocking of its matrix products from the CPU's cache sizes, read at run time;
