@@ -8,7 +8,9 @@ cd "$(dirname "$0")/.."
 seconds="${1:-60}"
 generator=()
 if command -v ninja >/dev/null 2>&1 && [ ! -f build-fuzz/CMakeCache.txt ]; then generator=(-G Ninja); fi
-cmake -S . -B build-fuzz "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
+# A unity build (batches of sources as one translation unit): half the compile time (83 s against
+# 174 s on 2 cores); the release build compiles the same sources file by file.
+cmake -S . -B build-fuzz "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_UNITY_BUILD=ON \
   -DONTIME_BUILD_FUZZERS=ON -DONTIME_BUILD_APPS=OFF -DONTIME_BUILD_BENCHMARKS=OFF -DBUILD_TESTING=OFF
 cmake --build build-fuzz --parallel "$(nproc)" --target instance_fuzzer planner_log_fuzzer ompl_benchmark_log_fuzzer
 
