@@ -122,10 +122,12 @@ SearchSolution BranchAndBoundAllocator::in_rounds(const State& state, const Budg
       quota_spent = done >= search_quota;
       return stopped || quota_spent;
     });
-    // Ended by neither the budget nor its quota: by the state cap, which the next round would hit at once.
+    // Ended by neither the budget nor its quota: by the state cap, which the next round would hit
+    // at once.
     if (found.exact || stopped || !quota_spent) return found;
   }
 }
+
 void BranchAndBoundAllocator::collect_statistics(Statistics& statistics) const {
   statistics.add(kSearchesCounter, static_cast<double>(counters_.searches));
   statistics.add(kIterationsCounter, static_cast<double>(counters_.work));

@@ -8,20 +8,22 @@
 // which raise the certified lower ends of every choice that may still be best, then the rest on
 // the search, which settles choices by those ends too. A budget of a stop condition alone (the
 // caller's clock) has no size to share: trials and search then take turns in rounds of doubling
-// work (kFirstRound units, then twice as many, ...), each its share of the round, until the search
-// finishes or the condition trips, so that the search runs however soon it trips. It keeps what it solved and bounded
-// for the rest of the episode, so that later decisions start from it. (The search alone, cut short, has gone deep into
-// the first choice it solves while the others keep their static lower ends: on navigation at 10 ms per decision that
-// loses 1.5% of the optimum, the trials nothing; docs/experiments.md.) Where the search finishes, the choice is the
-// optimal one (the memoised solver's). Cut short, it takes the choice with the best certified lower end and reports the
-// gap: the upper end of V*(state) minus that lower end, never below the choice's true loss V*(state) - Q*(state,
-// choice).
+// work (kFirstRound units, then twice as many, ...), each its share of the round, until the
+// search finishes or the condition trips, so that the search runs however soon it trips. It
+// keeps what it solved and bounded for the rest of the episode, so that later decisions start
+// from it. (The search alone, cut short, has gone deep into the first choice it solves while the
+// others keep their static lower ends: on navigation at 10 ms per decision that loses 1.5% of
+// the optimum, the trials nothing; docs/experiments.md.) Where the search finishes, the choice
+// is the optimal one (the memoised solver's). Cut short, it takes the choice with the best
+// certified lower end and reports the gap: the upper end of V*(state) minus that lower end,
+// never below the choice's true loss V*(state) - Q*(state, choice).
 //
 // Deterministic: the search is cleared at the start of every episode and its trials draw from
-// the episode's seed (after a restart at the cap, from a stream of it), so an episode's decisions depend on its seed
-// and its own history only, and with a work budget on no property of the machine. Not stationary (a decision depends on
-// what the episode solved before it). Cost per decision: its budget; memory: the search's table, cleared when it holds
-// `max-states` states.
+// the episode's seed (after a restart at the cap, from a stream of it), so an episode's
+// decisions depend on its seed and its own history only, and with a work budget on no property
+// of the machine. Not stationary (a decision depends on what the episode solved before it). Cost
+// per decision: its budget; memory: the search's table, cleared when it holds `max-states`
+// records (see BranchAndBoundSearch::size).
 
 #include <cstdint>
 #include <string_view>
