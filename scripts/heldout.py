@@ -37,7 +37,10 @@ import subprocess
 import sys
 
 TRAIN_SEEDS = range(1001, 1051)
-HELD_OUT_SEEDS = range(2001, 2021)
+# The held-out worlds of each domain. Two earlier rounds of kitchens are held out no more: the
+# analysis of 2001-2020 led to the kitchen's reach feature, and 3001-3020 were seen with its first,
+# linear form before the training worlds chose the log scale. The kitchen's are 4001-4020.
+HELD_OUT_SEEDS = {"navigation": range(2001, 2021), "manipulation": range(4001, 4021)}
 LEARNED = ("hazard", "boosted", "pooled")
 BELIEFS = (*LEARNED, "oracle")
 NAMES = {"hazard": "hazard model", "boosted": "boosted model", "pooled": "pooled Kaplan-Meier",
@@ -168,7 +171,7 @@ def main():
     parser.add_argument("--ontime", default="build/ontime")
     parser.add_argument("--out", help="output folder (default: heldout-DOMAIN)")
     parser.add_argument("--train", type=int, default=len(TRAIN_SEEDS), help="training worlds (first N seeds)")
-    parser.add_argument("--held-out", type=int, default=len(HELD_OUT_SEEDS), help="held-out worlds")
+    parser.add_argument("--held-out", type=int, default=20, help="held-out worlds (at most 20)")
     parser.add_argument("--train-trials", type=int, default=30, help="attempts per action of a training world")
     parser.add_argument("--oracle-trials", type=int, default=300, help="attempts per action of a held-out world")
     parser.add_argument("--skeletons", type=int, default=6, help="room paths of a held-out building")
@@ -221,7 +224,7 @@ def main():
             previous = json.load(text)
         if previous.get("settings") == vars(args) and previous.get("strengths") == strengths:
             done = {w["seed"]: w for w in previous["worlds"]}
-    for i, seed in enumerate(HELD_OUT_SEEDS[: args.held_out]):
+    for i, seed in enumerate(HELD_OUT_SEEDS[args.domain][: args.held_out]):
         print(f"held-out world {i + 1}/{args.held_out} (seed {seed})", file=sys.stderr)
         if seed in done:
             worlds.append(done[seed])

@@ -14,19 +14,29 @@ namespace {
 
 using std::numbers::pi;
 
-// Some draw reaches the object at `pose` with one of its grasps; `held`: whether the robot holds
-// it (a place) or it stands there (a pick). `alone` holds the object as its only movable one.
-bool reachable(const ManipulationWorld& alone, const ObjectPose& pose, bool held, std::uint64_t seed) {
+// Counts the draws that reach `object` (see the header) until `hits` have. `poses`: every movable
+// object's pose. `held`: the object is in the hand, to be placed at its pose in `poses`, or with
+// `region` at a placement each draw draws there; else it stands at its pose, to be picked.
+ReachCount count_reaching(const ManipulationWorld& world, const std::vector<ObjectPose>& poses, std::size_t object,
+                          bool held, const PlacementRegion* region, int hits, int draws, std::uint64_t seed) {
   SplitMix64 random(seed);
   const auto uniform = [&random](double low, double high) { return low + (high - low) * uniform01(random); };
-  const Pr2Arm arm(alone.robot.torso_lift);
-  const std::vector<Transform> grasps = box_grasps(alone.objects.front().size);
-  const ManipulationPlanner& planner = alone.planner;
-  const auto& floor = alone.floor;
-  ManipulationCollision collision(alone, arm, {pose}, held ? 0 : -1, Transform::Identity(), alone.robot.clearance);
-  for (int draw = 0; draw < kReachDraws; ++draw) {
+  const Pr2Arm arm(world.robot.torso_lift);
+  const std::vector<Transform> grasps = box_grasps(world.objects.at(object).size);
+  const ManipulationPlanner& planner = world.planner;
+  const auto& floor = world.floor;
+  ManipulationCollision collision(world, arm, poses, held ? static_cast<int>(object) : -1, Transform::Identity(),
+                                  world.robot.clearance);
+  ReachCount count;
+  while (count.reached < hits && count.drawn < draws) {
+    ++count.drawn;
     const Transform& grasp = grasps[std::min(
         grasps.size() - 1, static_cast<std::size_t>(uniform01(random) * static_cast<double>(grasps.size())))];
+    ObjectPose pose = poses.at(object);
+    if (region != nullptr) {
+      pose = ObjectPose{uniform(region->min_x, region->max_x), uniform(region->min_y, region->max_y),
+                        world.resting_z(object, *region), uniform(region->yaw_low, region->yaw_high)};
+    }
     if (held) collision.set_grasp(grasp.inverse());
     const Transform tool = object_transform(pose) * grasp;
     Transform back = Transform::Identity();
@@ -42,16 +52,17 @@ bool reachable(const ManipulationWorld& alone, const ObjectPose& pose, bool held
     ArmJoints guess{};
     for (std::size_t j = 0; j < kArmJointCount; ++j)
       guess[j] = uniform(pr2_left_arm_joints()[j].lower, pr2_left_arm_joints()[j].upper);
+    if (region != nullptr && collision.held_object_collides(pose)) continue;
     if (!(x > floor[0] && x < floor[2] && y > floor[1] && y < floor[3])) continue;
-    if (collision.collides(base, alone.robot.carry)) continue;
+    if (collision.collides(base, world.robot.carry)) continue;
     const Transform torso = base_transform(base) * arm.torso();
     if (!arm.may_reach(torso.inverse() * tool) || !arm.may_reach(torso.inverse() * backed)) continue;
     const std::optional<ArmJoints> joints = arm.inverse(torso.inverse() * tool, guess);
     if (!joints || collision.collides(base, *joints)) continue;
     const std::optional<ArmJoints> before = arm.inverse(torso.inverse() * backed, *joints);
-    if (before && !collision.collides(base, *before)) return true;
+    if (before && !collision.collides(base, *before)) ++count.reached;
   }
-  return false;
+  return count;
 }
 
 ManipulationWorld alone_with(const ManipulationWorld& world, std::size_t object) {
@@ -65,13 +76,21 @@ ManipulationWorld alone_with(const ManipulationWorld& world, std::size_t object)
 }  // namespace
 
 bool can_pick(const ManipulationWorld& world, std::size_t object, std::uint64_t seed) {
-  return reachable(alone_with(world, object), world.objects.at(object).pose, false, seed);
+  const ManipulationWorld alone = alone_with(world, object);
+  return count_reaching(alone, {world.objects.at(object).pose}, 0, false, nullptr, 1, kReachDraws, seed).reached > 0;
 }
 
 bool can_place(const ManipulationWorld& world, std::size_t object, std::size_t region, std::uint64_t seed) {
   const PlacementRegion& r = world.regions.at(region);
   const ObjectPose pose{(r.min_x + r.max_x) / 2, (r.min_y + r.max_y) / 2, world.resting_z(object, r), 0};
-  return reachable(alone_with(world, object), pose, true, seed);
+  const ManipulationWorld alone = alone_with(world, object);
+  return count_reaching(alone, {pose}, 0, true, nullptr, 1, kReachDraws, seed).reached > 0;
+}
+
+ReachCount count_reaching_draws(const ManipulationWorld& world, const std::vector<ObjectPose>& poses,
+                                std::size_t object, const PlacementRegion* region, int hits, int draws,
+                                std::uint64_t seed) {
+  return count_reaching(world, poses, object, region != nullptr, region, hits, draws, seed);
 }
 
 }  // namespace ontime::domains::detail

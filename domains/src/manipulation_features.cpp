@@ -6,6 +6,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "kitchen_reach.hpp"
 #include "planar_geometry.hpp"
 
 namespace ontime::domains {
@@ -113,9 +114,9 @@ double covered(const std::vector<std::vector<Point>>& footprints, const std::arr
 }  // namespace
 
 const std::vector<std::string>& manipulation_feature_names() {
-  static const std::vector<std::string> names{"is_place",          "object_short", "object_long",    "object_height",
-                                              "surface_height",    "reach",        "nearest_gap",    "neighbours",
-                                              "approach_occupied", "region_area",  "region_occupied"};
+  static const std::vector<std::string> names{
+      "is_place",    "object_short", "object_long",       "object_height", "surface_height",  "reach",
+      "nearest_gap", "neighbours",   "approach_occupied", "region_area",   "region_occupied", "log_reach_share"};
   return names;
 }
 
@@ -205,6 +206,24 @@ std::vector<double> manipulation_action_features(const ManipulationWorld& world,
     }
     region_occupied = region_area > 0 ? std::min(1.0, occupied / region_area) : (occupied > 0 ? 1.0 : 0.0);
   }
+
+  // Whether the approaches are open, not only how crowded they are: the robot's own target draws
+  // in the world the action starts in, the moved objects at the centres of their regions.
+  std::vector<ObjectPose> poses;
+  for (std::size_t j = 0; j < world.objects.size(); ++j) {
+    const auto went = moved.find(static_cast<int>(j));
+    if (went == moved.end()) {
+      poses.push_back(world.objects[j].pose);
+      continue;
+    }
+    const PlacementRegion& there = world.regions[static_cast<std::size_t>(went->second)];
+    poses.push_back({(there.min_x + there.max_x) / 2, (there.min_y + there.max_y) / 2, world.resting_z(j, there), 0});
+  }
+  const detail::ReachCount reach =
+      detail::count_reaching_draws(world, poses, static_cast<std::size_t>(subject), place ? region : nullptr,
+                                   kManipulationReachHits, kManipulationReachDraws, kManipulationReachSeed);
+  const double reach_share = static_cast<double>(reach.reached) / reach.drawn;
+  const double log_reach_share = std::log10(std::max(reach_share, kManipulationReachShareFloor));
   return {place ? 1.0 : 0.0,
           std::min(object.size[0], object.size[1]),
           std::max(object.size[0], object.size[1]),
@@ -215,7 +234,8 @@ std::vector<double> manipulation_action_features(const ManipulationWorld& world,
           neighbours,
           approach,
           region_area,
-          region_occupied};
+          region_occupied,
+          log_reach_share};
 }
 
 }  // namespace ontime::domains

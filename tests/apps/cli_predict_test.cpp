@@ -156,7 +156,7 @@ TEST(Cli, PredictWritesTheInstanceOfAnUnseenKitchen) {
   const std::string first = read_file(logs[0]);
   const json record = json::parse(first.substr(0, first.find('\n')));
   EXPECT_EQ(record["world"], "k1");
-  EXPECT_EQ(record["features"].size(), 11u);
+  EXPECT_EQ(record["features"].size(), 12u);            // the last, log_reach_share
   EXPECT_EQ(record["features"][0].get<double>(), 0.0);  // the first action picks
 
   const std::string model = (dir / "pooled.json").string();

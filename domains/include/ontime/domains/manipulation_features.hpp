@@ -2,7 +2,8 @@
 // The features of a manipulation action: what a conditional time model (learn/) sees of
 // move+pick(O) or move+place(O,R) in a kitchen it may never have refined in. One layout for both
 // kinds, a fixed-length vector from the world file's geometry alone (docs/learning.md,
-// "Features"), in O(objects + furniture boxes + skeleton positions) per action.
+// "Features"), in O(objects + furniture boxes + skeleton positions) per action, plus
+// log_reach_share's draws.
 //
 // The world the action starts in: the objects of its context (moved before it) no longer stand
 // where they started; where they went is read from the first skeleton holding the action (the
@@ -32,10 +33,27 @@
 //   region_occupied    place: the share of the rectangle covered by the others' footprints, plus
 //                      the footprint areas of the objects the prefix placed there, at most 1 (a
 //                      rectangle without area: 1 when anything is counted, else 0); pick: 0
+//   log_reach_share    log10 of the share of target draws, drawn as the refinement draws them (a
+//                      grasp, for a place a placement in the region, a base pose, the arm's IK
+//                      for the grasp and its approach) from kManipulationReachSeed, that reach
+//                      collision-free in the world the action starts in (the moved objects at
+//                      the centres of their regions): reaching draws over draws made, drawing
+//                      until kManipulationReachHits have reached or kManipulationReachDraws were
+//                      made; a share of 0 (none of those reached) counts as
+//                      kManipulationReachShareFloor. Gaps and counts say how crowded a subject
+//                      is; this says whether any approach is left open, which they cannot. On a
+//                      log scale because what matters is 0 against 1 in 1,000 against 1 in 100,
+//                      which a model linear in the share cannot tell apart
 //
 // A pick of an object that its context moved takes it at the centre of the region it went to.
-// The same vector for the same world and action on every machine (no randomness, no tolerances).
+// The same vector for the same world and action on every run: log_reach_share's draws come from a
+// fixed seed, the other features involve no randomness and no tolerances. log_reach_share goes
+// through libm and KDL as the refinement does (docs/reliability.md): where glibc picks another
+// build of sin or atan2 for another CPU, a draw on the edge of a collision may turn out otherwise.
+// It costs up to two IK solves per draw (up to about 50 ms for an action with no open approach);
+// the others are geometry of rectangles.
 
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -49,6 +67,14 @@ inline constexpr double kManipulationNeighbourRadius = 0.15;
 // The open gripper with its clearance (0.14 m) and 8 cm either side, where neighbours crowd the
 // hand and the forearm on their way to the object.
 inline constexpr double kManipulationApproachWidth = 0.3;
+// log_reach_share's draws: at most this many (an action a refinement finds at all reaches at about
+// 1 draw in 1,000 to 100 on the training kitchens), stopping after kManipulationReachHits reaching
+// ones, from this seed.
+inline constexpr int kManipulationReachDraws = 10000;
+inline constexpr int kManipulationReachHits = 10;
+// A tenth of the least share above 0 that the draws can find.
+inline constexpr double kManipulationReachShareFloor = 1e-5;
+inline constexpr std::uint64_t kManipulationReachSeed = 1;
 
 // The names, in the order of manipulation_action_features' vector.
 const std::vector<std::string>& manipulation_feature_names();
