@@ -177,7 +177,7 @@ void add_solve_command(CLI::App& app) {
   command->add_flag("--json", options->json, "Print JSON");
   command->add_flag("--no-timing", options->no_timing,
                     "Layered: leave out measured times and memory, so that outputs can be compared byte for byte");
-  command->callback([options, command] {
+  command->callback([options] {
     if (options->gap > 0 && options->method != "search") throw UsageError("--gap is for --method search");
     const Problem problem = load_problem(options->instance);
     if (problem.skeleton_count() > kMaxExactSkeletons) check_exact_work(problem, 1, options->instance);
