@@ -37,6 +37,8 @@ void add_predict_command(CLI::App& app) {
   command->add_flag("--library", options->predict.library,
                     "Every action of the world as a skeleton of its own, even when the world lists skeletons");
   command->add_option("--name", options->predict.name, "Instance name (default: the world's name)");
+  add_threads_option(*command, options->predict.threads,
+                     "Threads computing the actions' features (0: one per hardware thread)");
   command->add_flag("--json", options->json, "Print JSON");
   command->callback([options] {
     check_outputs({{"--output", options->output}}, {options->world, options->model});

@@ -1,9 +1,13 @@
 #include "ontime/domains/predict.hpp"
 
 #include <cmath>
+#include <cstdint>
+#include <optional>
 #include <stdexcept>
+#include <unordered_set>
 
 #include "ontime/util/error.hpp"
+#include "ontime/util/parallel.hpp"
 
 namespace ontime::domains {
 
@@ -36,14 +40,28 @@ Problem predict_instance(const Domain& domain, const DomainDefaults& defaults, c
                        "--library)");
     }
   }
+  // Each action once, in the order of its first appearance.
   std::vector<ActionFeatures> actions;
-  actions.reserve(ids.size());
+  std::unordered_set<std::string> seen;
   for (const std::string& id : ids) {
-    try {
-      actions.push_back({id, domain.action_features(id)});
-    } catch (const std::invalid_argument& error) {
-      throw UsageError(error.what());
-    }
+    if (seen.insert(id).second) actions.push_back({id, {}});
+  }
+  // An action that cannot be described: the first in that order is reported, whichever thread
+  // met it first.
+  std::vector<std::optional<std::string>> refusals(actions.size());
+  for_each_block(actions.size(), options.threads, 1, [&](unsigned /*thread*/) {
+    return [&](std::uint64_t begin, std::uint64_t end) {
+      for (std::uint64_t a = begin; a < end; ++a) {
+        try {
+          actions[a].features = domain.action_features(actions[a].id);
+        } catch (const std::invalid_argument& error) {
+          refusals[a] = error.what();
+        }
+      }
+    };
+  });
+  for (const std::optional<std::string>& refusal : refusals) {
+    if (refusal) throw UsageError(*refusal);
   }
   const Steps deadline = options.deadline > 0 ? options.deadline : defaults.collection.deadline;
   return predict_problem(model, actions, skeletons, deadline,

@@ -364,19 +364,23 @@ void bind_domains(py::module_& m) {
   m.def(
       "predict",
       [](const std::shared_ptr<DomainHandle>& domain, const std::shared_ptr<ConditionalTimeModel>& model,
-         Number<Steps, "deadline", 0, Problem::kMaxDeadline> deadline, bool library, const std::string& name) {
+         Number<Steps, "deadline", 0, Problem::kMaxDeadline> deadline, bool library, const std::string& name,
+         Threads threads) {
         domains::PredictOptions options;
         options.deadline = deadline;
         options.library = library;
         options.name = name;
+        options.threads = threads;
+        const py::gil_scoped_release release;
         return std::make_shared<Problem>(
             domains::predict_instance(*domain->loaded.domain, domain->loaded.defaults, *model, options));
       },
       py::arg("domain"), py::arg("model"), py::kw_only(), py::arg("deadline") = 0, py::arg("library") = false,
-      py::arg("name") = "",
+      py::arg("name") = "", py::arg("threads") = 0,
       "`ontime predict`: the instance of the domain's world with every action's distributions predicted by the "
       "conditional time model (the world's skeletons, or every action on its own with library=True or a world "
-      "without skeletons); deadline 0: the world file's.");
+      "without skeletons); deadline 0: the world file's. The actions' features are computed on `threads` threads "
+      "(0: one per hardware thread; the instance is the same for every count).");
 
   m.def(
       "generate_world",

@@ -56,6 +56,10 @@ def test_fit_and_predict_write_the_clis_files(corpus, cli):
     python_file = folder / "python-predicted.json"
     problem.save(python_file)
     assert json.loads(python_file.read_text()) == json.loads(instance_file.read_text())
+    one_thread = ontime.domains.predict(ontime.domains.load("navigation", unseen), loaded, threads=1)
+    assert one_thread.to_json() == problem.to_json()
+    with pytest.raises(ValueError, match="threads"):
+        ontime.domains.predict(ontime.domains.load("navigation", unseen), loaded, threads=-1)
 
 
 def test_predict_takes_numpy_rows_and_records_fit_as_files_do(corpus):
