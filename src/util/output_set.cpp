@@ -94,8 +94,15 @@ void publish(const std::vector<std::filesystem::path>& members, const std::files
 OutputSet::OutputSet(const std::filesystem::path& directory) : directory_(directory.empty() ? "." : directory) {
   std::string pattern = (directory_ / ".ontime-output-XXXXXX").string();
   check_length(pattern);
+  // The termination signals wait until the handler that removes the directory is in place: one
+  // that came between the directory's creation and the handler would leave it behind.
+  const sigset_t blocked = termination_set();
+  sigset_t previous_mask;
+  ::pthread_sigmask(SIG_BLOCK, &blocked, &previous_mask);
   if (::mkdtemp(pattern.data()) == nullptr) {
-    throw std::runtime_error(directory_.string() + ": cannot create a staging directory: " + std::strerror(errno));
+    const std::string reason = std::strerror(errno);
+    ::pthread_sigmask(SIG_SETMASK, &previous_mask, nullptr);
+    throw std::runtime_error(directory_.string() + ": cannot create a staging directory: " + reason);
   }
   staging_ = pattern;
   publish(members_, staging_);
@@ -105,9 +112,14 @@ OutputSet::OutputSet(const std::filesystem::path& directory) : directory_(direct
   for (std::size_t i = 0; i < std::size(kTerminationSignals); ++i) {
     ::sigaction(kTerminationSignals[i], &action, &previous_actions[i]);
   }
+  ::pthread_sigmask(SIG_SETMASK, &previous_mask, nullptr);
 }
 
 OutputSet::~OutputSet() {
+  // Likewise: a signal between the handlers' removal and the directory's would leave it behind.
+  const sigset_t blocked = termination_set();
+  sigset_t previous_mask;
+  ::pthread_sigmask(SIG_BLOCK, &blocked, &previous_mask);
   for (std::size_t i = 0; i < std::size(kTerminationSignals); ++i) {
     ::sigaction(kTerminationSignals[i], &previous_actions[i], nullptr);
   }
@@ -116,6 +128,7 @@ OutputSet::~OutputSet() {
     std::error_code ignored;
     std::filesystem::remove_all(staging_, ignored);
   }
+  ::pthread_sigmask(SIG_SETMASK, &previous_mask, nullptr);
 }
 
 std::filesystem::path OutputSet::stage(const std::filesystem::path& target) {
