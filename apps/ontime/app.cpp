@@ -78,6 +78,7 @@ std::unique_ptr<CLI::App> make_app() {
   add_score_command(*app);
   add_adapt_command(*app);
   add_fit_strength_command(*app);
+  add_fit_chain_command(*app);
   add_sample_log_command(*app);
   add_plot_command(*app);
 #if ONTIME_WITH_DOMAINS

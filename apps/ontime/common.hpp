@@ -28,6 +28,7 @@ void add_study_command(CLI::App& app);
 void add_train_command(CLI::App& app);
 void add_reduce_knapsack_command(CLI::App& app);
 void add_fit_command(CLI::App& app);
+void add_fit_chain_command(CLI::App& app);
 void add_sample_log_command(CLI::App& app);
 void add_plot_command(CLI::App& app);
 void add_collect_command(CLI::App& app);

@@ -18,6 +18,7 @@ and the library's formats. docs/python.md describes the whole API.
 from __future__ import annotations
 
 import json
+import operator
 import os
 from typing import Any, Iterable, Mapping, Optional, Sequence, Union
 
@@ -26,10 +27,12 @@ from ._ontime import (  # noqa: F401  (re-exported)
     Action,
     ActionAttempt,
     Allocator,
+    ChainFit,
     ConditionalTimeModel,
     Decision,
     Distribution,
     Error,
+    ExogenousChain,
     InputError,
     LiveSession,
     ManualClock,
@@ -48,6 +51,7 @@ from ._ontime import (  # noqa: F401  (re-exported)
     evaluate,
     fit_strength,
     histogram_csv,
+    load_chain,
     load_conditional_model,
     load_problem,
     make_allocator,
@@ -66,10 +70,10 @@ from . import _ontime
 __version__ = "0.1.0"
 
 __all__ = [
-    "NEVER", "Action", "ActionAttempt", "Allocator", "ConditionalTimeModel", "Decision", "Distribution", "Error", "InputError", "LiveSession",
+    "NEVER", "Action", "ActionAttempt", "Allocator", "ChainFit", "ConditionalTimeModel", "Decision", "Distribution", "Error", "ExogenousChain", "InputError", "LiveSession",
     "ManualClock", "Mdp", "OnlineBelief", "PlanningPosterior", "Problem",
     "ResourceLimitError", "Session", "State", "Status", "UsageError", "World", "allocators", "conditional_model_kinds",
-    "evaluate", "fit", "fit_conditional", "histogram_csv", "load_conditional_model", "load_problem", "make_allocator", "read_planner_log", "reduce_knapsack", "run_episodes", "sample_log", "score", "adapt", "fit_strength",
+    "evaluate", "fit", "fit_chain", "fit_conditional", "histogram_csv", "load_chain", "load_conditional_model", "load_problem", "make_allocator", "read_planner_log", "reduce_knapsack", "run_episodes", "sample_log", "score", "adapt", "fit_strength",
     "solve", "study", "table", "train_ppo",
     "write_planner_log",
 ]
@@ -249,6 +253,35 @@ def fit_conditional(records_or_paths: Union[PathLike, Sequence[PathLike], Iterab
     return _ontime._fit_conditional(logs, are_paths, float(step), kind, names, int(horizon), float(ridge), int(bins),
                                     int(trees), int(depth), float(learning_rate), float(min_child_weight),
                                     str(aft_distribution), float(aft_scale))
+
+
+def fit_chain(logs_or_sequences: Union[PathLike, Sequence[PathLike], Sequence[Sequence[Union[int, str]]]], *,
+              kind: str = "markov", name: str = "chain", prior: float = 0.0,
+              states: Optional[Sequence[Union[int, str]]] = None, capacity: int = 0) -> "ChainFit":
+    """An exogenous chain (docs/learning.md, "Exogenous chains"), as `ontime fit-chain` fits it: from one or
+    more observation logs (paths; JSON lines of sequence, step, state), or from sequences of states observed at
+    consecutive steps (each a list of names or whole numbers, e.g. a queue's lengths). kind "markov" frees every
+    transition probability (`prior` pseudo-transitions per entry; `states` in that order); "birth-death" is a
+    queue of `capacity` (0: the longest observed) with one arrival and one service probability per step."""
+    if isinstance(logs_or_sequences, (str, os.PathLike)):
+        logs, sequences = [os.fspath(logs_or_sequences)], []
+    else:
+        items = list(logs_or_sequences)
+        if items and all(isinstance(item, (str, os.PathLike)) for item in items):
+            logs, sequences = [os.fspath(item) for item in items], []
+        else:
+            logs, sequences = [], [[_state_name(state) for state in sequence] for sequence in items]
+    listed = [_state_name(state) for state in states] if states is not None else []
+    return _ontime._fit_chain(logs, sequences, kind, name, float(prior), listed, capacity)
+
+
+def _state_name(state: Union[int, str]) -> str:
+    """A state's name: a str as it is, a whole number >= 0 (int, numpy integer) as its digits."""
+    if isinstance(state, str):
+        return state
+    if isinstance(state, bool) or not hasattr(state, "__index__") or operator.index(state) < 0:
+        raise UsageError(f"a state is a name (str) or a whole number >= 0 (got {state!r})")
+    return str(operator.index(state))
 
 
 from . import env  # noqa: E402,F401  (ontime.env.EffortAllocationEnv)

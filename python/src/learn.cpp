@@ -10,6 +10,7 @@
 
 #include "bindings.hpp"
 #include "ontime/learn/attempt_scores.hpp"
+#include "ontime/learn/chain_fitting.hpp"
 #include "ontime/learn/conditional_model.hpp"
 #include "ontime/learn/fitting.hpp"
 #include "ontime/learn/log_sampling.hpp"
@@ -217,8 +218,44 @@ void bind_conditional(py::module_& m) {
 
 }  // namespace
 
+void bind_chain_fitting(py::module_& m) {
+  py::class_<ChainFit>(m, "ChainFit", "What ontime.fit_chain fitted: the chain and what it was fitted to.")
+      .def_readonly("chain", &ChainFit::chain)
+      .def_readonly("transitions_counted", &ChainFit::transitions)
+      .def_readonly("runs", &ChainFit::runs)
+      .def_readonly("log_likelihood", &ChainFit::log_likelihood)
+      .def_readonly("arrival", &ChainFit::arrival, "birth-death: the probability of an arrival per step")
+      .def_readonly("service", &ChainFit::service, "birth-death: the probability of a service per step");
+
+  m.def(
+      "_fit_chain",
+      [](const std::vector<std::string>& logs, const std::vector<std::vector<std::string>>& sequences,
+         const std::string& kind, const std::string& name, Number<double, "prior", 0.0> prior,
+         const std::vector<std::string>& states, Number<std::int64_t, "capacity", 0, kMaxChainStates - 1> capacity) {
+        ChainFitOptions options;
+        options.kind = chain_kind(kind);
+        options.name = name;
+        options.prior = prior;
+        options.states = states;
+        options.capacity = capacity;
+        const py::gil_scoped_release release;
+        std::vector<ChainRun> runs;
+        for (const std::string& log : logs) {
+          std::vector<ChainRun> read = load_chain_observations(log);
+          runs.insert(runs.end(), std::make_move_iterator(read.begin()), std::make_move_iterator(read.end()));
+        }
+        for (std::size_t i = 0; i < sequences.size(); ++i) {
+          runs.push_back(ChainRun{"sequences[" + std::to_string(i) + "]", std::to_string(i), 0, sequences[i]});
+        }
+        return fit_chain(runs, options);
+      },
+      py::arg("logs"), py::arg("sequences"), py::arg("kind"), py::arg("name"), py::arg("prior"), py::arg("states"),
+      py::arg("capacity"));
+}
+
 void bind_learn(py::module_& m) {
   bind_conditional(m);
+  bind_chain_fitting(m);
   m.def(
       "_fit",
       [](const std::string& log, bool log_is_path, const std::string& skeleton_data, bool skeletons_are_path,

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "bindings.hpp"
+#include "ontime/model/exogenous_chain.hpp"
 #include "ontime/model/instance_io.hpp"
 #include "ontime/model/planner_log.hpp"
 #include "ontime/util/error.hpp"
@@ -204,6 +205,58 @@ void bind_model(py::module_& m) {
         save_planner_log(attempts, path);
       },
       py::arg("text"), py::arg("source"), py::arg("path"));
+
+  py::class_<ExogenousChain>(m, "ExogenousChain",
+                             "An exogenous process (docs/learning.md, \"Exogenous chains\"): a finite Markov chain "
+                             "that advances one step per time step whatever the robot does. Made by "
+                             "ontime.fit_chain or ontime.load_chain.")
+      .def_readonly("name", &ExogenousChain::name)
+      .def_readonly("states", &ExogenousChain::states)
+      .def_property_readonly(
+          "start", [](const ExogenousChain& chain) { return chain.states.at(static_cast<std::size_t>(chain.start)); })
+      .def_property_readonly(
+          "transitions",
+          [](const ExogenousChain& chain) {
+            const auto n = static_cast<py::ssize_t>(chain.states.size());
+            py::array_t<double> matrix({n, n});
+            auto view = matrix.mutable_unchecked<2>();
+            for (py::ssize_t i = 0; i < n; ++i) {
+              for (py::ssize_t j = 0; j < n; ++j) {
+                view(i, j) = chain.transitions[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)];
+              }
+            }
+            return matrix;
+          },
+          "The transition matrix (numpy, a copy): row i is the distribution of the next state in state i.")
+      .def(
+          "distribution",
+          [](const ExogenousChain& chain, Number<std::int64_t, "steps", 0> steps,
+             const std::optional<std::string>& from) {
+            int index = chain.start;
+            if (from) {
+              index = chain.state_index(*from);
+              if (index < 0) throw UsageError("chain '" + chain.name + "' has no state '" + *from + "'");
+            }
+            const std::vector<double> distribution = chain_distribution(chain, index, steps);
+            return py::array_t<double>(static_cast<py::ssize_t>(distribution.size()), distribution.data());
+          },
+          py::arg("steps"), py::arg("from_state") = py::none(),
+          "The distribution of the state `steps` steps after the chain is in `from_state` (default: its start), "
+          "over `states` (numpy).")
+      .def("to_json", &chain_to_json, "The chain file's text.")
+      .def(
+          "save",
+          [](const ExogenousChain& chain, const py::object& path) {
+            save_chain(chain, std::string(py::str(py::module_::import("os").attr("fspath")(path))));
+          },
+          py::arg("path"), "Writes the chain file (atomically).");
+
+  m.def(
+      "load_chain",
+      [](const py::object& path) {
+        return load_chain(std::string(py::str(py::module_::import("os").attr("fspath")(path))));
+      },
+      py::arg("path"), "Reads a chain file (`ontime fit-chain`'s output); InputError naming the place and the rule.");
 }
 
 }  // namespace ontime::python

@@ -4,7 +4,6 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <regex>
 
 #include "ontime/util/atomic_file.hpp"
 #include "ontime/util/error.hpp"
@@ -19,18 +18,7 @@ class LineReader {
  public:
   LineReader(std::string source, std::size_t line) : source_(std::move(source)), line_(line) {}
 
-  RefinementAttempt read(std::string_view text) const {
-    Json record;
-    try {
-      record = detail::parse_json_strict<Json>(text, source_);
-    } catch (const InputError& error) {
-      // The parser counts lines within this one line; name the line of the file instead.
-      static const std::regex column(R"(line \d+, (column \d+))");
-      std::smatch match;
-      if (std::regex_match(error.place(), match, column))
-        throw InputError(source_, place() + ", " + match[1].str(), error.rule());
-      throw InputError(source_, place() + ": " + error.place(), error.rule());
-    }
+  RefinementAttempt read(const Json& record) const {
     if (!record.is_object())
       fail("", "a record must be a JSON object (got " + detail::describe_json_type(record) + ")");
     for (const auto& [key, value] : record.items()) {
@@ -132,17 +120,9 @@ class LineReader {
 std::vector<RefinementAttempt> parse_planner_log(std::string_view text, std::string_view source) {
   const std::string name(source);
   std::vector<RefinementAttempt> attempts;
-  std::size_t line = 0;
-  std::size_t begin = 0;
   std::size_t feature_count = 0;
-  while (begin < text.size()) {
-    std::size_t end = text.find('\n', begin);
-    if (end == std::string_view::npos) end = text.size();
-    ++line;
-    const std::string_view content = text.substr(begin, end - begin);
-    begin = end + 1;
-    if (content.find_first_not_of(" \t\r") == std::string_view::npos) continue;  // blank line
-    attempts.push_back(LineReader(name, line).read(content));
+  detail::for_each_json_line<Json>(text, name, [&](const Json& record, std::size_t line) {
+    attempts.push_back(LineReader(name, line).read(record));
     // Feature vectors are the same length throughout a log (one domain's extractor).
     const std::vector<double>& features = attempts.back().features;
     if (!features.empty()) {
@@ -153,7 +133,7 @@ std::vector<RefinementAttempt> parse_planner_log(std::string_view text, std::str
                              std::to_string(feature_count));
       }
     }
-  }
+  });
   if (attempts.empty()) throw InputError(name, "file", "the log holds no records (one JSON object per line)");
   return attempts;
 }

@@ -287,3 +287,68 @@ TEST(Cli, BoostedFitGivesTheSameBytesWhicheverLibmGlibcPicks) {
 
 }  // namespace
 }  // namespace ontime
+
+namespace ontime {
+namespace {
+
+using namespace cli_test;
+
+// `fit-chain`: a queue read once per step, fitted as a birth-death chain and as a free markov
+// one; bad logs and options exit 2, naming the file, the line or the step, and write nothing.
+TEST(Cli, FitChainWritesTheChainOfAQueuesObservations) {
+  const std::filesystem::path dir = scratch("fit-chain");
+  const std::string log = (dir / "queue.jsonl").string();
+  {
+    std::ofstream out(log);
+    const std::vector<int> lengths{0, 0, 1, 2, 2, 1, 1, 0, 1, 2, 3, 3, 2};
+    for (std::size_t t = 0; t < lengths.size(); ++t) {
+      out << "{\"sequence\": \"mon\", \"step\": " << t << ", \"state\": " << lengths[t] << "}\n";
+    }
+  }
+  const std::string chain = (dir / "queue.chain.json").string();
+  const auto fitted = ontime(
+      {"fit-chain", log, "--kind", "birth-death", "--name", "coffee-queue", "--capacity", "4", "-o", chain, "--json"});
+  ASSERT_EQ(fitted.exit_code, 0) << fitted.err;
+  const json out = json::parse(fitted.out);
+  EXPECT_EQ(out["kind"], "birth-death");
+  EXPECT_EQ(out["states"].size(), 5u);
+  EXPECT_EQ(out["transitions_counted"].get<int>(), 12);
+  // No stay at the capacity: the closed form, up 5 over 5 + 1 + 3 + 3 (ups, stays at 0, downs,
+  // stays in between).
+  EXPECT_DOUBLE_EQ(out["arrival"].get<double>(), 5.0 / 12);
+  const json file = json::parse(read_file(chain));
+  EXPECT_EQ(file["format"], "ontime-chain");
+  EXPECT_EQ(file["name"], "coffee-queue");
+  EXPECT_EQ(file["start"], "0");
+  EXPECT_EQ(file["transitions"], out["transitions"]);
+
+  const auto markov = ontime({"fit-chain", log, "-o", (dir / "markov.json").string()});
+  ASSERT_EQ(markov.exit_code, 0) << markov.err;
+  EXPECT_NE(markov.out.find("Fitted a markov chain 'chain' of 4 states to 12 transitions"), std::string::npos)
+      << markov.out;
+
+  const auto refused = [&dir](const std::vector<std::string>& arguments, const std::string& message) {
+    const std::string output = (dir / "refused.json").string();
+    std::vector<std::string> command{"fit-chain"};
+    command.insert(command.end(), arguments.begin(), arguments.end());
+    command.push_back("-o");
+    command.push_back(output);
+    const auto result = ontime(command);
+    EXPECT_EQ(result.exit_code, 2) << result.err;
+    EXPECT_NE(result.err.find(message), std::string::npos) << result.err;
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+    EXPECT_FALSE(std::filesystem::exists(output));
+  };
+  const std::string jump = (dir / "jump.jsonl").string();
+  std::ofstream(jump) << "{\"step\": 0, \"state\": 0}\n{\"step\": 1, \"state\": 2}\n";
+  refused({jump, "--kind", "birth-death"}, "jump.jsonl: sequence '', step 1: the queue goes from 0 to 2 in one step");
+  const std::string backwards = (dir / "backwards.jsonl").string();
+  std::ofstream(backwards) << "{\"step\": 4, \"state\": 0}\n{\"step\": 2, \"state\": 1}\n";
+  refused({backwards}, "backwards.jsonl: line 2: step: must be after the sequence's previous step, 4 (got 2)");
+  refused({log, "--kind", "poisson"}, "unknown chain kind 'poisson'");
+  refused({log, "--kind", "birth-death", "--states", "0,1"}, "give the capacity, not states");
+  refused({log, "--states", "0,1"}, "queue.jsonl: sequence 'mon', step 3: state '2' is not among the states listed");
+}
+
+}  // namespace
+}  // namespace ontime

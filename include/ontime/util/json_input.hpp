@@ -241,4 +241,38 @@ Json parse_json_strict(std::string_view text, const std::string& source) {
   return builder.take();
 }
 
+// Calls read(record, line) for each line of a JSON Lines text that is not blank, `line` counted
+// from 1 over the whole text; each line is parsed strictly (parse_json_strict), and a malformed
+// one raises InputError at `line L, column C` of the text (or `line L: PATH` for a key twice).
+// Returns the number of records read.
+template <class Json, class Read>
+std::size_t for_each_json_line(std::string_view text, const std::string& source, Read&& read) {
+  std::size_t records = 0;
+  std::size_t line = 0;
+  std::size_t begin = 0;
+  while (begin < text.size()) {
+    std::size_t end = text.find('\n', begin);
+    if (end == std::string_view::npos) end = text.size();
+    ++line;
+    const std::string_view content = text.substr(begin, end - begin);
+    begin = end + 1;
+    if (content.find_first_not_of(" \t\r") == std::string_view::npos) continue;  // blank
+    const std::string place = "line " + std::to_string(line);
+    Json record;
+    try {
+      record = parse_json_strict<Json>(content, source);
+    } catch (const InputError& error) {
+      // The parser counts lines within this one line (always its line 1); name the text's.
+      constexpr std::string_view kFirstLine = "line 1, ";
+      if (error.place().rfind(kFirstLine, 0) == 0) {
+        throw InputError(source, place + ", " + error.place().substr(kFirstLine.size()), error.rule());
+      }
+      throw InputError(source, place + ": " + error.place(), error.rule());
+    }
+    read(record, line);
+    ++records;
+  }
+  return records;
+}
+
 }  // namespace ontime::detail

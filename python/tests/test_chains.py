@@ -1,0 +1,74 @@
+"""Exogenous chains from Python: fit_chain gives the chain file `ontime fit-chain` writes, byte for byte,
+from a log or from sequences of observed states; the chain's matrix and distributions are numpy arrays;
+bad input is refused as the command line refuses it."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+import ontime
+
+
+def write_log(path, sequences):
+    with open(path, "w") as out:
+        for name, states in sequences.items():
+            for step, state in enumerate(states):
+                out.write(json.dumps({"sequence": name, "step": step, "state": state}) + "\n")
+
+
+def test_a_queue_fits_as_the_command_line_fits_it(tmp_path, cli):
+    log = tmp_path / "queue.jsonl"
+    write_log(log, {"mon": [0, 1, 1, 2, 1, 0, 0, 1], "tue": [1, 1, 2]})
+    chain_file = tmp_path / "queue.chain.json"
+    out = cli("fit-chain", log, "--kind", "birth-death", "--capacity", 3, "--name", "queue", "-o", chain_file, "--json")
+    fit = ontime.fit_chain(log, kind="birth-death", capacity=3, name="queue")
+    assert fit.chain.to_json() == chain_file.read_text()
+    assert fit.transitions_counted == out["transitions_counted"] == 9
+    assert fit.arrival == out["arrival"]
+    # Sequences in memory are the same observations: the same chain.
+    from_sequences = ontime.fit_chain([[0, 1, 1, 2, 1, 0, 0, 1], ["1", "1", "2"]], kind="birth-death", capacity=3,
+                                      name="queue")
+    assert from_sequences.chain.to_json() == fit.chain.to_json()
+    loaded = ontime.load_chain(chain_file)
+    assert loaded.states == ["0", "1", "2", "3"]
+    assert loaded.start == "0"
+
+
+def test_the_matrix_and_the_distributions_are_numpy_arrays(tmp_path):
+    fit = ontime.fit_chain([["open", "open", "closed", "open", "open"]], name="door")
+    chain = fit.chain
+    assert chain.states == ["closed", "open"]
+    assert chain.start == "open"
+    # open -> open twice, open -> closed once; closed -> open once.
+    np.testing.assert_array_equal(chain.transitions, np.array([[0.0, 1.0], [1 / 3, 2 / 3]]))
+    assert fit.log_likelihood == pytest.approx(2 * math.log(2 / 3) + math.log(1 / 3), abs=1e-12)
+    np.testing.assert_array_equal(chain.distribution(0), [0.0, 1.0])
+    two = chain.distribution(2, from_state="closed")
+    np.testing.assert_allclose(two, [1 / 3, 2 / 3], rtol=0, atol=1e-15)
+    chain.save(tmp_path / "door.json")
+    assert ontime.load_chain(tmp_path / "door.json").to_json() == chain.to_json()
+
+
+def test_bad_input_is_refused(tmp_path):
+    with pytest.raises(ontime.UsageError, match="unknown chain kind 'poisson'"):
+        ontime.fit_chain([[0, 1]], kind="poisson")
+    with pytest.raises(ontime.UsageError, match="whole number >= 0"):
+        ontime.fit_chain([[0, -1]])
+    with pytest.raises(ValueError, match="prior"):
+        ontime.fit_chain([[0, 1, 0]], prior=-1)
+    with pytest.raises(ontime.InputError, match=r"sequences\[1\]: sequence '1', step 2: the queue goes from 1 to 3"):
+        ontime.fit_chain([[0, 1], [0, 1, 3]], kind="birth-death")
+    log = tmp_path / "backwards.jsonl"
+    log.write_text('{"step": 2, "state": 0}\n{"step": 1, "state": 1}\n')
+    with pytest.raises(ontime.InputError, match="line 2: step"):
+        ontime.fit_chain(log)
+    broken = tmp_path / "broken.json"
+    broken.write_text('{"format": "ontime-chain", "version": 1, "name": "d", "states": ["a"], "start": "a", '
+                      '"transitions": [[0.5]]}')
+    with pytest.raises(ontime.InputError, match=r"transitions\[0\]: the probabilities of leaving state 'a' sum to 1"):
+        ontime.load_chain(broken)
+    chain = ontime.fit_chain([["a", "b", "a"]]).chain
+    with pytest.raises(ontime.UsageError, match="no state 'c'"):
+        chain.distribution(1, from_state="c")
