@@ -19,7 +19,7 @@
 namespace ontime {
 namespace {
 
-using Json = nlohmann::ordered_json;
+using ObservationJson = nlohmann::ordered_json;
 
 // A state's name that is a whole number written plainly ("0", "17"; not "017", "+3", "1.0").
 bool is_whole_number(const std::string& name) {
@@ -39,7 +39,7 @@ struct ObservedState {
   std::string state;
 };
 
-ObservedState read_observation(const Json& record, const std::string& source, std::size_t line) {
+ObservedState read_observation(const ObservationJson& record, const std::string& source, std::size_t line) {
   const std::string place = "line " + std::to_string(line);
   const auto fail = [&](const std::string& key, const std::string& rule) {
     throw InputError(source, key.empty() ? place : place + ": " + key, rule);
@@ -63,7 +63,7 @@ ObservedState read_observation(const Json& record, const std::string& source, st
   if (!step) fail("step", "must be a whole number of steps >= 0 (got " + record["step"].dump() + ")");
   observation.step = *step;
   if (!record.contains("state")) fail("", "missing required key 'state'");
-  const Json& state = record["state"];
+  const ObservationJson& state = record["state"];
   if (state.is_string()) {
     if (state.get<std::string>().empty()) fail("state", "a state's name is not empty");
     observation.state = state.get<std::string>();
@@ -325,7 +325,7 @@ std::vector<ChainRun> parse_chain_observations(std::string_view text, std::strin
   std::vector<ChainRun> runs;
   // Per sequence: its last step and the run that holds it.
   std::map<std::string, std::pair<std::int64_t, std::size_t>, std::less<>> last;
-  detail::for_each_json_line<Json>(text, name, [&](const Json& record, std::size_t line) {
+  detail::for_each_json_line<ObservationJson>(text, name, [&](const ObservationJson& record, std::size_t line) {
     ObservedState observation = read_observation(record, name, line);
     const auto found = last.find(observation.sequence);
     if (found != last.end() && observation.step <= found->second.first) {

@@ -13,7 +13,7 @@
 namespace ontime {
 namespace {
 
-using Json = nlohmann::ordered_json;
+using ChainJson = nlohmann::ordered_json;
 
 constexpr std::string_view kFormat = "ontime-chain";
 constexpr int kVersion = 1;
@@ -70,7 +70,7 @@ std::optional<ChainFault> find_chain_fault(const ExogenousChain& chain) {
     }
     if (!(std::abs(sum - 1.0) <= kChainRowTolerance)) {
       return ChainFault{place, "the probabilities of leaving state '" + chain.states[i] + "' sum to 1 (got " +
-                                   Json(sum).dump() + ")"};
+                                   ChainJson(sum).dump() + ")"};
     }
   }
   return std::nullopt;
@@ -78,7 +78,7 @@ std::optional<ChainFault> find_chain_fault(const ExogenousChain& chain) {
 
 ExogenousChain parse_chain(std::string_view text, std::string_view source) {
   const std::string name(source);
-  const Json root = detail::parse_json_strict<Json>(text, name);
+  const ChainJson root = detail::parse_json_strict<ChainJson>(text, name);
   const auto fail = [&name](const std::string& place, const std::string& rule) { throw InputError(name, place, rule); };
   if (!root.is_object())
     fail("top level", "a chain file is a JSON object (got " + detail::describe_json_type(root) + ")");
@@ -98,7 +98,7 @@ ExogenousChain parse_chain(std::string_view text, std::string_view source) {
     fail("name", "must be a non-empty string (got " + root["name"].dump() + ")");
   }
   chain.name = root["name"].get<std::string>();
-  const Json& states = root["states"];
+  const ChainJson& states = root["states"];
   if (!states.is_array())
     fail("states", "must be an array of state names (got " + detail::describe_json_type(states) + ")");
   for (std::size_t i = 0; i < states.size(); ++i) {
@@ -107,11 +107,11 @@ ExogenousChain parse_chain(std::string_view text, std::string_view source) {
     }
     chain.states.push_back(states[i].get<std::string>());
   }
-  const Json& start = root["start"];
+  const ChainJson& start = root["start"];
   if (!start.is_string()) fail("start", "must be a state's name (got " + start.dump() + ")");
   chain.start = chain.state_index(start.get<std::string>());
   if (chain.start < 0) fail("start", "'" + start.get<std::string>() + "' is not one of the chain's states");
-  const Json& rows = root["transitions"];
+  const ChainJson& rows = root["transitions"];
   if (!rows.is_array()) fail("transitions", "must be an array of rows (got " + detail::describe_json_type(rows) + ")");
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const std::string place = detail::json_index("transitions", i);
@@ -137,7 +137,7 @@ ExogenousChain load_chain(const std::filesystem::path& path) {
 std::string chain_to_json(const ExogenousChain& chain) {
   require_valid(chain);
   if (chain.name.empty()) throw UsageError("a chain has a non-empty name");
-  Json root = Json::object();
+  ChainJson root = ChainJson::object();
   root["format"] = std::string(kFormat);
   root["version"] = kVersion;
   root["name"] = chain.name;
@@ -148,7 +148,7 @@ std::string chain_to_json(const ExogenousChain& chain) {
   text.erase(text.size() - 2);  // the closing "\n}"
   text += ",\n  \"transitions\": [";
   for (std::size_t i = 0; i < chain.transitions.size(); ++i) {
-    text += (i == 0 ? "\n    " : ",\n    ") + Json(chain.transitions[i]).dump();
+    text += (i == 0 ? "\n    " : ",\n    ") + ChainJson(chain.transitions[i]).dump();
   }
   text += "\n  ]\n}\n";
   return text;
