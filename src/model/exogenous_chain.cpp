@@ -78,7 +78,7 @@ std::optional<ChainFault> find_chain_fault(const ExogenousChain& chain) {
 
 ExogenousChain parse_chain(std::string_view text, std::string_view source) {
   const std::string name(source);
-  const ChainJson root = detail::parse_json_strict<ChainJson>(text, name);
+  const auto root = detail::parse_json_strict<ChainJson>(text, name);
   const auto fail = [&name](const std::string& place, const std::string& rule) { throw InputError(name, place, rule); };
   if (!root.is_object())
     fail("top level", "a chain file is a JSON object (got " + detail::describe_json_type(root) + ")");
