@@ -15,7 +15,8 @@ seed). Debian 12 packages no gymnasium.
 
 Episode: one simulated episode of the problem (a hidden sampled world). Action: a skeleton index in
 [0, K). Observation: the normalised MDP state the ppo allocator sees (float32, 1 + 3 K values: CT/D,
-then per skeleton l_k/A_k, PT_k/D, ET_k/D). Reward: 1 on success, 0 otherwise (as in the paper).
+then per skeleton l_k/A_k, PT_k/D, ET_k/D). Reward: on success the executed skeleton's reward at its
+finish (SPEC §8; 1 when the instance declares no rewards, as in the paper), 0 otherwise.
 The episode terminates on success or failure (deadline passed, or no skeleton can still meet it); it
 is never truncated. info["action_mask"] (also env.action_masks()) marks the useful choices: one per
 group of skeletons sharing their next action, among those that can still succeed.

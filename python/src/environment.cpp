@@ -53,7 +53,7 @@ class EnvironmentCore {
     }
     session_->decide(static_cast<int>(action));
     const Status status = session_->carry_out(world_);
-    const double reward = status == Status::success ? 1.0 : 0.0;
+    const double reward = session_->reward();
     return py::make_tuple(observation(), reward, status != Status::running, false);
   }
 

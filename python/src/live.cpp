@@ -136,14 +136,19 @@ void bind_live(py::module_& m) {
           py::arg("seconds"), "Time the clock did not see but the deadline must.")
       .def(
           "add_skeleton",
-          [](LiveSessionHandle& h, const std::vector<std::string>& ids, std::vector<Action> new_actions) {
-            const int added = session_call([&] { return h.session.add_skeleton(ids, std::move(new_actions)); });
+          [](LiveSessionHandle& h, const std::vector<std::string>& ids, std::vector<Action> new_actions, double reward,
+             double reward_per_step) {
+            const int added = session_call([&] {
+              return h.session.add_skeleton(ids, std::move(new_actions), SkeletonReward{reward, reward_per_step});
+            });
             h.current = std::make_shared<const Problem>(h.session.problem());
             return added;
           },
-          py::arg("action_ids"), py::arg("new_actions") = std::vector<Action>{},
+          py::arg("action_ids"), py::arg("new_actions") = std::vector<Action>{}, py::arg("reward") = 1.0,
+          py::arg("reward_per_step") = 0.0,
           "A skeleton arrives: its action ids in order, and the actions the problem does not know yet "
-          "(ontime.Action objects, e.g. Problem.from_dict(...).actions). Returns its index.")
+          "(ontime.Action objects, e.g. Problem.from_dict(...).actions), with its reward (SPEC §8: worth "
+          "reward - reward_per_step * f when its execution ends at step f). Returns its index.")
       .def(
           "retire_skeleton",
           [](LiveSessionHandle& h, Number<int, "skeleton", 0> k) {
@@ -177,6 +182,10 @@ void bind_live(py::module_& m) {
             return py::int_(h.session.solution());
           },
           "The skeleton to execute after success, else None.")
+      .def_property_readonly(
+          "reward", [](const LiveSessionHandle& h) { return h.session.reward(); },
+          "What the episode earned (SPEC §8): after a success the solution's reward at the end of its execution in "
+          "steps of the robot's clock (1.0 without rewards), else 0.0.")
       .def_property_readonly("state",
                              [](const LiveSessionHandle& h) {
                                return StateView{h.session.state(), h.session.problem().skeleton_count()};

@@ -158,6 +158,23 @@ void bind_model(py::module_& m) {
             return out;
           },
           "The skeletons as lists of action ids.")
+      .def_property_readonly(
+          "rewards",
+          [](const Problem& p) {
+            py::list out;
+            for (const SkeletonReward& reward : p.rewards()) {
+              py::dict entry;
+              entry["value"] = reward.value;
+              entry["per_step"] = reward.per_step;
+              out.append(entry);
+            }
+            return out;
+          },
+          "Each skeleton's reward (SPEC §8) as {'value': v, 'per_step': c}: worth v - c * f when its execution "
+          "ends at step f. Every skeleton {'value': 1.0, 'per_step': 0.0} when the instance declares none.")
+      .def_property_readonly("has_rewards", &Problem::has_rewards,
+                             "Whether some skeleton's reward is not 1 at every finish (the objective is then the "
+                             "expected reward, else the success probability).")
       .def_property_readonly("skeleton_count", &Problem::skeleton_count)
       .def("find_action", &Problem::find_action, py::arg("id"), "Index of the action with this id, or -1.")
       .def("__repr__", [](const Problem& p) {

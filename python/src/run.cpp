@@ -238,6 +238,10 @@ void bind_run(py::module_& m) {
           },
           "The skeleton to execute after success, else None.")
       .def_property_readonly(
+          "reward", [](const SessionHandle& h) { return h.session.reward(); },
+          "What the episode earned (SPEC §8): after a success the solution's reward at its finish (1.0 without "
+          "rewards), else 0.0.")
+      .def_property_readonly(
           "steps_used", [](const SessionHandle& h) { return h.session.steps_used(); }, "Steps of effort spent (CT).")
       .def_property_readonly(
           "problem", [](const SessionHandle& h) { return std::const_pointer_cast<Problem>(h.allocator->mdp->problem); },

@@ -19,7 +19,8 @@ std::size_t grown_capacity(std::size_t capacity, std::size_t needed) noexcept {
 
 }  // namespace
 
-MctsAllocator::MctsAllocator(const Mdp& mdp, MctsOptions options) : mdp_(&mdp), options_(std::move(options)) {
+MctsAllocator::MctsAllocator(const Mdp& mdp, MctsOptions options)
+    : mdp_(&mdp), options_(std::move(options)), rewards_(mdp.problem().has_rewards()) {
   if (!(options_.exploration >= 0.0) || !std::isfinite(options_.exploration)) {
     throw UsageError("the exploration constant of mcts must be a finite number >= 0");
   }
@@ -43,7 +44,9 @@ void MctsAllocator::begin_episode(std::uint64_t seed) {
 
 std::size_t MctsAllocator::tree_bytes() const noexcept {
   return nodes_.capacity() * sizeof(DecisionNode) + edges_.capacity() * sizeof(Edge) +
-         outcomes_.capacity() * sizeof(Outcome) + (node_values_.capacity() + edge_values_.capacity()) * sizeof(double);
+         outcomes_.capacity() * sizeof(Outcome) +
+         (node_values_.capacity() + edge_values_.capacity() + edge_returns_.capacity() + outcome_rewards_.capacity()) *
+             sizeof(double);
 }
 
 bool MctsAllocator::would_exceed_memory(std::size_t nodes, std::size_t edges, std::size_t outcomes) const {
@@ -54,7 +57,12 @@ bool MctsAllocator::would_exceed_memory(std::size_t nodes, std::size_t edges, st
                                           grown_capacity(edge_values_.capacity(), edge_values_.size() + edges)) *
                                              sizeof(double)
                                        : 0;
-  return projected + values > options_.max_tree_bytes;
+  const std::size_t returns = rewards_
+                                  ? (grown_capacity(edge_returns_.capacity(), edge_returns_.size() + edges) +
+                                     grown_capacity(outcome_rewards_.capacity(), outcome_rewards_.size() + outcomes)) *
+                                        sizeof(double)
+                                  : 0;
+  return projected + values + returns > options_.max_tree_bytes;
 }
 
 void MctsAllocator::reset(const State& root) {
@@ -63,6 +71,8 @@ void MctsAllocator::reset(const State& root) {
   outcomes_.clear();
   node_values_.clear();
   edge_values_.clear();
+  edge_returns_.clear();
+  outcome_rewards_.clear();
   nodes_.emplace_back();
   if (bellman()) node_values_.push_back(0.0);
   root_state_ = root;
@@ -86,6 +96,7 @@ bool MctsAllocator::expand(std::uint32_t node, const State& state) {
     edges_.push_back(edge);
   }
   if (bellman()) edge_values_.resize(edges_.size(), 0.0);
+  if (rewards_) edge_returns_.resize(edges_.size(), 0.0);
   return true;
 }
 
@@ -100,6 +111,7 @@ bool MctsAllocator::expand_outcomes(std::uint32_t edge, const State& state) {
     State next = state;
     const Status status = mdp_->apply(next, choice, observation);
     outcomes_.push_back(Outcome{probability, observation, kNone, status});
+    if (rewards_) outcome_rewards_.push_back(status == Status::success ? mdp_->success_reward(next, choice) : 0.0);
   });
   return true;
 }
@@ -133,7 +145,7 @@ double MctsAllocator::rollout(State& state) {
     }
     const Observation observation = mdp_->sample_observation(state, choice, generator_);
     const Status status = mdp_->apply(state, choice, observation);
-    if (status == Status::success) return 1.0;
+    if (status == Status::success) return mdp_->success_reward(state, choice);
     if (status == Status::failure) return 0.0;
   }
 }
@@ -161,7 +173,7 @@ bool MctsAllocator::iterate() {
                     edge.outcome_count, [&](std::size_t o) { return outcomes_[first + o].probability; }, generator_));
     const Outcome& outcome = outcomes_[picked];
     if (outcome.status != Status::running) {
-      reward = outcome.status == Status::success ? 1.0 : 0.0;
+      reward = outcome.status != Status::success ? 0.0 : rewards_ ? outcome_rewards_[picked] : 1.0;
       outcomes_[picked].child = kReached;
       break;
     }
@@ -185,6 +197,7 @@ bool MctsAllocator::iterate() {
     Edge& edge = edges_[path_[i + 1]];
     ++edge.visits;
     edge.successes += reward > 0.5 ? 1U : 0U;
+    if (rewards_) edge_returns_[path_[i + 1]] += reward;
   }
   if (bellman()) back_up_bellman();
   return true;
@@ -205,7 +218,7 @@ void MctsAllocator::back_up_bellman() {
       if (outcome.child == kNone) continue;
       weight += outcome.probability;
       if (outcome.status == Status::success) {
-        sum += outcome.probability;
+        sum += outcome.probability * (rewards_ ? outcome_rewards_[o] : 1.0);
       } else if (outcome.status == Status::running) {
         sum += outcome.probability * node_values_[outcome.child];
       }
@@ -283,7 +296,7 @@ void MctsAllocator::reroot(std::uint32_t new_root) {
   std::vector<DecisionNode> nodes;
   std::vector<Edge> edges;
   std::vector<Outcome> outcomes;
-  std::vector<double> node_values, edge_values;
+  std::vector<double> node_values, edge_values, edge_returns, outcome_rewards;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pending{{new_root, 0}};
   nodes.push_back(nodes_[new_root]);
   if (bellman()) node_values.push_back(node_values_[new_root]);
@@ -307,11 +320,13 @@ void MctsAllocator::reroot(std::uint32_t new_root) {
             outcome.child = child;
           }
           outcomes.push_back(outcome);
+          if (rewards_) outcome_rewards.push_back(outcome_rewards_[o]);
         }
         edge.first_outcome = first;
       }
       edges.push_back(edge);
       if (bellman()) edge_values.push_back(edge_values_[e]);
+      if (rewards_) edge_returns.push_back(edge_returns_[e]);
     }
   }
   nodes_ = std::move(nodes);
@@ -319,6 +334,8 @@ void MctsAllocator::reroot(std::uint32_t new_root) {
   outcomes_ = std::move(outcomes);
   node_values_ = std::move(node_values);
   edge_values_ = std::move(edge_values);
+  edge_returns_ = std::move(edge_returns);
+  outcome_rewards_ = std::move(outcome_rewards);
 }
 
 void MctsAllocator::collect_statistics(Statistics& statistics) const {

@@ -11,6 +11,21 @@ constexpr std::int64_t kNeverFinishes = std::numeric_limits<std::int64_t>::max()
 
 }  // namespace
 
+bool ThompsonAllocator::better(int k, std::int64_t finish, int best, std::int64_t best_finish) const {
+  if (best < 0) return true;
+  const Problem& problem = mdp_->problem();
+  if (problem.has_rewards()) {
+    // The reward the drawn world gives each (-1: it misses the deadline there), then the sooner.
+    const auto worth = [&](int skeleton, std::int64_t at) {
+      return at <= mdp_->deadline() ? problem.reward_at(skeleton, static_cast<Steps>(at)) : -1.0;
+    };
+    const double mine = worth(k, finish);
+    const double theirs = worth(best, best_finish);
+    if (mine != theirs) return mine > theirs;
+  }
+  return finish < best_finish;
+}
+
 ThompsonAllocator::ThompsonAllocator(const Mdp& mdp)
     : mdp_(&mdp),
       drawn_at_(static_cast<std::size_t>(mdp.problem().action_count()), 0),
@@ -78,7 +93,7 @@ int ThompsonAllocator::choose(const State& state) {
     for (int k = 0; k < mdp_->skeleton_count(); ++k) {
       if (!mdp_->can_succeed(state, k)) continue;
       const std::int64_t finish = drawn_finish_with_backtracking(state, k);
-      if (best < 0 || finish < best_finish) {
+      if (better(k, finish, best, best_finish)) {
         best = k;
         best_finish = finish;
       }
@@ -99,7 +114,7 @@ int ThompsonAllocator::choose(const State& state) {
       const std::int64_t time = drawn_time(actions[position], spent);
       finish = time == kNeverFinishes ? kNeverFinishes : finish + time;
     }
-    if (best < 0 || finish < best_finish) {
+    if (better(k, finish, best, best_finish)) {
       best = k;
       best_finish = finish;
     }

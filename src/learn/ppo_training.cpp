@@ -176,7 +176,7 @@ class PpoTrainer {
       batch_.actions.push_back(action);
       batch_.log_probabilities.push_back(log_probabilities_[static_cast<std::size_t>(action)]);
       batch_.values.push_back(value);
-      batch_.rewards.push_back(status == Status::success ? 1.0 : 0.0);
+      batch_.rewards.push_back(session.reward());
     }
     // Advantages (GAE) and discounted returns of the episode; a cut-off episode (step
     // limit) is completed by the critic's value of its last state.

@@ -41,7 +41,7 @@ class InstanceReader {
     const Json root = detail::parse_json_strict<Json>(text, source_);
     if (!root.is_object())
       fail("top level", "an instance must be a JSON object (got " + detail::describe_json_type(root) + ")");
-    check_keys(root, "", {"name", "description", "deadline", "step_seconds", "actions", "skeletons"});
+    check_keys(root, "", {"name", "description", "deadline", "step_seconds", "actions", "skeletons", "rewards"});
 
     std::string name = std::filesystem::path(source_).stem().string();
     if (root.contains("name")) name = string_at(root["name"], "name");
@@ -75,9 +75,13 @@ class InstanceReader {
 
     std::vector<Action> actions = read_actions(root);
     std::vector<std::vector<int>> skeletons = read_skeletons(root, actions);
+    std::vector<SkeletonReward> rewards;
+    if (root.contains("rewards")) rewards = read_rewards(root["rewards"], skeletons.size());
     try {
       return Problem(std::move(name), static_cast<Steps>(*deadline), step_seconds, std::move(actions),
-                     std::move(skeletons), std::move(description));
+                     std::move(skeletons), std::move(description), std::move(rewards));
+    } catch (const RewardError& error) {
+      fail(detail::json_index("rewards", static_cast<std::size_t>(error.skeleton())), error.rule());
     } catch (const BacktrackingError& error) {
       // The backtracking rules need the skeletons (a culprit must come before the action on its
       // path): checked by the Problem, placed here.
@@ -136,6 +140,42 @@ class InstanceReader {
       actions.push_back(std::move(action));
     }
     return actions;
+  }
+
+  // [reward, ...], one per skeleton in the order of "skeletons" (SPEC §8): a number (the value at
+  // any finish) or {"value": v, "per_step": c}. The rules on the numbers are the Problem's.
+  std::vector<SkeletonReward> read_rewards(const Json& value, std::size_t skeleton_count) const {
+    if (!value.is_array()) {
+      fail("rewards", "must be an array with one reward per skeleton (got " + detail::describe_json_type(value) + ")");
+    }
+    if (value.size() != skeleton_count) {
+      fail("rewards", "has " + std::to_string(value.size()) + " entries for " + std::to_string(skeleton_count) +
+                          " skeletons: one reward per skeleton is needed");
+    }
+    std::vector<SkeletonReward> rewards;
+    for (std::size_t k = 0; k < value.size(); ++k) {
+      const Json& entry = value[k];
+      const std::string place = detail::json_index("rewards", k);
+      const auto number = [&](const Json& json, const std::string& at) {
+        if (!json.is_number()) fail(at, "must be a number (got " + detail::describe_json_type(json) + ")");
+        return json.get<double>();
+      };
+      SkeletonReward reward;
+      if (entry.is_object()) {
+        check_keys(entry, place, {"value", "per_step"});
+        if (!entry.contains("value")) fail(place, "missing required key 'value'");
+        reward.value = number(entry["value"], detail::json_member(place, "value"));
+        if (entry.contains("per_step"))
+          reward.per_step = number(entry["per_step"], detail::json_member(place, "per_step"));
+      } else if (entry.is_number()) {
+        reward.value = entry.get<double>();
+      } else {
+        fail(place, "a reward is a number or an object {\"value\": ..., \"per_step\": ...} (got " +
+                        detail::describe_json_type(entry) + ")");
+      }
+      rewards.push_back(reward);
+    }
+    return rewards;
   }
 
   // {"ACTION ID": probability, ...}: the actions an attempt that backtracks blames (SPEC §7).
@@ -294,6 +334,17 @@ std::string problem_to_json(const Problem& problem) {
     skeletons.push_back(skeleton);
   }
   root["skeletons"] = skeletons;
+  if (problem.has_rewards()) {
+    Json rewards = Json::array();
+    for (const SkeletonReward& reward : problem.rewards()) {
+      if (reward.per_step == 0.0) {
+        rewards.push_back(reward.value);
+      } else {
+        rewards.push_back(Json{{"value", reward.value}, {"per_step", reward.per_step}});
+      }
+    }
+    root["rewards"] = rewards;
+  }
   return root.dump(2) + "\n";
 }
 

@@ -16,13 +16,14 @@ namespace {
 }  // namespace
 
 Problem::Problem(std::string name, Steps deadline, double step_seconds, std::vector<Action> actions,
-                 std::vector<std::vector<int>> skeletons, std::string description)
+                 std::vector<std::vector<int>> skeletons, std::string description, std::vector<SkeletonReward> rewards)
     : name_(std::move(name)),
       description_(std::move(description)),
       deadline_(deadline),
       step_seconds_(step_seconds),
       actions_(std::move(actions)),
-      skeletons_(std::move(skeletons)) {
+      skeletons_(std::move(skeletons)),
+      rewards_(std::move(rewards)) {
   if (deadline_ < 1 || deadline_ > kMaxDeadline) {
     reject("deadline must be between 1 and " + std::to_string(kMaxDeadline) + " steps");
   }
@@ -74,7 +75,32 @@ Problem::Problem(std::string name, Steps deadline, double step_seconds, std::vec
     }
     completes_[static_cast<std::size_t>(path.back())] = 1;
   }
+  check_rewards();
   index_culprits();
+}
+
+void Problem::check_rewards() {
+  if (rewards_.empty()) rewards_.assign(skeletons_.size(), SkeletonReward{});
+  if (rewards_.size() != skeletons_.size()) {
+    reject(std::to_string(rewards_.size()) + " rewards for " + std::to_string(skeletons_.size()) +
+           " skeletons: one reward per skeleton is needed");
+  }
+  max_reward_ = 0.0;
+  for (std::size_t k = 0; k < rewards_.size(); ++k) {
+    const SkeletonReward& reward = rewards_[k];
+    const int index = static_cast<int>(k);
+    if (!(std::isfinite(reward.value) && reward.value >= 0.0 && reward.value <= 1.0)) {
+      throw RewardError(index, "the value must be a number within [0, 1]");
+    }
+    if (!(std::isfinite(reward.per_step) && reward.per_step >= 0.0)) {
+      throw RewardError(index, "the fall per step must be a number of at least 0");
+    }
+    if (reward.at(static_cast<double>(deadline_)) < 0.0) {
+      throw RewardError(index, "the reward falls below 0 before the deadline (value - per_step * deadline < 0)");
+    }
+    has_rewards_ = has_rewards_ || !reward.is_unit();
+    max_reward_ = std::max(max_reward_, reward.value);
+  }
 }
 
 void Problem::index_culprits() {

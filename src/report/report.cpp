@@ -96,6 +96,11 @@ std::string to_json(const Evaluation& evaluation) {
   out["successes"] = result.successes;
   out["success_rate"] = result.success_rate;
   out["ci95"] = result.ci95;
+  const bool rewards = evaluation.problem->has_rewards();
+  if (rewards) {
+    out["mean_reward"] = result.mean_reward;
+    out["reward_ci95"] = result.reward_ci95;
+  }
   if (evaluation.timing) {
     out["decision_time_us"] = latency_object(result.decision_time);
     out["seconds"] = result.seconds;
@@ -103,6 +108,7 @@ std::string to_json(const Evaluation& evaluation) {
   out["statistics"] = statistics_object(result.statistics);
   if (evaluation.exact) {
     out["exact_success_probability"] = evaluation.exact->success_probability;
+    if (rewards) out["exact_expected_reward"] = evaluation.exact->expected_reward;
     out["exact_states"] = evaluation.exact->states;
   }
   if (evaluation.regret) {
@@ -124,9 +130,12 @@ std::string to_text(const Evaluation& evaluation) {
   if (!evaluation.belief.empty()) out += fmt::format("planned with    {}\n", evaluation.belief);
   out += fmt::format("success rate    {:.4f} ± {:.4f}  ({} of {} episodes, seed {})\n", result.success_rate,
                      result.ci95, result.successes, result.episodes, evaluation.seed);
+  const bool rewards = evaluation.problem->has_rewards();
+  if (rewards) out += fmt::format("mean reward     {:.4f} ± {:.4f}\n", result.mean_reward, result.reward_ci95);
   if (evaluation.exact) {
     out += fmt::format("exact           {:.6f}  ({} states)\n", evaluation.exact->success_probability,
                        evaluation.exact->states);
+    if (rewards) out += fmt::format("exact reward    {:.6f}\n", evaluation.exact->expected_reward);
   }
   if (evaluation.regret) {
     const RegretEstimate& regret = *evaluation.regret;
@@ -150,7 +159,9 @@ Json solve_head(const Solve& solve, double lower, double upper, bool exact) {
   out["instance"] = solve.instance;
   out["name"] = solve.problem->name();
   out["method"] = solve.method;
-  out["optimal_success_probability"] = exact ? Json(lower) : Json(nullptr);
+  // With rewards (SPEC §8) the solvers' value is the optimal expected reward.
+  out[solve.problem->has_rewards() ? "optimal_expected_reward" : "optimal_success_probability"] =
+      exact ? Json(lower) : Json(nullptr);
   out["lower_bound"] = lower;
   out["upper_bound"] = upper;
   out["exact"] = exact;
@@ -255,21 +266,22 @@ std::string to_text(const Solve& solve) {
   const std::string first_action = first_action_of(solve);
   std::string out = fmt::format("instance                     {} ({}), deadline {}, {} skeletons\n", solve.instance,
                                 problem.name(), problem.deadline(), problem.skeleton_count());
+  const char* objective = problem.has_rewards() ? "optimal expected reward    " : "optimal success probability";
   if (solve.search) {
     const SearchSolution& search = *solve.search;
     if (search.exact) {
-      out += fmt::format("optimal success probability  {:.6f}\n", search.lower);
+      out += fmt::format("{}  {:.6f}\n", objective, search.lower);
     } else {
-      out += fmt::format("optimal success probability  in [{:.6f}, {:.6f}] (width {:.6f})\n", search.lower,
-                         search.upper, search.upper - search.lower);
+      out += fmt::format("{}  in [{:.6f}, {:.6f}] (width {:.6f})\n", objective, search.lower, search.upper,
+                         search.upper - search.lower);
     }
     return search_text(solve, std::move(out));
   }
   if (solution.exact) {
-    out += fmt::format("optimal success probability  {:.6f}\n", solution.lower);
+    out += fmt::format("{}  {:.6f}\n", objective, solution.lower);
   } else {
-    out += fmt::format("optimal success probability  in [{:.6f}, {:.6f}] (width {:.6f})\n", solution.lower,
-                       solution.upper, solution.upper - solution.lower);
+    out += fmt::format("{}  in [{:.6f}, {:.6f}] (width {:.6f})\n", objective, solution.lower, solution.upper,
+                       solution.upper - solution.lower);
   }
   if (solve.memoised) {
     if (solution.first_choice >= 0) {

@@ -63,12 +63,39 @@ struct LiveNanoseconds {
   }
 };
 
+// The rewards of episodes (SPEC §8), summed as whole multiples of 2^-32 (each reward and its square
+// rounded to one), so that the sums do not depend on the order threads and ranks add them in: a
+// double sum would change in its last bits with the thread count.
+struct RewardSum {
+  static constexpr double kUnit = 4294967296.0;  // 2^32
+  std::uint64_t units = 0;
+  std::uint64_t square_units = 0;
+
+  void add(double reward) noexcept {
+    units += static_cast<std::uint64_t>(std::llround(reward * kUnit));
+    square_units += static_cast<std::uint64_t>(std::llround(reward * reward * kUnit));
+  }
+  void add(const RewardSum& other) noexcept {
+    units += other.units;
+    square_units += other.square_units;
+  }
+  // The mean and the 95% half-width of the mean (normal approximation, as SPEC §4's).
+  void summarise(std::uint64_t episodes, double& mean, double& ci95) const noexcept {
+    if (episodes == 0) return;
+    const auto n = static_cast<double>(episodes);
+    mean = static_cast<double>(units) / kUnit / n;
+    const double variance = std::max(0.0, static_cast<double>(square_units) / kUnit / n - mean * mean);
+    ci95 = 1.96 * std::sqrt(variance / n);
+  }
+};
+
 // What one thread of run_episodes keeps until the threads' results are merged.
 struct ThreadRun {
   std::unique_ptr<Allocator> allocator;
   std::unique_ptr<World> world;
   RecordingTimer timer;
   std::uint64_t successes = 0;
+  RewardSum rewards;
   LiveNanoseconds live_nanoseconds;  // live runs: this thread's episodes' charges
   std::uint64_t model_successes = 0;
   std::uint64_t model_undecided = 0;
@@ -132,6 +159,7 @@ EpisodeResult drive(Session& session, World& world, const DecisionBudget& budget
   }
   result.status = session.status();
   result.solution = session.solution();
+  result.reward = session.reward();
   result.steps_used = session.steps_used();
   result.skeletons = session.problem().skeleton_count();
   result.attempts = session.take_attempts();
@@ -250,6 +278,7 @@ namespace {
 // What a rank's threads found, merged: the part of a MonteCarloResult that ranks exchange.
 struct RankPart {
   std::uint64_t successes = 0;
+  RewardSum rewards;
   std::uint64_t model_successes = 0;
   std::uint64_t model_undecided = 0;
   LiveNanoseconds live_nanoseconds;
@@ -260,6 +289,7 @@ struct RankPart {
 
   void merge(const RankPart& other) {
     successes += other.successes;
+    rewards.add(other.rewards);
     model_successes += other.model_successes;
     model_undecided += other.model_undecided;
     live_nanoseconds.add(other.live_nanoseconds);
@@ -294,6 +324,7 @@ void pack_episode(BytePacker& packer, std::uint64_t episode, const EpisodeResult
   packer.put(episode);
   packer.put(result.status);
   packer.put(result.solution);
+  packer.put(result.reward);
   packer.put(result.steps_used);
   packer.put(result.decisions);
   packer.put(result.live);
@@ -307,6 +338,7 @@ EpisodeResult unpack_episode(ByteUnpacker& unpacker, std::uint64_t& episode) {
   EpisodeResult result;
   result.status = unpacker.get<Status>();
   result.solution = unpacker.get<int>();
+  result.reward = unpacker.get<double>();
   result.steps_used = unpacker.get<Steps>();
   result.decisions = unpacker.get<int>();
   result.live = unpacker.get<LiveTotals>();
@@ -322,6 +354,7 @@ EpisodeResult unpack_episode(ByteUnpacker& unpacker, std::uint64_t& episode) {
 void merge_ranks(const Ranks& ranks, RankPart& part, const std::string& episodes, const MonteCarloOptions& options) {
   BytePacker packer;
   packer.put(part.successes);
+  packer.put(part.rewards);
   packer.put(part.model_successes);
   packer.put(part.model_undecided);
   packer.put(part.live_nanoseconds);
@@ -336,6 +369,7 @@ void merge_ranks(const Ranks& ranks, RankPart& part, const std::string& episodes
     ByteUnpacker unpacker(parts[r]);
     RankPart other;
     other.successes = unpacker.get<std::uint64_t>();
+    other.rewards = unpacker.get<RewardSum>();
     other.model_successes = unpacker.get<std::uint64_t>();
     other.model_undecided = unpacker.get<std::uint64_t>();
     other.live_nanoseconds = unpacker.get<LiveNanoseconds>();
@@ -394,6 +428,7 @@ MonteCarloResult run_many(const WorldFactory& worlds, const AllocatorFactory* al
         if (options.before_episode) options.before_episode(episode, *run.world);
         const EpisodeResult result = run_one(run, stream_seed(options.seed, episode));
         if (result.status == Status::success) ++run.successes;
+        run.rewards.add(result.reward);
         if (options.live) {
           run.live_nanoseconds.add(result.live);
           if (result.model_status == Status::success) ++run.model_successes;
@@ -423,6 +458,7 @@ MonteCarloResult run_many(const WorldFactory& worlds, const AllocatorFactory* al
   RankPart part;
   for (ThreadRun& run : runs) {
     part.successes += run.successes;
+    part.rewards.add(run.rewards);
     part.decisions.merge(run.timer.decisions);
     part.episode_totals.merge(run.timer.episodes);
     if (run.allocator) run.allocator->collect_statistics(part.statistics);
@@ -444,6 +480,7 @@ MonteCarloResult run_many(const WorldFactory& worlds, const AllocatorFactory* al
   result.success_rate =
       options.episodes == 0 ? 0.0 : static_cast<double>(result.successes) / static_cast<double>(options.episodes);
   result.ci95 = ci95_half_width(result.success_rate, options.episodes);
+  part.rewards.summarise(options.episodes, result.mean_reward, result.reward_ci95);
   result.decision_time = part.decisions.summary();
   result.episode_decision_time = part.episode_totals.summary();
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();

@@ -1,6 +1,8 @@
 #include "ontime/run/evaluation.hpp"
 
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "ontime/run/simulator.hpp"
@@ -54,24 +56,39 @@ ExactEvaluation evaluate_exactly(const Mdp& mdp, Allocator& allocator, std::size
                      std::string(allocator.name()) + "' does not (use Monte Carlo)");
   }
   allocator.begin_episode(0);
-  const auto run = [&](auto policy) {
-    detail::Expectimax<decltype(policy)> search(mdp, policy, max_states, 0.0,
-                                                "exact evaluation of " + std::string(allocator.name()));
-    search.set_stop(stop);
-    ExactEvaluation result;
-    result.success_probability = search.solve(mdp.start()).value;
-    result.states = search.memo().size();
-    return result;
+  // The value of the allocator's choices in `model`: `mdp`, or the same states with every
+  // reward 1 (its success probability).
+  const auto value_in = [&](const Mdp& model) {
+    const auto run = [&](auto policy) {
+      detail::Expectimax<decltype(policy)> search(model, policy, max_states, 0.0,
+                                                  "exact evaluation of " + std::string(allocator.name()));
+      search.set_stop(stop);
+      const double value = search.solve(model.start()).value;
+      return std::make_pair(value, search.memo().size());
+    };
+    if (model.has_backtracking()) return run(StationaryPolicy<0, detail::CompactBacktrackState>(allocator, model));
+    switch (detail::packed_words(model)) {
+      case 2:
+        return run(StationaryPolicy<2>(allocator, model));
+      case 4:
+        return run(StationaryPolicy<4>(allocator, model));
+      default:
+        return run(StationaryPolicy<0>(allocator, model));
+    }
   };
-  if (mdp.has_backtracking()) return run(StationaryPolicy<0, detail::CompactBacktrackState>(allocator, mdp));
-  switch (detail::packed_words(mdp)) {
-    case 2:
-      return run(StationaryPolicy<2>(allocator, mdp));
-    case 4:
-      return run(StationaryPolicy<4>(allocator, mdp));
-    default:
-      return run(StationaryPolicy<0>(allocator, mdp));
+  ExactEvaluation result;
+  std::tie(result.expected_reward, result.states) = value_in(mdp);
+  result.success_probability = result.expected_reward;
+  if (mdp.problem().has_rewards()) {
+    // The same policy (a stationary allocator chooses by the state alone) valued with reward 1.
+    const Problem& problem = mdp.problem();
+    const Problem unit(problem.name(), problem.deadline(), problem.step_seconds(),
+                       std::vector<Action>(problem.actions().begin(), problem.actions().end()),
+                       problem.skeleton_lists(), problem.description());
+    const Mdp success(unit);
+    result.success_probability = value_in(success).first;
   }
+  return result;
 }
 
 }  // namespace ontime

@@ -211,6 +211,7 @@ Status Session::report_live(int choice, int action, const Observation& observati
         solution_ = member;
         status_ = Status::success;
         ended_at_ = elapsed;
+        finish_seconds_ = elapsed + total;
       }
       break;
     }

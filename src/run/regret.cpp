@@ -42,7 +42,7 @@ class RegretMeter final : public Allocator {
     if (mdp_->useful_choices(before).empty()) return;  // an idle step: nothing to choose
     double q = 0.0;
     mdp_->for_each_outcome(before, choice, [&](double probability, Status outcome, const State& next) {
-      if (outcome == Status::success) q += probability;
+      if (outcome == Status::success) q += probability * mdp_->success_reward(next, choice);
       if (outcome == Status::running) q += probability * value(next);
     });
     episode_loss_ += value(before) - q;

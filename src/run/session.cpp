@@ -201,6 +201,13 @@ Status Session::report(const Observation& observation, double execution_seconds)
   return report_live(choice, action, observation, execution_seconds);
 }
 
+double Session::reward() const {
+  if (status_ != Status::success || solution_ < 0) return 0.0;
+  const SkeletonReward& reward = problem().reward(solution_);
+  if (clock_ != nullptr) return std::max(0.0, reward.at(finish_seconds_ / step_seconds()));  // (within a slice)
+  return reward.at(static_cast<double>(state_.time + state_.execution[static_cast<std::size_t>(solution_)]));
+}
+
 State Session::carried_over(const State& old, const Problem& next) const {
   // Effort spent on the actions in progress, read off the old skeletons sharing them.
   std::vector<std::uint16_t> spent(static_cast<std::size_t>(next.action_count()), 0);
@@ -240,11 +247,13 @@ State Session::carried_over(const State& old, const Problem& next) const {
   return out;
 }
 
-void Session::change_skeletons(std::vector<Action> actions, std::vector<std::vector<int>> skeletons) {
+void Session::change_skeletons(std::vector<Action> actions, std::vector<std::vector<int>> skeletons,
+                               std::vector<SkeletonReward> rewards) {
   const Problem& current = mdp_->problem();
   // Everything that can fail comes first, so that a failure leaves the session as it was.
-  auto problem = std::make_unique<Problem>(current.name(), current.deadline(), current.step_seconds(),
-                                           std::move(actions), std::move(skeletons), current.description());
+  auto problem =
+      std::make_unique<Problem>(current.name(), current.deadline(), current.step_seconds(), std::move(actions),
+                                std::move(skeletons), current.description(), std::move(rewards));
   auto mdp = std::make_unique<Mdp>(*problem);
   std::unique_ptr<Allocator> allocator;
   if (make_allocator_) {
@@ -290,7 +299,8 @@ void check_changeable(bool owns_problem, int pending, Status status, const char*
 
 }  // namespace
 
-int Session::add_skeleton(const std::vector<std::string>& action_ids, std::vector<Action> new_actions) {
+int Session::add_skeleton(const std::vector<std::string>& action_ids, std::vector<Action> new_actions,
+                          SkeletonReward reward) {
   check_changeable(owned_problem_ != nullptr, pending_, status_, "add_skeleton");
   const Problem& current = mdp_->problem();
   std::vector<Action> actions(current.actions().begin(), current.actions().end());
@@ -309,8 +319,10 @@ int Session::add_skeleton(const std::vector<std::string>& action_ids, std::vecto
   }
   std::vector<std::vector<int>> skeletons = current.skeleton_lists();
   skeletons.push_back(std::move(path));
+  std::vector<SkeletonReward> rewards(current.rewards().begin(), current.rewards().end());
+  rewards.push_back(reward);
   const int added = current.skeleton_count();
-  change_skeletons(std::move(actions), std::move(skeletons));
+  change_skeletons(std::move(actions), std::move(skeletons), std::move(rewards));
   return added;
 }
 
@@ -318,7 +330,8 @@ void Session::revise_distributions(const Problem& beliefs) {
   check_changeable(owned_problem_ != nullptr, pending_, status_, "revise_distributions");
   const Problem& current = mdp_->problem();
   const Problem revised = with_distributions_of(current, beliefs);
-  change_skeletons(std::vector<Action>(revised.actions().begin(), revised.actions().end()), current.skeleton_lists());
+  change_skeletons(std::vector<Action>(revised.actions().begin(), revised.actions().end()), current.skeleton_lists(),
+                   std::vector<SkeletonReward>(current.rewards().begin(), current.rewards().end()));
 }
 
 void Session::retire_skeleton(int k) {
@@ -334,10 +347,14 @@ void Session::retire_skeleton(int k) {
     return;
   }
   std::vector<std::vector<int>> skeletons;
+  std::vector<SkeletonReward> rewards;
   for (int other = 0; other < current.skeleton_count(); ++other) {
-    if (other != k) skeletons.emplace_back(current.skeleton(other).begin(), current.skeleton(other).end());
+    if (other == k) continue;
+    skeletons.emplace_back(current.skeleton(other).begin(), current.skeleton(other).end());
+    rewards.push_back(current.reward(other));
   }
-  change_skeletons(std::vector<Action>(current.actions().begin(), current.actions().end()), std::move(skeletons));
+  change_skeletons(std::vector<Action>(current.actions().begin(), current.actions().end()), std::move(skeletons),
+                   std::move(rewards));
 }
 
 }  // namespace ontime

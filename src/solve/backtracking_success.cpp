@@ -66,12 +66,18 @@ double BacktrackingSuccess::attempt(const Key& key, Steps spent, bool& ready) {
       // skeletons sharing this action; one that ends with it is complete and succeeds).
       const std::int64_t left = std::int64_t{deadline_} - ct - key.execution;
       double continuation = 0;
-      if (left >= 0 && last) {
+      if (left >= 0 && last && problem.has_rewards()) {
+        // With rewards (SPEC §8): the expected reward of the finish, not the chance it fits.
+        for (std::int64_t x = 0; x <= left; ++x) {
+          continuation += execution.pmf(static_cast<Steps>(x)) *
+                          problem.reward_at(k, static_cast<Steps>(std::int64_t{ct} + key.execution + x));
+        }
+      } else if (left >= 0 && last) {
         continuation = execution.cdf(static_cast<Steps>(left));
       } else if (left >= 0) {
         const auto next_value = [&](int member, std::int64_t x) {
           return problem.skeleton_length(member) == l + 1
-                     ? 1.0
+                     ? problem.reward_at(member, static_cast<Steps>(std::int64_t{ct} + key.execution + x))
                      : need(Key{member, l + 1, ct, static_cast<std::int32_t>(key.execution + x), next_restores}, ready);
         };
         for (std::int64_t x = 0; x <= left; ++x) {

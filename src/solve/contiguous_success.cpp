@@ -67,13 +67,25 @@ ContiguousSuccessTable::ContiguousSuccessTable(const Mdp& mdp, Aggregation aggre
       const int action = problem.action_at(k, l);
       const Distribution& execution = problem.action(action).execution;
       double* g = &continuation_[slot * row];
-      if (l + 1 == problem.skeleton_length(k)) {
+      if (l + 1 == problem.skeleton_length(k) && problem.has_rewards()) {
+        // With rewards (SPEC §8): the expected reward of the finish v + x, not the chance it fits.
+        const auto masses = execution.masses();
+        for (std::size_t v = 1; v <= deadline; ++v) {
+          double total = 0;
+          for (std::size_t x = 0; x < masses.size() && v + x <= deadline; ++x) {
+            total += masses[x] * problem.reward_at(k, static_cast<Steps>(v + x));
+          }
+          g[v] = total;
+        }
+      } else if (l + 1 == problem.skeleton_length(k)) {
         for (std::size_t v = 1; v <= deadline; ++v) g[v] = execution.cdf(static_cast<Steps>(deadline - v));
       } else {
         // PS(k', l + 1, 0, u) of a sharing skeleton k'; a k' that ends with this action is
-        // complete, and succeeds exactly when u <= D.
+        // complete, and succeeds exactly when u <= D (worth its reward then, 1 without rewards).
         const auto next_value = [&](int other, std::size_t u) -> double {
-          if (problem.skeleton_length(other) == l + 1) return u <= deadline ? 1.0 : 0.0;
+          if (problem.skeleton_length(other) == l + 1) {
+            return u <= deadline ? problem.reward_at(other, static_cast<Steps>(u)) : 0.0;
+          }
           if (u >= deadline) return 0.0;
           const std::size_t next = offsets_[static_cast<std::size_t>(other)] + static_cast<std::size_t>(l) + 1;
           return unconditioned[next * (deadline + 1) + u];

@@ -1,9 +1,10 @@
 #pragma once
 // Internal: memoised expectimax over the reachable states of the MDP, without recursion.
 //
-// V(s) = max over c in choices(s) of  sum_o P(o | s, c) * ([o is success] + [o running] V(o)),
-// 0 when there is no choice. `optimal` maximises over every useful choice; exact evaluation
-// passes the one choice an allocator makes. Time only grows along a path, so the reachable
+// V(s) = max over c in choices(s) of  sum_o P(o | s, c) * ([o is success] R(o) + [o running] V(o)),
+// 0 when there is no choice; R(o) is the completed skeleton's reward at its finish (SPEC §8), 1
+// without rewards (V is then the success probability, to the bit: p * 1 is p). `optimal` maximises over every useful
+// choice; exact evaluation passes the one choice an allocator makes. Time only grows along a path, so the reachable
 // states form a DAG of depth at most D; an explicit stack keeps deep deadlines off the call
 // stack, and one item buffer used as a stack avoids allocation per state.
 //
@@ -296,7 +297,7 @@ class Expectimax {
       for (; i < frame.end && items_[i].choice == choice; ++i) {
         const Item& item = items_[i];
         if (item.status == Status::success) {
-          value += item.probability;
+          value += item.probability * mdp_->success_reward(item.next, item.choice);
         } else if (item.status == Status::running) {
           value += item.probability * memo_.at(item.key).value;
         }

@@ -44,12 +44,14 @@ std::vector<std::vector<int>> root_subtrees(const Problem& problem) {
 Problem subproblem(const Problem& problem, const std::vector<int>& skeletons, const std::string& part) {
   std::vector<Action> actions(problem.actions().begin(), problem.actions().end());
   std::vector<std::vector<int>> paths;
+  std::vector<SkeletonReward> rewards;
   for (const int k : skeletons) {
     const auto path = problem.skeleton(k);
     paths.emplace_back(path.begin(), path.end());
+    rewards.push_back(problem.reward(k));
   }
   return Problem(problem.name() + " (" + part + ")", problem.deadline(), problem.step_seconds(), std::move(actions),
-                 std::move(paths));
+                 std::move(paths), problem.description(), std::move(rewards));
 }
 
 }  // namespace
@@ -148,6 +150,17 @@ LayeredSolution solve_layered(const Mdp& mdp, const LayeredSolveOptions& options
     }
     if (options.split == SplitMode::always) {
       throw UsageError("solve: a split does not apply to an instance with backtracking (SPEC §7)");
+    }
+    return layered::search_layers(mdp, options, false, nullptr);
+  }
+  if (mdp.problem().has_rewards()) {
+    // The same: a dropped group's share and a bounded subtree are bounds on a success
+    // probability, not on a reward (SPEC §8). Caps give a certified interval at the frontier.
+    if (options.tolerance > 0) {
+      throw UsageError("solve: a tolerance does not apply to an instance with rewards (SPEC §8)");
+    }
+    if (options.split == SplitMode::always) {
+      throw UsageError("solve: a split does not apply to an instance with rewards (SPEC §8)");
     }
     return layered::search_layers(mdp, options, false, nullptr);
   }

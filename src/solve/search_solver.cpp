@@ -373,8 +373,9 @@ class BranchAndBound {
     for (std::size_t i = choices_[c].begin; i < choices_[c].end; ++i) {
       const Item& item = items_[i];
       if (item.status == Status::success) {
-        lo += item.probability;
-        hi += item.probability;
+        const double reward = item.probability * mdp_->success_reward(item.next, choices_[c].choice);
+        lo += reward;
+        hi += reward;
       } else if (item.status == Status::running) {
         if (lower) lo += item.probability * item.lo;
         hi += item.probability * item.hi;
@@ -397,7 +398,9 @@ class BranchAndBound {
   }
 
   // ValueBounds' upper bound on V*(next), widened by kBoundSlack.
-  double static_upper(const Compact& next) const { return std::min(1.0, bounds_->upper(next) + kBoundSlack); }
+  double static_upper(const Compact& next) const {
+    return std::min(mdp_->problem().max_reward(), bounds_->upper(next) + kBoundSlack);
+  }
 
   // Tries to bring choice c's upper end to `threshold` or below by upper tests of its running
   // successors: each is asked for a share of the excess in proportion to its gap (probability
@@ -479,7 +482,7 @@ class BranchAndBound {
     for (std::size_t i = begin; i < end; ++i) {
       const double probability = items_[i].probability;
       if (items_[i].status == Status::success) {
-        value += probability;
+        value += probability * mdp_->success_reward(items_[i].next, choices_[c].choice);
       } else if (items_[i].status == Status::running) {
         // Copies: the recursion may move the items.
         const Compact next = items_[i].next;

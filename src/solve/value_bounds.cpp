@@ -66,6 +66,19 @@ ValueBounds::ValueBounds(const Mdp& mdp, std::size_t max_table_entries)
   const Problem& problem = mdp.problem();
   const auto deadline = static_cast<std::size_t>(deadline_);
   const std::size_t block = deadline * deadline;
+  max_reward_ = problem.max_reward();
+  // Committing to k may end in the success of a skeleton whose path is a prefix of k's (it
+  // completes on the way): the least reward at the deadline over those and k.
+  for (int k = 0; k < skeleton_count_; ++k) {
+    double floor = problem.reward_at(k, deadline_);
+    for (int m = 0; m < skeleton_count_; ++m) {
+      const int length = problem.skeleton_length(m);
+      if (length < problem.skeleton_length(k) && problem.action_at(k, length - 1) == problem.action_at(m, length - 1)) {
+        floor = std::min(floor, problem.reward_at(m, deadline_));
+      }
+    }
+    reward_floor_.push_back(floor);
+  }
 
   // The nodes of the prefix tree (actions some skeleton uses), deepest first, so that
   // children come before their parents.

@@ -6,6 +6,8 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <string>
+#include <vector>
 
 #include "ontime/util/error.hpp"
 #include "ontime/util/input_file.hpp"
@@ -291,6 +293,37 @@ TEST(InstanceIo, StepSecondsKeepEveryTimeFinite) {
             "(got 1e+308)");
   EXPECT_DOUBLE_EQ(parse_problem(instance_with(R"("deadline": 3, "step_seconds": 1e300)"), "x.json").step_seconds(),
                    1e300);
+}
+
+}  // namespace
+}  // namespace ontime
+
+namespace ontime {
+namespace {
+
+// Rewards (SPEC §8): a number or {"value", "per_step"} per skeleton; written back as read, and not
+// written at all when every skeleton is worth 1.
+TEST(InstanceIo, RewardsReadAndWriteBack) {
+  const std::string text = R"({"deadline": 6, "actions": {
+      "a": {"planning": {"pmf": {"1": 1.0}}, "execution": {"pmf": {"1": 1.0}}},
+      "b": {"planning": {"pmf": {"2": 1.0}}, "execution": {"pmf": {"0": 1.0}}}},
+      "skeletons": [["a"], ["b"]], "rewards": [0.7, {"value": 1.0, "per_step": 0.125}]})";
+  const Problem problem = parse_problem(text, "coffee.json");
+  ASSERT_TRUE(problem.has_rewards());
+  EXPECT_EQ(problem.reward(0), (SkeletonReward{0.7, 0.0}));
+  EXPECT_EQ(problem.reward(1), (SkeletonReward{1.0, 0.125}));
+  EXPECT_EQ(problem.reward_at(1, 4), 0.5);
+  EXPECT_EQ(problem.reward_at(0, 6), 0.7);
+  EXPECT_EQ(problem.max_reward(), 1.0);
+  const Problem again = parse_problem(problem_to_json(problem), "again.json");
+  EXPECT_EQ(std::vector<SkeletonReward>(again.rewards().begin(), again.rewards().end()),
+            std::vector<SkeletonReward>(problem.rewards().begin(), problem.rewards().end()));
+  const std::string plain = R"({"deadline": 6, "actions": {
+      "a": {"planning": {"pmf": {"1": 1.0}}, "execution": {"pmf": {"1": 1.0}}}}, "skeletons": [["a"]],
+      "rewards": [1]})";
+  const Problem unit = parse_problem(plain, "unit.json");
+  EXPECT_FALSE(unit.has_rewards());
+  EXPECT_EQ(problem_to_json(unit).find("rewards"), std::string::npos);
 }
 
 }  // namespace

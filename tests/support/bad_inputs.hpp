@@ -68,6 +68,15 @@ inline const std::array kBadInputs{
     BadInput{"culprit_probability_above_one.json", "actions.b.culprits.a", "a probability must be within [0, 1]"},
     BadInput{"culprits_sum_above_one.json", "actions.c", "the culprits' probabilities sum to 1.250000, not 1"},
     BadInput{"backtrack_and_planning_above_one.json", "actions.b", "planning and backtrack probabilities sum above 1"},
+    // Rewards (SPEC §8).
+    BadInput{"rewards_not_array.json", "rewards", "must be an array with one reward per skeleton"},
+    BadInput{"rewards_wrong_count.json", "rewards", "has 1 entries for 2 skeletons"},
+    BadInput{"reward_above_one.json", "rewards[1]", "the value must be a number within [0, 1]"},
+    BadInput{"reward_not_number.json", "rewards[0].value", "must be a number"},
+    BadInput{"reward_negative_fall.json", "rewards[0]", "the fall per step must be a number of at least 0"},
+    BadInput{"reward_below_zero_before_deadline.json", "rewards[1]", "falls below 0 before the deadline"},
+    BadInput{"reward_unknown_key.json", "rewards[0].slope", "unknown key"},
+    BadInput{"reward_missing_value.json", "rewards[0]", "missing required key 'value'"},
 };
 
 }  // namespace ontime::testing

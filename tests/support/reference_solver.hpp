@@ -4,7 +4,7 @@
 // pmf and survival, every legal choice (idle ones included), no pruning, no early failure.
 // It also gives the value of a stationary rule written on its own state, to check exact
 // evaluation of an allocator against a second implementation of that allocator.
-// Exponential; for small instances only.
+// With rewards (SPEC §8) its values are expected rewards. Exponential; for small instances only.
 
 #include <algorithm>
 #include <functional>
@@ -86,15 +86,20 @@ class ReferenceSolver {
     if (execution.never() > 0) durations.emplace_back(kTooSlow, execution.never());
     for (const auto& [duration, probability] : durations) {
       Node found = next;
-      bool success = false;
+      // The best reward of a skeleton completed in time (SPEC §8: value - per_step * finish), or
+      // none.
+      double reward = -1.0;
       for (const std::size_t m : sharing) {
         ++found.refined[m];
         found.spent[m] = 0;
         found.execution[m] = std::min(kTooSlow, found.execution[m] + duration);
-        success = success || (found.refined[m] == problem_.skeleton_length(static_cast<int>(m)) &&
-                              found.time + found.execution[m] <= problem_.deadline());
+        const long finish = found.time + found.execution[m];
+        if (found.refined[m] == problem_.skeleton_length(static_cast<int>(m)) && finish <= problem_.deadline()) {
+          const SkeletonReward& worth = problem_.rewards()[m];
+          reward = std::max(reward, worth.value - worth.per_step * static_cast<double>(finish));
+        }
       }
-      q += hazard * probability * (success ? 1.0 : value(found));
+      q += hazard * probability * (reward >= 0.0 ? reward : value(found));
     }
     return q;
   }

@@ -130,7 +130,8 @@ class MctsAllocator final : public Allocator {
   double estimate(std::uint32_t e) const noexcept {
     const Edge& edge = edges_[e];
     if (edge.visits == 0) return 0.0;
-    return bellman() ? edge_values_[e] : static_cast<double>(edge.successes) / edge.visits;
+    if (bellman()) return edge_values_[e];
+    return rewards_ ? edge_returns_[e] / edge.visits : static_cast<double>(edge.successes) / edge.visits;
   }
   bool bellman() const noexcept { return options_.backup == MctsBackup::bellman; }
   double leaf_value(State& state);  // a new node's value (bellman): a rollout's reward or a bound
@@ -154,6 +155,11 @@ class MctsAllocator final : public Allocator {
   // decision node (the leaf value until expanded), Q per edge (over the outcomes reached).
   std::vector<double> node_values_;
   std::vector<double> edge_values_;
+  // With rewards (SPEC §8) only, beside the edges and outcomes: an edge's sum of rewards (its
+  // `successes` counts rewards of 1 without them), and a success outcome's reward (else 0).
+  bool rewards_ = false;
+  std::vector<double> edge_returns_;
+  std::vector<double> outcome_rewards_;
   std::vector<std::uint32_t> path_;  // edges visited by the current iteration
   struct Counters {
     std::uint64_t searches = 0;       // decisions that ran a search

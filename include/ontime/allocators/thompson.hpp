@@ -14,6 +14,9 @@
 // sampled, not computed exactly. It spends effort where a plausible world says the deadline
 // is met soonest, which explores a skeleton in proportion to the chance that it is the
 // fastest, instead of committing to one estimate (dp-rerun) or searching (mcts).
+// With rewards (SPEC §8) the step goes to the skeleton whose drawn finish earns the most
+// (one that misses the deadline in the draw earns nothing), the soonest among equals; with
+// every reward 1 that is the soonest, as above.
 // No optimality guarantee.
 // Cost per decision: one inverse-CDF draw (a binary search over D + 1 steps) per remaining
 // action of the live skeletons, O(sum of remaining actions * log D); no allocation (the
@@ -51,6 +54,9 @@ class ThompsonAllocator final : public Allocator {
   // With backtracking: when skeleton k would finish in one draw of its refinement (kNever-like
   // maximum when past the deadline).
   std::int64_t drawn_finish_with_backtracking(const State& state, int k);
+  // Whether skeleton k, finishing at `finish` in the drawn world, beats `best` finishing at
+  // `best_finish` (best < 0: there is none yet).
+  bool better(int k, std::int64_t finish, int best, std::int64_t best_finish) const;
 
   const Mdp* mdp_;
   SplitMix64 generator_{0};

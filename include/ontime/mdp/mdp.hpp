@@ -115,6 +115,16 @@ class Mdp {
   template <class S>
   int completed_skeleton(const S& state, int choice) const;
 
+  // The terminal reward of the success `apply` just returned on `choice` (SPEC §8): the completed
+  // skeleton's reward at its finish, the state's CT plus its ET. 1 without rewards (the objective
+  // is then the success probability, and p * 1 is p to the bit).
+  template <class S>
+  double success_reward(const S& state, int choice) const {
+    if (!problem_->has_rewards()) return 1.0;
+    const int k = completed_skeleton(state, choice);
+    return problem_->reward_at(k, static_cast<Steps>(state.time + state.execution[static_cast<std::size_t>(k)]));
+  }
+
   // Calls visit(probability, status, next_state) for every outcome of choosing `choice` in
   // `state` (SPEC §2). Outcomes with zero probability are skipped; execution times that
   // cannot meet the deadline are merged into one outcome.

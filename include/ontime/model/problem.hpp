@@ -51,6 +51,35 @@ struct Action {
   std::vector<Culprit> culprits;
 };
 
+// What succeeding with a plan skeleton is worth (SPEC §8): `value` if its execution ended at step 0,
+// falling by `per_step` for every step of the finish time f = CT + ET (the step its execution ends,
+// at most the deadline): value - per_step * f. The default, 1 at every finish, makes the objective
+// the success probability of SPEC §2; with per_step 0 the reward is `value` exactly, whatever f.
+// A Problem keeps every reward within [0, 1] at every finish up to its deadline.
+struct SkeletonReward {
+  double value = 1.0;
+  double per_step = 0.0;
+
+  // (A real finish: a live session's plan ends between steps.)
+  double at(double finish) const noexcept { return value - per_step * finish; }
+  bool is_unit() const noexcept { return value == 1.0 && per_step == 0.0; }
+  friend bool operator==(const SkeletonReward&, const SkeletonReward&) = default;
+};
+
+// A broken reward rule of SPEC §8 in a Problem being built: the skeleton's index and the rule.
+// A UsageError like the other rules; instance files map it to its JSON place.
+class RewardError : public UsageError {
+ public:
+  RewardError(int skeleton, const std::string& rule)
+      : UsageError("skeleton " + std::to_string(skeleton) + "'s reward: " + rule), skeleton_(skeleton), rule_(rule) {}
+  int skeleton() const noexcept { return skeleton_; }
+  const std::string& rule() const noexcept { return rule_; }
+
+ private:
+  int skeleton_;
+  std::string rule_;
+};
+
 // A broken backtracking rule of SPEC §7 in a Problem being built: the action, the culprit named
 // (empty when the rule is about the action's backtrack distribution) and the rule. A UsageError,
 // so that code building problems catches it as any; instance files map it to its JSON place.
@@ -79,12 +108,15 @@ class Problem {
 
   // skeletons[k] lists indices into `actions`. Throws UsageError when a rule of
   // SPEC §1 is broken (bad deadline, empty or repeating skeleton, duplicate skeleton, sharing
-  // that does not follow a common prefix, planning mass at step 0, too many skeletons), and
+  // that does not follow a common prefix, planning mass at step 0, too many skeletons),
   // BacktrackingError for a broken rule of SPEC §7 (backtrack mass at step 0 or with planning
   // above 1, culprits that are not before the action on its path, probabilities outside [0, 1]
-  // or not summing to 1, culprits without backtracking or backtracking without culprits).
+  // or not summing to 1, culprits without backtracking or backtracking without culprits), and
+  // RewardError for a broken rule of SPEC §8. `rewards` has one entry per skeleton, or none: 1
+  // for every skeleton.
   Problem(std::string name, Steps deadline, double step_seconds, std::vector<Action> actions,
-          std::vector<std::vector<int>> skeletons, std::string description = {});
+          std::vector<std::vector<int>> skeletons, std::string description = {},
+          std::vector<SkeletonReward> rewards = {});
 
   const std::string& name() const noexcept { return name_; }
   const std::string& description() const noexcept { return description_; }
@@ -102,6 +134,15 @@ class Problem {
   int skeleton_length(int k) const { return static_cast<int>(skeleton(k).size()); }
   // The action at position l (0-based) of skeleton k.
   int action_at(int k, int l) const { return skeleton(k)[static_cast<std::size_t>(l)]; }
+
+  // Rewards (SPEC §8). Whether some skeleton's reward is not 1 at every finish (the objective is
+  // then the expected reward, else the success probability); skeleton k's reward; its value when
+  // its execution ends at step `finish`; the largest reward any skeleton can earn.
+  bool has_rewards() const noexcept { return has_rewards_; }
+  std::span<const SkeletonReward> rewards() const noexcept { return rewards_; }
+  const SkeletonReward& reward(int k) const { return rewards_.at(static_cast<std::size_t>(k)); }
+  double reward_at(int k, Steps finish) const { return reward(k).at(static_cast<double>(finish)); }
+  double max_reward() const noexcept { return max_reward_; }
 
   // Prefix tree. Every action used by some skeleton is one node.
   // Skeletons whose path passes through the action, ascending (N(k, l) of Eq. (1)).
@@ -129,10 +170,11 @@ class Problem {
 
   // The skeletons as lists of action indices (a copy, e.g. to build a changed problem).
   std::vector<std::vector<int>> skeleton_lists() const { return skeletons_; }
-  // This problem (name, deadline, step, skeletons, description) with other actions, in the same
-  // order: e.g. other distributions for the same ids. Throws UsageError as the constructor does.
+  // This problem (name, deadline, step, skeletons, description, rewards) with other actions, in
+  // the same order: e.g. other distributions for the same ids. Throws UsageError as the
+  // constructor does.
   Problem with_actions(std::vector<Action> actions) const {
-    return {name_, deadline_, step_seconds_, std::move(actions), skeletons_, description_};
+    return {name_, deadline_, step_seconds_, std::move(actions), skeletons_, description_, rewards_};
   }
 
  private:
@@ -142,6 +184,9 @@ class Problem {
   double step_seconds_;
   std::vector<Action> actions_;
   std::vector<std::vector<int>> skeletons_;
+  std::vector<SkeletonReward> rewards_;
+  bool has_rewards_ = false;
+  double max_reward_ = 1.0;
   std::vector<std::vector<int>> members_;
   std::vector<int> position_;
   std::vector<int> parent_;
@@ -151,6 +196,7 @@ class Problem {
   int culprit_slots_ = 0;
 
   void index_culprits();
+  void check_rewards();
 };
 
 // How one attempt to refine `action` ends (SPEC §7: a motion and a backtrack as competing risks),

@@ -41,6 +41,7 @@ class DecisionTimer {
 struct EpisodeResult {
   Status status = Status::failure;
   int solution = -1;     // skeleton executed on success
+  double reward = 0;     // Session::reward(): the solution's reward (1 without rewards), 0 on failure
   Steps steps_used = 0;  // steps of effort spent
   int decisions = 0;
   // Live episodes only: what the session charged, the step clock's verdict on the same calls
@@ -160,6 +161,10 @@ struct MonteCarloResult {
   std::uint64_t successes = 0;
   double success_rate = 0;
   double ci95 = 0;  // half-width: 1.96 * sqrt(r (1 - r) / N)  (SPEC §4)
+  // The mean reward of an episode (SPEC §8; the success rate, to within 2^-32, without rewards)
+  // and its 95% half-width.
+  double mean_reward = 0;
+  double reward_ci95 = 0;
   LatencySummary decision_time;
   LatencySummary episode_decision_time;  // total decision time of each episode (meta-level cost)
   double seconds = 0;                    // wall-clock time of the whole run

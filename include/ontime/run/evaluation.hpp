@@ -18,10 +18,13 @@ MonteCarloResult run_monte_carlo(const Mdp& mdp, const AllocatorFactory& factory
 
 struct ExactEvaluation {
   double success_probability = 0;
+  // The expected reward (SPEC §8): the success probability, to the bit, without rewards. With
+  // rewards the same policy is valued twice, once with every reward 1.
+  double expected_reward = 0;
   std::size_t states = 0;  // reachable running states under the allocator
 };
 
-// The success probability of a stationary allocator (SPEC §4): a finite sum over the states
+// The success probability and expected reward of a stationary allocator (SPEC §4, §8): a finite sum over the states
 // reachable under its choices, with no sampling. Throws UsageError when the allocator is not
 // stationary, ResourceLimitError past `max_states`, Cancelled once `stop` (checked every few
 // thousand states) returns true.

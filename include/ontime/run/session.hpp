@@ -171,7 +171,8 @@ class Session {
   void charge_outside(double seconds);
 
   // Sessions that own their problem: a skeleton arrives. `action_ids` lists its actions in
-  // order; `new_actions` brings those the problem does not know yet, with their distributions.
+  // order; `new_actions` brings those the problem does not know yet, with their distributions;
+  // `reward` is what succeeding with it is worth (SPEC §8; 1 by default).
   // Known actions are shared, so SPEC §1's prefix rule applies. What was learnt carries over:
   // the new skeleton starts with the leading actions already refined (their execution times
   // too) and the effort already spent on its next action. The allocator is made anew for the
@@ -180,7 +181,8 @@ class Session {
   // a broken rule or an allocator that cannot take the new problem (the session is then
   // unchanged), std::logic_error while a decision awaits its report, after the end, or for a
   // session that does not own its problem.
-  int add_skeleton(const std::vector<std::string>& action_ids, std::vector<Action> new_actions = {});
+  int add_skeleton(const std::vector<std::string>& action_ids, std::vector<Action> new_actions = {},
+                   SkeletonReward reward = {});
   // Sessions that own their problem: skeleton k leaves (e.g. the task planner found it
   // infeasible); later skeletons move down by one index. The last one leaving ends the session
   // as a failure. Same errors as add_skeleton.
@@ -210,6 +212,10 @@ class Session {
   const Problem& problem() const noexcept { return mdp_->problem(); }
   // The skeleton to execute after success, -1 before.
   int solution() const noexcept { return solution_; }
+  // What the episode earned (SPEC §8): after a success, the solution's reward at its finish (the
+  // state's CT plus the solution's ET; 1 without rewards), else 0.
+  // On the robot's clock, the finish is the plan's end in seconds over the step (a real number).
+  double reward() const;
   // Steps of effort spent so far (CT).
   Steps steps_used() const noexcept { return state_.time; }
   // What the session saw of each action of problem() so far, by action index.
@@ -251,7 +257,8 @@ class Session {
   // No skeleton can succeed and none is expected to come.
   bool out_of_skeletons() const;
   // Replaces the skeletons (add_skeleton, retire_skeleton) and carries the state over.
-  void change_skeletons(std::vector<Action> actions, std::vector<std::vector<int>> skeletons);
+  void change_skeletons(std::vector<Action> actions, std::vector<std::vector<int>> skeletons,
+                        std::vector<SkeletonReward> rewards);
   State carried_over(const State& old, const Problem& next) const;
 
   const Mdp* mdp_;
@@ -290,6 +297,7 @@ class Session {
   double last_report_ = 0;      // clock time of the last report (or the start)
   double decided_at_ = 0;       // clock time the pending decision was made
   double ended_at_ = -1;        // elapsed seconds when the session ended
+  double finish_seconds_ = -1;  // live success: when the plan's execution ends, elapsed seconds
   State model_state_;           // the step clock's state
   Status model_status_ = Status::running;
   std::vector<LiveStep> timeline_;

@@ -8,6 +8,10 @@
 //   PS = (1 / S_a(spent)) * sum_{t=1}^{D-used} p_a(spent + t) * G(k, l, used + t)
 // where G(k, l, v) = E_a(D - v) for the last action, and otherwise
 //   G(k, l, v) = sum_x e_a(x) * AGG_{k' in N(k,l)} PS(k', l+1, 0, v + x).
+// With rewards (SPEC §8), PS is the expected reward of that contiguous refinement instead: the
+// last action's E_a(D - v) becomes sum_x e_a(x) R_k(v + x) over finishes v + x <= D, and a
+// sharing skeleton that completes is worth its reward R_k'(u) instead of 1; without rewards
+// the tables are the success probabilities to the bit.
 // Eq. (1) depends on CT and ET only through their sum, so G is one table of D + 1 values per
 // (skeleton, position): everything that does not depend on `spent` is computed once, when the
 // table is built, and a query is one dot product of at most D - used terms.

@@ -1,5 +1,5 @@
 #pragma once
-// Certified bounds on the optimal success probability V*(s) of any state, from tables
+// Certified bounds on the optimal success probability (or expected reward) V*(s) of any state, from tables
 // (docs/theory.md, "Certified bounds on the optimum").
 //
 // lower(s): the exact success probability of the best commit policy, which from s refines
@@ -15,6 +15,13 @@
 // G computed exactly per node by a recursion over the tree; V*(s) <= upper(s). On problems
 // whose prefix tree is one path (one skeleton, or skeletons that are prefixes of each other)
 // both bounds equal V*.
+//
+// With rewards (SPEC §8), V* is the optimal expected reward and the bounds are scaled to it:
+// commit(s, k) is the commit policy's success probability times the least reward it can earn
+// (the reward at the deadline of k or of a skeleton completed on k's way, a prefix of k), so
+// still at most that policy's expected reward; upper(s) is the clairvoyant success probability times the
+// largest reward of any skeleton. Without rewards both factors are 1, and the bounds are the
+// success-probability bounds above to the bit.
 //
 // A state is anything with time, refined[k], spent[k] and execution[k] (State, or the exact
 // solver's fixed-size copy of it) reachable from the start. A skeleton contributes nothing
@@ -80,7 +87,7 @@ class ValueBounds {
     const auto slot = static_cast<std::size_t>(k);
     const std::size_t at = cell(slot, refined, spent, execution, time);
     if (at == kNoTable) return 0.0;
-    return commit_[commit_block_[path_start_[slot] + static_cast<std::size_t>(refined)] + at];
+    return commit_[commit_block_[path_start_[slot] + static_cast<std::size_t>(refined)] + at] * reward_floor_[slot];
   }
   double group_upper(int k, int refined, std::uint16_t spent, std::uint16_t execution,
                      std::int64_t time) const noexcept {
@@ -134,6 +141,9 @@ class ValueBounds {
   // action of its subtree gives up; per position, where the group's W starts (as reach_block_).
   std::vector<double> win_;
   std::vector<std::size_t> win_block_;
+  // Rewards (SPEC §8): per skeleton its least reward (at the deadline), and the largest value.
+  std::vector<double> reward_floor_;
+  double max_reward_ = 1.0;
 };
 
 template <class S>
@@ -166,7 +176,7 @@ double ValueBounds::upper(const S& state) const noexcept {
     const double group = group_upper(k, state.refined[slot], state.spent[slot], state.execution[slot], state.time);
     if (group > 0.0) all_fail *= 1.0 - group;
   }
-  return 1.0 - all_fail;
+  return (1.0 - all_fail) * max_reward_;
 }
 
 }  // namespace ontime

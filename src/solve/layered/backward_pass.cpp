@@ -70,6 +70,7 @@ struct LayeredSearch<W>::StateValue {
   const std::vector<Bounds>& foreign;
   const std::uint32_t* code = nullptr;
   const double* extra = nullptr;
+  const bool rewards = search->mdp_->problem().has_rewards();
   // What the end of the enumerated part is worth: nothing, or in a split's unflagged states
   // the bounded subtrees, fresh, with the time left.
   Bounds ended;
@@ -119,8 +120,10 @@ struct LayeredSearch<W>::StateValue {
     }
     const std::uint32_t at = *code++;
     if (at == kSuccessCode) {
-      lower_sum += probability;
-      upper_sum += probability;
+      // With rewards (SPEC §8) the success's reward is the next extra; else it is worth 1.
+      const double worth = rewards ? probability * *extra++ : probability;
+      lower_sum += worth;
+      upper_sum += worth;
       return;
     }
     if (at == kFailureCode && !has_extras && candidate != kWeakChoice && ended.upper == 0.0) {

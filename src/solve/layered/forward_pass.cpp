@@ -114,6 +114,7 @@ Cut LayeredSearch<W>::expand(const std::vector<Key>& current, int t, std::vector
   std::uint32_t foreign_count = 0;
   ScratchFile codes_file(scratch_.file(t, "codes"), t, "wb");
   ScratchFile extras_file(scratch_.file(t, "extras"), t, "wb");
+  const bool rewards = mdp_->problem().has_rewards();
   std::vector<ThreadBuffers> buffers(threads_);
   for (ThreadBuffers& buffer : buffers) {
     buffer.own.resize(shards_);
@@ -146,6 +147,8 @@ Cut LayeredSearch<W>::expand(const std::vector<Key>& current, int t, std::vector
           }
           if (outcome.status != Status::running) {
             output.codes.push_back(outcome.status == Status::success ? kSuccessCode : kFailureCode);
+            // With rewards (SPEC §8), a success's reward follows in the extras.
+            if (outcome.status == Status::success && rewards) output.extras.push_back(outcome.reward);
             return;
           }
           const Pending pending{outcome.key, static_cast<std::uint32_t>(b),

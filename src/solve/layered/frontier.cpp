@@ -42,7 +42,7 @@ void LayeredSearch<W>::value_frontier(const std::vector<Key>& keys, int t, std::
           values[i] = {bounds->lower(decoded), bounds->upper(decoded)};
           choices[i] = bounds->lower_choice(decoded);
         } else {
-          values[i] = {0.0, mdp_->any_can_succeed(decoded) ? 1.0 : 0.0};
+          values[i] = {0.0, mdp_->any_can_succeed(decoded) ? mdp_->problem().max_reward() : 0.0};
         }
       };
       for (std::uint64_t i = begin; i < end; ++i) {

@@ -26,7 +26,8 @@ using detail::PackedStateHash;
 // One 32-bit code per outcome: where the successor sits in the next layer (a shard's place, or
 // an entry of the layer's list of successors owned by other ranks), or success, failure; a
 // successor from which a tolerance dropped groups is preceded by kExtrasCode, and its factor
-// and boost are the next two doubles of the layer's extras file.
+// and boost are the next two doubles of the layer's extras file. With rewards (SPEC §8), each
+// success's reward is the next double of the extras file.
 inline constexpr std::uint32_t kForeignBase = 0x8000'0000U;
 inline constexpr std::uint32_t kSpecialBase = 0xFFFF'FFF0U;
 inline constexpr std::uint32_t kSuccessCode = 0xFFFF'FFFFU;

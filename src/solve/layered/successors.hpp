@@ -110,6 +110,7 @@ class Successors {
     bool extras = false;  // a tolerance dropped groups: the share below
     double factor = 1;    // product of (1 - G) over the dropped groups
     double boost = 0;     // best commit value among them
+    double reward = 1;    // success only: the completed skeleton's reward (SPEC §8)
   };
 
   Successors(const Mdp& mdp, const TreeTables& tree, const KeyLayout& layout, const ValueBounds* bounds,
@@ -228,6 +229,7 @@ class Successors {
                                  outcome.probability = probability;
                                  outcome.status = status;
                                  if (status == Status::running) outcome.key = layout_->encode<W>(next);
+                                 if (status == Status::success) outcome.reward = mdp_->success_reward(next, choice);
                                  sink(static_cast<const Outcome&>(outcome));
                                });
       } else {
@@ -360,6 +362,11 @@ class Successors {
     if (node.completes && next_time + execution <= deadline_) {
       outcome.status = Status::success;
       outcome.extras = false;
+      // The one skeleton ending at this node (two ending at the same node would be the same path).
+      const Problem& problem = mdp_->problem();
+      outcome.reward = problem.has_rewards()
+                           ? problem.reward_at(tree_->ending(node).front(), static_cast<Steps>(next_time + execution))
+                           : 1.0;
       return;
     }
     const std::int64_t room = std::int64_t{deadline_} - next_time;
