@@ -70,3 +70,24 @@ def test_bad_rewards_are_refused_with_their_place():
     document["rewards"][1] = {"value": 0.7, "per_step": 0.5}
     with pytest.raises(ontime.InputError, match=r"rewards\[1\]: .*falls below 0 before the deadline"):
         ontime.Problem.from_json(json.dumps(document), "coffee.json")
+
+
+def test_a_live_session_pays_by_the_robots_clock_and_takes_the_reward_of_an_arriving_skeleton():
+    one_step = {"pmf": {"1": 1.0}}
+    problem = ontime.Problem.from_dict({
+        "deadline": 10, "step_seconds": 1.0,
+        "actions": {"a": {"planning": one_step, "execution": {"pmf": {"2": 1.0}}},
+                    "b": {"planning": one_step, "execution": one_step}},
+        "skeletons": [["a"]], "rewards": [{"value": 1.0, "per_step": 0.1}],
+    })
+    clock = ontime.ManualClock()
+    session = ontime.LiveSession(problem, "greedy", clock=clock)
+    assert session.add_skeleton(["b"], reward=0.5, reward_per_step=0.02) == 1
+    assert session.problem.rewards[1] == {"value": 0.5, "per_step": 0.02}
+    session.retire_skeleton(1)
+    assert session.problem.rewards == [{"value": 1.0, "per_step": 0.1}]
+    session.choose()
+    clock.advance(1.0)
+    assert session.report_refined_seconds(2.5) == ontime.Status.success
+    # The plan ends 1.0 + 2.5 seconds in: 3.5 steps of 1 s.
+    assert session.reward == pytest.approx(1.0 - 0.1 * 3.5, abs=1e-12)

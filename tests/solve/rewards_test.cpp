@@ -71,6 +71,32 @@ TEST(Rewards, SearchAndLayeredSolversEqualTheMemoisedOneBitForBit) {
   }
 }
 
+TEST(Rewards, EveryCapsIntervalHoldsTheExpectedReward) {
+  // A cap cuts the layered solver at a frontier that takes ValueBounds, and the search where it
+  // stands: both intervals must hold the optimum with rewards as without.
+  int cut = 0;
+  for (std::uint64_t seed = 1; seed <= 60; ++seed) {
+    const Problem problem = with_random_rewards(testing::random_instance(seed, 6, 5, 16), 11 * seed);
+    const Mdp mdp(problem);
+    OptimalSolver memoised(mdp);
+    const double optimum = memoised.solve(mdp.start());
+    for (const std::uint64_t cap : {std::uint64_t{3}, std::uint64_t{10}, std::uint64_t{30}}) {
+      LayeredSolveOptions layered_options;
+      layered_options.max_states = cap;
+      const LayeredSolution layered = solve_layered(mdp, layered_options);
+      EXPECT_LE(layered.lower, optimum + 1e-12) << seed << " cap " << cap;
+      EXPECT_GE(layered.upper, optimum - 1e-12) << seed << " cap " << cap;
+      SearchSolveOptions search_options;
+      search_options.max_states = cap;
+      const SearchSolution search = solve_search(mdp, search_options);
+      EXPECT_LE(search.lower, optimum + 1e-12) << seed << " cap " << cap;
+      EXPECT_GE(search.upper, optimum - 1e-12) << seed << " cap " << cap;
+      cut += (layered.exact ? 0 : 1) + (search.exact ? 0 : 1);
+    }
+  }
+  EXPECT_GT(cut, 60);  // the caps do cut: 83 of the 360 solves here (many instances are tiny)
+}
+
 TEST(Rewards, ACommonRewardScalesTheSuccessProbability) {
   // Every skeleton worth c at any finish: the expected reward of every policy is c times its
   // success probability, so the optimum is c times the optimal success probability.
