@@ -376,18 +376,26 @@ std::string to_json(const Table& table) {
       Json entry;
       entry["success_rate"] = cell.sampled.success_rate;
       entry["ci95"] = cell.sampled.ci95;
+      if (row.rewards) {
+        entry["mean_reward"] = cell.sampled.mean_reward;
+        entry["reward_ci95"] = cell.sampled.reward_ci95;
+      }
       entry["decision_time_us"] = {{"median", cell.sampled.decision_time.median_us},
                                    {"p99", cell.sampled.decision_time.p99_us},
                                    {"mean", cell.sampled.decision_time.mean_us}};
       if (cell.exact) {
-        if (cell.exact->value) entry["exact_success_probability"] = *cell.exact->value;
+        if (cell.exact->value) {
+          entry[row.rewards ? "exact_expected_reward" : "exact_success_probability"] = *cell.exact->value;
+        }
         entry["exact"] = exact_object(*cell.exact);
       }
       cells[table.solvers[s]] = entry;
     }
     line["solvers"] = cells;
     if (row.optimum) {
-      if (row.optimum->value) line["optimal_success_probability"] = *row.optimum->value;
+      if (row.optimum->value) {
+        line[row.rewards ? "optimal_expected_reward" : "optimal_success_probability"] = *row.optimum->value;
+      }
       line["optimal_states"] = row.optimum->states;
       line["optimum"] = exact_object(*row.optimum);
     }
@@ -407,7 +415,10 @@ std::string to_markdown(const Table& table, const ParameterSpelling& spelling) {
     std::vector<std::string> line{row.label};
     for (std::size_t s = 0; s < row.cells.size(); ++s) {
       const TableCell& cell = row.cells[s];
-      std::string text = fmt::format("{:.3f} ± {:.3f}", cell.sampled.success_rate, cell.sampled.ci95);
+      // A row with rewards shows its mean reward (and expected rewards in parentheses).
+      std::string text = row.rewards
+                             ? fmt::format("{:.3f} ± {:.3f}", cell.sampled.mean_reward, cell.sampled.reward_ci95)
+                             : fmt::format("{:.3f} ± {:.3f}", cell.sampled.success_rate, cell.sampled.ci95);
       if (cell.exact) text += " (" + exact_text(*cell.exact) + ")";
       line.push_back(text);
       latency_sum[s] += cell.sampled.decision_time.mean_us;
@@ -422,8 +433,12 @@ std::string to_markdown(const Table& table, const ParameterSpelling& spelling) {
   if (table.exact) latency.emplace_back("");
   body.push_back(std::move(latency));
 
+  const bool any_rewards =
+      std::any_of(table.rows.begin(), table.rows.end(), [](const TableRow& row) { return row.rewards; });
   std::string out = fmt::format(
-      "Success probability: mean ± 95% over {} episodes (seed {}){}.\n\n", table.episodes, table.seed,
+      "Success probability{}: mean ± 95% over {} episodes (seed {}){}.\n\n",
+      any_rewards ? " (expected reward in the rows of instances with rewards, SPEC §8)" : "", table.episodes,
+      table.seed,
       table.exact
           ? "; exact value in parentheses; optimum = exact expectimax, or a certified [lower, upper] past " + cap
           : std::string());

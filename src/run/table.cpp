@@ -50,6 +50,7 @@ TableRow measure_row(const TableInstance& instance, const Mdp& mdp, const std::v
   row.source = instance.source;
   row.label = instance.label;
   row.name = instance.problem.name();
+  row.rewards = instance.problem.has_rewards();
   std::uint64_t finished = 0;
   for (std::size_t column = 0; column < solvers.size(); ++column) {
     MonteCarloOptions monte_carlo;
@@ -65,7 +66,8 @@ TableRow measure_row(const TableInstance& instance, const Mdp& mdp, const std::v
       const auto allocator = factories[column]();
       cell.exact = exact_part(max_states, [&] {
         const ExactEvaluation evaluation = evaluate_exactly(mdp, *allocator, max_states, options.stop);
-        return std::pair{evaluation.success_probability, evaluation.states};
+        // The objective: the expected reward, which is the success probability without rewards.
+        return std::pair{evaluation.expected_reward, evaluation.states};
       });
     }
     row.cells.push_back(std::move(cell));

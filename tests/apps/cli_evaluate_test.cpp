@@ -107,6 +107,29 @@ TEST(Cli, TablePrintsOneRowPerInstanceAndTheOptimum) {
   EXPECT_DOUBLE_EQ(out["rows"][0]["solvers"]["greedy"]["exact_success_probability"].get<double>(), 0.55);
 }
 
+// An instance with rewards (SPEC §8): solve, evaluate and table report the expected reward beside
+// the success probability, and the exact figures agree across the three.
+TEST(Cli, RewardsAreReportedBySolveEvaluateAndTable) {
+  const std::string coffee = testing::source_path("data/instances/rewards/meeting-with-coffee.json").string();
+  const auto solved = ontime({"solve", coffee, "--json"});
+  ASSERT_EQ(solved.exit_code, 0) << solved.err;
+  const json solve = json::parse(solved.out);
+  EXPECT_FALSE(solve.contains("optimal_success_probability"));
+  const double optimum = solve["optimal_expected_reward"].get<double>();
+  const auto evaluated = ontime({"evaluate", coffee, "--solver", "optimal", "--episodes", "500", "--exact", "--json"});
+  ASSERT_EQ(evaluated.exit_code, 0) << evaluated.err;
+  const json evaluation = json::parse(evaluated.out);
+  EXPECT_EQ(evaluation["exact_expected_reward"].get<double>(), optimum);
+  EXPECT_GT(evaluation["exact_success_probability"].get<double>(), optimum);
+  EXPECT_LT(evaluation["mean_reward"].get<double>(), evaluation["success_rate"].get<double>());
+  const auto tabled = ontime({"table", coffee, "--solvers", "dp-rerun", "--episodes", "500", "--exact", "--json"});
+  ASSERT_EQ(tabled.exit_code, 0) << tabled.err;
+  const json table = json::parse(tabled.out);
+  EXPECT_EQ(table["rows"][0]["optimal_expected_reward"].get<double>(), optimum);
+  EXPECT_LT(table["rows"][0]["solvers"]["dp-rerun"]["exact_expected_reward"].get<double>(), optimum);
+  EXPECT_TRUE(table["rows"][0]["solvers"]["dp-rerun"].contains("mean_reward"));
+}
+
 TEST(Cli, StudiesWriteTheirCsvAndPlot) {
   const auto directory = scratch("study");
   const auto anytime = ontime({"study", "anytime", paper("instance4"), paper("instance5"), "--episodes", "30",

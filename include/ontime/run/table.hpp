@@ -43,9 +43,12 @@ struct TableCell {
 };
 
 struct TableRow {
-  std::string label;             // the instance's file stem, or the name given
-  std::string source;            // where the instance came from (a file), as given
-  std::string name;              // the instance's own name
+  std::string label;   // the instance's file stem, or the name given
+  std::string source;  // where the instance came from (a file), as given
+  std::string name;    // the instance's own name
+  // The instance has rewards (SPEC §8): the exact parts are expected rewards, and the report
+  // shows the mean reward beside the success rate.
+  bool rewards = false;
   std::vector<TableCell> cells;  // one per column
   std::optional<ExactPart> optimum;
 };
