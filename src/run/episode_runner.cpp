@@ -63,29 +63,20 @@ struct LiveNanoseconds {
   }
 };
 
-// The rewards of episodes (SPEC §8), summed as whole multiples of 2^-32 (each reward and its square
-// rounded to one), so that the sums do not depend on the order threads and ranks add them in: a
-// double sum would change in its last bits with the thread count.
+// The rewards of episodes (SPEC §8) in statistics.hpp's order-free units, so that the sums do not
+// depend on the order threads and ranks add them in. Kept as integers: each episode adds up to
+// 2^32 units, which a double would hold exactly only up to 2^21 episodes.
 struct RewardSum {
-  static constexpr double kUnit = 4294967296.0;  // 2^32
   std::uint64_t units = 0;
   std::uint64_t square_units = 0;
 
   void add(double reward) noexcept {
-    units += static_cast<std::uint64_t>(std::llround(reward * kUnit));
-    square_units += static_cast<std::uint64_t>(std::llround(reward * reward * kUnit));
+    units += static_cast<std::uint64_t>(sum_units(reward));
+    square_units += static_cast<std::uint64_t>(sum_units(reward * reward));
   }
   void add(const RewardSum& other) noexcept {
     units += other.units;
     square_units += other.square_units;
-  }
-  // The mean and the 95% half-width of the mean (normal approximation, as SPEC §4's).
-  void summarise(std::uint64_t episodes, double& mean, double& ci95) const noexcept {
-    if (episodes == 0) return;
-    const auto n = static_cast<double>(episodes);
-    mean = static_cast<double>(units) / kUnit / n;
-    const double variance = std::max(0.0, static_cast<double>(square_units) / kUnit / n - mean * mean);
-    ci95 = 1.96 * std::sqrt(variance / n);
   }
 };
 
@@ -480,7 +471,11 @@ MonteCarloResult run_many(const WorldFactory& worlds, const AllocatorFactory* al
   result.success_rate =
       options.episodes == 0 ? 0.0 : static_cast<double>(result.successes) / static_cast<double>(options.episodes);
   result.ci95 = ci95_half_width(result.success_rate, options.episodes);
-  part.rewards.summarise(options.episodes, result.mean_reward, result.reward_ci95);
+  const MeanInterval rewards =
+      mean_interval_of_units(static_cast<double>(part.rewards.units), static_cast<double>(part.rewards.square_units),
+                             static_cast<double>(options.episodes));
+  result.mean_reward = rewards.mean;
+  result.reward_ci95 = rewards.ci95;
   result.decision_time = part.decisions.summary();
   result.episode_decision_time = part.episode_totals.summary();
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();

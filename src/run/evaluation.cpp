@@ -81,10 +81,7 @@ ExactEvaluation evaluate_exactly(const Mdp& mdp, Allocator& allocator, std::size
   result.success_probability = result.expected_reward;
   if (mdp.problem().has_rewards()) {
     // The same policy (a stationary allocator chooses by the state alone) valued with reward 1.
-    const Problem& problem = mdp.problem();
-    const Problem unit(problem.name(), problem.deadline(), problem.step_seconds(),
-                       std::vector<Action>(problem.actions().begin(), problem.actions().end()),
-                       problem.skeleton_lists(), problem.description());
+    const Problem unit = mdp.problem().with_rewards({});
     const Mdp success(unit);
     result.success_probability = value_in(success).first;
   }

@@ -70,7 +70,7 @@ class RegretMeter final : public Allocator {
   }
 
   // A whole number of kRegretUnit: sums of them are exact in any order.
-  static double units(double value) { return std::round(value / kRegretUnit); }
+  static double units(double value) { return sum_units(value); }
 
   double value(const State& state) { return exact_value(exact_, state, max_states_); }
 
@@ -101,9 +101,9 @@ std::optional<RegretEstimate> regret_estimate(const Statistics& statistics) {
   RegretEstimate estimate;
   estimate.optimum = *optimum;
   estimate.episodes = static_cast<std::uint64_t>(*episodes);
-  estimate.mean = *sum * kRegretUnit / *episodes;
-  const double variance = std::max(0.0, *squares * kRegretUnit / *episodes - estimate.mean * estimate.mean);
-  estimate.ci95 = 1.96 * std::sqrt(variance / *episodes);
+  const MeanInterval interval = mean_interval_of_units(*sum, *squares, *episodes);
+  estimate.mean = interval.mean;
+  estimate.ci95 = interval.ci95;
   return estimate;
 }
 

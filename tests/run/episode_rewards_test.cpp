@@ -20,13 +20,7 @@ Problem rewarded_instance3() {
   const Problem problem = testing::paper_instance("instance3");
   std::vector<SkeletonReward> rewards(static_cast<std::size_t>(problem.skeleton_count()), {0.6, 0.0});
   rewards[0] = {1.0, 0.02};
-  return {problem.name(),
-          problem.deadline(),
-          problem.step_seconds(),
-          std::vector<Action>(problem.actions().begin(), problem.actions().end()),
-          problem.skeleton_lists(),
-          {},
-          rewards};
+  return problem.with_rewards(rewards);
 }
 
 TEST(EpisodeRewards, TheMeanRewardEstimatesTheExactExpectedRewardForEveryThreadCount) {

@@ -32,13 +32,7 @@ Problem with_random_rewards(const Problem& problem, std::uint64_t seed) {
     if (unit(generator) < 0.5) reward.per_step = reward.value * unit(generator) / problem.deadline();
     rewards.push_back(reward);
   }
-  return {problem.name(),
-          problem.deadline(),
-          problem.step_seconds(),
-          std::vector<Action>(problem.actions().begin(), problem.actions().end()),
-          problem.skeleton_lists(),
-          problem.description(),
-          rewards};
+  return problem.with_rewards(rewards);
 }
 
 TEST(Rewards, TheOptimumIsTheReferenceSolversExpectedReward) {
@@ -104,10 +98,8 @@ TEST(Rewards, ACommonRewardScalesTheSuccessProbability) {
     const Problem problem = testing::paper_instance(name);
     const Mdp plain(problem);
     const double success = OptimalSolver(plain).solve(plain.start());
-    const Problem scaled(problem.name(), problem.deadline(), problem.step_seconds(),
-                         std::vector<Action>(problem.actions().begin(), problem.actions().end()),
-                         problem.skeleton_lists(), {},
-                         std::vector<SkeletonReward>(static_cast<std::size_t>(problem.skeleton_count()), {0.7, 0.0}));
+    const Problem scaled = problem.with_rewards(
+        std::vector<SkeletonReward>(static_cast<std::size_t>(problem.skeleton_count()), {0.7, 0.0}));
     const Mdp mdp(scaled);
     EXPECT_NEAR(OptimalSolver(mdp).solve(mdp.start()), 0.7 * success, 1e-14) << name;
   }
@@ -115,9 +107,8 @@ TEST(Rewards, ACommonRewardScalesTheSuccessProbability) {
 
 TEST(Rewards, ExplicitUnitRewardsAreNoRewards) {
   const Problem problem = testing::paper_instance("instance2");
-  const Problem unit(problem.name(), problem.deadline(), problem.step_seconds(),
-                     std::vector<Action>(problem.actions().begin(), problem.actions().end()), problem.skeleton_lists(),
-                     {}, std::vector<SkeletonReward>(static_cast<std::size_t>(problem.skeleton_count())));
+  const Problem unit =
+      problem.with_rewards(std::vector<SkeletonReward>(static_cast<std::size_t>(problem.skeleton_count())));
   EXPECT_FALSE(unit.has_rewards());
   EXPECT_EQ(unit.max_reward(), 1.0);
   const Mdp a(problem), b(unit);
@@ -161,11 +152,7 @@ TEST(Rewards, EquationOneOfAOneSkeletonProblemIsItsExpectedReward) {
 
 TEST(Rewards, BrokenRewardsAreRefusedWithTheSkeletonAndTheRule) {
   const Problem problem = testing::paper_instance("figure1");
-  const auto build = [&](std::vector<SkeletonReward> rewards) {
-    return Problem(problem.name(), problem.deadline(), problem.step_seconds(),
-                   std::vector<Action>(problem.actions().begin(), problem.actions().end()), problem.skeleton_lists(),
-                   {}, std::move(rewards));
-  };
+  const auto build = [&](std::vector<SkeletonReward> rewards) { return problem.with_rewards(std::move(rewards)); };
   const auto count = static_cast<std::size_t>(problem.skeleton_count());
   std::vector<SkeletonReward> rewards(count);
   rewards[1].value = std::numeric_limits<double>::quiet_NaN();

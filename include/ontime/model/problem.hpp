@@ -176,6 +176,11 @@ class Problem {
   Problem with_actions(std::vector<Action> actions) const {
     return {name_, deadline_, step_seconds_, std::move(actions), skeletons_, description_, rewards_};
   }
+  // This problem with other rewards (SPEC §8; none: 1 for every skeleton). Throws RewardError or
+  // UsageError as the constructor does.
+  Problem with_rewards(std::vector<SkeletonReward> rewards) const {
+    return {name_, deadline_, step_seconds_, actions_, skeletons_, description_, std::move(rewards)};
+  }
 
  private:
   std::string name_;

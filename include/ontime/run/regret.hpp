@@ -36,9 +36,9 @@ inline constexpr const char* kRegretSum = "regret_units";
 inline constexpr const char* kRegretSquares = "regret_square_units";
 inline constexpr const char* kRegretEpisodes = "regret_episodes";
 inline constexpr const char* kRegretOptimum = "regret_optimum";
-// The fixed point's unit, 2^-32 (2.3e-10): an episode's sum is rounded to it. Totals stay exact
-// up to 2^53 units (2^21 in all).
-inline constexpr double kRegretUnit = 0x1p-32;
+// The fixed point's unit (statistics.hpp's, 2^-32): an episode's sum is rounded to it. Totals
+// stay exact up to 2^53 units (2^21 in all).
+inline constexpr double kRegretUnit = kSumUnit;
 
 // Allocators of `allocators`, each measuring its losses against `mdp`'s optimum (see above). Each
 // solves V*(s0) when made: ResourceLimitError when that needs more than `max_states` states.

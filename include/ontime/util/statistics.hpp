@@ -7,12 +7,35 @@
 // the larger kept (peaks). Counters keep the order in which they were first added, so a
 // report lists them the same way every time.
 
+#include <algorithm>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace ontime {
+
+// Sums that do not depend on the order they are added in (threads, ranks): each value is rounded
+// to a whole number of units of 2^-32 (2.3e-10) and the whole numbers are added, exactly. Used
+// for per-episode figures (regret, rewards) summed over episodes.
+inline constexpr double kSumUnit = 0x1p-32;
+inline double sum_units(double value) { return std::round(value / kSumUnit); }
+
+// The mean of `count` values from the sums of their units and of their squares' units, and the
+// 95% half-width of the mean (1.96 standard errors, normal approximation).
+struct MeanInterval {
+  double mean = 0;
+  double ci95 = 0;
+};
+inline MeanInterval mean_interval_of_units(double units, double square_units, double count) {
+  MeanInterval out;
+  if (!(count >= 1)) return out;
+  out.mean = units * kSumUnit / count;
+  const double variance = std::max(0.0, square_units * kSumUnit / count - out.mean * out.mean);
+  out.ci95 = 1.96 * std::sqrt(variance / count);
+  return out;
+}
 
 class Statistics {
  public:
