@@ -20,6 +20,13 @@ std::int64_t least_steps(Steps steps) { return steps == kNever ? kUnreachable : 
 
 Mdp::Mdp(const Problem& problem)
     : problem_(&problem), skeleton_count_(problem.skeleton_count()), deadline_(problem.deadline()) {
+  bool timed = problem.has_chains();
+  for (const Action& action : problem.actions()) timed = timed || action.is_timed();
+  if (timed) {
+    throw UsageError(problem.name() +
+                     ": exogenous chains and actions that expire (SPEC §9) are read and checked, but no solver or "
+                     "allocator takes them yet");
+  }
   const auto deadline = static_cast<std::size_t>(deadline_);
   const auto action_count = static_cast<std::size_t>(problem.action_count());
 

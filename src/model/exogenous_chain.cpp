@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <unordered_set>
 
+#include "model/chain_fields.hpp"
 #include "ontime/util/atomic_file.hpp"
 #include "ontime/util/error.hpp"
 #include "ontime/util/input_file.hpp"
@@ -76,6 +77,55 @@ std::optional<ChainFault> find_chain_fault(const ExogenousChain& chain) {
   return std::nullopt;
 }
 
+namespace detail {
+
+ExogenousChain read_chain_fields(const nlohmann::ordered_json& object, const std::string& path, std::string name,
+                                 const std::string& source) {
+  const auto fail = [&source](const std::string& place, const std::string& rule) {
+    throw InputError(source, place, rule);
+  };
+  const auto at = [&path](std::string_view key) { return json_member(path, key); };
+  for (const char* key : {"states", "start", "transitions"}) {
+    if (!object.contains(key))
+      fail(path.empty() ? "top level" : path, std::string("missing required key '") + key + "'");
+  }
+  ExogenousChain chain;
+  chain.name = std::move(name);
+  const ChainJson& states = object["states"];
+  if (!states.is_array())
+    fail(at("states"), "must be an array of state names (got " + describe_json_type(states) + ")");
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    if (!states[i].is_string()) {
+      fail(json_index(at("states"), i), "a state's name is a string (got " + states[i].dump() + ")");
+    }
+    chain.states.push_back(states[i].get<std::string>());
+  }
+  const ChainJson& start = object["start"];
+  if (!start.is_string()) fail(at("start"), "must be a state's name (got " + start.dump() + ")");
+  chain.start = chain.state_index(start.get<std::string>());
+  if (chain.start < 0) fail(at("start"), "'" + start.get<std::string>() + "' is not one of the chain's states");
+  const ChainJson& rows = object["transitions"];
+  if (!rows.is_array()) fail(at("transitions"), "must be an array of rows (got " + describe_json_type(rows) + ")");
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const std::string place = json_index(at("transitions"), i);
+    if (!rows[i].is_array()) fail(place, "a row is an array of numbers (got " + describe_json_type(rows[i]) + ")");
+    std::vector<double> row;
+    for (std::size_t j = 0; j < rows[i].size(); ++j) {
+      if (!rows[i][j].is_number()) {
+        fail(json_index(place, j), "a transition probability is a number (got " + rows[i][j].dump() + ")");
+      }
+      row.push_back(rows[i][j].get<double>());
+    }
+    chain.transitions.push_back(std::move(row));
+  }
+  if (const std::optional<ChainFault> fault = find_chain_fault(chain)) {
+    fail(path.empty() ? fault->place : path + "." + fault->place, fault->rule);
+  }
+  return chain;
+}
+
+}  // namespace detail
+
 ExogenousChain parse_chain(std::string_view text, std::string_view source) {
   const std::string name(source);
   const auto root = detail::parse_json_strict<ChainJson>(text, name);
@@ -93,41 +143,10 @@ ExogenousChain parse_chain(std::string_view text, std::string_view source) {
   for (const char* key : {"name", "states", "start", "transitions"}) {
     if (!root.contains(key)) fail("top level", std::string("missing required key '") + key + "'");
   }
-  ExogenousChain chain;
   if (!root["name"].is_string() || root["name"].get<std::string>().empty()) {
     fail("name", "must be a non-empty string (got " + root["name"].dump() + ")");
   }
-  chain.name = root["name"].get<std::string>();
-  const ChainJson& states = root["states"];
-  if (!states.is_array())
-    fail("states", "must be an array of state names (got " + detail::describe_json_type(states) + ")");
-  for (std::size_t i = 0; i < states.size(); ++i) {
-    if (!states[i].is_string()) {
-      fail(detail::json_index("states", i), "a state's name is a string (got " + states[i].dump() + ")");
-    }
-    chain.states.push_back(states[i].get<std::string>());
-  }
-  const ChainJson& start = root["start"];
-  if (!start.is_string()) fail("start", "must be a state's name (got " + start.dump() + ")");
-  chain.start = chain.state_index(start.get<std::string>());
-  if (chain.start < 0) fail("start", "'" + start.get<std::string>() + "' is not one of the chain's states");
-  const ChainJson& rows = root["transitions"];
-  if (!rows.is_array()) fail("transitions", "must be an array of rows (got " + detail::describe_json_type(rows) + ")");
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    const std::string place = detail::json_index("transitions", i);
-    if (!rows[i].is_array())
-      fail(place, "a row is an array of numbers (got " + detail::describe_json_type(rows[i]) + ")");
-    std::vector<double> row;
-    for (std::size_t j = 0; j < rows[i].size(); ++j) {
-      if (!rows[i][j].is_number()) {
-        fail(detail::json_index(place, j), "a transition probability is a number (got " + rows[i][j].dump() + ")");
-      }
-      row.push_back(rows[i][j].get<double>());
-    }
-    chain.transitions.push_back(std::move(row));
-  }
-  if (const std::optional<ChainFault> fault = find_chain_fault(chain)) fail(fault->place, fault->rule);
-  return chain;
+  return detail::read_chain_fields(root, "", root["name"].get<std::string>(), name);
 }
 
 ExogenousChain load_chain(const std::filesystem::path& path) {

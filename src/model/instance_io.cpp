@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "model/chain_fields.hpp"
 #include "model/skeleton_list.hpp"
 #include "ontime/util/atomic_file.hpp"
 #include "ontime/util/error.hpp"
@@ -41,7 +42,8 @@ class InstanceReader {
     const Json root = detail::parse_json_strict<Json>(text, source_);
     if (!root.is_object())
       fail("top level", "an instance must be a JSON object (got " + detail::describe_json_type(root) + ")");
-    check_keys(root, "", {"name", "description", "deadline", "step_seconds", "actions", "skeletons", "rewards"});
+    check_keys(root, "",
+               {"name", "description", "deadline", "step_seconds", "chains", "actions", "skeletons", "rewards"});
 
     std::string name = std::filesystem::path(source_).stem().string();
     if (root.contains("name")) name = string_at(root["name"], "name");
@@ -73,13 +75,20 @@ class InstanceReader {
       }
     }
 
-    std::vector<Action> actions = read_actions(root);
+    std::vector<ExogenousChain> chains;
+    if (root.contains("chains")) chains = read_chains(root["chains"]);
+    std::vector<Action> actions = read_actions(root, chains);
     std::vector<std::vector<int>> skeletons = read_skeletons(root, actions);
     std::vector<SkeletonReward> rewards;
     if (root.contains("rewards")) rewards = read_rewards(root["rewards"], skeletons.size());
     try {
       return Problem(std::move(name), static_cast<Steps>(*deadline), step_seconds, std::move(actions),
-                     std::move(skeletons), std::move(description), std::move(rewards));
+                     std::move(skeletons), std::move(description), std::move(rewards), std::move(chains));
+    } catch (const ChainRuleError& error) {
+      // Chains are checked as they are read; what is left are the actions' references to them.
+      fail(error.action().empty() ? detail::json_member("chains", error.chain())
+                                  : detail::json_member(detail::json_member("actions", error.action()), error.field()),
+           error.rule());
     } catch (const RewardError& error) {
       fail(detail::json_index("rewards", static_cast<std::size_t>(error.skeleton())), error.rule());
     } catch (const BacktrackingError& error) {
@@ -108,7 +117,7 @@ class InstanceReader {
     return value.get<std::string>();
   }
 
-  std::vector<Action> read_actions(const Json& root) const {
+  std::vector<Action> read_actions(const Json& root, const std::vector<ExogenousChain>& chains) const {
     if (!root.contains("actions")) fail("top level", "missing required key 'actions'");
     const Json& actions_json = root["actions"];
     if (!actions_json.is_object()) {
@@ -123,14 +132,20 @@ class InstanceReader {
       if (!value.is_object())
         fail(path, "an action must be an object with 'planning' and 'execution' (got " +
                        detail::describe_json_type(value) + ")");
-      check_keys(value, path, {"planning", "execution", "backtrack", "culprits"});
+      check_keys(value, path, {"planning", "execution", "backtrack", "culprits", "expires"});
       for (const char* required : {"planning", "execution"}) {
         if (!value.contains(required)) fail(path, std::string("missing required key '") + required + "'");
       }
       Action action;
       action.id = id;
       action.planning = read_distribution(value["planning"], detail::json_member(path, "planning"), 1, "planning");
-      action.execution = read_distribution(value["execution"], detail::json_member(path, "execution"), 0, "execution");
+      const std::string execution_path = detail::json_member(path, "execution");
+      if (value["execution"].is_object() && value["execution"].contains("chain")) {
+        read_execution_by_state(value["execution"], execution_path, chains, action);
+      } else {
+        action.execution = read_distribution(value["execution"], execution_path, 0, "execution");
+      }
+      if (value.contains("expires")) read_expiry(value["expires"], detail::json_member(path, "expires"), action);
       if (value.contains("backtrack")) {
         action.backtrack =
             read_distribution(value["backtrack"], detail::json_member(path, "backtrack"), 1, "backtrack");
@@ -140,6 +155,101 @@ class InstanceReader {
       actions.push_back(std::move(action));
     }
     return actions;
+  }
+
+  // {"NAME": {"states": [...], "start": "...", "transitions": [[...], ...]}, ...} (SPEC §9).
+  std::vector<ExogenousChain> read_chains(const Json& value) const {
+    if (!value.is_object()) {
+      fail("chains", "must be an object mapping chain names to chains (got " + detail::describe_json_type(value) + ")");
+    }
+    std::vector<ExogenousChain> chains;
+    for (const auto& [name, chain] : value.items()) {
+      const std::string path = detail::json_member("chains", name);
+      if (name.empty()) fail(path, "a chain's name is not empty");
+      if (!chain.is_object()) {
+        fail(path, "a chain is an object with 'states', 'start' and 'transitions' (got " +
+                       detail::describe_json_type(chain) + ")");
+      }
+      check_keys(chain, path, {"states", "start", "transitions"});
+      chains.push_back(detail::read_chain_fields(chain, path, name, source_));
+    }
+    return chains;
+  }
+
+  // {"chain": "NAME", "by_state": {"STATE": DIST, ...}}: the execution time by the chain's state
+  // when the execution starts (SPEC §9). Which states the chain has is the Problem's to check.
+  void read_execution_by_state(const Json& value, const std::string& path, const std::vector<ExogenousChain>& chains,
+                               Action& action) const {
+    check_keys(value, path, {"chain", "by_state"});
+    if (!value["chain"].is_string()) {
+      fail(detail::json_member(path, "chain"), "must be a chain's name (got " + value["chain"].dump() + ")");
+    }
+    action.execution_chain = value["chain"].get<std::string>();
+    if (!value.contains("by_state")) fail(path, "missing required key 'by_state'");
+    const Json& states = value["by_state"];
+    const std::string states_path = detail::json_member(path, "by_state");
+    if (!states.is_object()) {
+      fail(states_path, "must be an object mapping the chain's states to distributions (got " +
+                            detail::describe_json_type(states) + ")");
+    }
+    const ExogenousChain* chain = nullptr;
+    for (const ExogenousChain& declared : chains) {
+      if (declared.name == action.execution_chain) chain = &declared;
+    }
+    if (chain == nullptr) {
+      fail(detail::json_member(path, "chain"), "no chain named '" + action.execution_chain + "' is declared");
+    }
+    for (const auto& [state, distribution] : states.items()) {
+      if (chain->state_index(state) < 0) {
+        fail(detail::json_member(states_path, state), "the chain '" + chain->name + "' has no such state");
+      }
+    }
+    // In the chain's order of states.
+    for (const std::string& state : chain->states) {
+      if (!states.contains(state)) fail(states_path, "missing the chain's state '" + state + "'");
+      action.execution_by_state.push_back(
+          read_distribution(states[state], detail::json_member(states_path, state), 0, "execution"));
+    }
+  }
+
+  // {"after": STEP, "chain": "NAME", "states": ["STATE", ...]}, each part optional but not all.
+  void read_expiry(const Json& value, const std::string& path, Action& action) const {
+    if (!value.is_object()) {
+      fail(path, "must be an object with 'after' and/or 'chain' and 'states' (got " +
+                     detail::describe_json_type(value) + ")");
+    }
+    check_keys(value, path, {"after", "chain", "states"});
+    if (value.empty()) fail(path, "needs 'after', or 'chain' and 'states'");
+    if (value.contains("after")) {
+      const std::optional<std::int64_t> after = detail::json_whole_number(value["after"], 0, Problem::kMaxDeadline);
+      if (!after) {
+        fail(detail::json_member(path, "after"), "must be a whole number of steps between 0 and " +
+                                                     std::to_string(Problem::kMaxDeadline) + " (got " +
+                                                     value["after"].dump() + ")");
+      }
+      action.start_by = static_cast<Steps>(*after);
+    }
+    if (value.contains("chain") != value.contains("states")) {
+      fail(path, "'chain' and 'states' come together");
+    }
+    if (value.contains("chain")) {
+      if (!value["chain"].is_string()) {
+        fail(detail::json_member(path, "chain"), "must be a chain's name (got " + value["chain"].dump() + ")");
+      }
+      action.blocking_chain = value["chain"].get<std::string>();
+      const Json& states = value["states"];
+      if (!states.is_array()) {
+        fail(detail::json_member(path, "states"),
+             "must be an array of the chain's state names (got " + detail::describe_json_type(states) + ")");
+      }
+      for (std::size_t i = 0; i < states.size(); ++i) {
+        if (!states[i].is_string()) {
+          fail(detail::json_index(detail::json_member(path, "states"), i),
+               "a state's name is a string (got " + states[i].dump() + ")");
+        }
+        action.blocking_states.push_back(states[i].get<std::string>());
+      }
+    }
   }
 
   // [reward, ...], one per skeleton in the order of "skeletons" (SPEC §8): a number (the value at
@@ -314,10 +424,37 @@ std::string problem_to_json(const Problem& problem) {
   if (!problem.description().empty()) root["description"] = problem.description();
   root["deadline"] = problem.deadline();
   root["step_seconds"] = problem.step_seconds();
+  if (problem.has_chains()) {
+    Json chains = Json::object();
+    for (const ExogenousChain& chain : problem.chains()) {
+      chains[chain.name] = Json{{"states", chain.states},
+                                {"start", chain.states[static_cast<std::size_t>(chain.start)]},
+                                {"transitions", chain.transitions}};
+    }
+    root["chains"] = chains;
+  }
   Json actions = Json::object();
   for (const Action& action : problem.actions()) {
     Json entry{{"planning", distribution_to_json(action.planning)},
                {"execution", distribution_to_json(action.execution)}};
+    if (!action.execution_chain.empty()) {
+      const int chain = problem.execution_chain(problem.find_action(action.id));
+      Json by_state = Json::object();
+      const std::vector<std::string>& states = problem.chains()[static_cast<std::size_t>(chain)].states;
+      for (std::size_t s = 0; s < states.size(); ++s) {
+        by_state[states[s]] = distribution_to_json(action.execution_by_state[s]);
+      }
+      entry["execution"] = Json{{"chain", action.execution_chain}, {"by_state", by_state}};
+    }
+    if (action.start_by != kNever || !action.blocking_chain.empty()) {
+      Json expires = Json::object();
+      if (action.start_by != kNever) expires["after"] = action.start_by;
+      if (!action.blocking_chain.empty()) {
+        expires["chain"] = action.blocking_chain;
+        expires["states"] = action.blocking_states;
+      }
+      entry["expires"] = expires;
+    }
     if (action.backtrack.never() < 1.0) {
       entry["backtrack"] = distribution_to_json(action.backtrack);
       Json culprits = Json::object();

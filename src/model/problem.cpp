@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <set>
 #include <string>
 #include <utility>
@@ -16,14 +17,16 @@ namespace {
 }  // namespace
 
 Problem::Problem(std::string name, Steps deadline, double step_seconds, std::vector<Action> actions,
-                 std::vector<std::vector<int>> skeletons, std::string description, std::vector<SkeletonReward> rewards)
+                 std::vector<std::vector<int>> skeletons, std::string description, std::vector<SkeletonReward> rewards,
+                 std::vector<ExogenousChain> chains)
     : name_(std::move(name)),
       description_(std::move(description)),
       deadline_(deadline),
       step_seconds_(step_seconds),
       actions_(std::move(actions)),
       skeletons_(std::move(skeletons)),
-      rewards_(std::move(rewards)) {
+      rewards_(std::move(rewards)),
+      chains_(std::move(chains)) {
   if (deadline_ < 1 || deadline_ > kMaxDeadline) {
     reject("deadline must be between 1 and " + std::to_string(kMaxDeadline) + " steps");
   }
@@ -77,6 +80,77 @@ Problem::Problem(std::string name, Steps deadline, double step_seconds, std::vec
   }
   check_rewards();
   index_culprits();
+  index_chains();
+}
+
+void Problem::index_chains() {
+  std::set<std::string> names;
+  std::int64_t joint = 1;
+  for (const ExogenousChain& chain : chains_) {
+    if (chain.name.empty()) throw ChainRuleError(chain.name, "", "", "a chain's name is not empty");
+    if (!names.insert(chain.name).second) throw ChainRuleError(chain.name, "", "", "the chain is declared twice");
+    if (const std::optional<ChainFault> fault = find_chain_fault(chain)) {
+      throw ChainRuleError(chain.name, "", "", fault->place + ": " + fault->rule);
+    }
+    joint *= chain.state_count();
+    if (joint > kMaxChainStates) {
+      throw ChainRuleError(chain.name, "", "",
+                           "the chains' states together (their product) exceed " + std::to_string(kMaxChainStates));
+    }
+  }
+  const auto find_chain = [&](const std::string& name) {
+    for (std::size_t c = 0; c < chains_.size(); ++c) {
+      if (chains_[c].name == name) return static_cast<int>(c);
+    }
+    return -1;
+  };
+  const std::size_t count = actions_.size();
+  execution_chain_.assign(count, -1);
+  blocking_chain_.assign(count, -1);
+  blocking_.assign(count, {});
+  for (std::size_t a = 0; a < count; ++a) {
+    const Action& action = actions_[a];
+    if (!action.execution_chain.empty()) {
+      const int chain = find_chain(action.execution_chain);
+      if (chain < 0) throw ChainRuleError(action.execution_chain, action.id, "execution", "no such chain");
+      const ExogenousChain& declared = chains_[static_cast<std::size_t>(chain)];
+      if (action.execution_by_state.size() != declared.states.size()) {
+        throw ChainRuleError(declared.name, action.id, "execution",
+                             "one execution distribution per state of the chain is needed (" +
+                                 std::to_string(declared.states.size()) + ", got " +
+                                 std::to_string(action.execution_by_state.size()) + ")");
+      }
+      execution_chain_[a] = chain;
+    } else if (!action.execution_by_state.empty()) {
+      throw ChainRuleError("", action.id, "execution", "execution distributions by state need a chain");
+    }
+    if (action.start_by != kNever && (action.start_by < 0 || action.start_by > deadline_)) {
+      throw ChainRuleError(
+          "", action.id, "expires",
+          "the last step to start must lie between 0 and the deadline (got " + std::to_string(action.start_by) + ")");
+    }
+    if (!action.blocking_chain.empty()) {
+      const int chain = find_chain(action.blocking_chain);
+      if (chain < 0) throw ChainRuleError(action.blocking_chain, action.id, "expires", "no such chain");
+      const ExogenousChain& declared = chains_[static_cast<std::size_t>(chain)];
+      if (action.blocking_states.empty()) {
+        throw ChainRuleError(declared.name, action.id, "expires", "the states that block the action are missing");
+      }
+      std::vector<char> blocked(declared.states.size(), 0);
+      for (const std::string& state : action.blocking_states) {
+        const int index = declared.state_index(state);
+        if (index < 0) throw ChainRuleError(declared.name, action.id, "expires", "no state '" + state + "'");
+        if (blocked[static_cast<std::size_t>(index)] != 0) {
+          throw ChainRuleError(declared.name, action.id, "expires", "the state '" + state + "' is listed twice");
+        }
+        blocked[static_cast<std::size_t>(index)] = 1;
+      }
+      blocking_chain_[a] = chain;
+      blocking_[a] = std::move(blocked);
+    } else if (!action.blocking_states.empty()) {
+      throw ChainRuleError("", action.id, "expires", "blocking states need a chain");
+    }
+  }
 }
 
 void Problem::check_rewards() {

@@ -253,7 +253,8 @@ void Session::change_skeletons(std::vector<Action> actions, std::vector<std::vec
   // Everything that can fail comes first, so that a failure leaves the session as it was.
   auto problem =
       std::make_unique<Problem>(current.name(), current.deadline(), current.step_seconds(), std::move(actions),
-                                std::move(skeletons), current.description(), std::move(rewards));
+                                std::move(skeletons), current.description(), std::move(rewards),
+                                std::vector<ExogenousChain>(current.chains().begin(), current.chains().end()));
   auto mdp = std::make_unique<Mdp>(*problem);
   std::unique_ptr<Allocator> allocator;
   if (make_allocator_) {

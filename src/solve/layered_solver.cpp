@@ -51,7 +51,8 @@ Problem subproblem(const Problem& problem, const std::vector<int>& skeletons, co
     rewards.push_back(problem.reward(k));
   }
   return Problem(problem.name() + " (" + part + ")", problem.deadline(), problem.step_seconds(), std::move(actions),
-                 std::move(paths), problem.description(), std::move(rewards));
+                 std::move(paths), problem.description(), std::move(rewards),
+                 std::vector<ExogenousChain>(problem.chains().begin(), problem.chains().end()));
 }
 
 }  // namespace

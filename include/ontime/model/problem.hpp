@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "ontime/model/distribution.hpp"
+#include "ontime/model/exogenous_chain.hpp"
 #include "ontime/util/error.hpp"
 #include "ontime/util/random.hpp"
 
@@ -49,6 +50,40 @@ struct Action {
   // never backtracks, as in SPEC §2.
   Distribution backtrack;
   std::vector<Culprit> culprits;
+  // Exogenous chains (SPEC §9), optional. The execution time drawn when the action's execution
+  // starts, from `execution_by_state[s]` with s the state of the chain named `execution_chain` at
+  // that moment (empty name: `execution`, drawn when the motion is found, as in SPEC §2).
+  std::string execution_chain;
+  std::vector<Distribution> execution_by_state;
+  // Expiry: the execution cannot start after step `start_by` (kNever: no such limit), nor while
+  // the chain named `blocking_chain` is in one of `blocking_states` (names); a plan that reaches
+  // an action it cannot start fails.
+  Steps start_by = kNever;
+  std::string blocking_chain;
+  std::vector<std::string> blocking_states;
+
+  // Whether the action's execution depends on when it starts (a chain or an expiry).
+  bool is_timed() const noexcept { return !execution_chain.empty() || start_by != kNever || !blocking_chain.empty(); }
+};
+
+// A broken chain rule of SPEC §9 in a Problem being built: the chain named, or the action and
+// which of its fields ("execution", "expires"), and the rule. A UsageError like the other rules;
+// instance files map it to its JSON place.
+class ChainRuleError : public UsageError {
+ public:
+  ChainRuleError(std::string chain, std::string action, std::string field, const std::string& rule)
+      : UsageError((action.empty() ? "chain '" + chain + "'" : "action '" + action + "', " + field) + ": " + rule),
+        chain_(std::move(chain)),
+        action_(std::move(action)),
+        field_(std::move(field)),
+        rule_(rule) {}
+  const std::string& chain() const noexcept { return chain_; }
+  const std::string& action() const noexcept { return action_; }  // empty: the rule is the chain's
+  const std::string& field() const noexcept { return field_; }
+  const std::string& rule() const noexcept { return rule_; }
+
+ private:
+  std::string chain_, action_, field_, rule_;
 };
 
 // What succeeding with a plan skeleton is worth (SPEC §8): `value` if its execution ended at step 0,
@@ -112,11 +147,11 @@ class Problem {
   // BacktrackingError for a broken rule of SPEC §7 (backtrack mass at step 0 or with planning
   // above 1, culprits that are not before the action on its path, probabilities outside [0, 1]
   // or not summing to 1, culprits without backtracking or backtracking without culprits), and
-  // RewardError for a broken rule of SPEC §8. `rewards` has one entry per skeleton, or none: 1
-  // for every skeleton.
+  // RewardError for a broken rule of SPEC §8, ChainRuleError for one of SPEC §9. `rewards` has one entry per skeleton,
+  // or none: 1 for every skeleton.
   Problem(std::string name, Steps deadline, double step_seconds, std::vector<Action> actions,
           std::vector<std::vector<int>> skeletons, std::string description = {},
-          std::vector<SkeletonReward> rewards = {});
+          std::vector<SkeletonReward> rewards = {}, std::vector<ExogenousChain> chains = {});
 
   const std::string& name() const noexcept { return name_; }
   const std::string& description() const noexcept { return description_; }
@@ -144,6 +179,17 @@ class Problem {
   double reward_at(int k, Steps finish) const { return reward(k).at(static_cast<double>(finish)); }
   double max_reward() const noexcept { return max_reward_; }
 
+  // Exogenous chains (SPEC §9): the chains, whether there are any; the index of the chain an
+  // action's execution depends on (-1: none), of the chain that may block it (-1: none) and
+  // whether state s of that chain blocks it.
+  std::span<const ExogenousChain> chains() const noexcept { return chains_; }
+  bool has_chains() const noexcept { return !chains_.empty(); }
+  int execution_chain(int action) const { return execution_chain_.at(static_cast<std::size_t>(action)); }
+  int blocking_chain(int action) const { return blocking_chain_.at(static_cast<std::size_t>(action)); }
+  bool blocks(int action, int state) const {
+    return blocking_.at(static_cast<std::size_t>(action)).at(static_cast<std::size_t>(state)) != 0;
+  }
+
   // Prefix tree. Every action used by some skeleton is one node.
   // Skeletons whose path passes through the action, ascending (N(k, l) of Eq. (1)).
   std::span<const int> members(int action) const { return members_.at(static_cast<std::size_t>(action)); }
@@ -170,16 +216,16 @@ class Problem {
 
   // The skeletons as lists of action indices (a copy, e.g. to build a changed problem).
   std::vector<std::vector<int>> skeleton_lists() const { return skeletons_; }
-  // This problem (name, deadline, step, skeletons, description, rewards) with other actions, in
+  // This problem (name, deadline, step, skeletons, description, rewards, chains) with other actions, in
   // the same order: e.g. other distributions for the same ids. Throws UsageError as the
   // constructor does.
   Problem with_actions(std::vector<Action> actions) const {
-    return {name_, deadline_, step_seconds_, std::move(actions), skeletons_, description_, rewards_};
+    return {name_, deadline_, step_seconds_, std::move(actions), skeletons_, description_, rewards_, chains_};
   }
-  // This problem with other rewards (SPEC §8; none: 1 for every skeleton). Throws RewardError or
-  // UsageError as the constructor does.
+  // This problem with other rewards (SPEC §8; none: 1 for every skeleton), its chains kept. Throws
+  // RewardError or UsageError as the constructor does.
   Problem with_rewards(std::vector<SkeletonReward> rewards) const {
-    return {name_, deadline_, step_seconds_, actions_, skeletons_, description_, std::move(rewards)};
+    return {name_, deadline_, step_seconds_, actions_, skeletons_, description_, std::move(rewards), chains_};
   }
 
  private:
@@ -190,6 +236,10 @@ class Problem {
   std::vector<Action> actions_;
   std::vector<std::vector<int>> skeletons_;
   std::vector<SkeletonReward> rewards_;
+  std::vector<ExogenousChain> chains_;
+  std::vector<int> execution_chain_;
+  std::vector<int> blocking_chain_;
+  std::vector<std::vector<char>> blocking_;
   bool has_rewards_ = false;
   double max_reward_ = 1.0;
   std::vector<std::vector<int>> members_;
@@ -202,6 +252,7 @@ class Problem {
 
   void index_culprits();
   void check_rewards();
+  void index_chains();
 };
 
 // How one attempt to refine `action` ends (SPEC §7: a motion and a backtrack as competing risks),
