@@ -6,6 +6,7 @@
 
 #include "ontime/model/instance_io.hpp"
 #include "ontime/util/error.hpp"
+#include "support/chain_reference.hpp"
 
 namespace ontime {
 namespace {
@@ -78,6 +79,37 @@ TEST(ChainInstance, BrokenChainsAndReferencesAreRefusedWithTheirPlace) {
             "actions.enter.expires: 'chain' and 'states' come together");
   EXPECT_EQ(place_of(changed(R"("start": "open")", R"("start": "ajar")")),
             "chains.door.start: 'ajar' is not one of the chain's states");
+}
+
+// The reference recursion of SPEC §9 (the yardstick of the solvers to come) on cases valued by hand.
+TEST(ChainInstance, TheReferenceValuesHandMadeCases) {
+  const auto instance = [](const std::string& expires) {
+    return parse_problem(R"({"deadline": 4,
+      "chains": {"queue": {"states": ["short", "long"], "start": "short", "transitions": [[0.7, 0.3], [0.4, 0.6]]}},
+      "actions": {"wait": {"planning": {"pmf": {"1": 1.0}},
+          "execution": {"chain": "queue", "by_state": {"short": {"pmf": {"1": 1.0}}, "long": {"pmf": {"5": 1.0}}}})" +
+                             expires + R"(}}, "skeletons": [["wait"]]})",
+                         "wait.json");
+  };
+  // Refined in step 1; the queue at step 1 is short w.p. 0.7 (done at 2 <= 4), long w.p. 0.3 (6 > 4).
+  EXPECT_DOUBLE_EQ(testing::ChainReferenceSolver(instance("")).optimum(), 0.7);
+  // It cannot start after step 0: it never starts.
+  EXPECT_DOUBLE_EQ(testing::ChainReferenceSolver(instance(R"(, "expires": {"after": 0})")).optimum(), 0.0);
+  // It cannot start while the queue is long: the same 0.7 (long ones missed the deadline anyway).
+  EXPECT_DOUBLE_EQ(
+      testing::ChainReferenceSolver(instance(R"(, "expires": {"chain": "queue", "states": ["long"]})")).optimum(), 0.7);
+  // Behind a move: both refined by step 2, the move runs from 2 to 3 and the wait starts at 3,
+  // done at once when the queue is short there, else at 8 > 4.
+  const Problem behind = parse_problem(R"({"deadline": 4,
+      "chains": {"queue": {"states": ["short", "long"], "start": "short", "transitions": [[0.7, 0.3], [0.4, 0.6]]}},
+      "actions": {"move": {"planning": {"pmf": {"1": 1.0}}, "execution": {"pmf": {"1": 1.0}}},
+        "wait": {"planning": {"pmf": {"1": 1.0}},
+          "execution": {"chain": "queue", "by_state": {"short": {"pmf": {"0": 1.0}}, "long": {"pmf": {"5": 1.0}}}}}},
+      "skeletons": [["move", "wait"]]})",
+                                       "behind.json");
+  const double p2 = 0.7 * 0.7 + 0.3 * 0.4;        // short at 2
+  const double p3 = p2 * 0.7 + (1.0 - p2) * 0.4;  // short at 3
+  EXPECT_NEAR(testing::ChainReferenceSolver(behind).optimum(), p3, 1e-15);
 }
 
 }  // namespace
