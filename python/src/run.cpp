@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <stdexcept>
 
@@ -36,6 +37,33 @@ struct SessionHandle {
 };
 
 // A World implemented in Python (a subclass of ontime.World), called with the GIL held.
+// The observation with the chains' states a caller reported after the step ({chain: state}, by
+// name; SPEC §9), which an instance with chains needs and one without refuses.
+using ChainStates = std::optional<std::map<std::string, std::string>>;
+Observation with_reported_chains(const Mdp& mdp, Observation observation, const ChainStates& reported) {
+  const auto chains = mdp.problem().chains();
+  if (!reported) {
+    if (mdp.has_chains()) {
+      throw UsageError("this instance has exogenous chains: report their states after the step (chains={name: state})");
+    }
+    return observation;
+  }
+  std::vector<int> states;
+  for (const ExogenousChain& chain : chains) {
+    const auto found = reported->find(chain.name);
+    if (found == reported->end()) throw UsageError("chains: the state of chain '" + chain.name + "' is missing");
+    const int state = chain.state_index(found->second);
+    if (state < 0) throw UsageError("chains: chain '" + chain.name + "' has no state '" + found->second + "'");
+    states.push_back(state);
+  }
+  for (const auto& [name, state] : *reported) {
+    bool known = false;
+    for (const ExogenousChain& chain : chains) known = known || chain.name == name;
+    if (!known) throw UsageError("chains: no chain named '" + name + "' is declared");
+  }
+  return observation.with_chains(mdp.joint_chain_state(states));
+}
+
 class PythonWorld final : public World {
  public:
   explicit PythonWorld(py::object world) : world_(std::move(world)) {}
@@ -203,18 +231,40 @@ void bind_run(py::module_& m) {
           py::kw_only(), py::arg("iterations") = py::none(), py::arg("seconds") = py::none(),
           "The same within this budget (iterations and/or seconds of search) for this decision only.")
       .def(
-          "report_not_yet", [](SessionHandle& h) { return session_call([&] { return h.session.report_not_yet(); }); },
-          "The step just decided found no motion. Returns the status.")
+          "report_not_yet",
+          [](SessionHandle& h, const ChainStates& chains) {
+            const Observation observation = with_reported_chains(h.session.mdp(), Observation::not_yet(), chains);
+            return session_call([&] { return h.session.report(observation); });
+          },
+          py::kw_only(), py::arg("chains") = py::none(),
+          "The step just decided found no motion. With exogenous chains (SPEC §9), `chains` gives their states "
+          "after the step ({chain: state}). Returns the status.")
       .def(
           "report_refined",
-          [](SessionHandle& h, long long execution_steps) {
+          [](SessionHandle& h, long long execution_steps, const ChainStates& chains) {
             if (execution_steps < 0) throw UsageError("execution time must be >= 0 steps");
             const Steps steps = execution_steps >= kNever ? kNever : static_cast<Steps>(execution_steps);
-            return session_call([&] { return h.session.report_refined(steps); });
+            const Observation observation = with_reported_chains(h.session.mdp(), Observation::found(steps), chains);
+            return session_call([&] { return h.session.report(observation); });
           },
-          py::arg("execution_steps"),
+          py::arg("execution_steps"), py::kw_only(), py::arg("chains") = py::none(),
           "The step just decided found a motion that takes `execution_steps` to execute (ontime.NEVER: it "
-          "cannot be executed). Returns the status.")
+          "cannot be executed; ignored for an action whose execution depends on a chain, drawn when it starts). "
+          "With exogenous chains, `chains` as for report_not_yet. Returns the status.")
+      .def_property_readonly(
+          "chains",
+          [](const SessionHandle& h) {
+            std::map<std::string, std::string> out;
+            const Mdp& mdp = h.session.mdp();
+            const auto chains = mdp.problem().chains();
+            for (std::size_t c = 0; c < chains.size(); ++c) {
+              out[chains[c].name] =
+                  chains[c]
+                      .states[static_cast<std::size_t>(mdp.chain_state(h.session.state().chains, static_cast<int>(c)))];
+            }
+            return out;
+          },
+          "The exogenous chains' states (SPEC §9), {chain: state}; empty without chains.")
       .def(
           "report_backtrack",
           [](SessionHandle& h, const std::string& culprit) {

@@ -72,3 +72,42 @@ def test_bad_input_is_refused(tmp_path):
     chain = ontime.fit_chain([["a", "b", "a"]]).chain
     with pytest.raises(ontime.UsageError, match="no state 'c'"):
         chain.distribution(1, from_state="c")
+
+
+QUEUE = {"deadline": 4,
+         "chains": {"queue": {"states": ["short", "long"], "start": "short", "transitions": [[0.7, 0.3], [0.4, 0.6]]}},
+         "actions": {"wait": {"planning": {"pmf": {"1": 1.0}},
+                              "execution": {"chain": "queue", "by_state": {"short": {"pmf": {"1": 1.0}},
+                                                                           "long": {"pmf": {"5": 1.0}}}}}},
+         "skeletons": [["wait"]]}
+
+
+def test_a_session_takes_the_chains_states_with_each_report(tmp_path):
+    path = tmp_path / "queue.json"
+    path.write_text(json.dumps(QUEUE))
+    problem = ontime.load_problem(path)
+    # The wait is refined in step 1 and starts at once: done at 2 if the queue is short then (0.7).
+    assert ontime.solve(problem)["optimal_success_probability"] == pytest.approx(0.7, abs=1e-15)
+    for state, reward in (("short", 1.0), ("long", 0.0)):
+        session = ontime.Session(ontime.make_allocator(problem, "optimal"))
+        assert session.chains == {"queue": "short"}
+        assert session.choose().action_id == "wait"
+        with pytest.raises(ontime.UsageError, match="report their states"):
+            session.report_refined(0)
+        with pytest.raises(ontime.UsageError, match="no state 'empty'"):
+            session.report_refined(0, chains={"queue": "empty"})
+        assert session.report_refined(0, chains={"queue": state}) == ontime.Status.success
+        assert session.chains == {"queue": state}
+        # The plan's expected reward from the reported state: certain either way here.
+        assert session.reward == reward
+
+
+def test_allocators_that_do_not_model_chains_refuse_them(tmp_path):
+    path = tmp_path / "queue.json"
+    path.write_text(json.dumps(QUEUE))
+    problem = ontime.load_problem(path)
+    with pytest.raises(ontime.UsageError, match="does not take instances with exogenous chains"):
+        ontime.make_allocator(problem, "dp-rerun")
+    evaluated = ontime.evaluate(problem, "round-robin", episodes=4000, exact=True, seed=3)
+    assert evaluated["exact_success_probability"] == pytest.approx(0.7, abs=1e-15)
+    assert abs(evaluated["success_rate"] - 0.7) <= 4 * evaluated["ci95"]

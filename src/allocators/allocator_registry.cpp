@@ -14,7 +14,8 @@ namespace ontime {
 namespace {
 
 constexpr Capability kAllCapabilities[] = {Capability::stationary,   Capability::randomised, Capability::anytime,
-                                           Capability::needs_policy, Capability::optimal,    Capability::certified};
+                                           Capability::needs_policy, Capability::optimal,    Capability::certified,
+                                           Capability::chains};
 
 // The whole text as a number of the parameter's type, or nothing.
 std::optional<double> parse_number(const Parameter& parameter, std::string_view text) {
@@ -56,6 +57,8 @@ std::string_view to_string(Capability capability) noexcept {
       return "optimal";
     case Capability::certified:
       return "certified";
+    case Capability::chains:
+      return "chains";
   }
   return "?";
 }
@@ -254,6 +257,11 @@ AllocatorFactory AllocatorRegistry::make_factory(std::string_view name, const Md
       throw unknown_name_error("allocator parameter", given, known);
     }
     parameter->check(value);
+  }
+  if (mdp.is_timed() && !kind.capabilities.has(Capability::chains)) {
+    throw UsageError(
+        fmt::format("allocator '{}' does not take instances with exogenous chains or expiry (SPEC §9) yet; {} do",
+                    kind.name, fmt::join(names({Capability::chains}, {}), ", ")));
   }
   return kind.make(mdp, ParameterReader(kind, values));
 }

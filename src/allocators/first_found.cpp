@@ -30,7 +30,7 @@ AllocatorKind first_found_kind() {
   return {
       .name = "first-found",
       .summary = "baseline: skeletons in found order, each until its action uses up a budget that doubles per round",
-      .capabilities = {Capability::stationary},
+      .capabilities = {Capability::stationary, Capability::chains},
       .parameters = {Parameter::integer(
           "budget", 4, 1, 65535, "steps on a skeleton's action before the next one is tried; doubled each round")},
       .make = [](const Mdp& mdp, const ParameterReader& parameters) -> AllocatorFactory {

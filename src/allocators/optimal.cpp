@@ -36,7 +36,7 @@ std::size_t max_states_of(const ParameterValues& values) {
 AllocatorKind optimal_kind() {
   return {.name = "optimal",
           .summary = "exact expectimax over the reachable MDP: the highest success probability any allocator can reach",
-          .capabilities = {Capability::stationary, Capability::optimal},
+          .capabilities = {Capability::stationary, Capability::optimal, Capability::chains},
           .parameters = {Parameter::integer("max-states", OptimalSolver::kDefaultMaxStates, 1, Parameter::kNoLimit,
                                             "cap on the states the exact solver and the exact evaluation may hold")},
           .make = [](const Mdp& mdp, const ParameterReader& parameters) -> AllocatorFactory {

@@ -16,16 +16,24 @@ constexpr std::int64_t kUnreachable = Mdp::kUnreachableNeed;
 
 std::int64_t least_steps(Steps steps) { return steps == kNever ? kUnreachable : steps; }
 
+// The fastest execution of a chain-dependent action in any state of its chain (kNever: none).
+Steps least_chain_execution(const Action& action) {
+  Steps least = kNever;
+  for (const Distribution& execution : action.execution_by_state) {
+    if (execution.min_step() != kNever)
+      least = least == kNever ? execution.min_step() : std::min(least, execution.min_step());
+  }
+  return least;
+}
+
 }  // namespace
 
 Mdp::Mdp(const Problem& problem)
     : problem_(&problem), skeleton_count_(problem.skeleton_count()), deadline_(problem.deadline()) {
-  bool timed = problem.has_chains();
-  for (const Action& action : problem.actions()) timed = timed || action.is_timed();
-  if (timed) {
+  if (problem.is_timed() && problem.has_backtracking()) {
     throw UsageError(problem.name() +
-                     ": exogenous chains and actions that expire (SPEC §9) are read and checked, but no solver or "
-                     "allocator takes them yet");
+                     ": exogenous chains or actions that expire (SPEC §9) together with backtracking (SPEC §7) are not "
+                     "modelled yet");
   }
   const auto deadline = static_cast<std::size_t>(deadline_);
   const auto action_count = static_cast<std::size_t>(problem.action_count());
@@ -52,6 +60,13 @@ Mdp::Mdp(const Problem& problem)
       next_finish_[a * (deadline + 1) + spent] = kNever;
     }
 
+    if (problem.execution_chain(static_cast<int>(a)) >= 0) {
+      // Drawn when the execution starts (SPEC §9): finding the motion adds nothing to ET; the
+      // least time still counts its fastest execution in any state of the chain.
+      execution_outcomes_[a].push_back({0, 1.0});
+      min_execution_[a] = least_chain_execution(action);
+      continue;
+    }
     double too_slow = action.execution.never();
     const auto execution = action.execution.masses();
     for (std::size_t x = 0; x < execution.size(); ++x) {
@@ -82,12 +97,15 @@ Mdp::Mdp(const Problem& problem)
     rest_[base + static_cast<std::size_t>(length)] = 0;
     for (int l = length; l-- > 0;) {
       const Action& action = problem.action(problem.action_at(k, l));
-      const std::int64_t least = least_steps(action.planning.min_step()) + least_steps(action.execution.min_step());
+      const Steps fastest =
+          action.execution_chain.empty() ? action.execution.min_step() : least_chain_execution(action);
+      const std::int64_t least = least_steps(action.planning.min_step()) + least_steps(fastest);
       rest_[base + static_cast<std::size_t>(l)] =
           std::min(kUnreachable, rest_[base + static_cast<std::size_t>(l) + 1] + least);
     }
   }
   if (problem.has_backtracking()) index_backtracking(problem);
+  if (problem.is_timed()) index_chains(problem);
 
   group_rest_.assign(action_count, kUnreachable);
   for (int k = 0; k < skeleton_count_; ++k) {
@@ -176,6 +194,165 @@ void Mdp::reject_idle_refinement(int choice) {
 
 void Mdp::reject_execution(Steps execution) {
   throw UsageError("execution time must be >= 0 steps (got " + std::to_string(execution) + ")");
+}
+
+}  // namespace ontime
+
+namespace ontime {
+
+void Mdp::index_chains(const Problem& problem) {
+  const auto chains = problem.chains();
+  chain_strides_.assign(chains.size(), 1);
+  joint_count_ = 1;
+  for (std::size_t c = 0; c < chains.size(); ++c) {
+    chain_strides_[c] = joint_count_;
+    joint_count_ *= static_cast<int>(chains[c].states.size());  // at most kMaxChainStates (Problem checks)
+    start_chains_ = static_cast<std::uint16_t>(start_chains_ + chains[c].start * chain_strides_[c]);
+  }
+  // Each joint state's steps: the product of its chains' rows, zero entries left out.
+  chain_step_offsets_.assign(1, 0);
+  for (int joint = 0; joint < joint_count_; ++joint) {
+    std::vector<ChainStep> steps{{0, 1.0}};
+    for (std::size_t c = 0; c < chains.size(); ++c) {
+      const auto& row = chains[c].transitions[static_cast<std::size_t>(
+          chain_state(static_cast<std::uint16_t>(joint), static_cast<int>(c)))];
+      std::vector<ChainStep> more;
+      for (const ChainStep& step : steps) {
+        for (std::size_t s = 0; s < row.size(); ++s) {
+          if (row[s] <= 0) continue;
+          more.push_back({static_cast<std::uint16_t>(step.next + static_cast<int>(s) * chain_strides_[c]),
+                          step.probability * row[s]});
+        }
+      }
+      steps = std::move(more);
+    }
+    chain_steps_.insert(chain_steps_.end(), steps.begin(), steps.end());
+    chain_step_offsets_.push_back(static_cast<std::uint32_t>(chain_steps_.size()));
+  }
+  timed_path_.assign(static_cast<std::size_t>(skeleton_count_), {});
+  for (int k = 0; k < skeleton_count_; ++k) {
+    for (const int action : problem.skeleton(k)) {
+      if (problem.timed_slot(action) >= 0) timed_path_[static_cast<std::size_t>(k)].push_back(action);
+    }
+  }
+}
+
+std::uint16_t Mdp::joint_chain_state(std::span<const int> states) const {
+  const auto chains = problem_->chains();
+  if (states.size() != chains.size()) {
+    throw UsageError("one state per chain is needed (" + std::to_string(chains.size()) + ", got " +
+                     std::to_string(states.size()) + ")");
+  }
+  int joint = 0;
+  for (std::size_t c = 0; c < chains.size(); ++c) {
+    if (states[c] < 0 || states[c] >= static_cast<int>(chains[c].states.size())) {
+      throw UsageError("chain '" + chains[c].name + "' has no state " + std::to_string(states[c]));
+    }
+    joint += states[c] * chain_strides_[c];
+  }
+  return static_cast<std::uint16_t>(joint);
+}
+
+double Mdp::execution_value(int k, Steps start, std::uint16_t joint, const std::uint16_t* restore,
+                            std::uint16_t execution) const {
+  const auto deadline = static_cast<std::size_t>(deadline_);
+  const auto joints = static_cast<std::size_t>(joint_count_);
+  if (start > deadline_) return 0.0;
+  // mass[t * joints + j]: P(the plan reaches the next timed action's static part at step t with
+  // the chains in j). Scratch kept per thread so that the solvers' many calls do not allocate.
+  thread_local std::vector<double> mass, moved, pending;
+  mass.assign((deadline + 1) * joints, 0.0);
+  mass[static_cast<std::size_t>(start) * joints + joint] = 1.0;
+  // One step of the chains for the mass at steps first .. deadline - 1, moved one step later.
+  const auto step_chains = [&](std::vector<double>& values, std::size_t rows) {
+    moved.assign(rows * joints, 0.0);
+    for (std::size_t t = 0; t + 1 < rows; ++t) {
+      for (std::size_t j = 0; j < joints; ++j) {
+        const double m = values[t * joints + j];
+        if (m == 0.0) continue;
+        for (const ChainStep& step : chain_steps(static_cast<std::uint16_t>(j))) {
+          moved[(t + 1) * joints + step.next] += m * step.probability;
+        }
+      }
+    }
+    values.swap(moved);
+  };
+  std::uint16_t before = 0;
+  for (const int action : timed_path_[static_cast<std::size_t>(k)]) {
+    const std::uint16_t at = restore[problem_->timed_slot(action)];
+    for (std::uint16_t gap = before; gap < at; ++gap) step_chains(mass, deadline + 1);
+    before = at;
+    const Action& model = problem_->action(action);
+    const int blocking = problem_->blocking_chain(action);
+    for (std::size_t t = 0; t <= deadline; ++t) {
+      const bool late = model.start_by != kNever && static_cast<Steps>(t) > model.start_by;
+      for (std::size_t j = 0; j < joints; ++j) {
+        if (late || (blocking >= 0 && problem_->blocks(action, chain_state(static_cast<std::uint16_t>(j), blocking)))) {
+          mass[t * joints + j] = 0.0;
+        }
+      }
+    }
+    const int chain = problem_->execution_chain(action);
+    if (chain < 0) continue;
+    // A chain-dependent execution: x ~ execution_by_state[the chain's state at its start]. The
+    // mass still executing is kept by steps left (pending[r * joints + j]) and moved with the
+    // chains one step at a time; what ends at step t joins the mass reaching the next action at t.
+    Steps longest = 0;
+    for (const Distribution& by_state : model.execution_by_state) {
+      if (by_state.max_step() != kNever) longest = std::max(longest, by_state.max_step());
+    }
+    const auto rows = static_cast<std::size_t>(std::min<Steps>(longest, deadline_)) + 1;
+    pending.assign(rows * joints, 0.0);
+    std::vector<double>& reached = mass;  // rewritten in place: step t is read before it is written
+    for (std::size_t t = 0; t <= deadline; ++t) {
+      for (std::size_t j = 0; j < joints; ++j) {
+        const double m = reached[t * joints + j];
+        if (m == 0.0) continue;
+        const Distribution& by_state =
+            model.execution_by_state[static_cast<std::size_t>(chain_state(static_cast<std::uint16_t>(j), chain))];
+        for (Steps x = by_state.min_step();
+             by_state.min_step() != kNever && x <= by_state.max_step() && static_cast<std::size_t>(x) < rows &&
+             t + static_cast<std::size_t>(x) <= deadline;
+             ++x) {
+          pending[static_cast<std::size_t>(x) * joints + j] += m * by_state.pmf(x);
+        }
+      }
+      for (std::size_t j = 0; j < joints; ++j) reached[t * joints + j] = pending[j];
+      // The rest moves one step: rows 1.. become rows 0.., with the chains' step.
+      moved.assign(rows * joints, 0.0);
+      for (std::size_t r = 1; r < rows; ++r) {
+        for (std::size_t j = 0; j < joints; ++j) {
+          const double m = pending[r * joints + j];
+          if (m == 0.0) continue;
+          for (const ChainStep& step : chain_steps(static_cast<std::uint16_t>(j))) {
+            moved[(r - 1) * joints + step.next] += m * step.probability;
+          }
+        }
+      }
+      pending.swap(moved);
+    }
+  }
+  // The static rest: a shift in time (the chains no longer matter), then the reward at the finish.
+  const std::uint16_t rest = execution >= before ? static_cast<std::uint16_t>(execution - before) : 0;
+  double value = 0.0;
+  for (std::size_t t = 0; t + rest <= deadline; ++t) {
+    double reached = 0.0;
+    for (std::size_t j = 0; j < joints; ++j) reached += mass[t * joints + j];
+    if (reached > 0.0) value += reached * problem_->reward_at(k, static_cast<Steps>(t + rest));
+  }
+  return value;
+}
+
+void Mdp::refuse_timed(std::string_view what) const {
+  if (!is_timed()) return;
+  throw UsageError(std::string(what) + ": " + problem_->name() +
+                   " has exogenous chains or actions that expire (SPEC §9), which only the memoised exact solver and "
+                   "exact evaluation model so far");
+}
+
+void Mdp::reject_chains(std::uint16_t joint) const {
+  throw UsageError("the chains' joint state " + std::to_string(joint) + " is out of range [0, " +
+                   std::to_string(joint_count_) + ")");
 }
 
 }  // namespace ontime

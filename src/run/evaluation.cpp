@@ -66,6 +66,7 @@ ExactEvaluation evaluate_exactly(const Mdp& mdp, Allocator& allocator, std::size
       const double value = search.solve(model.start()).value;
       return std::make_pair(value, search.memo().size());
     };
+    if (model.is_timed()) return run(StationaryPolicy<0, detail::CompactTimedState>(allocator, model));
     if (model.has_backtracking()) return run(StationaryPolicy<0, detail::CompactBacktrackState>(allocator, model));
     switch (detail::packed_words(model)) {
       case 2:

@@ -41,6 +41,7 @@ void Session::start_live(const Clock& clock, LiveOptions options) {
   if (!(options.decision_share > 0 && options.decision_share <= 1e6)) {
     throw UsageError("decision_share must be in (0, 1e6] slices (got " + std::to_string(options.decision_share) + ")");
   }
+  mdp_->refuse_timed("a live session");
   clock_ = &clock;
   live_ = options;
   // Execution seconds per action: the plan's seconds at success (owning sessions have them already).

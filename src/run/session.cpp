@@ -194,15 +194,44 @@ Status Session::report(const Observation& observation, double execution_seconds)
     status_ = model_status;
     // Skeletons still to come keep a session going that its present ones cannot save.
     if (status_ == Status::failure && more_expected_ && state_.time < mdp_->deadline()) status_ = Status::running;
-    if (status_ == Status::success) solution_ = mdp_->completed_skeleton(state_, choice);
+    if (status_ == Status::success) {
+      solution_ = mdp_->completed_skeleton(state_, choice);
+      if (mdp_->is_timed()) timed_reward_ = mdp_->success_reward(state_, choice);
+    }
     if (allocator_ != nullptr) allocator_->observe(before_, choice, state_, status_);
     return status_;
   }
   return report_live(choice, action, observation, execution_seconds);
 }
 
+Status Session::carry_out_timed(World& world) {
+  if (!exogenous_seeded_) {
+    // A stream of its own: the allocator's draws stay those of the same seed without chains.
+    exogenous_ = SplitMix64(stream_seed(seed_, 0x65786f67));
+    exogenous_seeded_ = true;
+  }
+  Observation observation = pending_action_ < 0
+                                ? Observation::not_yet()
+                                : world.step(pending_action_, state_.spent[static_cast<std::size_t>(pending_)]);
+  if (mdp_->has_chains()) observation = observation.with_chains(mdp_->sample_chain_step(state_.chains, exogenous_));
+  if (report(observation) != Status::success) return status_;
+  // The completed plan is executed in the simulated chains.
+  const auto slot = static_cast<std::size_t>(solution_);
+  const Steps finish = mdp_->sample_execution(solution_, state_.time, state_.chains, &state_.restore[0],
+                                              state_.execution[slot], exogenous_);
+  if (finish == kNever) {
+    status_ = Status::failure;
+    solution_ = -1;
+    timed_reward_ = 0;
+  } else {
+    timed_reward_ = problem().reward_at(solution_, finish);
+  }
+  return status_;
+}
+
 double Session::reward() const {
   if (status_ != Status::success || solution_ < 0) return 0.0;
+  if (mdp_->is_timed()) return timed_reward_;
   const SkeletonReward& reward = problem().reward(solution_);
   if (clock_ != nullptr) return std::max(0.0, reward.at(finish_seconds_ / step_seconds()));  // (within a slice)
   return reward.at(static_cast<double>(state_.time + state_.execution[static_cast<std::size_t>(solution_)]));
@@ -251,6 +280,7 @@ void Session::change_skeletons(std::vector<Action> actions, std::vector<std::vec
                                std::vector<SkeletonReward> rewards) {
   const Problem& current = mdp_->problem();
   // Everything that can fail comes first, so that a failure leaves the session as it was.
+  mdp_->refuse_timed("changing the skeletons of a session");
   auto problem =
       std::make_unique<Problem>(current.name(), current.deadline(), current.step_seconds(), std::move(actions),
                                 std::move(skeletons), current.description(), std::move(rewards),

@@ -27,6 +27,7 @@ Aggregation parse_aggregation(std::string_view text) {
 
 ContiguousSuccessTable::ContiguousSuccessTable(const Mdp& mdp, Aggregation aggregation)
     : mdp_(&mdp), aggregation_(aggregation), deadline_(mdp.deadline()) {
+  mdp.refuse_timed("Eq. (1)");
   const Problem& problem = mdp.problem();
   const auto deadline = static_cast<std::size_t>(deadline_);
   const std::size_t row = deadline + 2;  // G(v), v = 0 .. D + 1

@@ -100,12 +100,29 @@ struct CompactBacktrackState : CompactState {
 static_assert(sizeof(CompactBacktrackState) == sizeof(CompactState) + 32,
               "CompactBacktrackState must have no padding: it is hashed as bytes");
 
+// With exogenous chains or expiry (SPEC §9): the chains' joint state, and in `restore` the static
+// execution before each timed action (by Problem::timed_slot). The state and key of the exact
+// solvers for such a problem.
+struct CompactTimedState : CompactBacktrackState {
+  std::uint16_t chains = 0;
+
+  friend bool operator==(const CompactTimedState&, const CompactTimedState&) = default;
+};
+static_assert(sizeof(CompactTimedState) == sizeof(CompactBacktrackState) + 2,
+              "CompactTimedState must have no padding: it is hashed as bytes");
+
+// The slots of State::restore a problem uses: its culprits' or its timed actions' (one kind at most).
+inline int recorded_slots(const Problem& problem) noexcept {
+  return problem.culprit_slot_count() + problem.timed_slot_count();
+}
+
 // The fixed-size copy of a state: a CompactState, or with restore values a CompactBacktrackState
-// (`culprit_slots` of them).
+// (`culprit_slots` of them: recorded_slots), or with the chains' state too a CompactTimedState.
 template <class Compact = CompactState>
 Compact compact(const State& state, int skeleton_count, int culprit_slots = 0) noexcept {
   Compact out;
   out.time = state.time;
+  if constexpr (kHoldsChains<Compact>) out.chains = state.chains;
   for (int k = 0; k < skeleton_count; ++k) {
     const auto slot = static_cast<std::size_t>(k);
     out.refined[slot] = state.refined[slot];
@@ -147,6 +164,7 @@ void expanded(const Compact& compact, State& out) noexcept {
       out.restore[c] = compact.restore[c];
     }
   }
+  if constexpr (kHoldsChains<Compact>) out.chains = compact.chains;
   out.time = compact.time;
   for (std::size_t k = 0; k < compact.refined.size(); ++k) {
     out.refined[k] = compact.refined[k];
@@ -194,6 +212,11 @@ inline void require_exact_size(const Mdp& mdp, const std::string& what) {
     throw UsageError(what + ": the instance has " + std::to_string(mdp.problem().culprit_slot_count()) +
                      " actions that backtracking may blame; exact solving and exact evaluation take at most " +
                      std::to_string(kMaxExactCulpritSlots) + " (use a sampled evaluation or an approximate allocator)");
+  }
+  if (mdp.problem().timed_slot_count() > kMaxExactCulpritSlots) {
+    throw UsageError(what + ": the instance has " + std::to_string(mdp.problem().timed_slot_count()) +
+                     " timed actions (chains or expiry); exact solving and exact evaluation take at most " +
+                     std::to_string(kMaxExactCulpritSlots));
   }
 }
 
@@ -270,7 +293,7 @@ class Expectimax {
   };
 
   Compact compact_of(const State& state) const {
-    return compact<Compact>(state, mdp_->skeleton_count(), mdp_->problem().culprit_slot_count());
+    return compact<Compact>(state, mdp_->skeleton_count(), recorded_slots(mdp_->problem()));
   }
 
   void push(const Compact& state, const Key& key) {
@@ -368,10 +391,13 @@ class OptimalPolicy {
 
 // With backtracking (SPEC §7): states with their restore values, keyed whole. No slot is blanked:
 // a step on a group that cannot succeed may still backtrack and restore an action others share.
-class OptimalBacktrackPolicy {
+// With chains or expiry (SPEC §9) the same with CompactTimedState (OptimalTimedPolicy): the
+// chains' state and the executions before timed actions are part of the key.
+template <class CompactType = CompactBacktrackState>
+class OptimalRecordedPolicy {
  public:
-  using Compact = CompactBacktrackState;
-  explicit OptimalBacktrackPolicy(const Mdp& mdp) : mdp_(&mdp) {}
+  using Compact = CompactType;
+  explicit OptimalRecordedPolicy(const Mdp& mdp) : mdp_(&mdp) {}
 
   void choices(const Compact& state, std::vector<int>& out) const {
     for (const int choice : mdp_->useful_choices(state)) out.push_back(choice);
@@ -381,5 +407,7 @@ class OptimalBacktrackPolicy {
  private:
   const Mdp* mdp_;
 };
+using OptimalBacktrackPolicy = OptimalRecordedPolicy<CompactBacktrackState>;
+using OptimalTimedPolicy = OptimalRecordedPolicy<CompactTimedState>;
 
 }  // namespace ontime::detail

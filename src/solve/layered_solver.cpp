@@ -138,6 +138,7 @@ LayeredSolution solve_split(const Mdp& mdp, const LayeredSolveOptions& options, 
 }  // namespace
 
 LayeredSolution solve_layered(const Mdp& mdp, const LayeredSolveOptions& options) {
+  mdp.refuse_timed("the layered solver");
   detail::require_exact_size(mdp, "solve");
   if (!(options.tolerance >= 0.0 && options.tolerance <= 1.0)) {
     throw UsageError("solve: the tolerance must lie in [0, 1] (got " + std::to_string(options.tolerance) + ")");

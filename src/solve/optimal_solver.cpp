@@ -11,7 +11,8 @@ namespace {
 
 using Search =
     std::variant<detail::Expectimax<detail::OptimalPolicy<2>>, detail::Expectimax<detail::OptimalPolicy<4>>,
-                 detail::Expectimax<detail::OptimalPolicy<0>>, detail::Expectimax<detail::OptimalBacktrackPolicy>>;
+                 detail::Expectimax<detail::OptimalPolicy<0>>, detail::Expectimax<detail::OptimalBacktrackPolicy>,
+                 detail::Expectimax<detail::OptimalTimedPolicy>>;
 
 }  // namespace
 
@@ -23,6 +24,10 @@ struct OptimalSolver::Impl {
       return detail::Expectimax<detail::OptimalPolicy<Words>>(mdp, detail::OptimalPolicy<Words>(mdp), max_states,
                                                               OptimalSolver::kTieTolerance, "optimal");
     };
+    if (mdp.is_timed()) {
+      return detail::Expectimax<detail::OptimalTimedPolicy>(mdp, detail::OptimalTimedPolicy(mdp), max_states,
+                                                            OptimalSolver::kTieTolerance, "optimal");
+    }
     if (mdp.has_backtracking()) {
       return detail::Expectimax<detail::OptimalBacktrackPolicy>(mdp, detail::OptimalBacktrackPolicy(mdp), max_states,
                                                                 OptimalSolver::kTieTolerance, "optimal");
@@ -64,10 +69,11 @@ std::optional<int> OptimalSolver::best_choice(const State& state) const {
 }
 
 double OptimalSolver::max_bytes(const Problem& problem, std::size_t max_states) {
-  const double slot_bytes = problem.has_backtracking() ? 131
-                                                       : (problem.skeleton_count() <= 4 && problem.deadline() <= 253
-                                                              ? 33
-                                                              : (problem.skeleton_count() <= 10 ? 49 : 99));
+  const double slot_bytes = problem.is_timed()           ? 133
+                            : problem.has_backtracking() ? 131
+                                                         : (problem.skeleton_count() <= 4 && problem.deadline() <= 253
+                                                                ? 33
+                                                                : (problem.skeleton_count() <= 10 ? 49 : 99));
   return 3.0 * slot_bytes * static_cast<double>(max_states);
 }
 
@@ -86,6 +92,12 @@ void check_exact_work(const Problem& problem, std::size_t max_states, const std:
                          " skeletons; exact solving and exact evaluation take at most " +
                          std::to_string(kMaxExactSkeletons) +
                          " (sampled evaluation and the approximate allocators take any number)");
+  }
+  if (problem.timed_slot_count() > detail::kMaxExactCulpritSlots) {
+    throw InputError(source, "actions",
+                     std::to_string(problem.timed_slot_count()) +
+                         " timed actions (chains or expiry); exact solving and exact evaluation take at most " +
+                         std::to_string(detail::kMaxExactCulpritSlots));
   }
   if (problem.culprit_slot_count() > detail::kMaxExactCulpritSlots) {
     throw InputError(source, "actions",

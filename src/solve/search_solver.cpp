@@ -665,6 +665,7 @@ struct BranchAndBoundSearch::Impl {
 };
 
 BranchAndBoundSearch::BranchAndBoundSearch(const Mdp& mdp, std::uint64_t max_states) {
+  mdp.refuse_timed("the search solver");
   detail::require_exact_size(mdp, "search");
   impl_ = std::make_unique<Impl>(mdp, max_states);
 }
@@ -696,6 +697,7 @@ std::uint64_t BranchAndBoundSearch::size() const noexcept {
 }
 
 SearchSolution solve_search(const Mdp& mdp, const SearchSolveOptions& options) {
+  mdp.refuse_timed("the search solver");
   BranchAndBoundSearch search(mdp, options.max_states);
   std::function<bool(std::uint64_t)> stop;
   if (options.stop) stop = [&options](std::uint64_t) { return options.stop(); };

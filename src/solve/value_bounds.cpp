@@ -63,6 +63,7 @@ std::vector<double> convolve_execution(const Action& action, const std::vector<d
 
 ValueBounds::ValueBounds(const Mdp& mdp, std::size_t max_table_entries)
     : mdp_(&mdp), skeleton_count_(mdp.skeleton_count()), deadline_(mdp.deadline()) {
+  mdp.refuse_timed("the value bounds");
   const Problem& problem = mdp.problem();
   const auto deadline = static_cast<std::size_t>(deadline_);
   const std::size_t block = deadline * deadline;

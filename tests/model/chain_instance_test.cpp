@@ -83,14 +83,7 @@ TEST(ChainInstance, BrokenChainsAndReferencesAreRefusedWithTheirPlace) {
 
 // The reference recursion of SPEC §9 (the yardstick of the solvers to come) on cases valued by hand.
 TEST(ChainInstance, TheReferenceValuesHandMadeCases) {
-  const auto instance = [](const std::string& expires) {
-    return parse_problem(R"({"deadline": 4,
-      "chains": {"queue": {"states": ["short", "long"], "start": "short", "transitions": [[0.7, 0.3], [0.4, 0.6]]}},
-      "actions": {"wait": {"planning": {"pmf": {"1": 1.0}},
-          "execution": {"chain": "queue", "by_state": {"short": {"pmf": {"1": 1.0}}, "long": {"pmf": {"5": 1.0}}}})" +
-                             expires + R"(}}, "skeletons": [["wait"]]})",
-                         "wait.json");
-  };
+  const auto instance = testing::queue_wait_instance;
   // Refined in step 1; the queue at step 1 is short w.p. 0.7 (done at 2 <= 4), long w.p. 0.3 (6 > 4).
   EXPECT_DOUBLE_EQ(testing::ChainReferenceSolver(instance("")).optimum(), 0.7);
   // It cannot start after step 0: it never starts.

@@ -8,11 +8,25 @@
 #include <algorithm>
 #include <functional>
 #include <map>
+#include <string>
 #include <vector>
 
+#include "ontime/model/instance_io.hpp"
 #include "ontime/model/problem.hpp"
 
 namespace ontime::testing {
+
+// A queue and one wait (deadline 4) for cases valued by hand: the wait is refined in step 1 and
+// starts at once; it takes 1 step if the queue is short then (probability 0.7), else 5, past the
+// deadline. `expires` adds to the action's fields (e.g. `, "expires": {"after": 0}`).
+inline Problem queue_wait_instance(const std::string& expires) {
+  return parse_problem(R"({"deadline": 4,
+      "chains": {"queue": {"states": ["short", "long"], "start": "short", "transitions": [[0.7, 0.3], [0.4, 0.6]]}},
+      "actions": {"wait": {"planning": {"pmf": {"1": 1.0}},
+          "execution": {"chain": "queue", "by_state": {"short": {"pmf": {"1": 1.0}}, "long": {"pmf": {"5": 1.0}}}})" +
+                           expires + R"(}}, "skeletons": [["wait"]]})",
+                       "wait.json");
+}
 
 class ChainReferenceSolver {
  public:

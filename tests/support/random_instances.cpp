@@ -67,6 +67,63 @@ Problem random_instance(std::uint64_t seed, int max_skeletons, int max_length, S
   return build_instance(generator, "random-" + std::to_string(seed), deadline, skeleton_count, max_length);
 }
 
+Problem with_random_chains(const Problem& problem, std::uint64_t seed, bool rewards) {
+  SplitMix64 generator(seed);
+  std::vector<ExogenousChain> chains(static_cast<std::size_t>(uniform_int(generator, 1, 2)));
+  for (std::size_t c = 0; c < chains.size(); ++c) {
+    ExogenousChain& chain = chains[c];
+    chain.name = std::to_string(c);
+    chain.name.insert(0, "chain");
+    const int states = uniform_int(generator, 2, 3);
+    for (int s = 0; s < states; ++s) chain.states.push_back(std::to_string(s).insert(0, 1, 's'));
+    chain.start = uniform_int(generator, 0, states - 1);
+    for (int s = 0; s < states; ++s) {
+      std::vector<double> row(static_cast<std::size_t>(states), 0.0);
+      double total = 0;
+      for (double& entry : row) {
+        entry = generator() % 3 == 0 ? 0.0 : 0.1 + uniform01(generator);
+        total += entry;
+      }
+      if (total == 0) {
+        row[static_cast<std::size_t>(s)] = 1.0;
+        total = 1.0;
+      }
+      for (double& entry : row) entry /= total;
+      chain.transitions.push_back(std::move(row));
+    }
+  }
+  std::vector<Action> actions(problem.actions().begin(), problem.actions().end());
+  for (Action& action : actions) {
+    if (generator() % 3 == 0) {
+      const ExogenousChain& chain = chains[generator() % chains.size()];
+      action.execution_chain = chain.name;
+      for (int s = 0; s < chain.state_count(); ++s) {
+        action.execution_by_state.push_back(random_distribution(generator, 0, problem.deadline() / 2 + 1));
+      }
+    }
+    if (generator() % 3 == 0) {
+      const auto kind = generator() % 3;
+      if (kind != 1) action.start_by = uniform_int(generator, problem.deadline() / 3, problem.deadline());
+      if (kind != 0) {
+        const ExogenousChain& chain = chains[generator() % chains.size()];
+        action.blocking_chain = chain.name;
+        for (const std::string& state : chain.states) {
+          if (generator() % 2 == 0) action.blocking_states.push_back(state);
+        }
+        if (action.blocking_states.empty()) action.blocking_states.push_back(chain.states.back());
+      }
+    }
+  }
+  std::vector<SkeletonReward> values;
+  for (int k = 0; rewards && k < problem.skeleton_count(); ++k) {
+    SkeletonReward reward{0.2 + 0.8 * uniform01(generator), 0.0};
+    if (generator() % 2 == 0) reward.per_step = reward.value * uniform01(generator) / problem.deadline();
+    values.push_back(reward);
+  }
+  return {problem.name() + "-chains", problem.deadline(),    problem.step_seconds(), std::move(actions),
+          problem.skeleton_lists(),   problem.description(), std::move(values),      std::move(chains)};
+}
+
 Problem wide_instance(std::uint64_t seed, int skeleton_count, int max_length, Steps deadline) {
   SplitMix64 generator(seed);
   return build_instance(generator, "wide-" + std::to_string(skeleton_count), deadline, skeleton_count, max_length);

@@ -10,6 +10,12 @@ namespace ontime::testing {
 
 Problem random_instance(std::uint64_t seed, int max_skeletons = 4, int max_length = 3, Steps max_deadline = 9);
 
+// `problem` with one or two random exogenous chains of 2 or 3 states (some transitions 0), about a
+// third of its actions' executions depending on a chain's state, about a third of them expiring
+// (after a random step, in random states of a chain, or both) and, when `rewards`, a random
+// reward per skeleton (SPEC §8, §9). Same seed, same instance.
+Problem with_random_chains(const Problem& problem, std::uint64_t seed, bool rewards);
+
 // Exactly `skeleton_count` skeletons of at most `max_length` actions, built the same way.
 Problem wide_instance(std::uint64_t seed, int skeleton_count, int max_length, Steps deadline);
 

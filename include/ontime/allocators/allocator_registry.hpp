@@ -38,6 +38,7 @@ enum class Capability : std::uint32_t {
   needs_policy = 1U << 3,  // needs a trained policy (a file), not just the instance
   optimal = 1U << 4,       // attains the optimum: the reference column, not a competitor
   certified = 1U << 5,     // each decision carries a certified bound on its loss (a yardstick, like optimal)
+  chains = 1U << 6,        // takes instances with exogenous chains or expiry (SPEC §9)
 };
 
 class Capabilities {

@@ -11,6 +11,11 @@
 // The functions of a state are templates on its type S: State, or the exact solver's fixed-size
 // copy of it (anything with time, refined[k], spent[k] and execution[k]).
 //
+// Exogenous chains and actions that expire (SPEC §9): every step also moves the chains (an
+// observation carries their next joint state), a timed action's refinement records the static
+// execution before it (State::restore by Problem::timed_slot), and a success's reward is the
+// expected reward of executing the completed plan from the chains' state (execution_value).
+//
 // An Mdp refers to its Problem, which must outlive it. Its precomputed tables (hazards,
 // execution supports, lower bounds on remaining time) make a transition O(K) with no
 // allocation.
@@ -18,6 +23,7 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include "ontime/mdp/state.hpp"
@@ -63,6 +69,16 @@ struct Observation {
   static constexpr Observation found(Steps execution_steps) noexcept { return {true, execution_steps, -1}; }
   static constexpr Observation backtracked(int culprit_action) noexcept { return {false, 0, culprit_action}; }
   bool is_backtrack() const noexcept { return culprit >= 0; }
+  // Exogenous chains (SPEC §9): the chains' joint state after the step (Mdp::joint_chain_state);
+  // ignored without chains.
+  std::uint16_t chains = 0;
+
+  // This observation with the chains' joint state after the step.
+  constexpr Observation with_chains(std::uint16_t joint) const noexcept {
+    Observation out = *this;
+    out.chains = joint;
+    return out;
+  }
 };
 
 // Whether a state type holds the restore values of backtracking (State does; the exact solvers'
@@ -71,6 +87,13 @@ struct Observation {
 template <class S>
 inline constexpr bool kHoldsRestore = requires(S& state) {
   state.restore[0];
+};
+// Whether a state type holds the chains' joint state and its restore values hold the executions
+// before timed actions (State does; the exact solvers' compact copy only in its timed form). A
+// problem with chains or expiry (SPEC §9) needs such a state type.
+template <class S>
+inline constexpr bool kHoldsChains = kHoldsRestore<S>&& requires(S& state) {
+  state.chains;
 };
 
 class Mdp {
@@ -90,11 +113,61 @@ class Mdp {
   Steps deadline() const noexcept { return deadline_; }
 
   State start() const {
-    return State(static_cast<std::size_t>(skeleton_count_), static_cast<std::size_t>(problem_->culprit_slot_count()));
+    State state(static_cast<std::size_t>(skeleton_count_),
+                static_cast<std::size_t>(problem_->culprit_slot_count() + problem_->timed_slot_count()));
+    state.chains = start_chains_;
+    return state;
   }
   // Whether some action may backtrack (SPEC §7).
   bool has_backtracking() const noexcept { return problem_->has_backtracking(); }
 
+  // Exogenous chains and expiry (SPEC §9). Whether the problem has chains, or chains or timed
+  // actions; the number of joint states of the chains (1 without); the joint state of one state
+  // per chain (by index, in the problem's order of chains) and chain c's state in a joint state.
+  bool has_chains() const noexcept { return joint_count_ > 1 || problem_->has_chains(); }
+  bool is_timed() const noexcept { return problem_->is_timed(); }
+  int joint_chain_states() const noexcept { return joint_count_; }
+  // Throws UsageError naming `what` when the problem has chains or expiry: for the solvers and
+  // tables that do not model them yet.
+  void refuse_timed(std::string_view what) const;
+  std::uint16_t joint_chain_state(std::span<const int> states) const;
+  int chain_state(std::uint16_t joint, int chain) const noexcept {
+    const auto c = static_cast<std::size_t>(chain);
+    return (joint / chain_strides_[c]) % static_cast<int>(problem_->chains()[c].states.size());
+  }
+  // One joint state the chains may move to from `joint` in one step, with its probability.
+  struct ChainStep {
+    std::uint16_t next;
+    double probability;
+  };
+  std::span<const ChainStep> chain_steps(std::uint16_t joint) const noexcept {
+    return {chain_steps_.data() + chain_step_offsets_[joint], chain_steps_.data() + chain_step_offsets_[joint + 1U]};
+  }
+
+  // The expected reward of executing skeleton k's plan from step `start` with the chains in joint
+  // state `joint` (SPEC §9): `restore` holds the static execution before each timed action (by
+  // Problem::timed_slot) and `execution` the plan's whole static execution. Each timed action
+  // starts after the static execution before it and the chain-dependent executions drawn before
+  // it; one that cannot start (after its last step, or its chain in a blocking state) fails the
+  // plan; so does a finish after the deadline. Cost O(D * (gaps + the longest chain-dependent
+  // execution) * joint states * chain steps per joint state); no allocation after a thread's
+  // first call.
+  double execution_value(int k, Steps start, std::uint16_t joint, const std::uint16_t* restore,
+                         std::uint16_t execution) const;
+  // One execution of the same plan drawn from the model: the chains' steps and the
+  // chain-dependent executions. The step the execution ends, or kNever when the plan fails (an
+  // action that cannot start, a finish after the deadline).
+  template <class Generator>
+  Steps sample_execution(int k, Steps start, std::uint16_t joint, const std::uint16_t* restore, std::uint16_t execution,
+                         Generator& generator) const;
+  // The chains' step from `joint` drawn from the model.
+  template <class Generator>
+  std::uint16_t sample_chain_step(std::uint16_t joint, Generator& generator) const {
+    const auto steps = chain_steps(joint);
+    return steps[sample_index(
+                     steps.size(), [&steps](std::size_t i) { return steps[i].probability; }, generator)]
+        .next;
+  }
   // The action skeleton k refines next, or -1 when it is fully refined (choosing it idles).
   template <class S>
   int next_action(const S& state, int k) const noexcept {
@@ -120,6 +193,13 @@ class Mdp {
   // is then the success probability, and p * 1 is p to the bit).
   template <class S>
   double success_reward(const S& state, int choice) const {
+    if constexpr (kHoldsChains<S>) {
+      if (is_timed()) {
+        const int k = completed_skeleton(state, choice);
+        const auto slot = static_cast<std::size_t>(k);
+        return execution_value(k, state.time, state.chains, &state.restore[0], state.execution[slot]);
+      }
+    }
     if (!problem_->has_rewards()) return 1.0;
     const int k = completed_skeleton(state, choice);
     return problem_->reward_at(k, static_cast<Steps>(state.time + state.execution[static_cast<std::size_t>(k)]));
@@ -135,15 +215,23 @@ class Mdp {
   // `state` can produce, in the order of for_each_outcome, without applying them.
   template <class S, class Visitor>
   void for_each_observation(const S& state, int choice, Visitor&& visit) const;
+  // The same without the chains' step (Observation::chains 0): what refinement alone reveals.
+  template <class S, class Visitor>
+  void for_each_refinement(const S& state, int choice, Visitor&& visit) const;
 
   // Draws the observation of one step on `choice` from the model (hazard, then execution).
+  // With chains, then draws their step.
   template <class S, class Generator>
   Observation sample_observation(const S& state, int choice, Generator& generator) const;
+  // The refinement's draw alone (Observation::chains 0).
+  template <class S, class Generator>
+  Observation sample_refinement(const S& state, int choice, Generator& generator) const;
 
   // The choices worth considering: one per group of skeletons sharing their next action
   // (named by the group's lowest index), and only groups in which some skeleton can still
   // succeed. In increasing index order. Spending a step elsewhere cannot raise the success
-  // probability.
+  // probability. With backtracking every group with work left; with chains or expiry (SPEC §9)
+  // every group with work left and an idle choice (a skeleton with none), since waiting may pay.
   template <class S>
   ChoiceList useful_choices(const S& state) const;
   // Whether some skeleton sharing the next action of `action`'s group can still succeed.
@@ -225,6 +313,9 @@ class Mdp {
   [[noreturn]] static void reject_idle_refinement(int choice);
   [[noreturn]] static void reject_execution(Steps execution);
   [[noreturn]] void reject_culprit(int action, int culprit) const;
+  [[noreturn]] void reject_chains(std::uint16_t joint) const;
+  // The chains' tables and the timed paths (SPEC §9).
+  void index_chains(const Problem& problem);
   // The backtracking tables (SPEC §7): hazards, culprit slots along the paths and below each one.
   void index_backtracking(const Problem& problem);
 
@@ -249,6 +340,15 @@ class Mdp {
   std::vector<Steps> next_finish_;        // [action][spent]: least t >= 1 with p(spent + t) > 0, or kNever
   std::vector<std::vector<ExecutionOutcome>> execution_outcomes_;  // per action
   std::vector<Steps> min_execution_;                               // per action, kNever if none
+  // Exogenous chains (SPEC §9): the joint state at the start, each chain's stride in a joint
+  // state, and per joint state its steps (chain_steps_ from chain_step_offsets_[j] to [j + 1]).
+  std::uint16_t start_chains_ = 0;
+  int joint_count_ = 1;
+  std::vector<int> chain_strides_;
+  std::vector<std::uint32_t> chain_step_offsets_;
+  std::vector<ChainStep> chain_steps_;
+  // Per skeleton, its timed actions in the order of its path.
+  std::vector<std::vector<int>> timed_path_;
   // Backtracking only (empty otherwise).
   std::vector<double> backtrack_hazards_;  // [action][spent], spent < deadline
   // Per skeleton and position (offsets_ + k + l, as rest_): the culprit slot of the action there
@@ -260,6 +360,21 @@ class Mdp {
 
 template <class S, class Visitor>
 void Mdp::for_each_observation(const S& state, int choice, Visitor&& visit) const {
+  if constexpr (kHoldsChains<S>) {
+    if (has_chains()) {
+      // Every refinement outcome with every step of the chains (they move whatever happens).
+      const auto steps = chain_steps(state.chains);
+      for_each_refinement(state, choice, [&](double probability, const Observation& observation) {
+        for (const ChainStep& step : steps) visit(probability * step.probability, observation.with_chains(step.next));
+      });
+      return;
+    }
+  }
+  for_each_refinement(state, choice, std::forward<Visitor>(visit));
+}
+
+template <class S, class Visitor>
+void Mdp::for_each_refinement(const S& state, int choice, Visitor&& visit) const {
   const int action = next_action(state, choice);
   if (action < 0) {
     visit(1.0, Observation::not_yet());
@@ -296,6 +411,41 @@ void Mdp::for_each_outcome(const S& state, int choice, Visitor&& visit) const {
 
 template <class S, class Generator>
 Observation Mdp::sample_observation(const S& state, int choice, Generator& generator) const {
+  const Observation observation = sample_refinement(state, choice, generator);
+  if constexpr (kHoldsChains<S>) {
+    if (has_chains()) return observation.with_chains(sample_chain_step(state.chains, generator));
+  }
+  return observation;
+}
+
+template <class Generator>
+Steps Mdp::sample_execution(int k, Steps start, std::uint16_t joint, const std::uint16_t* restore,
+                            std::uint16_t execution, Generator& generator) const {
+  std::int64_t time = start;
+  std::uint16_t before = 0;
+  for (const int action : timed_path_[static_cast<std::size_t>(k)]) {
+    const std::uint16_t at = restore[problem_->timed_slot(action)];
+    for (; before < at && time <= deadline_; ++before, ++time) joint = sample_chain_step(joint, generator);
+    before = at;
+    const Action& model = problem_->action(action);
+    const int blocking = problem_->blocking_chain(action);
+    if (time > deadline_ || (model.start_by != kNever && time > model.start_by) ||
+        (blocking >= 0 && problem_->blocks(action, chain_state(joint, blocking)))) {
+      return kNever;
+    }
+    const int chain = problem_->execution_chain(action);
+    if (chain < 0) continue;
+    const Steps drawn = model.execution_by_state[static_cast<std::size_t>(chain_state(joint, chain))].sample(generator);
+    if (drawn == kNever || time + drawn > deadline_) return kNever;
+    for (Steps x = 0; x < drawn; ++x) joint = sample_chain_step(joint, generator);
+    time += drawn;
+  }
+  time += execution >= before ? execution - before : 0;
+  return time <= deadline_ ? static_cast<Steps>(time) : kNever;
+}
+
+template <class S, class Generator>
+Observation Mdp::sample_refinement(const S& state, int choice, Generator& generator) const {
   const int action = next_action(state, choice);
   if (action < 0) return Observation::not_yet();
   const Steps spent = state.spent[static_cast<std::size_t>(choice)];
@@ -374,13 +524,34 @@ bool Mdp::group_can_succeed(const S& state, int action) const noexcept {
 template <class S>
 ChoiceList Mdp::useful_choices(const S& state) const {
   ChoiceList choices;
-  const bool backtracking = has_backtracking();
+  // With backtracking a step on a group that cannot succeed may still backtrack and restore an
+  // action that other skeletons share; with chains or expiry (SPEC §9) such a step, or an idle
+  // one, waits, which may be worth more than finishing a plan now (a door may open). Then every
+  // group with work left is worth considering, and one idle choice if some skeleton has none.
+  const bool every_group = has_backtracking() || is_timed();
+  int idle = -1;
   for (int k = 0; k < skeleton_count_; ++k) {
     const int action = next_action(state, k);
-    if (action < 0 || problem_->members(action).front() != k) continue;
-    // With backtracking a step on a group that cannot succeed may still backtrack and restore an
-    // action that other skeletons share: every group with work left is worth considering.
-    if (backtracking || group_can_succeed(state, action)) choices.push_back(k);
+    if (action < 0) {
+      if (idle < 0) idle = k;
+      continue;
+    }
+    if (problem_->members(action).front() != k) continue;
+    if (every_group || group_can_succeed(state, action)) choices.push_back(k);
+  }
+  if (is_timed() && idle >= 0 && !choices.empty()) {
+    // In increasing index order, as the callers expect.
+    ChoiceList ordered;
+    bool placed = false;
+    for (const int k : choices) {
+      if (!placed && idle < k) {
+        ordered.push_back(idle);
+        placed = true;
+      }
+      ordered.push_back(k);
+    }
+    if (!placed) ordered.push_back(idle);
+    return ordered;
   }
   return choices;
 }
@@ -397,6 +568,9 @@ Status Mdp::apply(S& state, int choice, const Observation& observation) const {
   }
   if (observation.refined && observation.execution < 0) {
     reject_execution(observation.execution);
+  }
+  if constexpr (kHoldsChains<S>) {
+    if (has_chains() && observation.chains >= joint_count_) reject_chains(observation.chains);
   }
   if (observation.culprit >= 0) {
     // A backtrack: only on an action step, blaming one of that action's culprits.
@@ -416,6 +590,9 @@ Status Mdp::apply(S& state, int choice, const Observation& observation) const {
     }
   }
   ++state.time;
+  if constexpr (kHoldsChains<S>) {
+    if (has_chains()) state.chains = observation.chains;
+  }
   // An idle step (action < 0) only spends time.
   if (action >= 0 && !observation.refined) {
     for (const int member : problem_->members(action)) {
@@ -423,16 +600,25 @@ Status Mdp::apply(S& state, int choice, const Observation& observation) const {
       if (spent <= deadline_) ++spent;
     }
   } else if (action >= 0) {
-    const std::int64_t total =
-        observation.execution == kNever
-            ? std::int64_t{deadline_} + 1
-            : std::int64_t{state.execution[static_cast<std::size_t>(choice)]} + observation.execution;
+    // A chain-dependent execution is drawn when it starts (SPEC §9): none is added now.
+    const Steps observed = is_timed() && problem_->execution_chain(action) >= 0 ? Steps{0} : observation.execution;
+    const std::int64_t total = observed == kNever
+                                   ? std::int64_t{deadline_} + 1
+                                   : std::int64_t{state.execution[static_cast<std::size_t>(choice)]} + observed;
     const std::uint16_t execution = saturate_execution(total);
     if constexpr (kHoldsRestore<S>) {
       if (has_backtracking()) {
         const int culprit_slot = problem_->culprit_slot(action);
         if (culprit_slot >= 0) {
           state.restore[static_cast<std::size_t>(culprit_slot)] = state.execution[static_cast<std::size_t>(choice)];
+        }
+      }
+    }
+    if constexpr (kHoldsChains<S>) {
+      if (is_timed()) {
+        const int timed_slot = problem_->timed_slot(action);
+        if (timed_slot >= 0) {
+          state.restore[static_cast<std::size_t>(timed_slot)] = state.execution[static_cast<std::size_t>(choice)];
         }
       }
     }

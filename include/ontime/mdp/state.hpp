@@ -1,7 +1,9 @@
 #pragma once
 // The MDP state of SPEC §2: the steps used and, per skeleton, the actions refined, the steps
 // spent on the current action and the execution time of the refined ones; with backtracking
-// (SPEC §7), the execution before each action that may be blamed.
+// (SPEC §7), the execution before each action that may be blamed; with exogenous chains and
+// actions that expire (SPEC §9), the chains' joint state and the static execution before each
+// timed action.
 //
 // Up to kInlineSkeletons skeletons the per-skeleton values live inside the object, so that
 // the hot paths (transitions, searches, exact solving) copy a state without allocating;
@@ -118,20 +120,25 @@ class PerSkeleton {
 
 struct State {
   State() noexcept = default;
-  // The start state of a problem with `skeleton_count` skeletons and `culprit_slots` actions
-  // that backtracking may blame (Mdp::start() makes it).
-  explicit State(std::size_t skeleton_count, std::size_t culprit_slots = 0)
-      : refined(skeleton_count), spent(skeleton_count), execution(skeleton_count), restore(culprit_slots) {}
+  // The start state of a problem with `skeleton_count` skeletons and `recorded_slots` actions
+  // whose execution before them is recorded (Mdp::start() makes it).
+  explicit State(std::size_t skeleton_count, std::size_t recorded_slots = 0)
+      : refined(skeleton_count), spent(skeleton_count), execution(skeleton_count), restore(recorded_slots) {}
 
-  std::uint16_t time = 0;             // CT: steps used
+  std::uint16_t time = 0;  // CT: steps used
+  // Exogenous chains (SPEC §9): the chains' joint state (Mdp::joint_chain_state), 0 without chains.
+  std::uint16_t chains = 0;
   PerSkeleton<std::uint8_t> refined;  // l_k: actions refined
   PerSkeleton<std::uint16_t> spent;   // PT_k: steps on action l_k
   // ET_k: execution steps of the refined actions, saturated at deadline + 1 (any larger
   // value is equally too slow, and saturation keeps equivalent states equal).
   PerSkeleton<std::uint16_t> execution;
-  // Backtracking (SPEC §7): B_c for every action c some action may blame (by
-  // Problem::culprit_slot): the execution steps before c on its path, recorded when c was
-  // refined, 0 while it is not. All zero, and unused, in a problem without backtracking.
+  // B_c, the execution steps before action c on its path, recorded when c was refined, 0 while it
+  // is not, for every action c whose B_c matters: with backtracking (SPEC §7) the actions some
+  // action may blame (by Problem::culprit_slot; B_c is restored by a backtrack to c), with chains
+  // or expiry (SPEC §9) the timed actions (by Problem::timed_slot; c starts B_c after its plan is
+  // complete, plus the chain-dependent executions before it). A problem has one kind or neither
+  // (the Mdp refuses both at once); all zero, and unused, without either.
   PerSkeleton<std::uint16_t> restore;
 
   friend bool operator==(const State&, const State&) = default;

@@ -189,6 +189,12 @@ class Problem {
   bool blocks(int action, int state) const {
     return blocking_.at(static_cast<std::size_t>(action)).at(static_cast<std::size_t>(state)) != 0;
   }
+  // Whether the problem has chains or timed actions (Action::is_timed): its plans' values depend
+  // on when their actions start. The slot of a timed action (State::before holds the static
+  // execution before it on its path there), or -1; how many such slots.
+  bool is_timed() const noexcept { return has_chains() || timed_slots_ > 0; }
+  int timed_slot(int action) const { return timed_slot_.at(static_cast<std::size_t>(action)); }
+  int timed_slot_count() const noexcept { return timed_slots_; }
 
   // Prefix tree. Every action used by some skeleton is one node.
   // Skeletons whose path passes through the action, ascending (N(k, l) of Eq. (1)).
@@ -240,6 +246,8 @@ class Problem {
   std::vector<int> execution_chain_;
   std::vector<int> blocking_chain_;
   std::vector<std::vector<char>> blocking_;
+  std::vector<int> timed_slot_;
+  int timed_slots_ = 0;
   bool has_rewards_ = false;
   double max_reward_ = 1.0;
   std::vector<std::vector<int>> members_;

@@ -149,7 +149,9 @@ class Session {
 
   // Carries out the step just decided in `world`: one step of effort on its action,
   // world.step(action, effort already spent on it), reported as report() does; an idle step (no
-  // action left to refine) is reported as not yet without asking the world. Returns the status
+  // action left to refine) is reported as not yet without asking the world. With exogenous
+  // chains (SPEC §9) the session simulates them, drawn from its seed: their step joins the
+  // world's answer, and a completed plan's execution is drawn in them. Returns the status
   // after the step. Throws std::logic_error without a pending decision, and what the world or
   // report() throws.
   Status carry_out(World& world);
@@ -215,6 +217,9 @@ class Session {
   // What the episode earned (SPEC §8): after a success, the solution's reward at its finish (the
   // state's CT plus the solution's ET; 1 without rewards), else 0.
   // On the robot's clock, the finish is the plan's end in seconds over the step (a real number).
+  // With chains or expiry (SPEC §9): after carry_out, what the plan's execution drawn in the
+  // simulated chains earned (a plan that cannot be carried out ends the session in failure);
+  // after the caller's report, the plan's expected reward from the reported chains' state.
   double reward() const;
   // Steps of effort spent so far (CT).
   Steps steps_used() const noexcept { return state_.time; }
@@ -241,6 +246,7 @@ class Session {
 
  private:
   [[noreturn]] static void throw_without_decision();
+  Status carry_out_timed(World& world);
   // The live half (src/run/live_session.cpp).
   void start_live(const Clock& clock, LiveOptions options);
   // choose(), decide() and report() on the clock, once what every session checks and records is
@@ -285,6 +291,11 @@ class Session {
   std::unique_ptr<Allocator> owned_allocator_;
   AllocatorMaker make_allocator_;
   std::uint64_t seed_ = 0;
+  // Chains or expiry (SPEC §9): the simulated chains' draws (carry_out; seeded from seed_ on
+  // first use), and the reward of the success.
+  SplitMix64 exogenous_{0};
+  bool exogenous_seeded_ = false;
+  double timed_reward_ = 0;
   std::uint64_t changes_ = 0;   // skeleton changes so far: the allocator's seed stream
   bool more_expected_ = false;  // expect_more_skeletons()
 
@@ -307,6 +318,7 @@ class Session {
 // Inline, so that the runner's loop pays for no more than the calls it would make itself.
 inline Status Session::carry_out(World& world) {
   if (pending_ < 0) throw_without_decision();
+  if (mdp_->is_timed()) return carry_out_timed(world);
   if (pending_action_ < 0) return report_not_yet();  // an idle step: nothing to ask the world
   return report(world.step(pending_action_, state_.spent[static_cast<std::size_t>(pending_)]));
 }
