@@ -184,6 +184,63 @@ void BM_OptimalSolve(benchmark::State& bench) {
 }
 BENCHMARK(BM_OptimalSolve)->DenseRange(0, 5)->Unit(benchmark::kMicrosecond);
 
+// Exogenous chains (SPEC §9): the same meeting-with-coffee problem with a queue of n states (a
+// birth-death chain: one arrival w.p. 0.3, one service w.p. 0.4 per step; waiting in state s
+// takes 2s + 1 steps), nothing else varied. The optimum's cost should grow at most
+// linearly in n (the BigO fit).
+ontime::Problem queue_problem(int states) {
+  std::string names;
+  std::string rows;
+  std::string waits;
+  for (int s = 0; s < states; ++s) {
+    const std::string name = "\"q" + std::to_string(s) + "\"";
+    names += (s > 0 ? ", " : "") + name;
+    std::vector<double> row(static_cast<std::size_t>(states), 0.0);
+    const double up = s + 1 < states ? 0.3 * (s > 0 ? 0.6 : 1.0) : 0.0;
+    const double down = s > 0 ? 0.4 * (s + 1 < states ? 0.7 : 1.0) : 0.0;
+    if (s + 1 < states) row[static_cast<std::size_t>(s) + 1] = up;
+    if (s > 0) row[static_cast<std::size_t>(s) - 1] = down;
+    row[static_cast<std::size_t>(s)] = 1.0 - up - down;
+    std::string text;
+    for (std::size_t t = 0; t < row.size(); ++t) text += (t > 0 ? ", " : "") + std::to_string(row[t]);
+    rows += std::string(s > 0 ? ", " : "") + "[" + text + "]";
+    waits += (s > 0 ? ", " : "") + name + ": {\"pmf\": {\"" + std::to_string(2 * s + 1) + "\": 1.0}}";
+  }
+  return ontime::parse_problem(R"({"deadline": 24, "chains": {"queue": {"states": [)" + names +
+                                   R"(], "start": "q0", "transitions": [)" + rows +
+                                   R"(]}},
+      "actions": {
+        "go": {"planning": {"pmf": {"1": 0.3, "2": 0.3, "3": 0.2, "5": 0.1}}, "execution": {"pmf": {"2": 0.5, "3": 0.5}}},
+        "wait": {"planning": {"pmf": {"1": 0.6, "2": 0.3}}, "execution": {"chain": "queue", "by_state": {)" +
+                                   waits + R"(}}},
+        "enter": {"planning": {"pmf": {"2": 0.5, "3": 0.3, "6": 0.1}}, "execution": {"pmf": {"1": 1.0}},
+                  "expires": {"after": 22}},
+        "walk": {"planning": {"pmf": {"2": 0.3, "4": 0.3, "8": 0.2}}, "execution": {"pmf": {"4": 0.6, "7": 0.4}}}},
+      "skeletons": [["go", "wait", "enter"], ["walk"]],
+      "rewards": [{"value": 1.0, "per_step": 0.02}, {"value": 0.7, "per_step": 0.01}]})",
+                               "queue-" + std::to_string(states));
+}
+
+void BM_OptimalSolveChainStates(benchmark::State& bench) {
+  const ontime::Problem problem = queue_problem(static_cast<int>(bench.range(0)));
+  const ontime::Mdp mdp(problem);
+  std::size_t states = 0;
+  double value = 0;
+  for (auto _ : bench) {
+    ontime::OptimalSolver solver(mdp);
+    value = solver.solve(mdp.start());
+    states = solver.states();
+  }
+  bench.counters["states"] = static_cast<double>(states);
+  bench.counters["optimum"] = value;
+  bench.SetComplexityN(bench.range(0));
+}
+BENCHMARK(BM_OptimalSolveChainStates)
+    ->RangeMultiplier(2)
+    ->Range(2, 64)
+    ->Complexity(benchmark::oN)
+    ->Unit(benchmark::kMillisecond);
+
 // The layered solver on the domains (docs/performance.md): the navigation optimum (target
 // <= 10 s and <= 1 GiB on 2 cores) and the kitchen's split interval (target: width <= 0.02).
 // Real time, all hardware threads, once each (seconds of work).

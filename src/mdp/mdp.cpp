@@ -255,92 +255,91 @@ std::uint16_t Mdp::joint_chain_state(std::span<const int> states) const {
 
 double Mdp::execution_value(int k, Steps start, std::uint16_t joint, const std::uint16_t* restore,
                             std::uint16_t execution) const {
+  if (start > deadline_) return 0.0;
+  thread_local std::vector<double> table;
+  execution_table(k, restore, execution, table);
+  return table[static_cast<std::size_t>(start) * static_cast<std::size_t>(joint_count_) + joint];
+}
+
+void Mdp::execution_table(int k, const std::uint16_t* restore, std::uint16_t execution,
+                          std::vector<double>& out) const {
   const auto deadline = static_cast<std::size_t>(deadline_);
   const auto joints = static_cast<std::size_t>(joint_count_);
-  if (start > deadline_) return 0.0;
-  // mass[t * joints + j]: P(the plan reaches the next timed action's static part at step t with
-  // the chains in j). Scratch kept per thread so that the solvers' many calls do not allocate.
-  thread_local std::vector<double> mass, moved, pending;
-  mass.assign((deadline + 1) * joints, 0.0);
-  mass[static_cast<std::size_t>(start) * joints + joint] = 1.0;
-  // One step of the chains for the mass at steps first .. deadline - 1, moved one step later.
-  const auto step_chains = [&](std::vector<double>& values, std::size_t rows) {
-    moved.assign(rows * joints, 0.0);
-    for (std::size_t t = 0; t + 1 < rows; ++t) {
+  const std::size_t cells = (deadline + 1) * joints;
+  const auto& timed = timed_path_[static_cast<std::size_t>(k)];
+  // Backwards over the plan: `value` holds U(t, j), the expected reward from the point where the
+  // static execution before the next timed action (or the static rest) begins at step t with the
+  // chains in j. Scratch per thread: the solvers' many calls do not allocate.
+  thread_local std::vector<double> value, moved;
+  // One step of waiting: U'(t, j) = sum over j' of P(j, j') U(t + 1, j'); 0 at the deadline.
+  const auto wait_one_step = [&]() {
+    moved.assign(cells, 0.0);
+    for (std::size_t t = 0; t < deadline; ++t) {
       for (std::size_t j = 0; j < joints; ++j) {
-        const double m = values[t * joints + j];
-        if (m == 0.0) continue;
+        double sum = 0.0;
         for (const ChainStep& step : chain_steps(static_cast<std::uint16_t>(j))) {
-          moved[(t + 1) * joints + step.next] += m * step.probability;
+          sum += step.probability * value[(t + 1) * joints + step.next];
         }
+        moved[t * joints + j] = sum;
       }
     }
-    values.swap(moved);
+    value.swap(moved);
   };
-  std::uint16_t before = 0;
-  for (const int action : timed_path_[static_cast<std::size_t>(k)]) {
-    const std::uint16_t at = restore[problem_->timed_slot(action)];
-    for (std::uint16_t gap = before; gap < at; ++gap) step_chains(mass, deadline + 1);
-    before = at;
+  // After the last timed action: the static rest, then the reward at the finish.
+  const std::uint16_t last = timed.empty() ? 0 : restore[problem_->timed_slot(timed.back())];
+  const std::size_t rest = execution >= last ? execution - last : 0U;
+  value.assign(cells, 0.0);
+  for (std::size_t t = 0; t + rest <= deadline; ++t) {
+    const double reward = problem_->reward_at(k, static_cast<Steps>(t + rest));
+    for (std::size_t j = 0; j < joints; ++j) value[t * joints + j] = reward;
+  }
+  thread_local std::vector<double> started, waited;
+  for (std::size_t i = timed.size(); i-- > 0;) {
+    const int action = timed[i];
     const Action& model = problem_->action(action);
+    const int chain = problem_->execution_chain(action);
+    if (chain >= 0) {
+      // Started at t in j: x ~ execution_by_state[its chain's state in j], then U(t + x, .) after
+      // x steps of the chains. waited = U moved by x steps, for x = 0, 1, ...
+      started.assign(cells, 0.0);
+      waited = value;
+      Steps longest = 0;
+      for (const Distribution& by_state : model.execution_by_state) {
+        if (by_state.max_step() != kNever) longest = std::max(longest, by_state.max_step());
+      }
+      for (Steps x = 0; x <= std::min<Steps>(longest, deadline_); ++x) {
+        if (x > 0) {
+          value.swap(waited);
+          wait_one_step();
+          value.swap(waited);
+        }
+        for (std::size_t t = 0; t + static_cast<std::size_t>(x) <= deadline; ++t) {
+          for (std::size_t j = 0; j < joints; ++j) {
+            const double p =
+                model.execution_by_state[static_cast<std::size_t>(chain_state(static_cast<std::uint16_t>(j), chain))]
+                    .pmf(x);
+            if (p > 0.0) started[t * joints + j] += p * waited[t * joints + j];
+          }
+        }
+      }
+      value.swap(started);
+    }
+    // It cannot start after its last step, nor in a blocking state.
     const int blocking = problem_->blocking_chain(action);
     for (std::size_t t = 0; t <= deadline; ++t) {
       const bool late = model.start_by != kNever && static_cast<Steps>(t) > model.start_by;
       for (std::size_t j = 0; j < joints; ++j) {
         if (late || (blocking >= 0 && problem_->blocks(action, chain_state(static_cast<std::uint16_t>(j), blocking)))) {
-          mass[t * joints + j] = 0.0;
+          value[t * joints + j] = 0.0;
         }
       }
     }
-    const int chain = problem_->execution_chain(action);
-    if (chain < 0) continue;
-    // A chain-dependent execution: x ~ execution_by_state[the chain's state at its start]. The
-    // mass still executing is kept by steps left (pending[r * joints + j]) and moved with the
-    // chains one step at a time; what ends at step t joins the mass reaching the next action at t.
-    Steps longest = 0;
-    for (const Distribution& by_state : model.execution_by_state) {
-      if (by_state.max_step() != kNever) longest = std::max(longest, by_state.max_step());
-    }
-    const auto rows = static_cast<std::size_t>(std::min<Steps>(longest, deadline_)) + 1;
-    pending.assign(rows * joints, 0.0);
-    std::vector<double>& reached = mass;  // rewritten in place: step t is read before it is written
-    for (std::size_t t = 0; t <= deadline; ++t) {
-      for (std::size_t j = 0; j < joints; ++j) {
-        const double m = reached[t * joints + j];
-        if (m == 0.0) continue;
-        const Distribution& by_state =
-            model.execution_by_state[static_cast<std::size_t>(chain_state(static_cast<std::uint16_t>(j), chain))];
-        for (Steps x = by_state.min_step();
-             by_state.min_step() != kNever && x <= by_state.max_step() && static_cast<std::size_t>(x) < rows &&
-             t + static_cast<std::size_t>(x) <= deadline;
-             ++x) {
-          pending[static_cast<std::size_t>(x) * joints + j] += m * by_state.pmf(x);
-        }
-      }
-      for (std::size_t j = 0; j < joints; ++j) reached[t * joints + j] = pending[j];
-      // The rest moves one step: rows 1.. become rows 0.., with the chains' step.
-      moved.assign(rows * joints, 0.0);
-      for (std::size_t r = 1; r < rows; ++r) {
-        for (std::size_t j = 0; j < joints; ++j) {
-          const double m = pending[r * joints + j];
-          if (m == 0.0) continue;
-          for (const ChainStep& step : chain_steps(static_cast<std::uint16_t>(j))) {
-            moved[(r - 1) * joints + step.next] += m * step.probability;
-          }
-        }
-      }
-      pending.swap(moved);
-    }
+    // The static execution before it, since the previous timed action (or the plan's start).
+    const std::uint16_t at = restore[problem_->timed_slot(action)];
+    const std::uint16_t previous = i > 0 ? restore[problem_->timed_slot(timed[i - 1])] : 0;
+    for (std::uint16_t gap = previous; gap < at; ++gap) wait_one_step();
   }
-  // The static rest: a shift in time (the chains no longer matter), then the reward at the finish.
-  const std::uint16_t rest = execution >= before ? static_cast<std::uint16_t>(execution - before) : 0;
-  double value = 0.0;
-  for (std::size_t t = 0; t + rest <= deadline; ++t) {
-    double reached = 0.0;
-    for (std::size_t j = 0; j < joints; ++j) reached += mass[t * joints + j];
-    if (reached > 0.0) value += reached * problem_->reward_at(k, static_cast<Steps>(t + rest));
-  }
-  return value;
+  out.swap(value);
 }
 
 void Mdp::refuse_timed(std::string_view what) const {

@@ -217,7 +217,7 @@ Status Session::carry_out_timed(World& world) {
   if (report(observation) != Status::success) return status_;
   // The completed plan is executed in the simulated chains.
   const auto slot = static_cast<std::size_t>(solution_);
-  const Steps finish = mdp_->sample_execution(solution_, state_.time, state_.chains, &state_.restore[0],
+  const Steps finish = mdp_->sample_execution(solution_, state_.time, state_.chains, state_.restore.data(),
                                               state_.execution[slot], exogenous_);
   if (finish == kNever) {
     status_ = Status::failure;

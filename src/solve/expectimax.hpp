@@ -320,7 +320,7 @@ class Expectimax {
       for (; i < frame.end && items_[i].choice == choice; ++i) {
         const Item& item = items_[i];
         if (item.status == Status::success) {
-          value += item.probability * mdp_->success_reward(item.next, item.choice);
+          value += item.probability * success_reward(item.next, item.choice);
         } else if (item.status == Status::running) {
           value += item.probability * memo_.at(item.key).value;
         }
@@ -344,6 +344,44 @@ class Expectimax {
     items_.resize(frame.begin);
     frames_.pop_back();
   }
+
+  // R of a success (SPEC §8); with chains or expiry (SPEC §9) from the table of its plan's values
+  // over every start (Mdp::execution_table), made once per plan: a plan is its skeleton, its ET
+  // and the executions before its timed actions, so the tables' number does not grow with the
+  // chains' states, and each success costs a look-up.
+  double success_reward(const Compact& state, int choice) {
+    if constexpr (kHoldsChains<Compact>) {
+      if (mdp_->is_timed()) {
+        const int k = mdp_->completed_skeleton(state, choice);
+        const PlanKey key{static_cast<std::uint16_t>(k), state.execution[static_cast<std::size_t>(k)], state.restore};
+        auto found = plans_.find(key);
+        if (found == plans_.end()) {
+          if (plan_cells_ > kMaxPlanCells) {
+            return mdp_->execution_value(k, state.time, state.chains, state.restore.data(), key.execution);
+          }
+          found = plans_.try_emplace(key).first;
+          mdp_->execution_table(k, state.restore.data(), key.execution, found->second);
+          plan_cells_ += found->second.size();
+        }
+        return found
+            ->second[static_cast<std::size_t>(state.time) * static_cast<std::size_t>(mdp_->joint_chain_states()) +
+                     state.chains];
+      }
+    }
+    return mdp_->success_reward(state, choice);
+  }
+  struct PlanKey {
+    std::uint16_t skeleton;
+    std::uint16_t execution;
+    std::array<std::uint16_t, kMaxExactCulpritSlots> restore;
+    friend bool operator==(const PlanKey&, const PlanKey&) = default;
+  };
+  static_assert(sizeof(PlanKey) == 4 + 2 * kMaxExactCulpritSlots,
+                "PlanKey must have no padding: it is hashed as bytes");
+  // Past this many cached values (256 MiB) a success is valued without a table.
+  static constexpr std::size_t kMaxPlanCells = std::size_t{1} << 25;
+  absl::flat_hash_map<PlanKey, std::vector<double>, CompactStateHash> plans_;
+  std::size_t plan_cells_ = 0;
 
   // States between two checks of the stop condition: rare enough to cost nothing, frequent
   // enough (well under a millisecond of work) to stop promptly.

@@ -11,28 +11,14 @@
 #include "ontime/run/evaluation.hpp"
 #include "ontime/run/session.hpp"
 #include "ontime/util/error.hpp"
+#include "support/paper.hpp"
 
 namespace ontime {
 namespace {
 
-// To the meeting through the coffee queue (worth 1) or straight (0.7, falling with the finish);
-// the queue's length sets the wait, and the meeting room's door may lock for good.
-Problem coffee() {
-  return parse_problem(R"({"deadline": 12,
-      "chains": {"queue": {"states": ["short", "long"], "start": "short", "transitions": [[0.7, 0.3], [0.4, 0.6]]},
-                 "door": {"states": ["open", "locked"], "start": "open", "transitions": [[0.95, 0.05], [0, 1]]}},
-      "actions": {
-        "go": {"planning": {"pmf": {"1": 0.6, "2": 0.4}}, "execution": {"pmf": {"2": 1.0}}},
-        "wait": {"planning": {"pmf": {"1": 0.8}},
-                 "execution": {"chain": "queue", "by_state": {"short": {"pmf": {"1": 1.0}}, "long": {"pmf": {"4": 0.5, "6": 0.5}}}}},
-        "enter": {"planning": {"pmf": {"2": 0.7, "3": 0.3}}, "execution": {"pmf": {"1": 1.0}},
-                  "expires": {"after": 11, "chain": "door", "states": ["locked"]}},
-        "walk": {"planning": {"pmf": {"2": 0.5, "4": 0.5}}, "execution": {"pmf": {"3": 1.0}},
-                 "expires": {"chain": "door", "states": ["locked"]}}},
-      "skeletons": [["go", "wait", "enter"], ["walk"]],
-      "rewards": [1.0, {"value": 0.7, "per_step": 0.02}]})",
-                       "coffee.json");
-}
+// To the meeting through the coffee queue or straight there; the door may lock (the example
+// instance of SPEC §9).
+Problem coffee() { return load_problem(testing::source_path("data/instances/chains/meeting-through-the-queue.json")); }
 
 TEST(EpisodeChains, EpisodesEstimateTheExactValuesForEveryThreadCount) {
   const Problem problem = coffee();

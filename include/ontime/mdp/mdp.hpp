@@ -124,7 +124,7 @@ class Mdp {
   // Exogenous chains and expiry (SPEC §9). Whether the problem has chains, or chains or timed
   // actions; the number of joint states of the chains (1 without); the joint state of one state
   // per chain (by index, in the problem's order of chains) and chain c's state in a joint state.
-  bool has_chains() const noexcept { return joint_count_ > 1 || problem_->has_chains(); }
+  bool has_chains() const noexcept { return problem_->has_chains(); }
   bool is_timed() const noexcept { return problem_->is_timed(); }
   int joint_chain_states() const noexcept { return joint_count_; }
   // Throws UsageError naming `what` when the problem has chains or expiry: for the solvers and
@@ -154,6 +154,10 @@ class Mdp {
   // first call.
   double execution_value(int k, Steps start, std::uint16_t joint, const std::uint16_t* restore,
                          std::uint16_t execution) const;
+  // The same for every start at once: out[t * joint_chain_states() + j] is the value from step t
+  // in joint state j, (D + 1) * joint_chain_states() entries (computed backwards over the plan at
+  // the cost of one execution_value): the exact solvers keep one table per plan.
+  void execution_table(int k, const std::uint16_t* restore, std::uint16_t execution, std::vector<double>& out) const;
   // One execution of the same plan drawn from the model: the chains' steps and the
   // chain-dependent executions. The step the execution ends, or kNever when the plan fails (an
   // action that cannot start, a finish after the deadline).
@@ -197,7 +201,7 @@ class Mdp {
       if (is_timed()) {
         const int k = completed_skeleton(state, choice);
         const auto slot = static_cast<std::size_t>(k);
-        return execution_value(k, state.time, state.chains, &state.restore[0], state.execution[slot]);
+        return execution_value(k, state.time, state.chains, state.restore.data(), state.execution[slot]);
       }
     }
     if (!problem_->has_rewards()) return 1.0;
@@ -528,30 +532,17 @@ ChoiceList Mdp::useful_choices(const S& state) const {
   // action that other skeletons share; with chains or expiry (SPEC §9) such a step, or an idle
   // one, waits, which may be worth more than finishing a plan now (a door may open). Then every
   // group with work left is worth considering, and one idle choice if some skeleton has none.
-  const bool every_group = has_backtracking() || is_timed();
-  int idle = -1;
+  const bool timed = is_timed();
+  const bool every_group = timed || has_backtracking();
+  bool idle = timed;  // an idle choice is still to be offered
   for (int k = 0; k < skeleton_count_; ++k) {
     const int action = next_action(state, k);
     if (action < 0) {
-      if (idle < 0) idle = k;
-      continue;
+      if (idle) choices.push_back(k);
+      idle = false;
+    } else if (problem_->members(action).front() == k && (every_group || group_can_succeed(state, action))) {
+      choices.push_back(k);
     }
-    if (problem_->members(action).front() != k) continue;
-    if (every_group || group_can_succeed(state, action)) choices.push_back(k);
-  }
-  if (is_timed() && idle >= 0 && !choices.empty()) {
-    // In increasing index order, as the callers expect.
-    ChoiceList ordered;
-    bool placed = false;
-    for (const int k : choices) {
-      if (!placed && idle < k) {
-        ordered.push_back(idle);
-        placed = true;
-      }
-      ordered.push_back(k);
-    }
-    if (!placed) ordered.push_back(idle);
-    return ordered;
   }
   return choices;
 }
