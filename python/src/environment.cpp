@@ -40,8 +40,9 @@ class EnvironmentCore {
       seed_ = *seed;
       episode_ = 0;
     }
-    world_.begin_episode(stream_seed(seed_, episode_++));
-    session_.emplace(mdp_->mdp);
+    const std::uint64_t episode_seed = stream_seed(seed_, episode_++);
+    world_.begin_episode(episode_seed);
+    session_.emplace(mdp_->mdp, episode_seed);  // (its simulated chains, SPEC §9)
     return observation();
   }
 

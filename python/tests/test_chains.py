@@ -111,3 +111,19 @@ def test_allocators_that_do_not_model_chains_refuse_them(tmp_path):
     evaluated = ontime.evaluate(problem, "round-robin", episodes=4000, exact=True, seed=3)
     assert evaluated["exact_success_probability"] == pytest.approx(0.7, abs=1e-15)
     assert abs(evaluated["success_rate"] - 0.7) <= 4 * evaluated["ci95"]
+
+
+def test_the_environment_draws_each_episodes_chains(tmp_path):
+    from ontime.env import EffortAllocationEnv
+    path = tmp_path / "queue.json"
+    path.write_text(json.dumps(QUEUE))
+    env = EffortAllocationEnv(ontime.load_problem(path), seed=4)
+    rewards = []
+    for _ in range(400):
+        env.reset()
+        observation, reward, terminated, truncated, info = env.step(0)  # the wait, found in one step
+        assert terminated
+        rewards.append(reward)
+    # Only the queue is random here: short at step 1 (0.7) earns 1, long earns 0.
+    assert set(rewards) == {0.0, 1.0}
+    assert abs(np.mean(rewards) - 0.7) < 4 * math.sqrt(0.7 * 0.3 / 400)

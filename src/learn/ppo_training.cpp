@@ -144,7 +144,7 @@ class PpoTrainer {
   // choices, as the episode runner's allocators step through theirs.
   Status play_episode(std::uint64_t world_seed) {
     world_.begin_episode(world_seed);
-    Session session(mdp_);
+    Session session(mdp_, world_seed);  // (its simulated chains, SPEC §9)
     const State& state = session.state();
     const std::size_t first = batch_.steps();
     Status status = Status::running;

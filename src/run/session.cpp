@@ -40,11 +40,12 @@ Session::Session(const Mdp& mdp, Allocator& allocator, std::uint64_t seed, const
 
 // before_ stays empty until a transition needs it (a live report): a caller-decided session that
 // is not live never copies its state.
-Session::Session(const Mdp& mdp)
+Session::Session(const Mdp& mdp, std::uint64_t seed)
     : mdp_(&mdp),
       allocator_(nullptr),
       state_(mdp.start()),
-      attempts_(static_cast<std::size_t>(mdp.problem().action_count())) {}
+      attempts_(static_cast<std::size_t>(mdp.problem().action_count())),
+      seed_(seed) {}
 
 Session::Session(const Mdp& mdp, const Clock& clock, LiveOptions options) : Session(mdp) { start_live(clock, options); }
 

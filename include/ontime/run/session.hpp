@@ -115,8 +115,9 @@ class Session {
   // UsageError for a decision share outside (0, 1e6].
   Session(const Mdp& mdp, Allocator& allocator, std::uint64_t seed, const Clock& clock, LiveOptions options = {});
   // A session without an allocator: the caller decides every step (decide()). The Mdp must
-  // outlive it.
-  explicit Session(const Mdp& mdp);
+  // outlive it. `seed` draws the simulated chains (SPEC §9) when the steps are carried out in a
+  // World (carry_out): a learner's environment passes each episode's own.
+  explicit Session(const Mdp& mdp, std::uint64_t seed = 0);
   // The same live on `clock` (which must outlive it); its deadline starts now. Throws UsageError
   // for a decision share outside (0, 1e6].
   Session(const Mdp& mdp, const Clock& clock, LiveOptions options = {});
