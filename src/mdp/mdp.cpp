@@ -196,10 +196,6 @@ void Mdp::reject_execution(Steps execution) {
   throw UsageError("execution time must be >= 0 steps (got " + std::to_string(execution) + ")");
 }
 
-}  // namespace ontime
-
-namespace ontime {
-
 void Mdp::index_chains(const Problem& problem) {
   const auto chains = problem.chains();
   chain_strides_.assign(chains.size(), 1);
