@@ -4,7 +4,8 @@
 # MPI and SLURM check of scripts/cluster/check.sh); then clang-tidy over OnTime's sources
 # (.clang-tidy), the Python package installed by pip and the Debian package built, installed and
 # removed (both from build/); then the core alone without OMPL, FCL and KDL (build-core/: build,
-# the tool's refusals, install, consumer; compiled by clang, its warnings errors too); then builds
+# the tool's refusals, install, consumer; compiled by clang, file by file, its warnings errors
+# too: the other builds compile sources in batches, this one shows a missing include); then builds
 # the suite again with AddressSanitizer and UndefinedBehaviorSanitizer (build-sanitize/, clang:
 # two thirds of GCC's compile time) and runs it there too (warnings are checked by the first two
 # builds).

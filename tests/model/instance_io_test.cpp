@@ -13,6 +13,7 @@
 #include "ontime/util/input_file.hpp"
 #include "support/bad_inputs.hpp"
 #include "support/paper.hpp"
+#include "support/random_instances.hpp"
 
 namespace ontime {
 namespace {
@@ -241,18 +242,18 @@ TEST(InstanceIo, AControlByteInAKeyIsShownEscapedAndTheRuleKept) {
 // Loading is linear in the size of the file (bench/ontime_bench.cpp measures it); here: a large
 // object is read whole, in order, and a duplicate at its end is still found with its path.
 TEST(InstanceIo, AnObjectOfManyKeysIsReadInOrderAndDuplicatesAreFound) {
-  constexpr int kUnused = 100000;
+  const int unused = testing::repetitions_to_check(100000);
   std::string actions = kOneAction;
-  for (int i = 0; i < kUnused; ++i) {
+  for (int i = 0; i < unused; ++i) {
     actions +=
         ", \"u" + std::to_string(i) + R"(": {"planning": {"pmf": {"2": 0.5}}, "execution": {"pmf": {"1": 1.0}}})";
   }
   const std::string text = R"({"deadline": 3, "actions": {)" + actions + R"(}, "skeletons": [["a"]]})";
   const Problem problem = parse_problem(text, "many.json");
-  ASSERT_EQ(problem.action_count(), kUnused + 1);
+  ASSERT_EQ(problem.action_count(), unused + 1);
   EXPECT_EQ(problem.action(0).id, "a");
-  EXPECT_EQ(problem.action(kUnused).id, "u" + std::to_string(kUnused - 1));
-  EXPECT_DOUBLE_EQ(problem.action(kUnused).planning.pmf(2), 0.5);
+  EXPECT_EQ(problem.action(unused).id, "u" + std::to_string(unused - 1));
+  EXPECT_DOUBLE_EQ(problem.action(unused).planning.pmf(2), 0.5);
 
   const std::string duplicated = R"({"deadline": 3, "actions": {)" + actions + ", " + kOneAction + "}}";
   try {

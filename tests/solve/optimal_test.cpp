@@ -52,7 +52,9 @@ TEST(Optimal, MatchesAnIndependentReferenceOnRandomInstances) {
 // States are memoised under 16-byte, 32-byte or full keys depending on the skeleton count and
 // the deadline; each encoding must give the reference value.
 TEST(Optimal, EveryStateEncodingGivesTheReferenceValue) {
-  for (std::uint64_t seed = 1; seed <= 60; ++seed) {  // up to 6 skeletons: 16- and 32-byte keys
+  const int count = testing::repetitions_to_check(60);
+  for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count);
+       ++seed) {  // up to 6 skeletons: 16- and 32-byte keys
     const Problem problem = testing::random_instance(seed * 7919, 6, 2, 7);
     const Mdp mdp(problem);
     OptimalSolver solver(mdp);

@@ -28,6 +28,19 @@ inline Problem queue_wait_instance(const std::string& expires) {
                        "wait.json");
 }
 
+// A door open at even steps only, and a plan through it found in one step: entering as soon as the
+// motion is found (step 1) fails; a step spent elsewhere first (on a plan that cannot succeed)
+// waits for the door and succeeds.
+inline Problem door_open_at_even_steps() {
+  return parse_problem(R"({"deadline": 6,
+      "chains": {"door": {"states": ["open", "locked"], "start": "open", "transitions": [[0, 1], [1, 0]]}},
+      "actions": {"enter": {"planning": {"pmf": {"1": 1.0}}, "execution": {"pmf": {"1": 1.0}},
+                            "expires": {"chain": "door", "states": ["locked"]}},
+                  "other": {"planning": {"pmf": {}}, "execution": {"pmf": {"1": 1.0}}}},
+      "skeletons": [["enter"], ["other"]]})",
+                       "door.json");
+}
+
 class ChainReferenceSolver {
  public:
   struct Node {

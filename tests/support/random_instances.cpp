@@ -1,5 +1,10 @@
 #include "support/random_instances.hpp"
 
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -127,6 +132,18 @@ Problem with_random_chains(const Problem& problem, std::uint64_t seed, bool rewa
 Problem wide_instance(std::uint64_t seed, int skeleton_count, int max_length, Steps deadline) {
   SplitMix64 generator(seed);
   return build_instance(generator, "wide-" + std::to_string(skeleton_count), deadline, skeleton_count, max_length);
+}
+
+int repetitions_to_check(int count) {
+  const char* share = std::getenv("ONTIME_TEST_SHARE");
+  if (share == nullptr || *share == '\0') return count;
+  char* end = nullptr;
+  const double value = std::strtod(share, &end);
+  if (end == share || *end != '\0' || !(value > 0.0 && value <= 1.0)) {
+    ADD_FAILURE() << "ONTIME_TEST_SHARE: a number in (0, 1], got '" << share << "'";
+    return count;
+  }
+  return std::max(1, static_cast<int>(std::ceil(value * count)));
 }
 
 }  // namespace ontime::testing

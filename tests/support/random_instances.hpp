@@ -16,6 +16,12 @@ Problem random_instance(std::uint64_t seed, int max_skeletons = 4, int max_lengt
 // reward per skeleton (SPEC §8, §9). Same seed, same instance.
 Problem with_random_chains(const Problem& problem, std::uint64_t seed, bool rewards);
 
+// How many of `count` repetitions (random instances, generated keys) a test checks: all of them,
+// or the share named by the environment variable ONTIME_TEST_SHARE (in (0, 1], at least one). The
+// sanitizer run sets 0.25: the first repetitions take the same code paths under the sanitizers at
+// a quarter of the cost, and the release build checks them all.
+int repetitions_to_check(int count);
+
 // Exactly `skeleton_count` skeletons of at most `max_length` actions, built the same way.
 Problem wide_instance(std::uint64_t seed, int skeleton_count, int max_length, Steps deadline);
 
