@@ -127,3 +127,22 @@ def test_the_environment_draws_each_episodes_chains(tmp_path):
     # Only the queue is random here: short at step 1 (0.7) earns 1, long earns 0.
     assert set(rewards) == {0.0, 1.0}
     assert abs(np.mean(rewards) - 0.7) < 4 * math.sqrt(0.7 * 0.3 / 400)
+
+
+def test_the_averaging_baseline_cannot_wait_for_a_door(tmp_path):
+    # A door open at even steps only. Averaged, it is open 4 steps in 7 whenever the robot comes, so
+    # the baseline enters as soon as the motion is found (step 1, locked); the optimum waits a step.
+    door = {"deadline": 6,
+            "chains": {"door": {"states": ["open", "locked"], "start": "open", "transitions": [[0, 1], [1, 0]]}},
+            "actions": {"enter": {"planning": {"pmf": {"1": 1.0}}, "execution": {"pmf": {"1": 1.0}},
+                                  "expires": {"chain": "door", "states": ["locked"]}},
+                        "other": {"planning": {"pmf": {}}, "execution": {"pmf": {"1": 1.0}}}},
+            "skeletons": [["enter"], ["other"]]}
+    path = tmp_path / "door.json"
+    path.write_text(json.dumps(door))
+    problem = ontime.load_problem(path)
+    optimal = ontime.evaluate(problem, "optimal", episodes=200, exact=True, seed=1)
+    averaged = ontime.evaluate(problem, "averaged", episodes=200, exact=True, seed=1)
+    assert optimal["exact_success_probability"] == 1.0
+    assert averaged["exact_success_probability"] == 0.0
+    assert averaged["success_rate"] == 0.0

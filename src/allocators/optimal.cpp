@@ -45,12 +45,16 @@ AllocatorKind optimal_kind() {
             std::shared_ptr<const OptimalSolver> solved = std::move(solver);
             return [model = &mdp, solved] { return std::make_unique<OptimalAllocator>(*model, solved); };
           },
-          .needs = {.memory = {.parameter = "max-states",
-                               .bytes =
-                                   [](const Problem& problem, const ParameterReader& parameters) {
-                                     return OptimalSolver::max_bytes(problem, parameters.integer("max-states"));
-                                   },
-                               .per_allocator = false}}};
+          .needs = exact_solve_needs()};
+}
+
+AllocatorNeeds exact_solve_needs() {
+  return {.memory = {.parameter = "max-states",
+                     .bytes =
+                         [](const Problem& problem, const ParameterReader& parameters) {
+                           return OptimalSolver::max_bytes(problem, parameters.integer("max-states"));
+                         },
+                     .per_allocator = false}};
 }
 
 }  // namespace ontime

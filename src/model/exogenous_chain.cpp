@@ -186,21 +186,25 @@ std::vector<double> chain_distribution(const ExogenousChain& chain, int from, st
   }
   if (steps < 0)
     throw UsageError("chain '" + chain.name + "': a number of steps >= 0 (got " + std::to_string(steps) + ")");
-  // (By hand: one fixed summation order, so the same bits on every machine, and the rows of
-  // states the chain cannot be in skipped.)
   std::vector<double> now(n, 0.0);
   std::vector<double> next(n);
   now[static_cast<std::size_t>(from)] = 1.0;
   for (std::int64_t t = 0; t < steps; ++t) {
-    std::fill(next.begin(), next.end(), 0.0);
-    for (std::size_t i = 0; i < n; ++i) {
-      if (now[i] == 0.0) continue;
-      const std::vector<double>& row = chain.transitions[i];
-      for (std::size_t j = 0; j < n; ++j) next[j] += now[i] * row[j];
-    }
+    advance_chain_distribution(chain, now, next);
     now.swap(next);
   }
   return now;
+}
+
+void advance_chain_distribution(const ExogenousChain& chain, std::span<const double> now, std::span<double> next) {
+  // (By hand: one fixed summation order, so the same bits on every machine, and the rows of
+  // states the chain cannot be in skipped.)
+  std::fill(next.begin(), next.end(), 0.0);
+  for (std::size_t i = 0; i < now.size(); ++i) {
+    if (now[i] == 0.0) continue;
+    const std::vector<double>& row = chain.transitions[i];
+    for (std::size_t j = 0; j < next.size(); ++j) next[j] += now[i] * row[j];
+  }
 }
 
 }  // namespace ontime

@@ -21,6 +21,11 @@ class ParameterValues;
 // given in `values`, or its default. Throws UsageError for a bad value.
 std::size_t max_states_of(const ParameterValues& values);
 
+struct AllocatorNeeds;
+// What a kind that solves its instance exactly once, under its `max-states` parameter, needs: the
+// memory of OptimalSolver::max_bytes, shared by its allocators (the optimal and averaged kinds).
+AllocatorNeeds exact_solve_needs();
+
 // Follows the optimal policy. The solve from the start state is done once and shared by all
 // allocators a factory makes; a state outside it (a session resumed elsewhere) is solved on
 // demand by a private solver.

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -60,5 +61,10 @@ void save_chain(const ExogenousChain& chain, const std::filesystem::path& path);
 // chain.states. Summed in a fixed order (row by row, state by state), so that it is the same on
 // every machine. O(steps * n^2). Throws UsageError for an invalid chain or `from`, or steps < 0.
 std::vector<double> chain_distribution(const ExogenousChain& chain, int from, std::int64_t steps);
+
+// One step of a distribution over the chain's states: next[j] = sum_i now[i] * transitions[i][j], in
+// that fixed order (rows of states with no mass skipped). Both spans have one entry per state (not
+// checked); no allocation.
+void advance_chain_distribution(const ExogenousChain& chain, std::span<const double> now, std::span<double> next);
 
 }  // namespace ontime
