@@ -6,7 +6,8 @@ queues for a coffee, is worth 1.0; going around it, without one, 0.7. The queue'
 exogenous chain fitted to simulated observations, and the way around passes a door that locks.
 The study sweeps the queue's length when the robot starts, from empty to full, and compares
 exactly the chain-aware optimum (`optimal`) with the baseline that plans on the chain's mean
-occupancy and follows that plan blind to the queue (`averaged`), and with two chain-blind
+occupancy and follows that plan blind to the queue (`averaged`), with the paper's heuristic
+reading the queue at every step (`dp-rerun`, SPEC §9's rule), and with two chain-blind
 heuristics.
 
 What the script computes, every step an `ontime` command or standard-library Python, every random
@@ -54,7 +55,7 @@ choice drawn from `--seed`:
    `ontime evaluate --exact` of `optimal`, `averaged`, `averaged --horizon H` (`--long-horizon`,
    default 10000: the chain's occupancy averaged over H steps from the start, about the long-run
    mix a log of past waits gives; left out with a note when the command line does not know
-   `--horizon`), `first-found` and `round-robin`: each policy's exact expected reward and success
+   `--horizon`), `dp-rerun`, `first-found` and `round-robin`: each policy's exact expected reward and success
    probability. `optimal` re-solves inside `evaluate`; its exact reward is checked against the
    solve's at every start. The sweep evaluates exactly only (`--episodes 1`, the least the command
    accepts); at the fitted chain's start (the empty queue of the morning) each allocator is also
@@ -458,7 +459,8 @@ def allocator_columns(args):
     if args.long_horizon:
         columns.append((f"averaged --horizon {args.long_horizon}",
                         ["averaged", "--horizon", str(args.long_horizon)]))
-    columns += [("first-found", ["first-found"]), ("round-robin", ["round-robin"])]
+    columns += [("dp-rerun", ["dp-rerun"]), ("first-found", ["first-found"]),
+                ("round-robin", ["round-robin"])]
     return columns
 
 

@@ -107,7 +107,9 @@ def test_allocators_that_do_not_model_chains_refuse_them(tmp_path):
     path.write_text(json.dumps(QUEUE))
     problem = ontime.load_problem(path)
     with pytest.raises(ontime.UsageError, match="does not take instances with exogenous chains"):
-        ontime.make_allocator(problem, "dp-rerun")
+        ontime.make_allocator(problem, "branch-and-bound")
+    with pytest.raises(ontime.UsageError, match="'sum' has no form with chains"):
+        ontime.make_allocator(problem, "dp-rerun", aggregation="sum")
     evaluated = ontime.evaluate(problem, "round-robin", episodes=4000, exact=True, seed=3)
     assert evaluated["exact_success_probability"] == pytest.approx(0.7, abs=1e-15)
     assert abs(evaluated["success_rate"] - 0.7) <= 4 * evaluated["ci95"]
@@ -146,3 +148,19 @@ def test_the_averaging_baseline_cannot_wait_for_a_door(tmp_path):
     assert optimal["exact_success_probability"] == 1.0
     assert averaged["exact_success_probability"] == 0.0
     assert averaged["success_rate"] == 0.0
+
+
+def test_the_allocators_that_model_chains_know_the_queue(tmp_path):
+    # One skeleton: every allocator that takes chains refines it at once; the wait starts at step 1,
+    # short then with probability 0.7 (done at 2), long with 0.3 (done at 6, past the deadline).
+    path = tmp_path / "queue.json"
+    path.write_text(json.dumps(QUEUE))
+    problem = ontime.load_problem(path)
+    for name in ("dp", "dp-rerun", "greedy", "found-order-round-robin"):
+        evaluated = ontime.evaluate(problem, name, episodes=2000, exact=True, seed=5)
+        assert evaluated["exact_success_probability"] == pytest.approx(0.7, abs=1e-15), name
+        assert abs(evaluated["success_rate"] - 0.7) <= 4 * evaluated["ci95"], name
+    for name in ("thompson", "mcts"):
+        search = {"iterations": 200} if name == "mcts" else {}
+        evaluated = ontime.evaluate(problem, name, episodes=2000, seed=5, **search)
+        assert abs(evaluated["success_rate"] - 0.7) <= 4 * evaluated["ci95"], name

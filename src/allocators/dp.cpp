@@ -4,15 +4,20 @@
 
 #include "ontime/allocators/allocator_registry.hpp"
 #include "ontime/solve/backtracking_success.hpp"
+#include "ontime/solve/timed_contiguous_success.hpp"
 
 namespace ontime {
 namespace {
 
 int best_single_skeleton(const Mdp& mdp) {
-  // Eq. (1), or with backtracking (SPEC §7) its extension, for every skeleton from the start.
+  // Eq. (1), or with backtracking (SPEC §7) its extension, or with chains or expiry (SPEC §9) the
+  // exact value of refining the skeleton alone, for every skeleton from the start.
   std::optional<ContiguousSuccessTable> table;
   std::optional<BacktrackingSuccess> backtracking;
-  if (mdp.has_backtracking()) {
+  std::optional<TimedContiguousSuccess> timed;
+  if (mdp.is_timed()) {
+    timed.emplace(mdp);
+  } else if (mdp.has_backtracking()) {
     backtracking.emplace(mdp, Aggregation::self);
   } else {
     table.emplace(mdp, Aggregation::self);
@@ -21,7 +26,9 @@ int best_single_skeleton(const Mdp& mdp) {
   int best = 0;
   double best_value = -1;
   for (int k = 0; k < mdp.skeleton_count(); ++k) {
-    const double value = table ? table->success_probability(k, 0, 0, 0) : backtracking->success_probability(start, k);
+    const double value = table          ? table->success_probability(k, 0, 0, 0)
+                         : backtracking ? backtracking->success_probability(start, k)
+                                        : timed->expected_reward(start, k);
     if (value > best_value) {
       best_value = value;
       best = k;
@@ -37,7 +44,7 @@ DpAllocator::DpAllocator(const Mdp& mdp) : chosen_(best_single_skeleton(mdp)) {}
 AllocatorKind dp_kind() {
   return {.name = "dp",
           .summary = "the paper's DP: the single skeleton most likely to succeed alone, refined for the whole episode",
-          .capabilities = {Capability::stationary},
+          .capabilities = {Capability::stationary, Capability::chains},
           .parameters = {},
           .make = [](const Mdp& mdp, const ParameterReader&) -> AllocatorFactory {
             const int chosen = DpAllocator(mdp).chosen_skeleton();

@@ -1,14 +1,23 @@
 #include "ontime/allocators/dp_rerun.hpp"
 
+#include <string>
+
 #include "ontime/allocators/allocator_registry.hpp"
+#include "ontime/util/error.hpp"
 
 namespace ontime {
 
-DpRerunAllocator::DpRerunAllocator(const Mdp& mdp, Aggregation aggregation) : mdp_(&mdp) {
-  if (mdp.has_backtracking()) {
-    backtracking_ = std::make_unique<BacktrackingSuccess>(mdp, aggregation);
+DpRerunAllocator::DpRerunAllocator(const Mdp& mdp, std::optional<Aggregation> aggregation) : mdp_(&mdp) {
+  if (mdp.is_timed()) {
+    if (aggregation.value_or(Aggregation::self) != Aggregation::self) {
+      throw UsageError(std::string("dp-rerun: aggregation '").append(to_string(*aggregation)) +
+                       "' has no form with chains or expiry (SPEC §9); 'self' is the one taken");
+    }
+    timed_ = std::make_unique<TimedContiguousSuccess>(mdp);
+  } else if (mdp.has_backtracking()) {
+    backtracking_ = std::make_unique<BacktrackingSuccess>(mdp, aggregation.value_or(Aggregation::sum));
   } else {
-    table_ = std::make_shared<ContiguousSuccessTable>(mdp, aggregation);
+    table_ = std::make_shared<ContiguousSuccessTable>(mdp, aggregation.value_or(Aggregation::sum));
     worked_on_.reserve(static_cast<std::size_t>(mdp.skeleton_count()));
   }
 }
@@ -21,12 +30,15 @@ DpRerunAllocator::DpRerunAllocator(const Mdp& mdp, std::shared_ptr<const Contigu
 DpRerunAllocator::DpRerunAllocator(const Mdp& mdp, std::unique_ptr<BacktrackingSuccess> backtracking)
     : mdp_(&mdp), backtracking_(std::move(backtracking)) {}
 
-int DpRerunAllocator::choose_with_backtracking(const State& state) {
+DpRerunAllocator::DpRerunAllocator(const Mdp& mdp, std::unique_ptr<TimedContiguousSuccess> timed)
+    : mdp_(&mdp), timed_(std::move(timed)) {}
+
+int DpRerunAllocator::choose_memoised(const State& state) {
   int best = -1;
   double best_value = -1;
   for (int k = 0; k < mdp_->skeleton_count(); ++k) {
     if (mdp_->next_action(state, k) < 0) continue;
-    const double value = backtracking_->success_probability(state, k);
+    const double value = timed_ ? timed_->expected_reward(state, k) : backtracking_->success_probability(state, k);
     if (value > best_value) {
       best_value = value;
       best = k;
@@ -36,7 +48,7 @@ int DpRerunAllocator::choose_with_backtracking(const State& state) {
 }
 
 int DpRerunAllocator::choose(const State& state) {
-  if (backtracking_) return choose_with_backtracking(state);
+  if (backtracking_ || timed_) return choose_memoised(state);
   // The largest PS, ties to the lowest index. Skeletons worked on (PT_k > 0) need a dot product:
   // they are left for a second pass, where those whose bound is below the best are skipped.
   int best = -1;
@@ -72,11 +84,22 @@ AllocatorKind dp_rerun_kind() {
   return {
       .name = "dp-rerun",
       .summary = "the paper's DP_Rerun: Eq. (1) re-evaluated before every step, the most promising skeleton refined",
-      .capabilities = {Capability::stationary},
+      .capabilities = {Capability::stationary, Capability::chains},
       .parameters = {Parameter::choice("aggregation", "sum", {"sum", "max", "self"},
-                                       "how Eq. (1) combines the skeletons sharing an action")},
+                                       "how Eq. (1) combines the skeletons sharing an action (with chains or expiry "
+                                       "only self, the default there)")},
       .make = [](const Mdp& mdp, const ParameterReader& parameters) -> AllocatorFactory {
         const Aggregation aggregation = parse_aggregation(parameters.text("aggregation"));
+        if (mdp.is_timed()) {
+          if (parameters.given("aggregation") && aggregation != Aggregation::self) {
+            throw UsageError("parameter 'aggregation': '" + parameters.text("aggregation") +
+                             "' has no form with chains or expiry (SPEC §9); 'self' is the one taken");
+          }
+          const TimedContiguousSuccess probe(mdp);  // checks the instance's size once, before any episode
+          return [model = &mdp] {
+            return std::make_unique<DpRerunAllocator>(*model, std::make_unique<TimedContiguousSuccess>(*model));
+          };
+        }
         if (mdp.has_backtracking()) {
           return [model = &mdp, aggregation] {
             return std::make_unique<DpRerunAllocator>(*model,

@@ -23,7 +23,7 @@ AllocatorKind found_order_round_robin_kind() {
   return {
       .name = "found-order-round-robin",
       .summary = "baseline: the skeletons not known dead in turn, in found order, the (CT mod n)-th of n at step CT",
-      .capabilities = {Capability::stationary},
+      .capabilities = {Capability::stationary, Capability::chains},
       .parameters = {},
       .make = [](const Mdp& mdp, const ParameterReader&) -> AllocatorFactory {
         return [model = &mdp] { return std::make_unique<FoundOrderRoundRobinAllocator>(*model); };

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
 #include <utility>
 
 #include "allocators/detail/anytime_budget.hpp"
@@ -20,12 +23,34 @@ std::size_t grown_capacity(std::size_t capacity, std::size_t needed) noexcept {
 }  // namespace
 
 MctsAllocator::MctsAllocator(const Mdp& mdp, MctsOptions options)
-    : mdp_(&mdp), options_(std::move(options)), rewards_(mdp.problem().has_rewards()) {
+    : mdp_(&mdp),
+      options_(std::move(options)),
+      // With chains or expiry a completed plan is worth its expected reward over the chains' paths
+      // while it executes (SPEC §9), which may be below 1 even without rewards.
+      rewards_(mdp.problem().has_rewards() || mdp.is_timed()) {
   if (!(options_.exploration >= 0.0) || !std::isfinite(options_.exploration)) {
     throw UsageError("the exploration constant of mcts must be a finite number >= 0");
   }
   if (options_.leaf_bounds && options_.backup != MctsBackup::bellman) {
     throw UsageError("mcts: leaf values from bounds need bellman backups (a mean counts rewards 0 or 1)");
+  }
+  if (mdp.has_chains()) {
+    // A chance node holds every refinement outcome times every step of the chains (SPEC §9), and
+    // counts them in 16 bits.
+    std::size_t refinement = 0;
+    for (int action = 0; action < mdp.problem().action_count(); ++action) {
+      refinement =
+          std::max(refinement, mdp.execution_outcomes(action).size() + 1 + mdp.problem().culprits(action).size());
+    }
+    std::size_t steps = 0;
+    for (int joint = 0; joint < mdp.joint_chain_states(); ++joint) {
+      steps = std::max(steps, mdp.chain_steps(static_cast<std::uint16_t>(joint)).size());
+    }
+    if (refinement * steps > std::numeric_limits<std::uint16_t>::max()) {
+      throw UsageError("mcts: a step may have " + std::to_string(refinement * steps) +
+                       " outcomes (refinement outcomes times steps of the chains); its chance nodes hold at most " +
+                       std::to_string(std::numeric_limits<std::uint16_t>::max()));
+    }
   }
   if (options_.rollout) {
     rollout_policy_ = options_.rollout();
@@ -361,7 +386,7 @@ AllocatorKind mcts_kind() {
   return {
       .name = "mcts",
       .summary = "Monte Carlo tree search (UCT with chance nodes) sampling the model before every step",
-      .capabilities = {Capability::randomised, Capability::anytime},
+      .capabilities = {Capability::randomised, Capability::anytime, Capability::chains},
       .parameters = {Parameter::integer("iterations", 10'000, 1, Parameter::kNoLimit,
                                         "search iterations per decision (no limit when only time-budget is given)"),
                      Parameter::real("time-budget", 0, 0, Parameter::kNoLimit,

@@ -85,8 +85,37 @@ std::int64_t ThompsonAllocator::drawn_finish_with_backtracking(const State& stat
   return time + execution;
 }
 
+ThompsonAllocator::Draw ThompsonAllocator::drawn_plan_with_chains(const State& state, int k) {
+  // Skeleton k refined alone in one draw of the model: planning, static executions and the
+  // chains' steps as the MDP draws them, until a plan is completed (worth its expected reward
+  // over the chains' paths while it executes) or the episode is lost (worth -1).
+  scratch_ = state;
+  for (;;) {
+    const Observation observation = mdp_->sample_observation(scratch_, k, generator_);
+    const Status status = mdp_->apply(scratch_, k, observation);
+    if (status == Status::success) return {mdp_->success_reward(scratch_, k), scratch_.time};
+    if (status == Status::failure) return {-1.0, kNeverFinishes};
+  }
+}
+
+int ThompsonAllocator::choose_with_chains(const State& state) {
+  int best = -1;
+  Draw best_draw{-1.0, kNeverFinishes};
+  for (int k = 0; k < mdp_->skeleton_count(); ++k) {
+    if (!mdp_->can_succeed(state, k)) continue;
+    const Draw draw = drawn_plan_with_chains(state, k);
+    if (best < 0 || draw.worth > best_draw.worth ||
+        (draw.worth == best_draw.worth && draw.completed < best_draw.completed)) {
+      best = k;
+      best_draw = draw;
+    }
+  }
+  return best >= 0 ? best : mdp_->first_with_work_left(state);
+}
+
 int ThompsonAllocator::choose(const State& state) {
   ++decision_;
+  if (mdp_->is_timed()) return choose_with_chains(state);
   if (mdp_->has_backtracking()) {
     int best = -1;
     std::int64_t best_finish = kNeverFinishes;
@@ -125,7 +154,7 @@ int ThompsonAllocator::choose(const State& state) {
 AllocatorKind thompson_kind() {
   return {.name = "thompson",
           .summary = "Thompson-style: one world drawn from the model per step, the skeleton finishing soonest in it",
-          .capabilities = {Capability::randomised},
+          .capabilities = {Capability::randomised, Capability::chains},
           .parameters = {},
           .make = [](const Mdp& mdp, const ParameterReader&) -> AllocatorFactory {
             return [model = &mdp] { return std::make_unique<ThompsonAllocator>(*model); };

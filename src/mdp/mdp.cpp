@@ -341,8 +341,8 @@ void Mdp::execution_table(int k, const std::uint16_t* restore, std::uint16_t exe
 void Mdp::refuse_timed(std::string_view what) const {
   if (!is_timed()) return;
   throw UsageError(std::string(what) + ": " + problem_->name() +
-                   " has exogenous chains or actions that expire (SPEC §9), which only the memoised exact solver and "
-                   "exact evaluation model so far");
+                   " has exogenous chains or actions that expire (SPEC §9), not modelled there yet; the memoised exact "
+                   "solver, exact evaluation and the allocators listed with 'chains' ('ontime allocators') model them");
 }
 
 void Mdp::reject_chains(std::uint16_t joint) const {

@@ -246,17 +246,25 @@ State Session::carried_over(const State& old, const Problem& next) const {
     if (action >= 0) spent[static_cast<std::size_t>(action)] = old.spent[static_cast<std::size_t>(k)];
   }
   const std::int64_t saturated = std::int64_t{next.deadline()} + 1;
-  State out(static_cast<std::size_t>(next.skeleton_count()), static_cast<std::size_t>(next.culprit_slot_count()));
+  // What a refined action adds to ET: its execution, or nothing when that depends on a chain and
+  // is drawn when it starts (SPEC §9).
+  const auto static_steps = [&](int action) -> std::int64_t {
+    if (next.is_timed() && next.execution_chain(action) >= 0) return 0;
+    return std::max<Steps>(0, action_execution_steps_[static_cast<std::size_t>(action)]);
+  };
+  State out(static_cast<std::size_t>(next.skeleton_count()),
+            static_cast<std::size_t>(next.culprit_slot_count() + next.timed_slot_count()));
   out.time = old.time;
-  // Backtracking (SPEC §7): B_c of every refined culprit, the execution before it on its path.
+  out.chains = old.chains;  // the chains are carried over in their order: the same joint state
+  // Backtracking (SPEC §7): B_c of every refined culprit, the execution before it on its path;
+  // chains or expiry (SPEC §9): the same of every refined timed action (a problem has one kind).
   for (int c = 0; c < next.action_count(); ++c) {
-    const int slot = next.culprit_slot(c);
+    const int slot = next.culprit_slot(c) >= 0 ? next.culprit_slot(c) : next.is_timed() ? next.timed_slot(c) : -1;
     const auto index = static_cast<std::size_t>(c);
     if (slot < 0 || index >= action_execution_steps_.size() || action_execution_steps_[index] < 0) continue;
     std::int64_t before = 0;
-    for (int up = next.parent(c); up >= 0; up = next.parent(up)) {
-      before = std::min(saturated, before + std::max<Steps>(0, action_execution_steps_[static_cast<std::size_t>(up)]));
-    }
+    for (int up = next.parent(c); up >= 0; up = next.parent(up))
+      before = std::min(saturated, before + static_steps(up));
     out.restore[static_cast<std::size_t>(slot)] = static_cast<std::uint16_t>(before);
   }
   for (int k = 0; k < next.skeleton_count(); ++k) {
@@ -266,7 +274,7 @@ State Session::carried_over(const State& old, const Problem& next) const {
     while (refined < path.size()) {
       const auto action = static_cast<std::size_t>(path[refined]);
       if (action >= action_execution_steps_.size() || action_execution_steps_[action] < 0) break;
-      execution = std::min(saturated, execution + action_execution_steps_[action]);
+      execution = std::min(saturated, execution + static_steps(path[refined]));
       ++refined;
     }
     const auto slot = static_cast<std::size_t>(k);
@@ -281,7 +289,6 @@ void Session::change_skeletons(std::vector<Action> actions, std::vector<std::vec
                                std::vector<SkeletonReward> rewards) {
   const Problem& current = mdp_->problem();
   // Everything that can fail comes first, so that a failure leaves the session as it was.
-  mdp_->refuse_timed("changing the skeletons of a session");
   auto problem =
       std::make_unique<Problem>(current.name(), current.deadline(), current.step_seconds(), std::move(actions),
                                 std::move(skeletons), current.description(), std::move(rewards),

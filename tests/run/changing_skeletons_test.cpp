@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -10,11 +11,14 @@
 
 #include "ontime/allocators/allocator_registry.hpp"
 #include "ontime/allocators/optimal.hpp"
+#include "ontime/model/instance_io.hpp"
 #include "ontime/run/clock.hpp"
 #include "ontime/run/session.hpp"
 #include "ontime/run/simulator.hpp"
 #include "ontime/util/error.hpp"
+#include "ontime/util/random.hpp"
 #include "support/paper.hpp"
+#include "support/random_instances.hpp"
 
 namespace ontime {
 namespace {
@@ -100,6 +104,93 @@ TEST(ChangingSkeletons, AnArrivingSkeletonStartsFromWhatWasLearntAndEveryExactAl
       }
     }
   }
+}
+
+// `full`'s actions, chains and rewards with some of its skeletons, in the order given.
+Problem with_chain_skeletons(const Problem& full, const std::vector<int>& which) {
+  std::vector<std::vector<int>> skeletons;
+  std::vector<SkeletonReward> rewards;
+  for (const int k : which) {
+    skeletons.emplace_back(full.skeleton(k).begin(), full.skeleton(k).end());
+    rewards.push_back(full.reward(k));
+  }
+  return Problem(full.name(), full.deadline(), full.step_seconds(),
+                 std::vector<Action>(full.actions().begin(), full.actions().end()), std::move(skeletons),
+                 full.description(), std::move(rewards),
+                 std::vector<ExogenousChain>(full.chains().begin(), full.chains().end()));
+}
+
+// With chains and expiry (SPEC §9) the carried state holds the chains' joint state and the static
+// execution before each refined timed action, as if the skeleton had been there from the start.
+TEST(ChangingSkeletons, WithChainsTheStateCarriesTheChainsAndTheExecutionsBeforeTimedActions) {
+  int compared = 0;
+  for (std::uint64_t seed = 1; seed <= 400; ++seed) {
+    const Problem full =
+        testing::with_random_chains(testing::random_instance(seed + 300, 5, 3, 9), seed + 300, seed % 2 == 0);
+    if (full.skeleton_count() < 3) continue;
+    Session session(with_chain_skeletons(full, {0, 1}), maker("round-robin"), seed);
+    const Mdp full_mdp(full);
+    HiddenWorld world(full, seed);
+    SplitMix64 chains(seed);
+    std::vector<std::pair<int, Observation>> history;
+    for (int i = 0; i < 6 && session.status() == Status::running; ++i) {
+      const Decision decision = session.choose();
+      Observation seen =
+          decision.action < 0
+              ? Observation::not_yet()
+              : world.step(decision.action, session.state().spent[static_cast<std::size_t>(decision.skeleton)]);
+      seen = seen.with_chains(full_mdp.sample_chain_step(session.state().chains, chains));
+      history.emplace_back(decision.action, seen);
+      session.report(seen);
+    }
+    if (session.status() != Status::running) continue;
+    session.add_skeleton(ids_of(full, 2), {}, full.reward(2));
+    const Problem expected_problem = with_chain_skeletons(full, {0, 1, 2});
+    const State expected = replayed(expected_problem, history);
+    EXPECT_EQ(session.state(), expected) << "seed " << seed;
+    ++compared;
+    if (session.status() != Status::running) continue;
+    OptimalSolver in_session(session.mdp());
+    const Mdp fresh_mdp(expected_problem);
+    OptimalSolver from_scratch(fresh_mdp);
+    EXPECT_EQ(in_session.solve(session.state()), from_scratch.solve(expected)) << "seed " << seed;
+  }
+  EXPECT_GT(compared, 10);
+}
+
+TEST(ChangingSkeletons, ASkeletonArrivingBehindARefinedTimedActionFindsItsExecutionBefore) {
+  // move (2 steps of execution), then the coffee (its wait depends on the queue, drawn when it
+  // starts), then the meeting; a second way on from the coffee arrives once it is refined.
+  const Problem full = parse_problem(R"({"deadline": 30,
+      "chains": {"queue": {"states": ["short", "long"], "start": "long", "transitions": [[0.5, 0.5], [0.5, 0.5]]}},
+      "actions": {"move": {"planning": {"pmf": {"1": 1.0}}, "execution": {"pmf": {"2": 1.0}}},
+                  "coffee": {"planning": {"pmf": {"1": 1.0}},
+                             "execution": {"chain": "queue", "by_state": {"short": {"pmf": {"1": 1.0}},
+                                                                          "long": {"pmf": {"6": 1.0}}}}},
+                  "meet": {"planning": {"pmf": {"4": 1.0}}, "execution": {"pmf": {"1": 1.0}}},
+                  "call": {"planning": {"pmf": {"3": 1.0}}, "execution": {"pmf": {"1": 1.0}}}},
+      "skeletons": [["move", "coffee", "meet"], ["move", "coffee", "call"]]})",
+                                     "coffee.json");
+  Session session(with_chain_skeletons(full, {0}), Session::AllocatorMaker{}, 1);
+  const int move = full.find_action("move");
+  const int coffee = full.find_action("coffee");
+  // Step 1 finds the move (queue short after it), step 2 the coffee (queue long after it); the
+  // coffee's reported 5 steps are not its wait, which is drawn when it starts.
+  std::vector<std::pair<int, Observation>> history{{move, Observation::found(2).with_chains(0)},
+                                                   {coffee, Observation::found(5).with_chains(1)}};
+  for (const auto& [action, observation] : history) {
+    ASSERT_EQ(session.decide(0).action, session.problem().find_action(full.action(action).id));
+    session.report(observation);
+  }
+  ASSERT_EQ(session.status(), Status::running);
+  session.add_skeleton(ids_of(full, 1), {}, full.reward(1));
+  const State& carried = session.state();
+  EXPECT_EQ(carried.time, 2);
+  EXPECT_EQ(carried.chains, 1);        // long
+  EXPECT_EQ(carried.refined[1], 2);    // move and coffee
+  EXPECT_EQ(carried.execution[1], 2);  // the move's; the coffee's wait is drawn when it starts
+  EXPECT_EQ(carried.restore[static_cast<std::size_t>(full.timed_slot(coffee))], 2);  // the execution before it
+  EXPECT_EQ(carried, replayed(full, history));
 }
 
 TEST(ChangingSkeletons, ARetiredSkeletonLeavesTheOthersAsTheyWere) {

@@ -7,6 +7,7 @@
 
 #include "ontime/allocators/allocator_registry.hpp"
 #include "ontime/model/instance_io.hpp"
+#include "ontime/run/clock.hpp"
 #include "ontime/run/episode_runner.hpp"
 #include "ontime/run/evaluation.hpp"
 #include "ontime/run/session.hpp"
@@ -42,11 +43,14 @@ TEST(EpisodeChains, EpisodesEstimateTheExactValuesForEveryThreadCount) {
   }
 }
 
-TEST(EpisodeChains, WhatSessionsDoNotTakeYetIsRefused) {
+TEST(EpisodeChains, ASessionWithChainsRetiresASkeletonButIsNotLiveYet) {
   const Problem problem = coffee();
   Session session(problem, Session::AllocatorMaker{}, 1);
-  EXPECT_THROW(session.retire_skeleton(0), UsageError);
-  EXPECT_EQ(session.problem().skeleton_count(), 2);  // nothing lost
+  session.retire_skeleton(0);
+  EXPECT_EQ(session.problem().skeleton_count(), 1);
+  EXPECT_EQ(session.state().chains, Mdp(problem).start().chains);
+  ManualClock clock;
+  EXPECT_THROW(Session(problem, Session::AllocatorMaker{}, 1, &clock), UsageError);
 }
 
 }  // namespace

@@ -60,6 +60,12 @@ class ChainReferenceSolver {
 
   double optimum() { return solve({}); }
   double value_of(Rule rule) { return solve(std::move(rule)); }
+  // The value of following `rule` from `node` on.
+  double value_from(const Node& node, Rule rule) {
+    rule_ = std::move(rule);
+    memo_.clear();
+    return value(node);
+  }
 
   // The expected reward of executing skeleton m from step `start` with the chains in `chains`,
   // its refined actions' executions `executions` (kAtStart: drawn when the action starts).

@@ -2,8 +2,9 @@
 // `dp` (the paper's DP, SPEC §3): the best linear contiguous policy over single skeletons.
 //
 // Computes PS(k, 0, 0, 0) of Eq. (1) with aggregation `self` for every skeleton (with
-// backtracking, SPEC §7, its extension: backtracking_success.hpp), picks the largest once (ties:
-// lowest index) and refines only that skeleton for the whole episode.
+// backtracking, SPEC §7, its extension: backtracking_success.hpp; with chains or expiry, SPEC §9,
+// the exact value of refining the skeleton alone: timed_contiguous_success.hpp), picks the largest
+// once (ties: lowest index) and refines only that skeleton for the whole episode.
 // No guarantee beyond optimality among "one skeleton, refined contiguously" policies.
 // Cost: one ContiguousSuccessTable build at construction; O(1) per decision.
 

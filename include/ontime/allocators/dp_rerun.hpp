@@ -12,23 +12,34 @@
 // best so far: O(K) with a few dot products, no allocation (see docs/performance.md). With
 // backtracking (SPEC §7) PS is its extension (backtracking_success.hpp), memoised per allocator:
 // O(K) hash lookups once the values an episode needs are known.
+// With chains or expiry (SPEC §9) PS is the exact expected reward of refining the skeleton alone
+// from the state, the chains read now and modelled from there (timed_contiguous_success.hpp):
+// Eq. (1) has no form for a chain, and that is the value Eq. (1) stands for with aggregation
+// `self`, the only one taken then (the default becomes `self`). Memoised per allocator as well.
 
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "ontime/allocators/allocator.hpp"
 #include "ontime/solve/backtracking_success.hpp"
 #include "ontime/solve/contiguous_success.hpp"
+#include "ontime/solve/timed_contiguous_success.hpp"
 
 namespace ontime {
 
 class DpRerunAllocator final : public Allocator {
  public:
-  DpRerunAllocator(const Mdp& mdp, Aggregation aggregation = Aggregation::sum);
+  // No aggregation: `sum`, or `self` with chains or expiry; another with them throws UsageError.
+  explicit DpRerunAllocator(const Mdp& mdp, std::optional<Aggregation> aggregation = std::nullopt);
   DpRerunAllocator(const Mdp& mdp, std::shared_ptr<const ContiguousSuccessTable> table);
 
   // With backtracking (SPEC §7): Eq. (1)'s extension, memoised by this allocator as it decides.
   DpRerunAllocator(const Mdp& mdp, std::unique_ptr<BacktrackingSuccess> backtracking);
+
+  // With chains or expiry (SPEC §9): the value of refining each skeleton alone, memoised by this
+  // allocator as it decides.
+  DpRerunAllocator(const Mdp& mdp, std::unique_ptr<TimedContiguousSuccess> timed);
 
   std::string_view name() const noexcept override { return "dp-rerun"; }
   int choose(const State& state) override;
@@ -37,11 +48,13 @@ class DpRerunAllocator final : public Allocator {
   const ContiguousSuccessTable& table() const noexcept { return *table_; }
 
  private:
-  int choose_with_backtracking(const State& state);
+  // With backtracking or chains: the largest memoised value over the skeletons with work left.
+  int choose_memoised(const State& state);
 
   const Mdp* mdp_;
   std::shared_ptr<const ContiguousSuccessTable> table_;
   std::unique_ptr<BacktrackingSuccess> backtracking_;
+  std::unique_ptr<TimedContiguousSuccess> timed_;
   std::vector<int> worked_on_;  // skeletons with steps spent on their current action (scratch)
 };
 

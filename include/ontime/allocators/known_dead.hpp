@@ -8,7 +8,9 @@
 // leaves no room for one more step of effort: the next motion is found at CT + 1 at the
 // earliest and executes in 0 steps or more, so CT + 1 + ET_k > D rules the skeleton out. This
 // also covers the "never" and too-slow execution times, which the MDP saturates at D + 1.
-// Any skeleton the model says can still succeed (Mdp::can_succeed) passes this test.
+// Any skeleton the model says can still succeed (Mdp::can_succeed) passes this test. With chains
+// (SPEC §9) ET_k is the static part of the execution, a lower bound of what is still to come, so
+// the test still only rules out.
 // Cost: O(1).
 
 #include <cstddef>

@@ -29,6 +29,11 @@
 // rollouts settles on a1_1 (Q* = 0.920) because a2_1's first rollouts fail; bellman with upper
 // leaves picks a2_1 (Q* = 0.942) in every seed tried (docs/experiments.md).
 //
+// With chains or expiry (SPEC §9) an outcome is a refinement outcome and a step of the chains
+// (Mdp::for_each_observation), so the tree branches on the chains too, waiting is a choice, and a
+// success is worth its plan's expected reward over the chains' paths. Leaf values from the bounds
+// and rollout policies that do not take chains are refused there (exit 2).
+//
 // It sees only the MDP state: the search samples from the model's distributions, never from
 // the hidden outcomes of the episode it decides for. After each observed transition the
 // matching subtree becomes the new root (tree reuse).

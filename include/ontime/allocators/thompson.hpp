@@ -27,6 +27,14 @@
 // after which the refinement goes on from the culprit with the execution before it restored),
 // until the skeleton is refined or the deadline passes; the step goes to the skeleton finishing
 // soonest in its draw. O(D) draws per skeleton at most.
+//
+// With chains or expiry (SPEC §9) a skeleton's draw is its refinement alone as the MDP draws it
+// (planning, static executions and the chains' steps, Mdp::sample_observation), until it completes
+// a plan or the episode is lost. The chains' path while the plan executes is not drawn: the plan
+// is worth its expected reward over those paths (Mdp::success_reward), a lost draw nothing. The
+// step goes to the skeleton whose draw is worth the most, the soonest completed among equals.
+// Every skeleton is drawn on its own (an action two skeletons share is drawn for each), and no
+// draw waits for the chains. O(D) draws per skeleton at most.
 
 #include <cstdint>
 #include <vector>
@@ -54,6 +62,13 @@ class ThompsonAllocator final : public Allocator {
   // With backtracking: when skeleton k would finish in one draw of its refinement (kNever-like
   // maximum when past the deadline).
   std::int64_t drawn_finish_with_backtracking(const State& state, int k);
+  // With chains or expiry: one draw of skeleton k refined alone, and the choice from such draws.
+  struct Draw {
+    double worth;            // the plan's expected reward, -1 when the draw loses the episode
+    std::int64_t completed;  // the step its refinement completed (kNever-like maximum when lost)
+  };
+  Draw drawn_plan_with_chains(const State& state, int k);
+  int choose_with_chains(const State& state);
   // Whether skeleton k, finishing at `finish` in the drawn world, beats `best` finishing at
   // `best_finish` (best < 0: there is none yet).
   bool better(int k, std::int64_t finish, int best, std::int64_t best_finish) const;
@@ -64,6 +79,7 @@ class ThompsonAllocator final : public Allocator {
   std::vector<std::uint64_t> drawn_at_;         // per action: the decision of its last draw
   std::vector<std::int64_t> drawn_time_;        // per action: its draw in that decision
   std::vector<std::int64_t> execution_before_;  // backtracking: ET before each position (scratch)
+  State scratch_;                               // chains: the state of one skeleton's draw
 };
 
 }  // namespace ontime
