@@ -8,8 +8,10 @@
 #include <atomic>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <limits>
+#include <map>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -88,6 +90,13 @@ struct MdpHandle {
   std::shared_ptr<const Problem> problem;
   Mdp mdp;
 };
+
+// The chains' states a caller reports after a step ({chain: state}, by name; SPEC §9): the
+// observation with their joint state, which an instance with chains needs (UsageError without)
+// and one without refuses; and the states of a joint state, by name.
+using ChainStates = std::optional<std::map<std::string, std::string>>;
+Observation with_reported_chains(const Mdp& mdp, Observation observation, const ChainStates& reported);
+std::map<std::string, std::string> chain_states(const Mdp& mdp, std::uint16_t joint);
 
 // A State with the number of skeletons it is about, so that Python sees K entries, not 16.
 struct StateView {

@@ -110,16 +110,34 @@ void bind_live(py::module_& m) {
           "ended (the deadline passed, or no skeleton can succeed any more).")
       .def(
           "report_not_yet",
-          [](LiveSessionHandle& h) { return session_call([&] { return h.session.report_not_yet(); }); },
-          "The planner's call found no motion. Returns the status.")
+          [](LiveSessionHandle& h, const ChainStates& chains) {
+            const Observation observation = with_reported_chains(h.session.mdp(), Observation::not_yet(), chains);
+            return session_call([&] { return h.session.report(observation); });
+          },
+          py::kw_only(), py::arg("chains") = py::none(),
+          "The planner's call found no motion. With exogenous chains (SPEC §9), `chains` gives their states now "
+          "({chain: state}, required then); steps the clock moved on between reports keep the states last "
+          "reported. Returns the status.")
       .def(
           "report_refined_seconds",
           [](LiveSessionHandle& h,
-             Number<double, "execution_seconds", 0.0, std::numeric_limits<double>::infinity()> seconds) {
-            return session_call([&] { return h.session.report_refined_seconds(seconds); });
+             Number<double, "execution_seconds", 0.0, std::numeric_limits<double>::infinity()> seconds,
+             const ChainStates& chains) {
+            // Checked first (required with chains, refused without), then carried by the report.
+            const std::uint16_t joint = with_reported_chains(h.session.mdp(), Observation::not_yet(), chains).chains;
+            return session_call([&] {
+              return chains ? h.session.report_refined_seconds(seconds, joint)
+                            : h.session.report_refined_seconds(seconds);
+            });
           },
-          py::arg("execution_seconds"),
-          "The call found a motion taking `execution_seconds` to execute (math.inf: it cannot be executed).")
+          py::arg("execution_seconds"), py::kw_only(), py::arg("chains") = py::none(),
+          "The call found a motion taking `execution_seconds` to execute (math.inf: it cannot be executed; not "
+          "used for an action whose execution depends on a chain, drawn when it starts). With exogenous chains, "
+          "`chains` as for report_not_yet; a completed plan is then worth its expected reward from the reported "
+          "states (`reward`).")
+      .def_property_readonly(
+          "chains", [](const LiveSessionHandle& h) { return chain_states(h.session.mdp(), h.session.state().chains); },
+          "The exogenous chains' states (SPEC §9) as last reported, {chain: state}; empty without chains.")
       .def(
           "report_backtrack",
           [](LiveSessionHandle& h, const std::string& culprit) {

@@ -37,33 +37,6 @@ struct SessionHandle {
 };
 
 // A World implemented in Python (a subclass of ontime.World), called with the GIL held.
-// The observation with the chains' states a caller reported after the step ({chain: state}, by
-// name; SPEC §9), which an instance with chains needs and one without refuses.
-using ChainStates = std::optional<std::map<std::string, std::string>>;
-Observation with_reported_chains(const Mdp& mdp, Observation observation, const ChainStates& reported) {
-  const auto chains = mdp.problem().chains();
-  if (!reported) {
-    if (mdp.has_chains()) {
-      throw UsageError("this instance has exogenous chains: report their states after the step (chains={name: state})");
-    }
-    return observation;
-  }
-  std::vector<int> states;
-  for (const ExogenousChain& chain : chains) {
-    const auto found = reported->find(chain.name);
-    if (found == reported->end()) throw UsageError("chains: the state of chain '" + chain.name + "' is missing");
-    const int state = chain.state_index(found->second);
-    if (state < 0) throw UsageError("chains: chain '" + chain.name + "' has no state '" + found->second + "'");
-    states.push_back(state);
-  }
-  for (const auto& [name, state] : *reported) {
-    bool known = false;
-    for (const ExogenousChain& chain : chains) known = known || chain.name == name;
-    if (!known) throw UsageError("chains: no chain named '" + name + "' is declared");
-  }
-  return observation.with_chains(mdp.joint_chain_state(states));
-}
-
 class PythonWorld final : public World {
  public:
   explicit PythonWorld(py::object world) : world_(std::move(world)) {}
@@ -127,6 +100,41 @@ MonteCarloResult run_with_hooks(const Mdp& mdp, const WorldFactory& worlds, cons
 }
 
 }  // namespace
+
+// The observation with the chains' states a caller reported after the step ({chain: state}, by
+// name; SPEC §9), which an instance with chains needs and one without refuses.
+Observation with_reported_chains(const Mdp& mdp, Observation observation, const ChainStates& reported) {
+  const auto chains = mdp.problem().chains();
+  if (!reported) {
+    if (mdp.has_chains()) {
+      throw UsageError("this instance has exogenous chains: report their states after the step (chains={name: state})");
+    }
+    return observation;
+  }
+  std::vector<int> states;
+  for (const ExogenousChain& chain : chains) {
+    const auto found = reported->find(chain.name);
+    if (found == reported->end()) throw UsageError("chains: the state of chain '" + chain.name + "' is missing");
+    const int state = chain.state_index(found->second);
+    if (state < 0) throw UsageError("chains: chain '" + chain.name + "' has no state '" + found->second + "'");
+    states.push_back(state);
+  }
+  for (const auto& [name, state] : *reported) {
+    bool known = false;
+    for (const ExogenousChain& chain : chains) known = known || chain.name == name;
+    if (!known) throw UsageError("chains: no chain named '" + name + "' is declared");
+  }
+  return observation.with_chains(mdp.joint_chain_state(states));
+}
+
+std::map<std::string, std::string> chain_states(const Mdp& mdp, std::uint16_t joint) {
+  std::map<std::string, std::string> out;
+  const auto chains = mdp.problem().chains();
+  for (std::size_t c = 0; c < chains.size(); ++c) {
+    out[chains[c].name] = chains[c].states[static_cast<std::size_t>(mdp.chain_state(joint, static_cast<int>(c)))];
+  }
+  return out;
+}
 
 void check_episodes(std::uint64_t episodes) {
   if (episodes == 0) throw UsageError("episodes must be at least 1");
@@ -252,18 +260,7 @@ void bind_run(py::module_& m) {
           "cannot be executed; ignored for an action whose execution depends on a chain, drawn when it starts). "
           "With exogenous chains, `chains` as for report_not_yet. Returns the status.")
       .def_property_readonly(
-          "chains",
-          [](const SessionHandle& h) {
-            std::map<std::string, std::string> out;
-            const Mdp& mdp = h.session.mdp();
-            const auto chains = mdp.problem().chains();
-            for (std::size_t c = 0; c < chains.size(); ++c) {
-              out[chains[c].name] =
-                  chains[c]
-                      .states[static_cast<std::size_t>(mdp.chain_state(h.session.state().chains, static_cast<int>(c)))];
-            }
-            return out;
-          },
+          "chains", [](const SessionHandle& h) { return chain_states(h.session.mdp(), h.session.state().chains); },
           "The exogenous chains' states (SPEC §9), {chain: state}; empty without chains.")
       .def(
           "report_backtrack",

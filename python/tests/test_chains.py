@@ -164,3 +164,32 @@ def test_the_allocators_that_model_chains_know_the_queue(tmp_path):
         search = {"iterations": 200} if name == "mcts" else {}
         evaluated = ontime.evaluate(problem, name, episodes=2000, seed=5, **search)
         assert abs(evaluated["success_rate"] - 0.7) <= 4 * evaluated["ci95"], name
+
+
+def test_a_live_session_takes_the_queue_with_each_report():
+    # move (2 s), then the coffee: a 1-step wait with the queue short when it starts, 6 when long.
+    problem = ontime.Problem.from_dict({
+        "deadline": 6, "step_seconds": 1.0,
+        "chains": {"queue": {"states": ["short", "long"], "start": "short", "transitions": [[0.8, 0.2], [0.4, 0.6]]}},
+        "actions": {"move": {"planning": {"pmf": {"1": 1.0}}, "execution": {"pmf": {"2": 1.0}}},
+                    "coffee": {"planning": {"pmf": {"1": 1.0}},
+                               "execution": {"chain": "queue", "by_state": {"short": {"pmf": {"1": 1.0}},
+                                                                            "long": {"pmf": {"6": 1.0}}}}}},
+        "skeletons": [["move", "coffee"]],
+    })
+    for queue, short_when_it_starts in (("short", 0.8 * 0.8 + 0.2 * 0.4), ("long", 0.4 * 0.8 + 0.6 * 0.4)):
+        clock = ontime.ManualClock()
+        session = ontime.LiveSession(problem, "dp-rerun", clock=clock)
+        assert session.chains == {"queue": "short"}
+        assert session.choose().action_id == "move"
+        clock.advance(1.0)
+        with pytest.raises(ontime.UsageError, match="report their states"):
+            session.report_refined_seconds(2.0)
+        assert session.report_refined_seconds(2.0, chains={"queue": "long"}) == ontime.Status.running
+        assert session.chains == {"queue": "long"}
+        assert session.choose().action_id == "coffee"
+        clock.advance(1.0)
+        # The coffee's reported 30 s are not its wait: the static part (2 s from 2 s in) fits.
+        assert session.report_refined_seconds(30.0, chains={"queue": queue}) == ontime.Status.success
+        # The move runs in steps 2-3; the coffee starts at 4, two steps of the queue after the report.
+        assert session.reward == pytest.approx(short_when_it_starts, abs=1e-15)

@@ -41,7 +41,6 @@ void Session::start_live(const Clock& clock, LiveOptions options) {
   if (!(options.decision_share > 0 && options.decision_share <= 1e6)) {
     throw UsageError("decision_share must be in (0, 1e6] slices (got " + std::to_string(options.decision_share) + ")");
   }
-  mdp_->refuse_timed("a live session");
   clock_ = &clock;
   live_ = options;
   // Execution seconds per action: the plan's seconds at success (owning sessions have them already).
@@ -149,12 +148,19 @@ Decision Session::record_live_decision(int choice, double begin, Steps steps_bef
 }
 
 Status Session::report_refined_seconds(double execution_seconds) {
+  return report(Observation::found(execution_steps(execution_seconds)), execution_seconds);
+}
+
+Status Session::report_refined_seconds(double execution_seconds, std::uint16_t chains) {
+  return report(Observation::found(execution_steps(execution_seconds)).with_chains(chains), execution_seconds);
+}
+
+Steps Session::execution_steps(double execution_seconds) const {
   check_seconds(execution_seconds, "execution time");
   const double slices = std::ceil(execution_seconds / step_seconds() - kSliceTolerance);
-  const Steps steps = std::isinf(execution_seconds) || slices >= static_cast<double>(kNever)
-                          ? kNever
-                          : static_cast<Steps>(std::max(0.0, slices));
-  return report(Observation::found(steps), execution_seconds);
+  return std::isinf(execution_seconds) || slices >= static_cast<double>(kNever)
+             ? kNever
+             : static_cast<Steps>(std::max(0.0, slices));
 }
 
 Status Session::report_live(int choice, int action, const Observation& observation, double execution_seconds) {
@@ -204,15 +210,24 @@ Status Session::report_live(int choice, int action, const Observation& observati
       if (!problem.completes_a_skeleton(action) || problem.skeleton_length(member) != problem.position(action) + 1) {
         continue;
       }
-      // The plan to execute: every action of the completed skeleton, in seconds.
+      // The plan to execute: every action of the completed skeleton, in seconds. With chains or
+      // expiry (SPEC §9) its static part: an execution that depends on a chain is drawn when it
+      // starts, and the plan is worth its expected reward from the state now (chains as reported).
       double total = 0;
-      for (const int part : problem.skeleton(member))
+      for (const int part : problem.skeleton(member)) {
+        if (mdp_->is_timed() && problem.execution_chain(part) >= 0) continue;
         total += action_execution_seconds_[static_cast<std::size_t>(part)];
+      }
       if (elapsed + total <= deadline_seconds() + kSliceTolerance * step_seconds_) {
         solution_ = member;
         status_ = Status::success;
         ended_at_ = elapsed;
         finish_seconds_ = elapsed + total;
+        if (mdp_->is_timed()) {
+          const auto slot = static_cast<std::size_t>(member);
+          timed_reward_ =
+              mdp_->execution_value(member, state_.time, state_.chains, state_.restore.data(), state_.execution[slot]);
+        }
       }
       break;
     }

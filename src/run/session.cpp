@@ -206,6 +206,13 @@ Status Session::report(const Observation& observation, double execution_seconds)
 }
 
 Status Session::carry_out_timed(World& world) {
+  if (clock_ != nullptr) {
+    // The clock may move several steps between two reports, and the simulated chains would
+    // then have to move with it, unseen by the report that applies them.
+    throw UsageError(
+        "a live session with exogenous chains or expiry (SPEC §9) takes the caller's reports with the chains' "
+        "states; carrying its steps out in a world is not supported yet");
+  }
   if (!exogenous_seeded_) {
     // A stream of its own: the allocator's draws stay those of the same seed without chains.
     exogenous_ = SplitMix64(stream_seed(seed_, 0x65786f67));

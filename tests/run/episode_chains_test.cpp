@@ -11,6 +11,7 @@
 #include "ontime/run/episode_runner.hpp"
 #include "ontime/run/evaluation.hpp"
 #include "ontime/run/session.hpp"
+#include "ontime/run/simulator.hpp"
 #include "ontime/util/error.hpp"
 #include "support/paper.hpp"
 
@@ -43,14 +44,17 @@ TEST(EpisodeChains, EpisodesEstimateTheExactValuesForEveryThreadCount) {
   }
 }
 
-TEST(EpisodeChains, ASessionWithChainsRetiresASkeletonButIsNotLiveYet) {
+TEST(EpisodeChains, ASessionWithChainsRetiresASkeletonAndALiveOneTakesOnlyReports) {
   const Problem problem = coffee();
   Session session(problem, Session::AllocatorMaker{}, 1);
   session.retire_skeleton(0);
   EXPECT_EQ(session.problem().skeleton_count(), 1);
   EXPECT_EQ(session.state().chains, Mdp(problem).start().chains);
   ManualClock clock;
-  EXPECT_THROW(Session(problem, Session::AllocatorMaker{}, 1, &clock), UsageError);
+  Session live(problem, Session::AllocatorMaker{}, 1, &clock);
+  HiddenWorld world(problem, 1);
+  live.decide(0);
+  EXPECT_THROW(live.carry_out(world), UsageError);  // the simulated chains would not follow the clock
 }
 
 }  // namespace

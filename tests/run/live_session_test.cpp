@@ -11,6 +11,7 @@
 
 #include "ontime/allocators/allocator_registry.hpp"
 #include "ontime/allocators/dp_rerun.hpp"
+#include "ontime/model/instance_io.hpp"
 #include "ontime/run/clock.hpp"
 #include "ontime/run/episode_runner.hpp"
 #include "ontime/run/session.hpp"
@@ -302,6 +303,39 @@ TEST(LiveSession, EpisodesKeepTheirTimelineWhenAsked) {
   }
   EXPECT_DOUBLE_EQ(result.live.planning, planning);
   EXPECT_EQ(result.steps_used, result.decisions);
+}
+
+// A live session with exogenous chains (SPEC §9): move (2 s), then the coffee, whose wait is 1
+// step with the queue short when it starts and 6 when long; deadline 6 steps of 1 s.
+TEST(LiveSession, WithChainsTheReportsBringTheQueueAndThePlanIsWorthItsExpectedReward) {
+  const Problem problem = parse_problem(R"({"deadline": 6, "step_seconds": 1.0,
+      "chains": {"queue": {"states": ["short", "long"], "start": "short", "transitions": [[0.8, 0.2], [0.4, 0.6]]}},
+      "actions": {"move": {"planning": {"pmf": {"1": 1.0}}, "execution": {"pmf": {"2": 1.0}}},
+                  "coffee": {"planning": {"pmf": {"1": 1.0}},
+                             "execution": {"chain": "queue", "by_state": {"short": {"pmf": {"1": 1.0}},
+                                                                          "long": {"pmf": {"6": 1.0}}}}}},
+      "skeletons": [["move", "coffee"]]})",
+                                        "live-queue.json");
+  const Mdp mdp(problem);
+  for (const std::uint16_t queue : {std::uint16_t{0}, std::uint16_t{1}}) {
+    ManualClock clock;
+    Session session(problem, Session::AllocatorMaker{}, 1, &clock);
+    ASSERT_EQ(session.decide(0).action, problem.find_action("move"));
+    clock.advance(1.0);
+    ASSERT_EQ(session.report_refined_seconds(2.0, 0), Status::running);
+    ASSERT_EQ(session.decide(0).action, problem.find_action("coffee"));
+    clock.advance(1.5);  // an overrun: the report comes 2.5 s in, and the third step is charged
+    // The coffee's reported 30 s are not its wait (drawn when it starts): the plan's static part,
+    // 2 s from 2.5 s in, fits in the 6 s.
+    ASSERT_EQ(session.report_refined_seconds(30.0, queue), Status::success);
+    EXPECT_EQ(session.state().time, 3);
+    EXPECT_EQ(session.state().chains, queue);
+    // The move runs in steps 3-4, the coffee starts at step 5 with the queue two steps on from
+    // the reported state: short then (a 1-step wait, done at 6) wins, long (done at 11) loses.
+    const double short_at_5 = queue == 0 ? 0.8 * 0.8 + 0.2 * 0.4 : 0.4 * 0.8 + 0.6 * 0.4;
+    EXPECT_NEAR(session.reward(), short_at_5, 1e-15);
+    EXPECT_EQ(session.reward(), mdp.execution_value(0, 3, queue, session.state().restore.data(), 2));
+  }
 }
 
 }  // namespace

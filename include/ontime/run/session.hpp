@@ -152,9 +152,9 @@ class Session {
   // world.step(action, effort already spent on it), reported as report() does; an idle step (no
   // action left to refine) is reported as not yet without asking the world. With exogenous
   // chains (SPEC §9) the session simulates them, drawn from its seed: their step joins the
-  // world's answer, and a completed plan's execution is drawn in them. Returns the status
-  // after the step. Throws std::logic_error without a pending decision, and what the world or
-  // report() throws.
+  // world's answer, and a completed plan's execution is drawn in them (not in a live session:
+  // UsageError). Returns the status after the step. Throws std::logic_error without a pending
+  // decision, and what the world or report() throws.
   Status carry_out(World& world);
 
   // Reports the outcome of the step just decided. Throws std::logic_error without a
@@ -167,6 +167,14 @@ class Session {
   // form converts steps to seconds at step_seconds each). Throws UsageError for a negative or
   // non-finite time; infinity means the motion cannot be executed.
   Status report_refined_seconds(double execution_seconds);
+  // The same with exogenous chains (SPEC §9): `chains` is their joint state after the step
+  // (Mdp::joint_chain_state). A live session with chains or expiry takes the caller's reports
+  // (not carry_out): each report brings the chains' state now, and steps the clock moved on
+  // between reports keep the state last reported. A completed plan's static part must fit in
+  // seconds (the execution reported for an action that depends on a chain is not used: it is
+  // drawn when the action starts); the plan is then worth its expected reward from the state at
+  // the report (reward()).
+  Status report_refined_seconds(double execution_seconds, std::uint16_t chains);
 
   // Live sessions: time the clock did not see but the deadline must (e.g. spent on another
   // clock), added to the seconds gone. Throws UsageError for a negative or non-finite time,
@@ -259,6 +267,9 @@ class Session {
   // The search iterations the allocator has run so far (its "iterations" counter; 0 if none).
   std::uint64_t search_iterations() const;
   Status report(const Observation& observation, double execution_seconds);
+  // The whole slices an execution of `execution_seconds` takes (kNever for infinity); UsageError
+  // for a negative or NaN time.
+  Steps execution_steps(double execution_seconds) const;
   Steps steps_at(double seconds) const noexcept;
   void end_if_out_of_time();
   // No skeleton can succeed and none is expected to come.
