@@ -412,6 +412,11 @@ AllocatorKind mcts_kind() {
           if (options.backup != MctsBackup::bellman) {
             throw UsageError("parameter 'leaf': '" + leaf + "' needs backup 'bellman' (a mean counts rewards 0 or 1)");
           }
+          if (leaf == "lower" && mdp.is_timed()) {
+            throw UsageError(
+                "parameter 'leaf': the commit bound does not value exogenous chains or expiry (SPEC §9); use "
+                "'upper' or 'rollout'");
+          }
           options.leaf_bounds = std::make_shared<const ValueBounds>(mdp);  // ResourceLimitError past its cap
           options.optimistic_leaves = leaf == "upper";
         }

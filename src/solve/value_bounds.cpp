@@ -1,6 +1,8 @@
 #include "ontime/solve/value_bounds.hpp"
 
 #include <algorithm>
+#include <array>
+#include <span>
 #include <string>
 
 #include "ontime/util/error.hpp"
@@ -41,10 +43,14 @@ void fill_block(const Mdp& mdp, int action, const std::vector<double>& found, do
 // of budget left once it is refined (slower executions leave a negative budget: value
 // `too_slow`, 0 but for the upper bound under backtracking, where the actions below may still
 // give up).
+// With chains (SPEC §9) an execution that depends on a chain counts 0 steps here, the relaxation
+// of the upper bound (`action.execution` is not its distribution then).
 std::vector<double> convolve_execution(const Action& action, const std::vector<double>& after, double too_slow) {
   const std::size_t size = after.size();
   std::vector<double> found(size, 0.0);
-  const auto masses = action.execution.masses();
+  static constexpr std::array<double, 1> kNoSteps{1.0};
+  const std::span<const double> masses =
+      action.execution_chain.empty() ? action.execution.masses() : std::span<const double>(kNoSteps);
   for (std::size_t x = 0; x < std::min(size, masses.size()); ++x) {
     if (masses[x] <= 0.0) continue;
     for (std::size_t m = x; m < size; ++m) found[m] += masses[x] * after[m - x];
@@ -63,7 +69,6 @@ std::vector<double> convolve_execution(const Action& action, const std::vector<d
 
 ValueBounds::ValueBounds(const Mdp& mdp, std::size_t max_table_entries)
     : mdp_(&mdp), skeleton_count_(mdp.skeleton_count()), deadline_(mdp.deadline()) {
-  mdp.refuse_timed("the value bounds");
   const Problem& problem = mdp.problem();
   const auto deadline = static_cast<std::size_t>(deadline_);
   const std::size_t block = deadline * deadline;
@@ -78,7 +83,9 @@ ValueBounds::ValueBounds(const Mdp& mdp, std::size_t max_table_entries)
         floor = std::min(floor, problem.reward_at(m, deadline_));
       }
     }
-    reward_floor_.push_back(floor);
+    // With chains or expiry (SPEC §9) the commit tables, made from the static distributions, do not
+    // value the chains: no commit value is claimed (lower() is 0, sound and vacuous).
+    reward_floor_.push_back(mdp.is_timed() ? 0.0 : floor);
   }
 
   // The nodes of the prefix tree (actions some skeleton uses), deepest first, so that

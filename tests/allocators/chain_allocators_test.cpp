@@ -121,6 +121,11 @@ TEST(ChainAllocators, OnlyASearchThatCanWaitGetsThroughTheDoor) {
   options.time_decisions = false;
   EXPECT_EQ(run_monte_carlo(mdp, allocator_registry().make_factory("thompson", mdp), options).successes, 0U);
   EXPECT_EQ(run_monte_carlo(mdp, allocator_registry().make_factory("mcts", mdp), options).successes, 100U);
+  // Bellman backups with the upper bound's relaxation at new nodes find the wait too.
+  const AllocatorFactory bounded =
+      allocator_registry().make_factory("mcts", mdp, {{"backup", "bellman"}, {"leaf", "upper"}});
+  EXPECT_EQ(run_monte_carlo(mdp, bounded, options).successes, 100U);
+  EXPECT_THROW(allocator_registry().make_factory("mcts", mdp, {{"backup", "bellman"}, {"leaf", "lower"}}), UsageError);
 }
 
 // Skeleton 0 goes through a door that is locked for good; skeleton 1 goes around, slower.

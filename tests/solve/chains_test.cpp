@@ -127,7 +127,6 @@ TEST(Chains, WhatDoesNotModelThemYetRefusesThem) {
   EXPECT_THROW(solve_search(mdp), UsageError);
   const AllocatorRegistry& registry = allocator_registry();
   EXPECT_THROW(registry.make_factory("branch-and-bound", mdp, {}), UsageError);
-  EXPECT_THROW(registry.make_factory("mcts", mdp, {{"backup", "bellman"}, {"leaf", "upper"}}), UsageError);
   for (const char* name : {"optimal", "round-robin", "dp", "dp-rerun", "greedy", "thompson", "mcts"}) {
     EXPECT_NO_THROW(registry.make_factory(name, mdp, {})) << name;
   }

@@ -206,6 +206,35 @@ TEST(ValueBounds, BracketTheOptimumOnTheStartAndOnReachableStates) {
   EXPECT_GT(states, 30000U);
 }
 
+// With chains and expiry (SPEC §9): the upper bound is a relaxation (chain-dependent executions
+// 0, no expiry) and still bounds the optimum; no commit value is claimed.
+TEST(ValueBounds, WithChainsTheUpperBoundStillBoundsTheOptimumAndTheLowerIsVacuous) {
+  std::size_t states = 0;
+  int tight = 0;
+  const int count = testing::repetitions_to_check(200);
+  for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
+    const Problem problem =
+        testing::with_random_chains(testing::random_instance(seed + 700, 4, 3, 9), seed + 700, seed % 2 == 0);
+    const Mdp mdp(problem);
+    const ValueBounds bounds(mdp);
+    OptimalSolver solver(mdp);
+    std::vector<State> checked = reachable_states(mdp, seed, 10);
+    checked.push_back(mdp.start());
+    for (const State& state : checked) {
+      const double optimum = solver.solve(state);
+      const double upper = bounds.upper(state);
+      EXPECT_GE(upper, optimum - kBoundsRounding) << "seed " << seed << " time " << state.time;
+      EXPECT_LE(upper, problem.max_reward());
+      EXPECT_EQ(bounds.lower(state), 0.0);
+      EXPECT_EQ(bounds.lower_choice(state), -1);
+      tight += optimum > 0 && upper < problem.max_reward() ? 1 : 0;
+      ++states;
+    }
+  }
+  EXPECT_GT(states, static_cast<std::size_t>(count) * 10);
+  EXPECT_GT(tight, count);  // the bound says more than "at most the largest reward" on many states
+}
+
 TEST(ValueBounds, UpperIsTheClairvoyantProbabilityEnumeratedOutcomeByOutcome) {
   for (std::uint64_t seed = 1; seed <= 400; ++seed) {
     const Problem problem = testing::random_instance(seed * 31, 3, 3, 8);

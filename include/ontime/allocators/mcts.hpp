@@ -31,8 +31,10 @@
 //
 // With chains or expiry (SPEC §9) an outcome is a refinement outcome and a step of the chains
 // (Mdp::for_each_observation), so the tree branches on the chains too, waiting is a choice, and a
-// success is worth its plan's expected reward over the chains' paths. Leaf values from the bounds
-// and rollout policies that do not take chains are refused there (exit 2).
+// success is worth its plan's expected reward over the chains' paths. Upper-bound leaves are the
+// relaxation of value_bounds.hpp (chain-dependent executions 0, no expiry); the commit bound
+// does not value chains and is refused there (exit 2), as are rollout policies that do not take
+// chains.
 //
 // It sees only the MDP state: the search samples from the model's distributions, never from
 // the hidden outcomes of the episode it decides for. After each observed transition the

@@ -38,6 +38,15 @@
 // is spent (CT + ET_k >= D, but CT + 1 < D). The restore values are not read: the relaxation
 // never needs them, and the commit bound never gets there.
 //
+// With exogenous chains or expiry (SPEC §9) upper(s) is still an upper bound: it is the
+// clairvoyant relaxation of the problem with every execution that depends on a chain taking 0
+// steps and no action expiring. A success of any policy needs the static part of some skeleton's
+// remaining planning and execution to fit the time left, which is what the relaxation counts (a
+// wait only uses time), and a success is worth at most the largest reward. The commit tables
+// read the static distributions only, so they would overrate a commit there: commit(s, k) and
+// lower(s) are 0 (sound, vacuous) and lower_choice(s) is -1. The exact value of a commit with
+// chains is TimedContiguousSuccess's (memoised, so not something these shared tables can hold).
+//
 // Cost: the tables hold (nodes + sum of skeleton lengths) * D^2 doubles, built in
 // O((nodes + sum of lengths) * D^2) time; the constructor throws ResourceLimitError past
 // `max_table_entries`. Each bound is then O(K) table lookups, with no allocation. A
