@@ -55,6 +55,11 @@ TEST(EpisodeChains, ASessionWithChainsRetiresASkeletonAndALiveOneTakesOnlyReport
   HiddenWorld world(problem, 1);
   live.decide(0);
   EXPECT_THROW(live.carry_out(world), UsageError);  // the simulated chains would not follow the clock
+  MonteCarloOptions options;
+  options.episodes = 10;
+  options.live = LiveRun{};
+  const Mdp mdp(problem);
+  EXPECT_THROW(run_monte_carlo(mdp, make_allocator_factory("round-robin", mdp), options), UsageError);
 }
 
 }  // namespace

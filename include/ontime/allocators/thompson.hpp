@@ -31,8 +31,9 @@
 // With chains or expiry (SPEC §9) a skeleton's draw is its refinement alone as the MDP draws it
 // (planning, static executions and the chains' steps, Mdp::sample_observation), until it completes
 // a plan or the episode is lost. The chains' path while the plan executes is not drawn: the plan
-// is worth its expected reward over those paths (Mdp::success_reward), a lost draw nothing. The
-// step goes to the skeleton whose draw is worth the most, the soonest completed among equals.
+// is worth its expected reward over those paths (Mdp::success_reward), and a lost draw ranks
+// below any completed plan. The step goes to the skeleton whose draw is worth the most, the
+// soonest completed among equals.
 // Every skeleton is drawn on its own (an action two skeletons share is drawn for each), and no
 // draw waits for the chains. O(D) draws per skeleton at most.
 
