@@ -141,16 +141,15 @@ void add_solve_command(CLI::App& app) {
   CLI::App* command = app.add_subcommand(
       "solve", "Exact optimal success probability and first choice, or a certified interval around it");
   command->add_option("INSTANCE", options->instance, "Instance file (JSON, SPEC §5)")->required();
-  CLI::Option* method =
-      command
-          ->add_option(
-              "--method", options->method,
-              "layered (default: the whole tree; where a cap cuts it, a split follows, but for an instance "
-              "with backtracking; memoised is the default for an instance with chains or expiry), split (the strongest "
-              "first-action subtree enumerated, the others bounded; "
-              "not with backtracking), memoised, or search (branch and bound: exact, solving only the states the "
-              "bounds cannot settle)")
-          ->check(CLI::IsMember({"layered", "split", "memoised", "search"}));
+  command
+      ->add_option("--method", options->method,
+                   "layered (default: the whole tree; where a cap cuts it, a split follows, but for an instance "
+                   "with backtracking, rewards, chains or expiry), split (the strongest "
+                   "first-action subtree enumerated, the others bounded; "
+                   "not with backtracking, rewards, chains or expiry), memoised, or search (branch and bound: exact, "
+                   "solving only the states the "
+                   "bounds cannot settle)")
+      ->check(CLI::IsMember({"layered", "split", "memoised", "search"}));
   add_number_option(*command, "--max-states", options->max_states,
                     "Cap on states: layered and search give an interval past it, memoised stops with an error "
                     "(default: none for layered, 10000000 for memoised and search)",
@@ -180,11 +179,9 @@ void add_solve_command(CLI::App& app) {
   command->add_flag("--json", options->json, "Print JSON");
   command->add_flag("--no-timing", options->no_timing,
                     "Layered: leave out measured times and memory, so that outputs can be compared byte for byte");
-  command->callback([options, method] {
+  command->callback([options] {
     if (options->gap > 0 && options->method != "search") throw UsageError("--gap is for --method search");
     const Problem problem = load_problem(options->instance);
-    // Chains and expiry (SPEC §9): only the memoised solver models them so far.
-    if (method->count() == 0 && problem.is_timed()) options->method = "memoised";
     if (problem.skeleton_count() > kMaxExactSkeletons) check_exact_work(problem, 1, options->instance);
     const Mdp mdp(problem);
     if (options->method == "memoised") {

@@ -48,8 +48,7 @@ void bind_solve(py::module_& m) {
          const py::object& policy, Number<int, "policy_layers", 1, 1'000'000> policy_layers,
          Number<double, "gap", 0.0, 1.0> gap) {
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
-        // Chains and expiry (SPEC §9): only the memoised solver models them so far (the CLI's default too).
-        const std::string method = method_given.value_or(mdp->problem->is_timed() ? "memoised" : "layered");
+        const std::string method = method_given.value_or("layered");
         if (gap > 0 && method != "search") throw UsageError("gap is for method='search'");
         if (method != "layered" && method != "split" && method != "memoised" && method != "search") {
           throw UsageError("method must be 'layered', 'split', 'memoised' or 'search' (got '" + method + "')");
@@ -125,8 +124,8 @@ void bind_solve(py::module_& m) {
       py::kw_only(), py::arg("method") = py::none(), py::arg("tolerance") = 0.0, py::arg("max_memory_mib") = 0,
       py::arg("max_disk_mib") = 0, py::arg("scratch") = py::none(), py::arg("policy") = py::none(),
       py::arg("policy_layers") = 1, py::arg("gap") = 0.0,
-      "The exact optimal success probability and first choice (the layered solver; the memoised one for an "
-      "instance with chains or expiry), as `ontime solve --json` reports them; where a cap cuts the whole tree, a "
+      "The exact optimal success probability (or expected reward) and first choice (the layered solver), as "
+      "`ontime solve --json` reports them; where a cap cuts the whole tree, a "
       "certified interval [lower_bound, upper_bound] "
       "instead (optimal_success_probability None), tightened by a split when the skeletons' first actions "
       "differ. method='split' splits straight away (the strongest first-action subtree enumerated, the others "

@@ -107,7 +107,7 @@ def test_allocators_that_do_not_model_chains_refuse_them(tmp_path):
     path.write_text(json.dumps(QUEUE))
     problem = ontime.load_problem(path)
     with pytest.raises(ontime.UsageError, match="does not take instances with exogenous chains"):
-        ontime.make_allocator(problem, "branch-and-bound")
+        ontime.make_allocator(problem, "ppo")
     with pytest.raises(ontime.UsageError, match="'sum' has no form with chains"):
         ontime.make_allocator(problem, "dp-rerun", aggregation="sum")
     evaluated = ontime.evaluate(problem, "round-robin", episodes=4000, exact=True, seed=3)
@@ -160,10 +160,23 @@ def test_the_allocators_that_model_chains_know_the_queue(tmp_path):
         evaluated = ontime.evaluate(problem, name, episodes=2000, exact=True, seed=5)
         assert evaluated["exact_success_probability"] == pytest.approx(0.7, abs=1e-15), name
         assert abs(evaluated["success_rate"] - 0.7) <= 4 * evaluated["ci95"], name
-    for name in ("thompson", "mcts"):
+    for name in ("thompson", "mcts", "branch-and-bound"):
         search = {"iterations": 200} if name == "mcts" else {}
         evaluated = ontime.evaluate(problem, name, episodes=2000, seed=5, **search)
         assert abs(evaluated["success_rate"] - 0.7) <= 4 * evaluated["ci95"], name
+
+
+def test_every_exact_method_solves_the_queue_to_the_same_bits(tmp_path):
+    path = tmp_path / "queue.json"
+    path.write_text(json.dumps(QUEUE))
+    problem = ontime.load_problem(path)
+    solved = {method: ontime.solve(problem, method=method) for method in ("layered", "memoised", "search")}
+    assert solved["layered"]["method"] == "layered"  # the default with chains as without
+    assert ontime.solve(problem)["method"] == "layered"
+    for method, out in solved.items():
+        assert out["optimal_success_probability"] == pytest.approx(0.7, abs=1e-15), method
+        assert out["optimal_success_probability"] == solved["memoised"]["optimal_success_probability"], method
+        assert out["first_choice"] == 0, method
 
 
 def test_a_live_session_takes_the_queue_with_each_report():

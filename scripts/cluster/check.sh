@@ -11,7 +11,8 @@
 #  3. a usage error under mpirun and under srun: reported once, exit 2;
 #  4. the layered exact solver on a cut of the kitchen (the paper's manipulation instance, its
 #     first layers up to 300000 states, then a certified interval) and on navigation's fitted
-#     instance: one process, `mpirun -np 2` and a 2-task job give the same output.
+#     instance: one process, `mpirun -np 2` and a 2-task job give the same output; on the coffee
+#     building (exogenous chains, SPEC §9), one process and `mpirun -np 2`.
 # Usage: scripts/cluster/check.sh [ONTIME]   (default build/ontime; needs root or sudo for SLURM)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -38,6 +39,7 @@ kitchen="$root/data/instances/manipulation.json"
 cut=("$kitchen" --max-states 300000 --json --stats --no-timing)
 solve_cut=(solve "${cut[@]}" --threads 1)
 solve_nav=(solve nav.json --threads 1 --json --no-timing)
+solve_chains=(solve "$root/data/instances/chains/coffee-building.json" --threads 1 --json --no-timing)
 
 same() {  # same FILE...: each file of one/ equals the one in the other folders named after it
   local folder=$1
@@ -79,6 +81,7 @@ wait_for_journal() {  # wait_for_journal DIR: until its ranks have journaled som
 mkdir -p "$work/one" "$work/mpi" "$work/fault" "$work/slurm-run"
 (cd "$work/one" && "$ontime" "${collect[@]}" > collect.txt && "$ontime" "${evaluate[@]}" > evaluate.json)
 (cd "$work/one" && "$ontime" "${solve_cut[@]}" > solve-cut.json && "$ontime" "${solve_nav[@]}" > solve-nav.json)
+(cd "$work/one" && "$ontime" "${solve_chains[@]}" > solve-chains.json)
 
 # 1a. mpirun -np 2.
 started=$(date +%s.%N)
@@ -88,7 +91,8 @@ echo "cluster check: mpirun -np 2 collection took $(echo "$(date +%s.%N) - $star
 same mpi nav.jsonl nav.json evaluate.json
 (cd "$work/mpi" && "${mpirun[@]}" "$ontime" "${solve_cut[@]}" > solve-cut.json)
 (cd "$work/mpi" && "${mpirun[@]}" "$ontime" "${solve_nav[@]}" > solve-nav.json)
-same mpi solve-cut.json solve-nav.json
+(cd "$work/mpi" && "${mpirun[@]}" "$ontime" "${solve_chains[@]}" > solve-chains.json)
+same mpi solve-cut.json solve-nav.json solve-chains.json
 
 # 2. A rank that dies: killed once the ranks have journaled some 300 trials between them.
 (cd "$work/fault" && exec "${mpirun[@]}" "$ontime" "${collect[@]}" > collect.txt 2> collect.err) &

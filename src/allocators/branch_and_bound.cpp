@@ -142,7 +142,7 @@ AllocatorKind branch_and_bound_kind() {
           .summary =
               "branch and bound from the current state within a budget per decision: optimal where it ends, else "
               "the best certified lower end and its gap",
-          .capabilities = {Capability::anytime, Capability::certified},
+          .capabilities = {Capability::anytime, Capability::certified, Capability::chains},
           .parameters = {Parameter::integer("iterations", 10'000, 1, Parameter::kNoLimit,
                                             "work per decision: states expanded by a trial or an upper test, or "
                                             "solved (no limit when only time-budget is given)"),

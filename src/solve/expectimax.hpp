@@ -220,6 +220,42 @@ inline void require_exact_size(const Mdp& mdp, const std::string& what) {
   }
 }
 
+// With chains or expiry (SPEC §9): R of a success, from the table of its plan's values over
+// every start (Mdp::execution_table, so each value is execution_value's to the bit), made once
+// per plan. A plan is its skeleton, its ET and the executions before its timed actions, so the
+// tables' number does not grow with the chains' states, and each success costs a look-up.
+// Past kMaxCells cached values (256 MiB) a success is valued without a table. One per thread.
+class PlanValues {
+ public:
+  double reward(const Mdp& mdp, const CompactTimedState& state, int choice) {
+    const int k = mdp.completed_skeleton(state, choice);
+    const Key key{static_cast<std::uint16_t>(k), state.execution[static_cast<std::size_t>(k)], state.restore};
+    auto found = tables_.find(key);
+    if (found == tables_.end()) {
+      if (cells_ > kMaxCells)
+        return mdp.execution_value(k, state.time, state.chains, state.restore.data(), key.execution);
+      found = tables_.try_emplace(key).first;
+      mdp.execution_table(k, state.restore.data(), key.execution, found->second);
+      cells_ += found->second.size();
+    }
+    return found->second[static_cast<std::size_t>(state.time) * static_cast<std::size_t>(mdp.joint_chain_states()) +
+                         state.chains];
+  }
+
+ private:
+  struct Key {
+    std::uint16_t skeleton;
+    std::uint16_t execution;
+    std::array<std::uint16_t, kMaxExactCulpritSlots> restore;
+    friend bool operator==(const Key&, const Key&) = default;
+  };
+  static_assert(sizeof(Key) == 4 + 2 * kMaxExactCulpritSlots,
+                "PlanValues::Key must have no padding: it is hashed as bytes");
+  static constexpr std::size_t kMaxCells = std::size_t{1} << 25;
+  absl::flat_hash_map<Key, std::vector<double>, CompactStateHash> tables_;
+  std::size_t cells_ = 0;
+};
+
 // The search runs on compact states (the Mdp's functions are templates on the state type): a
 // copy is a plain 82-byte copy (114 with backtracking's restore values), with no indirection.
 //
@@ -345,43 +381,14 @@ class Expectimax {
     frames_.pop_back();
   }
 
-  // R of a success (SPEC §8); with chains or expiry (SPEC §9) from the table of its plan's values
-  // over every start (Mdp::execution_table), made once per plan: a plan is its skeleton, its ET
-  // and the executions before its timed actions, so the tables' number does not grow with the
-  // chains' states, and each success costs a look-up.
+  // R of a success (SPEC §8); with chains or expiry (SPEC §9) from the plans' tables.
   double success_reward(const Compact& state, int choice) {
     if constexpr (kHoldsChains<Compact>) {
-      if (mdp_->is_timed()) {
-        const int k = mdp_->completed_skeleton(state, choice);
-        const PlanKey key{static_cast<std::uint16_t>(k), state.execution[static_cast<std::size_t>(k)], state.restore};
-        auto found = plans_.find(key);
-        if (found == plans_.end()) {
-          if (plan_cells_ > kMaxPlanCells) {
-            return mdp_->execution_value(k, state.time, state.chains, state.restore.data(), key.execution);
-          }
-          found = plans_.try_emplace(key).first;
-          mdp_->execution_table(k, state.restore.data(), key.execution, found->second);
-          plan_cells_ += found->second.size();
-        }
-        return found
-            ->second[static_cast<std::size_t>(state.time) * static_cast<std::size_t>(mdp_->joint_chain_states()) +
-                     state.chains];
-      }
+      if (mdp_->is_timed()) return plans_.reward(*mdp_, state, choice);
     }
     return mdp_->success_reward(state, choice);
   }
-  struct PlanKey {
-    std::uint16_t skeleton;
-    std::uint16_t execution;
-    std::array<std::uint16_t, kMaxExactCulpritSlots> restore;
-    friend bool operator==(const PlanKey&, const PlanKey&) = default;
-  };
-  static_assert(sizeof(PlanKey) == 4 + 2 * kMaxExactCulpritSlots,
-                "PlanKey must have no padding: it is hashed as bytes");
-  // Past this many cached values (256 MiB) a success is valued without a table.
-  static constexpr std::size_t kMaxPlanCells = std::size_t{1} << 25;
-  absl::flat_hash_map<PlanKey, std::vector<double>, CompactStateHash> plans_;
-  std::size_t plan_cells_ = 0;
+  PlanValues plans_;
 
   // States between two checks of the stop condition: rare enough to cost nothing, frequent
   // enough (well under a millisecond of work) to stop promptly.

@@ -138,31 +138,22 @@ LayeredSolution solve_split(const Mdp& mdp, const LayeredSolveOptions& options, 
 }  // namespace
 
 LayeredSolution solve_layered(const Mdp& mdp, const LayeredSolveOptions& options) {
-  mdp.refuse_timed("the layered solver");
   detail::require_exact_size(mdp, "solve");
   if (!(options.tolerance >= 0.0 && options.tolerance <= 1.0)) {
     throw UsageError("solve: the tolerance must lie in [0, 1] (got " + std::to_string(options.tolerance) + ")");
   }
-  if (mdp.has_backtracking()) {
-    // A tolerance drops a group by its clairvoyant chance, and a split bounds whole subtrees by
-    // it: under backtracking that bound counts every backtrack as a success (docs/theory.md), too
-    // loose to drop anything by. Caps still give a certified interval at the frontier.
-    if (options.tolerance > 0) {
-      throw UsageError("solve: a tolerance does not apply to an instance with backtracking (SPEC §7)");
-    }
+  // A tolerance drops a group by its clairvoyant chance, and a split bounds whole subtrees by
+  // it. Under backtracking that bound counts every backtrack as a success (docs/theory.md), too
+  // loose to drop anything by; with rewards it bounds a success probability, not a reward; with
+  // chains or expiry it reads neither. Caps still give a certified interval at the frontier.
+  const std::string unbounded = mdp.has_backtracking()        ? "backtracking (SPEC §7)"
+                                : mdp.is_timed()              ? "chains or expiry (SPEC §9)"
+                                : mdp.problem().has_rewards() ? "rewards (SPEC §8)"
+                                                              : "";
+  if (!unbounded.empty()) {
+    if (options.tolerance > 0) throw UsageError("solve: a tolerance does not apply to an instance with " + unbounded);
     if (options.split == SplitMode::always) {
-      throw UsageError("solve: a split does not apply to an instance with backtracking (SPEC §7)");
-    }
-    return layered::search_layers(mdp, options, false, nullptr);
-  }
-  if (mdp.problem().has_rewards()) {
-    // The same: a dropped group's share and a bounded subtree are bounds on a success
-    // probability, not on a reward (SPEC §8). Caps give a certified interval at the frontier.
-    if (options.tolerance > 0) {
-      throw UsageError("solve: a tolerance does not apply to an instance with rewards (SPEC §8)");
-    }
-    if (options.split == SplitMode::always) {
-      throw UsageError("solve: a split does not apply to an instance with rewards (SPEC §8)");
+      throw UsageError("solve: a split does not apply to an instance with " + unbounded);
     }
     return layered::search_layers(mdp, options, false, nullptr);
   }

@@ -69,7 +69,7 @@ class BranchAndBound {
   // true (checked after every `check_interval` units of work: a state solved or expanded by an
   // upper test, counted from this call's start). What was solved and refined is kept.
   SearchSolution run(const State& from, const std::function<bool(std::uint64_t)>& stop, std::uint64_t check_interval) {
-    const auto start = detail::compact<Compact>(from, mdp_->skeleton_count(), mdp_->problem().culprit_slot_count());
+    const auto start = detail::compact<Compact>(from, mdp_->skeleton_count(), detail::recorded_slots(mdp_->problem()));
     stop_ = &stop;
     check_interval_ = check_interval;
     work_start_ = work_;
@@ -96,7 +96,7 @@ class BranchAndBound {
   // them starts from them. Returns from's interval and the choice of the best lower end.
   SearchSolution trials(const State& from, const std::function<bool(std::uint64_t)>& stop, std::uint64_t check_interval,
                         double gap) {
-    const auto start = detail::compact<Compact>(from, mdp_->skeleton_count(), mdp_->problem().culprit_slot_count());
+    const auto start = detail::compact<Compact>(from, mdp_->skeleton_count(), detail::recorded_slots(mdp_->problem()));
     const Key key = policy_.key(start);
     work_start_ = work_;
     trials_end_.clear();
@@ -373,7 +373,7 @@ class BranchAndBound {
     for (std::size_t i = choices_[c].begin; i < choices_[c].end; ++i) {
       const Item& item = items_[i];
       if (item.status == Status::success) {
-        const double reward = item.probability * mdp_->success_reward(item.next, choices_[c].choice);
+        const double reward = item.probability * success_reward(item.next, choices_[c].choice);
         lo += reward;
         hi += reward;
       } else if (item.status == Status::running) {
@@ -395,6 +395,15 @@ class BranchAndBound {
       if (items_[i].status == Status::running && !items_[i].exact) look_up(items_[i], lower);
     }
     sum_up(c, lower);
+  }
+
+  // R of a success (SPEC §8); with chains or expiry (SPEC §9) from the plans' tables, as the
+  // memoised solver takes it.
+  double success_reward(const Compact& state, int choice) {
+    if constexpr (kHoldsChains<Compact>) {
+      if (mdp_->is_timed()) return plans_.reward(*mdp_, state, choice);
+    }
+    return mdp_->success_reward(state, choice);
   }
 
   // ValueBounds' upper bound on V*(next), widened by kBoundSlack.
@@ -482,7 +491,7 @@ class BranchAndBound {
     for (std::size_t i = begin; i < end; ++i) {
       const double probability = items_[i].probability;
       if (items_[i].status == Status::success) {
-        value += probability * mdp_->success_reward(items_[i].next, choices_[c].choice);
+        value += probability * success_reward(items_[i].next, choices_[c].choice);
       } else if (items_[i].status == Status::running) {
         // Copies: the recursion may move the items.
         const Compact next = items_[i].next;
@@ -587,6 +596,7 @@ class BranchAndBound {
   std::uint64_t tested_ = 0;
   std::uint64_t bounded_ = 0;
   std::uint64_t choices_cut_ = 0;
+  detail::PlanValues plans_;  // with chains or expiry: the successes' rewards
 };
 
 // Runs `work` on a thread of its own whose stack holds `stack_bytes`, and waits for it; rethrows
@@ -623,9 +633,13 @@ void run_on_own_stack(std::size_t stack_bytes, const std::function<void()>& work
 }
 
 using Engine = std::variant<BranchAndBound<detail::OptimalPolicy<2>>, BranchAndBound<detail::OptimalPolicy<4>>,
-                            BranchAndBound<detail::OptimalPolicy<0>>, BranchAndBound<detail::OptimalBacktrackPolicy>>;
+                            BranchAndBound<detail::OptimalPolicy<0>>, BranchAndBound<detail::OptimalBacktrackPolicy>,
+                            BranchAndBound<detail::OptimalTimedPolicy>>;
 
 Engine make_engine(const Mdp& mdp, const ValueBounds& bounds, std::uint64_t max_states) {
+  if (mdp.is_timed()) {
+    return BranchAndBound<detail::OptimalTimedPolicy>(mdp, detail::OptimalTimedPolicy(mdp), bounds, max_states);
+  }
   if (mdp.has_backtracking()) {
     return BranchAndBound<detail::OptimalBacktrackPolicy>(mdp, detail::OptimalBacktrackPolicy(mdp), bounds, max_states);
   }
@@ -665,7 +679,6 @@ struct BranchAndBoundSearch::Impl {
 };
 
 BranchAndBoundSearch::BranchAndBoundSearch(const Mdp& mdp, std::uint64_t max_states) {
-  mdp.refuse_timed("the search solver");
   detail::require_exact_size(mdp, "search");
   impl_ = std::make_unique<Impl>(mdp, max_states);
 }
@@ -697,7 +710,6 @@ std::uint64_t BranchAndBoundSearch::size() const noexcept {
 }
 
 SearchSolution solve_search(const Mdp& mdp, const SearchSolveOptions& options) {
-  mdp.refuse_timed("the search solver");
   BranchAndBoundSearch search(mdp, options.max_states);
   std::function<bool(std::uint64_t)> stop;
   if (options.stop) stop = [&options](std::uint64_t) { return options.stop(); };

@@ -25,6 +25,7 @@
 #include "ontime/util/error.hpp"
 #include "ontime/util/random.hpp"
 #include "support/backtracking_reference.hpp"
+#include "support/exact_solver_checks.hpp"
 #include "support/paper.hpp"
 #include "support/random_instances.hpp"
 
@@ -400,25 +401,7 @@ TEST(Backtracking, TheLayeredSolverEqualsTheMemoisedOneBitForBit) {
     const Problem problem = with_backtracking(testing::random_instance(seed, 3, 3, 6), seed + 1000);
     if (!problem.has_backtracking()) continue;
     ++backtracking;
-    const Mdp mdp(problem);
-    OptimalSolver solver(mdp);
-    const double optimum = solver.solve(mdp.start());
-    for (const unsigned threads : {1U, 2U}) {
-      LayeredSolveOptions options;
-      options.threads = threads;
-      options.policy_layers = 3;
-      const LayeredSolution layered = solve_layered(mdp, options);
-      ASSERT_TRUE(layered.exact);
-      EXPECT_EQ(layered.lower, optimum);
-      EXPECT_EQ(layered.upper, optimum);
-      EXPECT_EQ(layered.first_choice, solver.best_choice(mdp.start()).value_or(-1));
-      EXPECT_EQ(layered.states, solver.states());
-      ASSERT_FALSE(layered.policy.empty());
-      for (const PolicyEntry& entry : layered.policy) {
-        EXPECT_EQ(entry.lower, solver.solve(entry.state));
-        EXPECT_EQ(entry.choice, solver.best_choice(entry.state).value_or(-1));
-      }
-    }
+    testing::expect_layered_equals_memoised(Mdp(problem));
   }
   EXPECT_GE(backtracking, 25);
 }
@@ -432,29 +415,7 @@ TEST(Backtracking, TheSearchEqualsTheMemoisedSolverBitForBit) {
     const Problem problem = with_backtracking(testing::random_instance(seed, 3, 3, 6), seed + 1000);
     if (!problem.has_backtracking()) continue;
     ++backtracking;
-    const Mdp mdp(problem);
-    OptimalSolver solver(mdp);
-    const double optimum = solver.solve(mdp.start());
-    const SearchSolution search = solve_search(mdp);
-    ASSERT_TRUE(search.exact);
-    EXPECT_EQ(search.lower, optimum);
-    EXPECT_EQ(search.first_choice, solver.best_choice(mdp.start()).value_or(-1));
-    EXPECT_LE(search.states, solver.states());
-    for (const std::uint64_t budget : {2U, 20U}) {
-      // Trials' bounds hold under backtracking, and the search after them keeps the bits.
-      BranchAndBoundSearch trialled(mdp);
-      const SearchSolution trials = trialled.trials(mdp.start(), [&](std::uint64_t work) { return work >= budget; });
-      EXPECT_LE(trials.lower, optimum + OptimalSolver::kTieTolerance);  // as SearchSolver.Trials* says
-      EXPECT_GE(trials.upper, optimum);
-      const SearchSolution after = trialled.search(mdp.start());
-      EXPECT_EQ(after.lower, optimum);
-      EXPECT_EQ(after.first_choice, search.first_choice);
-    }
-    SearchSolveOptions capped;
-    capped.max_states = search.states / 2 + 1;
-    const SearchSolution cut = solve_search(mdp, capped);
-    EXPECT_LE(cut.lower, optimum + 1e-15);
-    EXPECT_GE(cut.upper, optimum - 1e-15);
+    testing::expect_search_equals_memoised(Mdp(problem));
   }
   EXPECT_GE(backtracking, 25);
 }

@@ -1,6 +1,7 @@
 // Exogenous chains and actions that expire (SPEC §9) in the MDP, the memoised exact solver and
-// exact evaluation: each against the independent reference recursion on random instances and
-// on cases valued by hand; what does not model them yet refuses them.
+// exact evaluation, each against the independent reference recursion on random instances and on
+// cases valued by hand; the layered solver against the memoised one; what does not model them
+// yet refuses them.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -16,6 +17,8 @@
 #include "ontime/solve/search_solver.hpp"
 #include "ontime/util/error.hpp"
 #include "support/chain_reference.hpp"
+#include "support/exact_solver_checks.hpp"
+#include "support/paper.hpp"
 #include "support/random_instances.hpp"
 
 namespace ontime {
@@ -120,14 +123,108 @@ TEST(Chains, ExactEvaluationOfARuleIsTheReferencesValue) {
   }
 }
 
+// The layered solver walks the MDP's own outcomes in the memoised solver's order, layer by
+// layer, with the chains' joint state and the timed slots in its keys: the same value to the
+// bit, the same first choice and states, on any thread count; the policy it keeps holds the
+// chains' state (its states solve to its values).
+TEST(Chains, TheLayeredSolverEqualsTheMemoisedOneBitForBit) {
+  const int count = testing::repetitions_to_check(60);
+  int valued = 0;
+  int large = 0;
+  for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    const Problem problem =
+        testing::with_random_chains(testing::random_instance(seed + 900, 4, 4, 14), seed + 900, seed % 2 == 0);
+    const Mdp mdp(problem);
+    OptimalSolver solver(mdp);
+    valued += solver.solve(mdp.start()) > 0 ? 1 : 0;
+    large += solver.states() >= 20 ? 1 : 0;
+    testing::expect_layered_equals_memoised(mdp);
+  }
+  EXPECT_GT(valued, count / 3);  // not a comparison of zeros
+  EXPECT_GT(large, count / 6);   // nor of one-state trees only
+}
+
+// The coffee building has 632,272 states (5 s here for the three solvers): the sanitizer run,
+// which checks a share of the repetitions, takes the meeting only.
+TEST(Chains, TheLayeredSolverAndTheSearchEqualTheMemoisedOneOnTheShippedExamples) {
+  const std::vector<std::string> paths{"data/instances/chains/meeting-through-the-queue.json",
+                                       "data/instances/chains/coffee-building.json"};
+  const int count = testing::repetitions_to_check(static_cast<int>(paths.size()));
+  for (int i = 0; i < count; ++i) {
+    const std::string& path = paths[static_cast<std::size_t>(i)];
+    SCOPED_TRACE(path);
+    const Problem problem = load_problem(testing::source_path(path));
+    ASSERT_TRUE(problem.has_chains());
+    const Mdp mdp(problem);
+    OptimalSolver solver(mdp);
+    const double optimum = solver.solve(mdp.start());
+    EXPECT_GT(optimum, 0.4);
+    LayeredSolveOptions options;
+    options.threads = 2;
+    const LayeredSolution layered = solve_layered(mdp, options);
+    ASSERT_TRUE(layered.exact);
+    EXPECT_EQ(layered.lower, optimum);
+    EXPECT_EQ(layered.first_choice, solver.best_choice(mdp.start()).value_or(-1));
+    EXPECT_EQ(layered.states, solver.states());
+    const SearchSolution search = solve_search(mdp);
+    ASSERT_TRUE(search.exact);
+    EXPECT_EQ(search.lower, optimum);
+    EXPECT_EQ(search.first_choice, layered.first_choice);
+  }
+}
+
+// A cap ends the forward pass at a frontier valued by ValueBounds (0 below, the clairvoyant
+// relaxation above with chains): the interval holds the optimum at every cap, and the caps do cut.
+TEST(Chains, EveryLayeredCapsIntervalHoldsTheOptimum) {
+  const int count = testing::repetitions_to_check(40);
+  int cut = 0;
+  for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
+    const Problem problem =
+        testing::with_random_chains(testing::random_instance(seed + 300, 4, 4, 10), seed + 300, seed % 2 == 1);
+    const double expected = optimum(problem);
+    const Mdp mdp(problem);
+    for (const std::uint64_t cap : {std::uint64_t{3}, std::uint64_t{10}, std::uint64_t{30}}) {
+      LayeredSolveOptions options;
+      options.max_states = cap;
+      const LayeredSolution layered = solve_layered(mdp, options);
+      EXPECT_LE(layered.lower, expected + 1e-12) << seed << " cap " << cap;
+      EXPECT_GE(layered.upper, expected - 1e-12) << seed << " cap " << cap;
+      cut += layered.exact ? 0 : 1;
+    }
+  }
+  EXPECT_GT(cut, count);
+}
+
+// The search takes the memoised solver's keys and outcomes with chains, and ValueBounds holds
+// there (0 below, the relaxation above): the same value to the bit and the same first choice,
+// after trials too; a cap's interval holds the optimum.
+TEST(Chains, TheSearchEqualsTheMemoisedSolverBitForBit) {
+  const int count = testing::repetitions_to_check(60);
+  for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    testing::expect_search_equals_memoised(
+        Mdp(testing::with_random_chains(testing::random_instance(seed + 900, 4, 4, 14), seed + 900, seed % 2 == 0)));
+  }
+}
+
+TEST(Chains, TheLayeredSolverRefusesWhatBoundsOnlyASuccessProbability) {
+  const Mdp mdp(testing::queue_wait_instance(""));
+  LayeredSolveOptions options;
+  options.tolerance = 1e-3;
+  EXPECT_THROW(solve_layered(mdp, options), UsageError);
+  options.tolerance = 0;
+  options.split = SplitMode::always;
+  EXPECT_THROW(solve_layered(mdp, options), UsageError);
+}
+
 TEST(Chains, WhatDoesNotModelThemYetRefusesThem) {
   const Problem problem = testing::queue_wait_instance("");
   const Mdp mdp(problem);
-  EXPECT_THROW(solve_layered(mdp), UsageError);
-  EXPECT_THROW(solve_search(mdp), UsageError);
   const AllocatorRegistry& registry = allocator_registry();
-  EXPECT_THROW(registry.make_factory("branch-and-bound", mdp, {}), UsageError);
-  for (const char* name : {"optimal", "round-robin", "dp", "dp-rerun", "greedy", "thompson", "mcts"}) {
+  EXPECT_THROW(registry.make_factory("ppo", mdp, {}), UsageError);
+  for (const char* name :
+       {"optimal", "round-robin", "dp", "dp-rerun", "greedy", "thompson", "mcts", "branch-and-bound"}) {
     EXPECT_NO_THROW(registry.make_factory(name, mdp, {})) << name;
   }
 }

@@ -16,7 +16,10 @@
 // the optimum, the trials nothing; docs/experiments.md.) Where the search finishes, the choice
 // is the optimal one (the memoised solver's). Cut short, it takes the choice with the best
 // certified lower end and reports the gap: the upper end of V*(state) minus that lower end,
-// never below the choice's true loss V*(state) - Q*(state, choice).
+// never below the choice's true loss V*(state) - Q*(state, choice). With chains or expiry
+// (SPEC §9) the search models them as the exact solver does (its states hold the chains' joint
+// state, and it may wait); ValueBounds' lower end is then 0, so a decision cut short leans on
+// what its trials and search solved, and its gap is wider than without chains.
 //
 // Deterministic: the search is cleared at the start of every episode and its trials draw from
 // the episode's seed (after a restart at the cap, from a stream of it), so an episode's

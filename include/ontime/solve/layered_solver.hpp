@@ -40,6 +40,15 @@
 // UsageError there (their bound counts every give-up as a success and would drop nothing), and
 // `fallback` never splits.
 //
+// Chains and expiry (SPEC §9): keys also hold the chains' joint state and the static execution
+// before each timed action, nothing is blanked (a step may wait for a chain), the outcomes are
+// the MDP's own and a success is worth its plan's expected reward over the chains' paths (each
+// thread keeps a table per plan, as the memoised solver does), so the value is again the
+// memoised solver's to the bit. A cap's frontier gets ValueBounds, whose lower end is 0 there
+// (the commit tables do not value chains) and whose upper end is the clairvoyant relaxation with
+// every chain-dependent execution 0. A tolerance or `split == always` is a UsageError, as with
+// rewards (SPEC §8), and `fallback` never splits.
+//
 // Ranks: states are owned by the rank their key hashes to; each rank expands its own, sends the
 // successors it finds to their owners (all_to_all, chunk by chunk) and learns their places; going
 // back, it asks the owners for those places' values. Every rank returns the same solution.

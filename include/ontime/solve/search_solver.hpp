@@ -26,7 +26,11 @@
 // state's interval comes from one step of lookahead over what was solved: lower is at most V*
 // (a certified bound, not the value of a policy as the layered solver's is), upper at least V*.
 // Deterministic: one thread, the same order every run. Backtracking (SPEC §7) is taken as the
-// memoised solver takes it (whole states with their restore values as keys).
+// memoised solver takes it (whole states with their restore values as keys), and so are chains
+// and expiry (SPEC §9: keys with the chains' joint state and the timed slots, a success worth its
+// plan's expected reward). There ValueBounds' lower end is 0 and its upper end the clairvoyant
+// relaxation with every chain-dependent execution 0: still sound, so the value is still exact,
+// but looser, so more of the tree is solved than without chains.
 //
 // Cost: time and memory linear in the states solved or expanded by upper tests (one table of
 // both, a slot of the packed key and 16 bytes each) times their outcomes, with a table lookup

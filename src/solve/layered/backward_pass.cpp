@@ -70,7 +70,7 @@ struct LayeredSearch<W>::StateValue {
   const std::vector<Bounds>& foreign;
   const std::uint32_t* code = nullptr;
   const double* extra = nullptr;
-  const bool rewards = search->mdp_->problem().has_rewards();
+  const bool rewards = search->mdp_->problem().has_rewards() || search->mdp_->is_timed();  // as the forward pass
   // What the end of the enumerated part is worth: nothing, or in a split's unflagged states
   // the bounded subtrees, fresh, with the time left.
   Bounds ended;

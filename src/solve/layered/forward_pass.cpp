@@ -114,7 +114,7 @@ Cut LayeredSearch<W>::expand(const std::vector<Key>& current, int t, std::vector
   std::uint32_t foreign_count = 0;
   ScratchFile codes_file(scratch_.file(t, "codes"), t, "wb");
   ScratchFile extras_file(scratch_.file(t, "extras"), t, "wb");
-  const bool rewards = mdp_->problem().has_rewards();
+  const bool rewards = mdp_->problem().has_rewards() || mdp_->is_timed();  // a success's reward may not be 1
   std::vector<ThreadBuffers> buffers(threads_);
   for (ThreadBuffers& buffer : buffers) {
     buffer.own.resize(shards_);

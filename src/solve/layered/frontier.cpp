@@ -37,6 +37,7 @@ void LayeredSearch<W>::value_frontier(const std::vector<Key>& keys, int t, std::
     return [&](std::uint64_t begin, std::uint64_t end) {
       CompactState state;
       detail::CompactBacktrackState back_state;
+      detail::CompactTimedState timed_state;
       const auto bound = [&](const auto& decoded, std::uint64_t i) {
         if (bounds != nullptr) {
           values[i] = {bounds->lower(decoded), bounds->upper(decoded)};
@@ -46,7 +47,10 @@ void LayeredSearch<W>::value_frontier(const std::vector<Key>& keys, int t, std::
         }
       };
       for (std::uint64_t i = begin; i < end; ++i) {
-        if (mdp_->has_backtracking()) {
+        if (mdp_->is_timed()) {
+          layout_->decode(keys[i], t, timed_state);
+          bound(timed_state, i);
+        } else if (mdp_->has_backtracking()) {
           layout_->decode(keys[i], t, back_state);
           bound(back_state, i);
         } else {

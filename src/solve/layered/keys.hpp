@@ -6,6 +6,7 @@
 // or). Also the 32-bit codes that the scratch files hold per outcome, and the hash that places
 // a key on its rank and in its shard. Every operation here is O(skeletons) or less.
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cstddef>
@@ -41,8 +42,10 @@ inline constexpr int kWeakChoice = -2;
 // Where each skeleton's fields sit in a key: refined in just enough bits for the skeleton's
 // length, PT and ET in just enough for 0 .. D + 1 and one more code for a blanked slot; with
 // backtracking (SPEC §7), then one field of the same width per culprit slot for its restore
-// value (an execution, 0 .. D + 1); in a split, one more bit flags the copies one layer on (a
-// step went to the bounded subtrees). A field never straddles two words, so that rewriting a
+// value (an execution, 0 .. D + 1); with chains or expiry (SPEC §9), one such field per timed
+// slot (the static execution before the timed action) and, with chains, one field just wide
+// enough for their joint state; in a split, one more bit flags the copies one layer on (a step
+// went to the bounded subtrees). A field never straddles two words, so that rewriting a
 // skeleton's is a mask and an or.
 class KeyLayout {
  public:
@@ -68,10 +71,15 @@ class KeyLayout {
       field.mask = ((std::uint64_t{1} << (refined_bits + 2 * counter_bits_)) - 1) << shift;
       field.blank = (blank_code_ << refined_bits | blank_code_ << (refined_bits + counter_bits_)) << shift;
     }
-    restore_slots_ = mdp.problem().culprit_slot_count();
+    restore_slots_ = detail::recorded_slots(mdp.problem());
     for (int c = 0; c < restore_slots_; ++c) {
       const auto [word, shift] = place(counter_bits_);
       restore_[static_cast<std::size_t>(c)] = {word, shift};
+    }
+    if (mdp.has_chains()) {
+      chain_bits_ = std::max(1, static_cast<int>(std::bit_width(static_cast<unsigned>(mdp.joint_chain_states() - 1))));
+      const auto [word, shift] = place(chain_bits_);
+      chains_ = {word, shift};
     }
     if (flag) {
       const auto [word, shift] = place(1);
@@ -104,7 +112,8 @@ class KeyLayout {
   }
 
   // A state's key (its time is the layer's). A CompactBacktrackState's restore values are
-  // written too; a CompactState's only for a problem without backtracking.
+  // written too, and a CompactTimedState's chains; a CompactState's only for a problem without
+  // backtracking, chains or expiry.
   template <std::size_t W, class Compact>
   PackedState<W> encode(const Compact& state) const noexcept {
     PackedState<W> key;
@@ -119,6 +128,10 @@ class KeyLayout {
         key.words[static_cast<std::size_t>(place.word)] |= code(state.restore[static_cast<std::size_t>(c)])
                                                            << place.shift;
       }
+    }
+    if constexpr (kHoldsChains<Compact>) {
+      if (chain_bits_ > 0)
+        key.words[static_cast<std::size_t>(chains_.word)] |= std::uint64_t{state.chains} << chains_.shift;
     }
     return key;
   }
@@ -141,6 +154,12 @@ class KeyLayout {
         out.restore[static_cast<std::size_t>(c)] =
             counter(key.words[static_cast<std::size_t>(place.word)] >> place.shift & counter_mask);
       }
+    }
+    if constexpr (kHoldsChains<Compact>) {
+      out.chains = chain_bits_ == 0
+                       ? std::uint16_t{0}
+                       : static_cast<std::uint16_t>(key.words[static_cast<std::size_t>(chains_.word)] >> chains_.shift &
+                                                    ((std::uint64_t{1} << chain_bits_) - 1));
     }
   }
 
@@ -168,6 +187,8 @@ class KeyLayout {
   std::array<Field, kMaxExactSkeletons> fields_{};
   int restore_slots_ = 0;
   std::array<Place, detail::kMaxExactCulpritSlots> restore_{};
+  int chain_bits_ = 0;  // 0: no chains
+  Place chains_;
 };
 
 // The rank that owns a key, and the shard of a rank's layer table a key falls into: two mixes

@@ -81,7 +81,11 @@ void LayeredSearch<W>::finish() {
   });
   for (const PolicyRecord& record : policy) {
     State state = mdp_->start();  // sized for the skeletons and the restore values
-    if (mdp_->has_backtracking()) {
+    if (mdp_->is_timed()) {
+      detail::CompactTimedState compact;
+      layout_->decode(record.key, record.layer, compact);
+      detail::expanded(compact, state);
+    } else if (mdp_->has_backtracking()) {
       detail::CompactBacktrackState compact;
       layout_->decode(record.key, record.layer, compact);
       detail::expanded(compact, state);
@@ -115,7 +119,8 @@ LayeredSolution run_search(const Mdp& mdp, const LayeredSolveOptions& options, b
 LayeredSolution search_layers(const Mdp& mdp, const LayeredSolveOptions& options, bool flag, const WeakCluster* weak) {
   const int words = KeyLayout(mdp, flag).words();
   if (words > static_cast<int>(kMaxExactSkeletons) + 1) {
-    // Only backtracking's restore values, with a deadline in the tens of thousands, get here.
+    // Only restore values (backtracking's, or timed slots'), with a deadline in the tens of
+    // thousands, get here.
     throw UsageError("solve: a state of " + mdp.problem().name() + " needs " + std::to_string(words) +
                      " words of key, above the layered solver's " + std::to_string(kMaxExactSkeletons + 1) +
                      "; the memoised solver (--method memoised) takes it");

@@ -94,8 +94,11 @@ class TreeTables {
 // With backtracking (SPEC §7) a key holds the whole state with its restore values and nothing
 // is blanked (a step on a group that cannot succeed may still backtrack and restore an action
 // others share), so the walk decodes the state and takes the MDP's own outcomes
-// (Mdp::useful_choices, Mdp::for_each_outcome), exactly the memoised solver's; neither a
-// tolerance nor a split is taken there (solve_layered refuses them).
+// (Mdp::useful_choices, Mdp::for_each_outcome), exactly the memoised solver's. The same with
+// chains or expiry (SPEC §9), whose keys hold the timed slots and the chains' joint state too
+// (a step that cannot finish a plan may still wait for a chain), and whose successes are worth
+// the MDP's expected reward over the chains' paths (Mdp::success_reward). Neither a tolerance
+// nor a split is taken there (solve_layered refuses them).
 template <std::size_t W>
 class Successors {
  public:
@@ -123,7 +126,8 @@ class Successors {
         split_(split),
         deadline_(mdp.deadline()),
         skeletons_(mdp.skeleton_count()),
-        backtracking_(mdp.has_backtracking()) {}
+        backtracking_(mdp.has_backtracking()),
+        timed_(mdp.is_timed()) {}
 
   // Calls sink(outcome) for every outcome, with keys (forward).
   template <class Sink>
@@ -139,6 +143,12 @@ class Successors {
 
   // The start, blanked as a successor is, and reduced by the tolerance with its own share.
   Outcome start() {
+    if (timed_) {
+      Outcome outcome;
+      outcome.key = layout_->encode<W>(detail::compact<detail::CompactTimedState>(
+          mdp_->start(), skeletons_, detail::recorded_slots(mdp_->problem())));
+      return outcome;
+    }
     if (backtracking_) {
       Outcome outcome;
       outcome.key = layout_->encode<W>(detail::compact<detail::CompactBacktrackState>(
@@ -215,25 +225,25 @@ class Successors {
     }
   }
 
-  // With backtracking: the MDP's outcomes of the decoded state, in its order (the backward pass
-  // takes the observations' probabilities without applying them).
-  template <bool kKeys, class Sink>
-  void walk_backtracking(const Key& key, int t, Sink& sink) {
-    layout_->decode(key, t, back_state_);
-    for (const int choice : mdp_->useful_choices(back_state_)) {
+  // With backtracking, chains or expiry: the MDP's outcomes of the decoded state (`scratch`,
+  // of the state type that holds what the key holds), in its order (the backward pass takes
+  // the observations' probabilities without applying them).
+  template <bool kKeys, class Compact, class Sink>
+  void walk_whole(const Key& key, int t, Compact& scratch, Sink& sink) {
+    layout_->decode(key, t, scratch);
+    for (const int choice : mdp_->useful_choices(scratch)) {
       if constexpr (kKeys) {
-        mdp_->for_each_outcome(back_state_, choice,
-                               [&](double probability, Status status, const detail::CompactBacktrackState& next) {
-                                 Outcome outcome;
-                                 outcome.choice = choice;
-                                 outcome.probability = probability;
-                                 outcome.status = status;
-                                 if (status == Status::running) outcome.key = layout_->encode<W>(next);
-                                 if (status == Status::success) outcome.reward = mdp_->success_reward(next, choice);
-                                 sink(static_cast<const Outcome&>(outcome));
-                               });
+        mdp_->for_each_outcome(scratch, choice, [&](double probability, Status status, const Compact& next) {
+          Outcome outcome;
+          outcome.choice = choice;
+          outcome.probability = probability;
+          outcome.status = status;
+          if (status == Status::running) outcome.key = layout_->encode<W>(next);
+          if (status == Status::success) outcome.reward = success_reward(next, choice);
+          sink(static_cast<const Outcome&>(outcome));
+        });
       } else {
-        mdp_->for_each_observation(back_state_, choice, [&](double probability, const Observation&) {
+        mdp_->for_each_observation(scratch, choice, [&](double probability, const Observation&) {
           Outcome outcome;
           outcome.choice = choice;
           outcome.probability = probability;
@@ -243,10 +253,23 @@ class Successors {
     }
   }
 
+  template <class Compact>
+  double success_reward(const Compact& state, int choice) {
+    if constexpr (kHoldsChains<Compact>) {
+      return plans_.reward(*mdp_, state, choice);
+    } else {
+      return mdp_->success_reward(state, choice);
+    }
+  }
+
   template <bool kKeys, class Sink>
   void walk(const Key& key, int t, Sink& sink) {
+    if (timed_) {
+      walk_whole<kKeys>(key, t, timed_state_, sink);
+      return;
+    }
     if (backtracking_) {
-      walk_backtracking<kKeys>(key, t, sink);
+      walk_whole<kKeys>(key, t, back_state_, sink);
       return;
     }
     layout_->decode(key, t, state_);
@@ -402,9 +425,12 @@ class Successors {
   Steps deadline_;
   int skeletons_;
   bool backtracking_;
+  bool timed_;
   // Scratch of one walk, kept to avoid allocation per state.
   CompactState state_;
   detail::CompactBacktrackState back_state_;
+  detail::CompactTimedState timed_state_;
+  detail::PlanValues plans_;  // with chains or expiry: the successes' rewards
   std::vector<Group> groups_;
   std::vector<char> alive_, kept_;
 };
