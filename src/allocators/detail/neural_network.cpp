@@ -163,7 +163,11 @@ void Adam<Scalar>::step(Mlp<Scalar>& network) {
   const auto update = [&](auto& parameter, const auto& gradient, auto& m, auto& v) {
     m = b1 * m + (Scalar(1) - b1) * gradient;
     v = b2 * v + (Scalar(1) - b2) * gradient.cwiseProduct(gradient);
-    parameter.array() -= rate * m.array() / (v.array().sqrt() + epsilon);
+    // Each square root correctly rounded (sqrtss): Eigen's vectorised float sqrt, under its
+    // default EIGEN_FAST_MATH, starts from the rsqrtps approximation, whose bits differ between
+    // CPU makers (Intel and AMD), and a policy trained with the same seed would differ with them.
+    const auto root = [](Scalar x) { return std::sqrt(x); };
+    parameter.array() -= rate * m.array() / (v.array().unaryExpr(root) + epsilon);
   };
   for (std::size_t layer = 0; layer < weight_m_.size(); ++layer) {
     update(network.weights()[layer], network.weight_gradients()[layer], weight_m_[layer], weight_v_[layer]);
