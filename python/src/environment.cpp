@@ -27,7 +27,8 @@ class EnvironmentCore {
       : mdp_(std::move(mdp)),
         world_(*mdp_->problem, 0),
         seed_(seed),
-        features_(static_cast<std::size_t>(feature_count(mdp_->mdp.skeleton_count()))),
+        features_(static_cast<std::size_t>(
+            feature_count(mdp_->mdp.skeleton_count(), chain_feature_count(mdp_->mdp.problem())))),
         start_(mdp_->mdp.start()) {}
 
   int skeleton_count() const { return mdp_->mdp.skeleton_count(); }

@@ -102,17 +102,23 @@ def test_a_session_takes_the_chains_states_with_each_report(tmp_path):
         assert session.reward == reward
 
 
-def test_allocators_that_do_not_model_chains_refuse_them(tmp_path):
+def test_every_allocator_takes_chains_and_ppo_learns_the_queue(tmp_path):
+    assert all("chains" in kind["capabilities"] for kind in ontime.allocators())
     path = tmp_path / "queue.json"
     path.write_text(json.dumps(QUEUE))
     problem = ontime.load_problem(path)
-    with pytest.raises(ontime.UsageError, match="does not take instances with exogenous chains"):
-        ontime.make_allocator(problem, "ppo")
     with pytest.raises(ontime.UsageError, match="'sum' has no form with chains"):
         ontime.make_allocator(problem, "dp-rerun", aggregation="sum")
     evaluated = ontime.evaluate(problem, "round-robin", episodes=4000, exact=True, seed=3)
     assert evaluated["exact_success_probability"] == pytest.approx(0.7, abs=1e-15)
     assert abs(evaluated["success_rate"] - 0.7) <= 4 * evaluated["ci95"]
+    # One skeleton and one useful choice: any policy refines it; its file records the chain inputs
+    # (the queue's two states and the timed slot of the wait).
+    policy = tmp_path / "queue.policy.json"
+    ontime.train_ppo(problem, policy, episodes=50, seed=2)
+    assert json.loads(policy.read_text())["chain_inputs"] == 3
+    evaluated = ontime.evaluate(problem, "ppo", policy=str(policy), episodes=2000, exact=True, seed=3)
+    assert evaluated["exact_success_probability"] == pytest.approx(0.7, abs=1e-15)
 
 
 def test_the_environment_draws_each_episodes_chains(tmp_path):

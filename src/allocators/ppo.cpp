@@ -8,7 +8,14 @@
 
 namespace ontime {
 
-int feature_count(int skeleton_count) noexcept { return 1 + 3 * skeleton_count; }
+int feature_count(int skeleton_count, int chain_inputs) noexcept { return 1 + 3 * skeleton_count + chain_inputs; }
+
+int chain_feature_count(const Problem& problem) noexcept {
+  if (!problem.is_timed()) return 0;
+  int count = problem.timed_slot_count();
+  for (const ExogenousChain& chain : problem.chains()) count += chain.state_count();
+  return count;
+}
 
 void normalised_state(const Mdp& mdp, const State& state, std::span<float> out) noexcept {
   const Problem& problem = mdp.problem();
@@ -22,10 +29,21 @@ void normalised_state(const Mdp& mdp, const State& state, std::span<float> out) 
     out[base + 2] = static_cast<float>(state.spent[slot]) / deadline;
     out[base + 3] = static_cast<float>(state.execution[slot]) / deadline;
   }
+  if (!mdp.is_timed()) return;
+  auto at = static_cast<std::size_t>(feature_count(count));
+  const auto chains = static_cast<int>(problem.chains().size());
+  for (int c = 0; c < chains; ++c) {
+    const int states = problem.chains()[static_cast<std::size_t>(c)].state_count();
+    const int current = mdp.chain_state(state.chains, c);
+    for (int s = 0; s < states; ++s) out[at++] = s == current ? 1.0F : 0.0F;
+  }
+  for (int slot = 0; slot < problem.timed_slot_count(); ++slot) {
+    out[at++] = static_cast<float>(state.restore[static_cast<std::size_t>(slot)]) / deadline;
+  }
 }
 
 void state_features(const Mdp& mdp, const State& state, PolicyNetwork::Vector& features) {
-  features.resize(feature_count(mdp.skeleton_count()));
+  features.resize(feature_count(mdp.skeleton_count(), chain_feature_count(mdp.problem())));
   normalised_state(mdp, state, std::span<float>(features.data(), static_cast<std::size_t>(features.size())));
 }
 
@@ -42,6 +60,12 @@ PpoAllocator::PpoAllocator(const Mdp& mdp, std::shared_ptr<const PpoPolicy> poli
                      " skeletons and deadline " + std::to_string(policy_->deadline) + " ('" + policy_->instance +
                      "'), not for this instance (" + std::to_string(mdp.skeleton_count()) + " skeletons, deadline " +
                      std::to_string(mdp.deadline()) + ")");
+  }
+  if (policy_->chain_inputs != chain_feature_count(mdp.problem())) {
+    throw UsageError("the ppo policy was trained with " + std::to_string(policy_->chain_inputs) +
+                     " inputs for exogenous chains and timed actions ('" + policy_->instance +
+                     "'), this instance has " + std::to_string(chain_feature_count(mdp.problem())) +
+                     " (SPEC §9): retrain it on this instance");
   }
   evaluation_ = std::make_unique<Evaluation>(Evaluation{policy_->networks->actor, {}});
 }
@@ -86,7 +110,7 @@ void check_trained_on(const PpoPolicy& policy, const Problem& problem, const std
 AllocatorKind ppo_kind() {
   return {.name = "ppo",
           .summary = "a policy learned by Proximal Policy Optimization from episodes alone, acting greedily",
-          .capabilities = {Capability::stationary, Capability::needs_policy},
+          .capabilities = {Capability::stationary, Capability::needs_policy, Capability::chains},
           .parameters = {Parameter::path(
                              "policy", "trained policy file (JSON); for several instances, one per instance in order"),
                          Parameter::choice(

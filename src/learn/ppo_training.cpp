@@ -125,7 +125,7 @@ class PpoTrainer {
       : mdp_(mdp),
         h_(h),
         count_(mdp.skeleton_count()),
-        inputs_(feature_count(count_)),
+        inputs_(feature_count(count_, chain_feature_count(mdp.problem()))),
         networks_(initial_networks(stream_seed(seed, 0))),
         actor_optimiser_(networks_.actor, h.actor_learning_rate),
         critic_optimiser_(networks_.critic, h.critic_learning_rate),
@@ -284,6 +284,7 @@ PpoTraining train_ppo(const Mdp& mdp, std::uint64_t episodes, std::uint64_t seed
   policy.instance = mdp.problem().name();
   policy.instance_digest = instance_digest(mdp.problem());
   policy.skeleton_count = mdp.skeleton_count();
+  policy.chain_inputs = chain_feature_count(mdp.problem());
   policy.deadline = mdp.deadline();
   policy.seed = seed;
   policy.episodes = episodes;

@@ -13,6 +13,7 @@
 #include "ontime/run/evaluation.hpp"
 #include "ontime/solve/optimal_solver.hpp"
 #include "ontime/util/error.hpp"
+#include "support/chain_reference.hpp"
 #include "support/paper.hpp"
 
 namespace ontime {
@@ -145,6 +146,56 @@ TEST(Ppo, DecidesUnderBacktracking) {
                           mdp, [&] { return std::make_unique<PpoAllocator>(mdp, policy); }, options)
                           .success_rate;
   EXPECT_NEAR(rate, exact, 4 * std::sqrt(exact * (1 - exact) / static_cast<double>(options.episodes)));
+}
+
+// With chains or expiry (SPEC §9) the features go on with each chain's state one-hot and each
+// timed slot's static execution / D, after the 1 + 3 K of any instance.
+TEST(Ppo, FeaturesOfAStateWithChainsHoldTheChainsOneHotAndTheTimedSlots) {
+  const Problem problem = testing::door_open_at_even_steps();
+  const Mdp mdp(problem);
+  ASSERT_EQ(chain_feature_count(problem), 2 + 1);  // the door's two states, the timed slot of "enter"
+  ASSERT_EQ(feature_count(2, chain_feature_count(problem)), 1 + 6 + 3);
+  State state = mdp.start();
+  ASSERT_EQ(mdp.apply(state, 1, Observation::not_yet().with_chains(1)), Status::running);  // a wait: the door locks
+  state.restore[0] = 3;  // (as if 3 steps of execution were ahead of "enter")
+  std::vector<float> out(10, -1.0F);
+  normalised_state(mdp, state, out);
+  const std::vector<float> expected{1.0F / 6, 0, 0, 0, 0, 1.0F / 6, 0, 0, 1, 3.0F / 6};
+  EXPECT_EQ(out, expected);
+  // Without chains or expiry nothing is added.
+  EXPECT_EQ(chain_feature_count(testing::paper_instance("instance1")), 0);
+}
+
+// The door opens at even steps: entering as soon as the motion is found fails, a step spent
+// elsewhere first succeeds. A policy trained there records its chain inputs, reads back, decides
+// exactly as the optimum does, and its episodes agree with its exact value; it is refused by an
+// instance of the same shape without chains.
+TEST(Ppo, LearnsToWaitForTheDoor) {
+  const Problem problem = testing::door_open_at_even_steps();
+  const Mdp mdp(problem);
+  PpoHyperparameters small;
+  small.steps_per_epoch = 200;
+  PpoAllocator untrained(mdp, std::make_shared<const PpoPolicy>(train_ppo(mdp, 1, 2, small).policy));
+  EXPECT_EQ(evaluate_exactly(mdp, untrained).expected_reward, 0.0);  // it enters at once
+  const PpoPolicy trained = train_ppo(mdp, 400, 2, small).policy;
+  EXPECT_EQ(trained.chain_inputs, 3);
+  const auto policy = std::make_shared<const PpoPolicy>(parse_ppo_policy(ppo_policy_to_json(trained), "door-policy"));
+  EXPECT_EQ(ppo_policy_to_json(*policy), ppo_policy_to_json(trained));
+  PpoAllocator allocator(mdp, policy);
+  const ExactEvaluation exact = evaluate_exactly(mdp, allocator);
+  EXPECT_EQ(exact.expected_reward, 1.0);
+  MonteCarloOptions options;
+  options.episodes = 200;
+  options.seed = 5;
+  const MonteCarloResult episodes = run_monte_carlo(
+      mdp, [&] { return std::make_unique<PpoAllocator>(mdp, policy); }, options);
+  EXPECT_EQ(episodes.success_rate, 1.0);
+  const Problem plain = testing::paper_instance("instance4");  // 2 skeletons, as the door's
+  ASSERT_EQ(plain.skeleton_count(), problem.skeleton_count());
+  PpoPolicy reshaped = trained;
+  reshaped.deadline = plain.deadline();
+  const Mdp plain_mdp(plain);
+  EXPECT_THROW(PpoAllocator(plain_mdp, std::make_shared<const PpoPolicy>(reshaped)), UsageError);
 }
 
 // 60 episodes hold at least two epochs of 200 steps, so that the second update starts from

@@ -38,11 +38,17 @@ struct PpoHyperparameters {
   double target_kl = 0.01;  // actor steps stop early past 1.5 x this KL
 };
 
-// The number of features of a state with K skeletons: 1 + 3 K.
-int feature_count(int skeleton_count) noexcept;
-// The features of a state, written to `out` (size feature_count): CT / D, then per skeleton
-// l_k / A_k, PT_k / D and ET_k / D (ET_k saturates at D + 1, so its feature at (D + 1) / D).
-// The input of the policy networks, and the observation of the Python environment.
+// The number of features of a state with K skeletons: 1 + 3 K, and `chain_inputs` more with
+// chains or expiry (chain_feature_count).
+int feature_count(int skeleton_count, int chain_inputs = 0) noexcept;
+// The features beyond 1 + 3 K that a problem with chains or expiry (SPEC §9) adds: one per
+// state of each chain, then one per timed slot; 0 for any other problem.
+int chain_feature_count(const Problem& problem) noexcept;
+// The features of a state, written to `out` (size feature_count(K, chain_feature_count)): CT / D,
+// then per skeleton l_k / A_k, PT_k / D and ET_k / D (ET_k saturates at D + 1, so its feature at
+// (D + 1) / D); with chains or expiry, then each chain's state one-hot (1 at its state, 0 at
+// its others), then each timed slot's static execution before its action / D. The input of the
+// policy networks, and the observation of the Python environment.
 void normalised_state(const Mdp& mdp, const State& state, std::span<float> out) noexcept;
 
 // The actor and critic networks; defined inside the library (they are Eigen matrices, which
@@ -55,6 +61,7 @@ struct PpoPolicy {
   std::string instance;         // name of the instance it was trained on
   std::string instance_digest;  // instance_digest() of it; empty in files written before digests
   int skeleton_count = 0;
+  int chain_inputs = 0;  // chain_feature_count of the instance (with chains or expiry; else 0)
   Steps deadline = 0;
   std::uint64_t seed = 0;
   std::uint64_t episodes = 0;  // training episodes

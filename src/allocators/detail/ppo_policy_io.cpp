@@ -71,8 +71,8 @@ class PolicyReader {
       fail("version", "this version of ontime reads policy files of version " + std::to_string(kVersion));
     }
     detail::check_known_keys(root, "",
-                             {"format", "version", "instance", "instance_digest", "skeletons", "deadline", "seed",
-                              "episodes", "features", "hyperparameters", "actor", "critic"},
+                             {"format", "version", "instance", "instance_digest", "skeletons", "chain_inputs",
+                              "deadline", "seed", "episodes", "features", "hyperparameters", "actor", "critic"},
                              source_);
     PpoPolicy policy;
     policy.instance = text_at(root, "instance");
@@ -84,6 +84,10 @@ class PolicyReader {
     }
     policy.skeleton_count = static_cast<int>(integer_at(root, "skeletons", 1, Problem::kMaxSkeletons));
     policy.deadline = static_cast<Steps>(integer_at(root, "deadline", 1, Problem::kMaxDeadline));
+    // (Optional: a policy of an instance with chains or expiry, SPEC §9; absent means 0.)
+    if (root.contains("chain_inputs")) {
+      policy.chain_inputs = static_cast<int>(integer_at(root, "chain_inputs", 1, 1 << 20));
+    }
     policy.seed = static_cast<std::uint64_t>(integer_at(root, "seed", 0, INT64_MAX));
     policy.episodes = static_cast<std::uint64_t>(integer_at(root, "episodes", 0, INT64_MAX));
     if (!root.contains("hyperparameters") || !root["hyperparameters"].is_object()) {
@@ -108,7 +112,7 @@ class PolicyReader {
     h.max_episode_steps = static_cast<int>(integer_at(hyper, "max_episode_steps", 1, 100000000, "hyperparameters"));
     h.target_kl = number_at(hyper, "target_kl", "hyperparameters");
 
-    const int inputs = feature_count(policy.skeleton_count);
+    const int inputs = feature_count(policy.skeleton_count, policy.chain_inputs);
     policy.networks = std::make_shared<const PpoNetworks>(
         PpoNetworks{network_at(root, "actor", inputs, policy.skeleton_count), network_at(root, "critic", inputs, 1)});
     return policy;
@@ -232,7 +236,14 @@ std::string ppo_policy_to_json(const PpoPolicy& policy) {
   root["deadline"] = policy.deadline;
   root["seed"] = policy.seed;
   root["episodes"] = policy.episodes;
-  root["features"] = "time / D; per skeleton: refined / length, spent / D, execution / D";
+  if (policy.chain_inputs > 0) {
+    root["chain_inputs"] = policy.chain_inputs;
+    root["features"] =
+        "time / D; per skeleton: refined / length, spent / D, execution / D; per chain: its state one-hot; per timed "
+        "slot: execution before the action / D";
+  } else {
+    root["features"] = "time / D; per skeleton: refined / length, spent / D, execution / D";
+  }
   root["hyperparameters"] = {{"hidden_layers", h.hidden_layers},
                              {"hidden_units", h.hidden_units},
                              {"clip", h.clip},
