@@ -486,12 +486,6 @@ MonteCarloResult run_many(const WorldFactory& worlds, const AllocatorFactory* al
 
 MonteCarloResult run_episodes(const Mdp& mdp, const WorldFactory& worlds, const AllocatorFactory& allocators,
                               const MonteCarloOptions& options) {
-  if (options.live && mdp.is_timed()) {
-    // Refused before any episode rather than by the first step (Session::carry_out).
-    throw UsageError(
-        "live episodes in a simulated world do not model exogenous chains or expiry (SPEC §9) yet: the simulated "
-        "chains would have to move with the clock between reports");
-  }
   return run_many(worlds, &allocators, options, [&](ThreadRun& run, std::uint64_t seed) {
     return run_episode(mdp, *run.allocator, *run.world, seed, options.decision_budget,
                        options.time_decisions ? &run.timer : nullptr, options.live);

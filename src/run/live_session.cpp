@@ -87,6 +87,7 @@ void Session::charge_outside(double seconds) {
 void Session::end_if_out_of_time() {
   const double elapsed = elapsed_seconds();
   state_.time = static_cast<std::uint16_t>(std::max<Steps>(state_.time, steps_at(elapsed)));
+  if (simulated_chains_) state_.chains = simulated_chains_at(state_.time);
   if (state_.time >= mdp_->deadline() || out_of_skeletons()) {
     status_ = Status::failure;
     ended_at_ = elapsed;
@@ -193,6 +194,7 @@ Status Session::report_live(int choice, int action, const Observation& observati
     }
   }
   state_.time = static_cast<std::uint16_t>(std::max<Steps>(before_.time, steps_at(elapsed)));
+  if (simulated_chains_) state_.chains = simulated_chains_at(state_.time);  // (carried out in a world)
 
   LiveStep& step = timeline_.back();
   step.planning_seconds = planning;

@@ -206,22 +206,25 @@ Status Session::report(const Observation& observation, double execution_seconds)
 }
 
 Status Session::carry_out_timed(World& world) {
-  if (clock_ != nullptr) {
-    // The clock may move several steps between two reports, and the simulated chains would
-    // then have to move with it, unseen by the report that applies them.
-    throw UsageError(
-        "a live session with exogenous chains or expiry (SPEC §9) takes the caller's reports with the chains' "
-        "states; carrying its steps out in a world is not supported yet");
-  }
   if (!exogenous_seeded_) {
     // A stream of its own: the allocator's draws stay those of the same seed without chains.
     exogenous_ = SplitMix64(stream_seed(seed_, 0x65786f67));
     exogenous_seeded_ = true;
   }
+  if (clock_ != nullptr && !simulated_chains_) {
+    // A live session in a world: the chains follow the clock (report_live, end_if_out_of_time),
+    // one step of their path per step of CT, however many steps a report charges.
+    simulated_chains_ = true;
+    chain_path_.assign(1, mdp_->start().chains);
+    state_.chains = simulated_chains_at(state_.time);
+  }
   Observation observation = pending_action_ < 0
                                 ? Observation::not_yet()
                                 : world.step(pending_action_, state_.spent[static_cast<std::size_t>(pending_)]);
-  if (mdp_->has_chains()) observation = observation.with_chains(mdp_->sample_chain_step(state_.chains, exogenous_));
+  if (mdp_->has_chains()) {
+    observation = observation.with_chains(simulated_chains_ ? simulated_chains_at(state_.time + 1)
+                                                            : mdp_->sample_chain_step(state_.chains, exogenous_));
+  }
   if (report(observation) != Status::success) return status_;
   // The completed plan is executed in the simulated chains.
   const auto slot = static_cast<std::size_t>(solution_);
@@ -235,6 +238,14 @@ Status Session::carry_out_timed(World& world) {
     timed_reward_ = problem().reward_at(solution_, finish);
   }
   return status_;
+}
+
+std::uint16_t Session::simulated_chains_at(Steps t) {
+  if (!mdp_->has_chains()) return 0;
+  while (chain_path_.size() <= static_cast<std::size_t>(t)) {
+    chain_path_.push_back(mdp_->sample_chain_step(chain_path_.back(), exogenous_));
+  }
+  return chain_path_[static_cast<std::size_t>(t)];
 }
 
 double Session::reward() const {

@@ -44,22 +44,12 @@ TEST(EpisodeChains, EpisodesEstimateTheExactValuesForEveryThreadCount) {
   }
 }
 
-TEST(EpisodeChains, ASessionWithChainsRetiresASkeletonAndALiveOneTakesOnlyReports) {
+TEST(EpisodeChains, ASessionWithChainsRetiresASkeleton) {
   const Problem problem = coffee();
   Session session(problem, Session::AllocatorMaker{}, 1);
   session.retire_skeleton(0);
   EXPECT_EQ(session.problem().skeleton_count(), 1);
   EXPECT_EQ(session.state().chains, Mdp(problem).start().chains);
-  ManualClock clock;
-  Session live(problem, Session::AllocatorMaker{}, 1, &clock);
-  HiddenWorld world(problem, 1);
-  live.decide(0);
-  EXPECT_THROW(live.carry_out(world), UsageError);  // the simulated chains would not follow the clock
-  MonteCarloOptions options;
-  options.episodes = 10;
-  options.live = LiveRun{};
-  const Mdp mdp(problem);
-  EXPECT_THROW(run_monte_carlo(mdp, make_allocator_factory("round-robin", mdp), options), UsageError);
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 #include "ontime/run/simulator.hpp"
 #include "ontime/util/error.hpp"
 #include "ontime/util/random.hpp"
+#include "support/chain_reference.hpp"
 #include "support/paper.hpp"
 
 namespace ontime {
@@ -186,10 +187,12 @@ TEST(LiveSession, AnAnytimeAllocatorGetsItsShareOfASlice) {
   EXPECT_THROW(Session(fast_mdp, *searcher, 1, clock, LiveOptions{.decision_share = 0.0}), UsageError);
 }
 
-// A hidden world on a manual clock that one step of effort advances by exactly one slice.
+// A hidden world on a manual clock that one step of effort advances by exactly one slice (or by
+// `slices` of them).
 class SlicedWorld final : public World {
  public:
-  explicit SlicedWorld(const Problem& problem) : world_(problem, 0), slice_(problem.step_seconds()) {}
+  explicit SlicedWorld(const Problem& problem, double slices = 1)
+      : world_(problem, 0), slice_(slices * problem.step_seconds()) {}
   void begin_episode(std::uint64_t seed) override { world_.begin_episode(seed); }
   Observation step(int action, Steps spent) override {
     clock_.advance(slice_);
@@ -231,6 +234,49 @@ TEST(LiveSession, ExactSlicesAndInstantDecisionsGiveTheModelsSuccesses) {
       EXPECT_DOUBLE_EQ(live.live_mean.overrun, 0.0);
       EXPECT_GT(live.live_mean.planning, 0.0);
     }
+  }
+}
+
+// With exogenous chains (SPEC §9) a live session carried out in a world simulates the chains
+// along its clock. On exact slices with instant decisions that is one chain step per report, as
+// in the model: the same episodes succeed and earn the same rewards.
+TEST(LiveSession, WithChainsExactSlicesAndInstantDecisionsGiveTheModelsEpisodes) {
+  const Problem problem = load_problem(testing::source_path("data/instances/chains/meeting-through-the-queue.json"));
+  const Mdp mdp(problem);
+  for (const char* solver : {"optimal", "dp-rerun", "round-robin", "thompson"}) {
+    SCOPED_TRACE(solver);
+    const AllocatorFactory factory = make_allocator_factory(solver, mdp);
+    MonteCarloOptions options;
+    options.episodes = 2000;
+    options.seed = 5;
+    options.threads = 2;
+    const MonteCarloResult model = run_episodes(mdp, hidden_worlds(problem), factory, options);
+    options.live = LiveRun{};
+    options.threads = 1;
+    const MonteCarloResult live = run_episodes(
+        mdp, [&problem] { return std::make_unique<SlicedWorld>(problem); }, factory, options);
+    EXPECT_GT(model.successes, 1000U);
+    EXPECT_EQ(live.successes, model.successes);
+    EXPECT_EQ(live.mean_reward, model.mean_reward);
+    // The step clock's verdict is the plan completed in time; its execution in the chains is
+    // drawn by the live session alone.
+    EXPECT_GE(live.model_successes, live.successes);
+  }
+}
+
+// A door open at even steps and a planner call that takes two slices: the chains still move once
+// per step of the clock, so after each call (steps 2, 4 and 6) the door is open; one step of
+// the chains per report would have it locked.
+TEST(LiveSession, SimulatedChainsFollowTheClockAcrossLongCalls) {
+  const Problem problem = testing::door_open_at_even_steps();
+  SlicedWorld world(problem, 2);
+  world.begin_episode(1);
+  Session session(problem, Session::AllocatorMaker{}, 1, world.clock());
+  for (const Steps time : {2, 4, 6}) {
+    session.decide(1);  // the other skeleton: its planner never finds a motion
+    EXPECT_EQ(session.carry_out(world), time < 6 ? Status::running : Status::failure);
+    EXPECT_EQ(session.state().time, time);
+    EXPECT_EQ(session.state().chains, 0) << "step " << time;  // open
   }
 }
 

@@ -168,9 +168,10 @@ class Session {
   // non-finite time; infinity means the motion cannot be executed.
   Status report_refined_seconds(double execution_seconds);
   // The same with exogenous chains (SPEC §9): `chains` is their joint state after the step
-  // (Mdp::joint_chain_state). A live session with chains or expiry takes the caller's reports
-  // (not carry_out): each report brings the chains' state now, and steps the clock moved on
-  // between reports keep the state last reported. A completed plan's static part must fit in
+  // (Mdp::joint_chain_state). Each report brings the chains' state now, and steps the clock
+  // moved on between reports keep the state last reported. (Carried out in a world instead,
+  // carry_out, a live session simulates the chains along the clock: one step of their path per
+  // step of CT, however many a report charges.) A completed plan's static part must fit in
   // seconds (the execution reported for an action that depends on a chain is not used: it is
   // drawn when the action starts); the plan is then worth its expected reward from the state at
   // the report (reward()).
@@ -250,12 +251,18 @@ class Session {
   LiveTotals totals() const;
   // Live sessions: the same planner calls judged by the model's step clock (one step per call,
   // steps of execution, nothing charged for thinking or overruns): success or failure once that
-  // clock decided, running when the live session ended before it did.
+  // clock decided, running when the live session ended before it did. With chains or expiry
+  // (SPEC §9) its success is a plan completed in time: the plan's execution in the chains is
+  // drawn for the live session only.
   Status model_status() const noexcept { return model_status_; }
 
  private:
   [[noreturn]] static void throw_without_decision();
   Status carry_out_timed(World& world);
+  // A live session carried out in a world (SPEC §9): the simulated chains' joint state at step t.
+  // Their path is drawn step by step from exogenous_ as far as it is needed, so that the clock may
+  // move several steps between two reports and the chains still move once per step.
+  std::uint16_t simulated_chains_at(Steps t);
   // The live half (src/run/live_session.cpp).
   void start_live(const Clock& clock, LiveOptions options);
   // choose(), decide() and report() on the clock, once what every session checks and records is
@@ -308,6 +315,9 @@ class Session {
   SplitMix64 exogenous_{0};
   bool exogenous_seeded_ = false;
   double timed_reward_ = 0;
+  // A live session carried out in a world: the simulated chains' path (by step, from the start).
+  std::vector<std::uint16_t> chain_path_;
+  bool simulated_chains_ = false;
   std::uint64_t changes_ = 0;   // skeleton changes so far: the allocator's seed stream
   bool more_expected_ = false;  // expect_more_skeletons()
 
