@@ -84,7 +84,10 @@ void add_train_command(CLI::App& app) {
     // the same, without the exact figure.
     if (problem.skeleton_count() <= kMaxExactSkeletons) {
       PpoAllocator greedy(mdp, std::make_shared<const PpoPolicy>(training.policy));
-      trained.exact = evaluate_exactly(mdp, greedy).success_probability;
+      const ExactEvaluation exact = evaluate_exactly(mdp, greedy);
+      trained.exact = exact.success_probability;
+      // As evaluate reports it: the expected reward beside the success for an instance with rewards.
+      if (problem.has_rewards()) trained.exact_reward = exact.expected_reward;
     }
     fmt::print("{}", options->json ? report::to_json(trained) + "\n" : report::to_text(trained));
   });

@@ -473,6 +473,7 @@ std::string to_json(const Training& training) {
   out["epochs"] = training.epochs;
   out["seconds"] = training.seconds;
   out["exact_success_probability"] = training.exact ? Json(*training.exact) : Json(nullptr);
+  if (training.exact_reward) out["exact_expected_reward"] = *training.exact_reward;
   return dump(out);
 }
 
@@ -481,6 +482,9 @@ std::string to_text(const Training& training) {
                                 training.problem->name(), training.episodes, training.epochs, training.seconds);
   if (training.exact) {
     out += fmt::format("exact success probability of the trained policy (greedy): {:.4f}\n", *training.exact);
+    if (training.exact_reward) {
+      out += fmt::format("exact expected reward of the trained policy (greedy):    {:.6f}\n", *training.exact_reward);
+    }
   } else {
     out += fmt::format("exact success probability of the trained policy: not computed ({} skeletons; at most {})\n",
                        training.problem->skeleton_count(), kMaxExactSkeletons);

@@ -52,6 +52,30 @@ TEST(Cli, TrainWritesAPolicyThatEvaluateAndTableUse) {
   EXPECT_NE(bad.err.find(paper("instance4") + ": format: "), std::string::npos) << bad.err;
 }
 
+// On an instance with rewards and chains (SPEC §8, §9) train reports the policy's exact expected
+// reward beside its success, the figures evaluate --exact gives for the same policy; without
+// rewards, no reward key.
+TEST(Cli, TrainReportsTheExpectedRewardWithRewards) {
+  const auto directory = scratch("train-rewards");
+  const std::string instance = testing::source_path("data/instances/chains/meeting-through-the-queue.json").string();
+  const std::string policy = (directory / "meeting.json").string();
+  const auto trained = ontime({"train", instance, "--solver", "ppo", "--episodes", "200", "--seed", "1", "--out",
+                               policy, "--no-plot", "--json"});
+  ASSERT_EQ(trained.exit_code, 0) << trained.err;
+  const json report = json::parse(trained.out);
+  const auto evaluated =
+      ontime({"evaluate", instance, "--solver", "ppo", "--policy", policy, "--episodes", "100", "--exact", "--json"});
+  ASSERT_EQ(evaluated.exit_code, 0) << evaluated.err;
+  const json exact = json::parse(evaluated.out);
+  EXPECT_EQ(report["exact_expected_reward"].get<double>(), exact["exact_expected_reward"].get<double>());
+  EXPECT_EQ(report["exact_success_probability"].get<double>(), exact["exact_success_probability"].get<double>());
+  EXPECT_LT(report["exact_expected_reward"].get<double>(), report["exact_success_probability"].get<double>());
+  const auto plain = ontime({"train", paper("instance4"), "--solver", "ppo", "--episodes", "20", "--out",
+                             (directory / "plain.json").string(), "--no-plot", "--json"});
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_FALSE(json::parse(plain.out).contains("exact_expected_reward"));
+}
+
 // An interrupted run leaves the previous output file as it was; a complete run replaces it whole.
 TEST(Cli, InterruptedTrainingLeavesTheOldFile) {
   const auto directory = scratch("interrupt");

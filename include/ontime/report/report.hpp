@@ -86,6 +86,7 @@ struct Training {
   std::size_t epochs = 0;
   double seconds = 0;
   std::optional<double> exact = {};
+  std::optional<double> exact_reward = {};  // the expected reward too, for an instance with rewards (SPEC §8)
 };
 std::string to_json(const Training& training);
 std::string to_text(const Training& training);
