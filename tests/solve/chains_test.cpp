@@ -211,13 +211,7 @@ TEST(Chains, TheSearchEqualsTheMemoisedSolverBitForBit) {
 
 TEST(Chains, TheLayeredSolverRefusesWhatBoundsOnlyASuccessProbability) {
   const Problem problem = testing::queue_wait_instance("");  // (an Mdp holds a reference to its problem)
-  const Mdp mdp(problem);
-  LayeredSolveOptions options;
-  options.tolerance = 1e-3;
-  EXPECT_THROW(solve_layered(mdp, options), UsageError);
-  options.tolerance = 0;
-  options.split = SplitMode::always;
-  EXPECT_THROW(solve_layered(mdp, options), UsageError);
+  testing::expect_layered_refuses_a_tolerance_and_a_split(Mdp(problem));
 }
 
 TEST(Chains, EveryAllocatorTakesThem) {

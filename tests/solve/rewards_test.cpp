@@ -14,6 +14,7 @@
 #include "ontime/solve/search_solver.hpp"
 #include "ontime/solve/value_bounds.hpp"
 #include "ontime/util/error.hpp"
+#include "support/exact_solver_checks.hpp"
 #include "support/paper.hpp"
 #include "support/random_instances.hpp"
 #include "support/reference_solver.hpp"
@@ -177,13 +178,7 @@ TEST(Rewards, BrokenRewardsAreRefusedWithTheSkeletonAndTheRule) {
 
 TEST(Rewards, TheLayeredSolverRefusesADropOrASplitOfRewards) {
   const Problem problem = with_random_rewards(testing::paper_instance("instance3"), 3);
-  const Mdp mdp(problem);
-  LayeredSolveOptions options;
-  options.tolerance = 1e-3;
-  EXPECT_THROW(solve_layered(mdp, options), UsageError);
-  options.tolerance = 0;
-  options.split = SplitMode::always;
-  EXPECT_THROW(solve_layered(mdp, options), UsageError);
+  testing::expect_layered_refuses_a_tolerance_and_a_split(Mdp(problem));
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
 #pragma once
-// Checks shared by the property tests of the exact solvers: the layered solver and the search
-// against the memoised solver on one instance, to the bit.
+// Checks shared by the tests of the exact solvers: the layered solver and the search against the
+// memoised solver on one instance, to the bit; the layered solver's refusals.
 
 #include <gtest/gtest.h>
 
@@ -10,6 +10,7 @@
 #include "ontime/solve/layered_solver.hpp"
 #include "ontime/solve/optimal_solver.hpp"
 #include "ontime/solve/search_solver.hpp"
+#include "ontime/util/error.hpp"
 
 namespace ontime::testing {
 
@@ -62,6 +63,17 @@ inline void expect_search_equals_memoised(const Mdp& mdp) {
   const SearchSolution cut = solve_search(mdp, capped);
   EXPECT_LE(cut.lower, optimum + 1e-15);
   EXPECT_GE(cut.upper, optimum - 1e-15);
+}
+
+// The layered solver refuses a tolerance and a split (both bound a success probability read from
+// the static distributions: not a reward, nor chains or expiry).
+inline void expect_layered_refuses_a_tolerance_and_a_split(const Mdp& mdp) {
+  LayeredSolveOptions options;
+  options.tolerance = 1e-3;
+  EXPECT_THROW(solve_layered(mdp, options), UsageError);
+  options.tolerance = 0;
+  options.split = SplitMode::always;
+  EXPECT_THROW(solve_layered(mdp, options), UsageError);
 }
 
 }  // namespace ontime::testing
