@@ -212,3 +212,15 @@ def test_a_live_session_takes_the_queue_with_each_report():
         assert session.report_refined_seconds(30.0, chains={"queue": queue}) == ontime.Status.success
         # The move runs in steps 2-3; the coffee starts at 4, two steps of the queue after the report.
         assert session.reward == pytest.approx(short_when_it_starts, abs=1e-15)
+
+
+def test_backtracking_with_chains_solves_and_evaluates(source_dir):
+    # The cup carried through a door that locks, placing it sometimes blaming the grasp (SPEC §7, §9).
+    problem = ontime.load_problem(source_dir / "data" / "instances" / "chains" / "cup-through-the-door.json")
+    solved = {method: ontime.solve(problem, method=method) for method in ("layered", "memoised", "search")}
+    for method, out in solved.items():
+        assert out["optimal_expected_reward"] == solved["memoised"]["optimal_expected_reward"], method
+    assert solved["layered"]["optimal_expected_reward"] == pytest.approx(0.620783, abs=5e-7)
+    evaluated = ontime.evaluate(problem, "dp-rerun", episodes=4000, exact=True, seed=3)
+    assert evaluated["exact_expected_reward"] < solved["layered"]["optimal_expected_reward"]
+    assert abs(evaluated["mean_reward"] - evaluated["exact_expected_reward"]) <= 4 * evaluated["reward_ci95"] / 1.96

@@ -37,7 +37,9 @@ void normalised_state(const Mdp& mdp, const State& state, std::span<float> out) 
     const int current = mdp.chain_state(state.chains, c);
     for (int s = 0; s < states; ++s) out[at++] = s == current ? 1.0F : 0.0F;
   }
-  for (int slot = 0; slot < problem.timed_slot_count(); ++slot) {
+  // The timed slots follow the culprits' in State::restore.
+  const int first = problem.culprit_slot_count();
+  for (int slot = first; slot < first + problem.timed_slot_count(); ++slot) {
     out[at++] = static_cast<float>(state.restore[static_cast<std::size_t>(slot)]) / deadline;
   }
 }

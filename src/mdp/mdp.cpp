@@ -30,11 +30,6 @@ Steps least_chain_execution(const Action& action) {
 
 Mdp::Mdp(const Problem& problem)
     : problem_(&problem), skeleton_count_(problem.skeleton_count()), deadline_(problem.deadline()) {
-  if (problem.is_timed() && problem.has_backtracking()) {
-    throw UsageError(problem.name() +
-                     ": exogenous chains or actions that expire (SPEC §9) together with backtracking (SPEC §7) are not "
-                     "modelled yet");
-  }
   const auto deadline = static_cast<std::size_t>(deadline_);
   const auto action_count = static_cast<std::size_t>(problem.action_count());
 
@@ -104,8 +99,8 @@ Mdp::Mdp(const Problem& problem)
           std::min(kUnreachable, rest_[base + static_cast<std::size_t>(l) + 1] + least);
     }
   }
-  if (problem.has_backtracking()) index_backtracking(problem);
   if (problem.is_timed()) index_chains(problem);
+  if (problem.has_backtracking()) index_backtracking(problem);
 
   group_rest_.assign(action_count, kUnreachable);
   for (int k = 0; k < skeleton_count_; ++k) {
@@ -159,17 +154,21 @@ void Mdp::index_backtracking(const Problem& problem) {
       slot_at_[base + static_cast<std::size_t>(l)] = problem.culprit_slot(problem.action_at(k, l));
     }
   }
+  // With chains or expiry the timed slots of those actions too: a backtrack un-refines them, and
+  // zeroed slots keep equivalent states equal.
   slots_below_.assign(static_cast<std::size_t>(problem.culprit_slot_count()), {});
   for (int c = 0; c < problem.action_count(); ++c) {
     const int slot = problem.culprit_slot(c);
     if (slot < 0) continue;
     std::vector<int>& below = slots_below_[static_cast<std::size_t>(slot)];
     below.push_back(slot);
+    if (problem.timed_slot(c) >= 0) below.push_back(problem.timed_slot(c));
     for (int d = 0; d < problem.action_count(); ++d) {
-      if (d == c || problem.culprit_slot(d) < 0) continue;
+      if (d == c) continue;
       for (int up = problem.parent(d); up >= 0; up = problem.parent(up)) {
         if (up == c) {
-          below.push_back(problem.culprit_slot(d));
+          if (problem.culprit_slot(d) >= 0) below.push_back(problem.culprit_slot(d));
+          if (problem.timed_slot(d) >= 0) below.push_back(problem.timed_slot(d));
           break;
         }
       }

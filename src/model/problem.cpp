@@ -111,7 +111,8 @@ void Problem::index_chains() {
   timed_slot_.assign(count, -1);
   for (std::size_t a = 0; a < count; ++a) {
     const Action& action = actions_[a];
-    if (action.is_timed()) timed_slot_[a] = timed_slots_++;
+    // After the culprits' slots (index_culprits runs first): one State::restore holds both.
+    if (action.is_timed()) timed_slot_[a] = culprit_slots_ + timed_slots_++;
     if (!action.execution_chain.empty()) {
       const int chain = find_chain(action.execution_chain);
       if (chain < 0) throw ChainRuleError(action.execution_chain, action.id, "execution", "no such chain");

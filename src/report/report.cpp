@@ -352,6 +352,24 @@ std::string policy_lines(const Solve& solve) {
       }
       line["restore"] = std::move(restore);
     }
+    if (solve.problem->is_timed()) {
+      // Chains or expiry (SPEC §9): each chain's state by name, and the static execution before
+      // each refined timed action, by its id.
+      // (The joint state numbers the first chain's state fastest, as Mdp::joint_chain_state.)
+      Json chains = Json::object();
+      int joint = entry.state.chains;
+      for (const ExogenousChain& chain : solve.problem->chains()) {
+        chains[chain.name] = chain.states[static_cast<std::size_t>(joint % chain.state_count())];
+        joint /= chain.state_count();
+      }
+      if (!chains.empty()) line["chains"] = std::move(chains);
+      Json before = Json::object();
+      for (int a = 0; a < solve.problem->action_count(); ++a) {
+        const int slot = solve.problem->timed_slot(a);
+        if (slot >= 0) before[solve.problem->action(a).id] = entry.state.restore[static_cast<std::size_t>(slot)];
+      }
+      line["before"] = std::move(before);
+    }
     line["choice"] = entry.choice;
     line["lower_bound"] = entry.lower;
     line["upper_bound"] = entry.upper;

@@ -275,15 +275,17 @@ State Session::carried_over(const State& old, const Problem& next) const {
   out.time = old.time;
   out.chains = old.chains;  // the chains are carried over in their order: the same joint state
   // Backtracking (SPEC §7): B_c of every refined culprit, the execution before it on its path;
-  // chains or expiry (SPEC §9): the same of every refined timed action (a problem has one kind).
+  // chains or expiry (SPEC §9): the same of every refined timed action (an action may have both).
   for (int c = 0; c < next.action_count(); ++c) {
-    const int slot = next.culprit_slot(c) >= 0 ? next.culprit_slot(c) : next.is_timed() ? next.timed_slot(c) : -1;
     const auto index = static_cast<std::size_t>(c);
-    if (slot < 0 || index >= action_execution_steps_.size() || action_execution_steps_[index] < 0) continue;
+    if (next.culprit_slot(c) < 0 && next.timed_slot(c) < 0) continue;
+    if (index >= action_execution_steps_.size() || action_execution_steps_[index] < 0) continue;
     std::int64_t before = 0;
     for (int up = next.parent(c); up >= 0; up = next.parent(up))
       before = std::min(saturated, before + static_steps(up));
-    out.restore[static_cast<std::size_t>(slot)] = static_cast<std::uint16_t>(before);
+    for (const int slot : {next.culprit_slot(c), next.timed_slot(c)}) {
+      if (slot >= 0) out.restore[static_cast<std::size_t>(slot)] = static_cast<std::uint16_t>(before);
+    }
   }
   for (int k = 0; k < next.skeleton_count(); ++k) {
     const std::span<const int> path = next.skeleton(k);

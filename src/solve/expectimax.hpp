@@ -85,8 +85,8 @@ struct CompactState {
 };
 static_assert(sizeof(CompactState) == 2 + 16 + 32 + 32, "CompactState must have no padding: it is hashed as bytes");
 
-// The most actions backtracking may blame (Problem::culprit_slot_count) in a problem the exact
-// solvers take.
+// The most restore values (Problem::culprit_slot_count actions backtracking may blame and
+// Problem::timed_slot_count timed actions, together) in a problem the exact solvers take.
 inline constexpr int kMaxExactCulpritSlots = 16;
 
 // A CompactState with backtracking's restore values (SPEC §7): the state the exact solvers work
@@ -111,7 +111,7 @@ struct CompactTimedState : CompactBacktrackState {
 static_assert(sizeof(CompactTimedState) == sizeof(CompactBacktrackState) + 2,
               "CompactTimedState must have no padding: it is hashed as bytes");
 
-// The slots of State::restore a problem uses: its culprits' or its timed actions' (one kind at most).
+// The slots of State::restore a problem uses: its culprits', then its timed actions'.
 inline int recorded_slots(const Problem& problem) noexcept {
   return problem.culprit_slot_count() + problem.timed_slot_count();
 }
@@ -217,6 +217,12 @@ inline void require_exact_size(const Mdp& mdp, const std::string& what) {
     throw UsageError(what + ": the instance has " + std::to_string(mdp.problem().timed_slot_count()) +
                      " timed actions (chains or expiry); exact solving and exact evaluation take at most " +
                      std::to_string(kMaxExactCulpritSlots));
+  }
+  if (recorded_slots(mdp.problem()) > kMaxExactCulpritSlots) {
+    throw UsageError(what + ": the instance has " + std::to_string(mdp.problem().culprit_slot_count()) +
+                     " actions that backtracking may blame and " + std::to_string(mdp.problem().timed_slot_count()) +
+                     " timed actions; exact solving and exact evaluation take at most " +
+                     std::to_string(kMaxExactCulpritSlots) + " together");
   }
 }
 

@@ -105,6 +105,13 @@ void check_exact_work(const Problem& problem, std::size_t max_states, const std:
                          " actions that backtracking may blame; exact solving and exact evaluation take at most " +
                          std::to_string(detail::kMaxExactCulpritSlots));
   }
+  if (detail::recorded_slots(problem) > detail::kMaxExactCulpritSlots) {
+    throw InputError(source, "actions",
+                     std::to_string(problem.culprit_slot_count()) + " actions that backtracking may blame and " +
+                         std::to_string(problem.timed_slot_count()) +
+                         " timed actions; exact solving and exact evaluation take at most " +
+                         std::to_string(detail::kMaxExactCulpritSlots) + " together");
+  }
   check_memory_for(spell_parameter(spelling, "max-states") + " " + std::to_string(max_states),
                    OptimalSolver::max_bytes(problem, max_states));
 }

@@ -166,6 +166,23 @@ TEST(Ppo, FeaturesOfAStateWithChainsHoldTheChainsOneHotAndTheTimedSlots) {
   EXPECT_EQ(chain_feature_count(testing::paper_instance("instance1")), 0);
 }
 
+// With backtracking too the timed slots follow the culprits' in the state: the features read the
+// timed ones only.
+TEST(Ppo, FeaturesWithBacktrackingAndChainsReadTheTimedSlots) {
+  const Problem problem = testing::door_and_regrasp();
+  const Mdp mdp(problem);
+  ASSERT_EQ(chain_feature_count(problem), 2 + 1);  // the door's two states, the timed slot of "a"
+  State state = mdp.start();
+  ASSERT_EQ(mdp.apply(state, 0, Observation::found(2).with_chains(1)), Status::running);
+  ASSERT_EQ(mdp.apply(state, 0, Observation::found(2).with_chains(0)), Status::running);
+  state.restore[0] = 7;  // (the culprit slot of "a" set apart from its timed slot)
+  state.restore[1] = 5;
+  std::vector<float> out(7, -1.0F);
+  normalised_state(mdp, state, out);
+  const std::vector<float> expected{2.0F / 20, 2.0F / 3, 0, 4.0F / 20, 1, 0, 5.0F / 20};
+  EXPECT_EQ(out, expected);
+}
+
 // The door opens at even steps: entering as soon as the motion is found fails, a step spent
 // elsewhere first succeeds. A policy trained there records its chain inputs, reads back, decides
 // exactly as the optimum does, and its episodes agree with its exact value; it is refused by an

@@ -32,38 +32,7 @@
 namespace ontime {
 namespace {
 
-// A random small instance where every action after the first of its path may backtrack: a share
-// `beta` of its attempts (drawn per action, up to 0.6) give up at one or two steps instead of
-// finding, blaming one or two of its ancestors.
-Problem with_backtracking(const Problem& problem, std::uint64_t seed) {
-  SplitMix64 generator(seed);
-  std::vector<Action> actions(problem.actions().begin(), problem.actions().end());
-  for (int a = 0; a < problem.action_count(); ++a) {
-    std::vector<int> ancestors;
-    for (int up = problem.parent(a); up >= 0; up = problem.parent(up)) ancestors.push_back(up);
-    if (ancestors.empty() || generator() % 4 == 0) continue;
-    Action& action = actions[static_cast<std::size_t>(a)];
-    const double beta = 0.15 + 0.45 * uniform01(generator);
-    std::vector<double> planning(action.planning.masses().begin(), action.planning.masses().end());
-    for (double& mass : planning) mass *= 1.0 - beta;
-    action.planning = Distribution::from_pmf(std::move(planning));
-    std::vector<double> back(static_cast<std::size_t>(problem.deadline()) + 1, 0.0);
-    const auto first = 1 + static_cast<std::size_t>(generator() % static_cast<std::uint64_t>(problem.deadline()));
-    const auto second = 1 + static_cast<std::size_t>(generator() % static_cast<std::uint64_t>(problem.deadline()));
-    back[first] += beta / 2;
-    back[second] += beta / 2;
-    action.backtrack = Distribution::from_pmf(std::move(back));
-    const int blamed = ancestors[generator() % ancestors.size()];
-    action.culprits = {{problem.action(blamed).id, 1.0}};
-    if (ancestors.size() > 1 && generator() % 2 == 0) {
-      const int other = ancestors
-          [(static_cast<std::size_t>(std::find(ancestors.begin(), ancestors.end(), blamed) - ancestors.begin()) + 1) %
-           ancestors.size()];
-      action.culprits = {{problem.action(blamed).id, 0.7}, {problem.action(other).id, 0.3}};
-    }
-  }
-  return problem.with_actions(std::move(actions));
-}
+using testing::with_backtracking;
 
 // Stationary rules written twice: on the library's state (an allocator) and on the reference's.
 class LowestWithWork final : public Allocator {

@@ -105,19 +105,10 @@ TEST(Chains, ExactEvaluationOfARuleIsTheReferencesValue) {
     const Mdp mdp(problem);
     ClockAndChains rule(problem.skeleton_count());
     const ExactEvaluation exact = evaluate_exactly(mdp, rule);
-    const auto joint = [&problem](const testing::ChainReferenceSolver::Node& node) {
-      int value = 0;
-      int stride = 1;
-      for (std::size_t c = 0; c < node.chains.size(); ++c) {
-        value += node.chains[c] * stride;
-        stride *= problem.chains()[c].state_count();
-      }
-      return value;
-    };
-    const double expected =
-        testing::ChainReferenceSolver(problem).value_of([&](const testing::ChainReferenceSolver::Node& node) {
-          return (node.time + joint(node)) % problem.skeleton_count();
-        });
+    testing::ChainReferenceSolver reference(problem);
+    const double expected = reference.value_of([&](const testing::ChainReferenceSolver::Node& node) {
+      return (node.time + reference.joint(node)) % problem.skeleton_count();
+    });
     EXPECT_NEAR(exact.expected_reward, expected, 1e-12) << "seed " << seed;
     EXPECT_LE(exact.expected_reward, optimum(problem) + 1e-12) << "seed " << seed;
   }

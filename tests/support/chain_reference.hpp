@@ -1,9 +1,11 @@
 #pragma once
 // An independent, deliberately plain implementation of SPEC §9 (exogenous chains and actions that
-// expire, with §8's rewards; no backtracking) and of optimal expectimax over it, to check the
+// expire, with §8's rewards and §7's backtracking) and of optimal expectimax over it, to check the
 // library's solvers: its own state (every refined action's drawn execution kept in order, the
 // chains' states), its own transitions, every legal choice, no pruning; the plan's execution
-// followed step by step along every path of the chains. Exponential; for small instances only.
+// followed step by step along every path of the chains. A backtrack to culprit c cuts every
+// skeleton through c back to c's position: its drawn executions from there on are forgotten, so
+// its execution before c is what is left. Exponential; for small instances only.
 
 #include <algorithm>
 #include <functional>
@@ -41,6 +43,22 @@ inline Problem door_open_at_even_steps() {
                        "door.json");
 }
 
+// With backtracking (SPEC §7) too: z (found in step 1, executes 2 steps) then a (found in step 1, executes 2, cannot
+// start while the door is locked), then b, whose attempts give up after one step and blame a, or find a motion after
+// two, half the time each. The door alternates open and locked every step.
+inline Problem door_and_regrasp() {
+  return parse_problem(R"({"deadline": 20,
+      "chains": {"door": {"states": ["open", "locked"], "start": "open", "transitions": [[0, 1], [1, 0]]}},
+      "actions": {
+        "z": {"planning": {"pmf": {"1": 1.0}}, "execution": {"pmf": {"2": 1.0}}},
+        "a": {"planning": {"pmf": {"1": 1.0}}, "execution": {"pmf": {"2": 1.0}},
+              "expires": {"chain": "door", "states": ["locked"]}},
+        "b": {"planning": {"pmf": {"2": 0.5}}, "execution": {"pmf": {"1": 1.0}},
+              "backtrack": {"pmf": {"1": 0.5}}, "culprits": {"a": 1.0}}},
+      "skeletons": [["z", "a", "b"]]})",
+                       "door-and-regrasp.json");
+}
+
 class ChainReferenceSolver {
  public:
   struct Node {
@@ -57,6 +75,18 @@ class ChainReferenceSolver {
   static constexpr long kTooSlow = 1'000'000;
 
   explicit ChainReferenceSolver(const Problem& problem) : problem_(problem) {}
+
+  // The chains' joint state of a node, numbered as the library numbers it (the first chain's
+  // state varies fastest).
+  int joint(const Node& node) const {
+    int value = 0;
+    int stride = 1;
+    for (std::size_t c = 0; c < node.chains.size(); ++c) {
+      value += node.chains[c] * stride;
+      stride *= problem_.chains()[c].state_count();
+    }
+    return value;
+  }
 
   double optimum() { return solve({}); }
   double value_of(Rule rule) { return solve(std::move(rule)); }
@@ -206,11 +236,40 @@ class ChainReferenceSolver {
       }
     }
     const Action& model = problem_.action(action);
-    const double survival = model.planning.survival(node.spent[slot]);
-    const double hazard = survival > 0 ? model.planning.pmf(node.spent[slot] + 1) / survival : 0.0;
+    const int spent = node.spent[slot];
+    double hazard = 0.0;
+    double back = 0.0;
+    if (model.backtrack.never() >= 1.0) {
+      const double survival = model.planning.survival(spent);
+      hazard = survival > 0 ? model.planning.pmf(spent + 1) / survival : 0.0;
+    } else {
+      // The attempt ends with a motion or a give-up; P(neither in `spent` steps), summed plainly.
+      double alive = 1.0;
+      for (int t = 1; t <= spent; ++t) alive -= model.planning.pmf(t) + model.backtrack.pmf(t);
+      hazard = alive > 0 ? model.planning.pmf(spent + 1) / alive : 0.0;
+      back = alive > 0 ? model.backtrack.pmf(spent + 1) / alive : 0.0;
+    }
     Node missed = node;
     for (const std::size_t m : sharing) ++missed.spent[m];
-    settle(1.0 - hazard, missed);
+    settle(1.0 - hazard - back, missed);
+    for (const Culprit& culprit : model.culprits) {
+      if (back <= 0 || culprit.probability <= 0) continue;
+      const int blamed = problem_.find_action(culprit.id);
+      const auto position = static_cast<std::size_t>(problem_.position(blamed));
+      Node undone = node;
+      for (int m = 0; m < problem_.skeleton_count(); ++m) {
+        const auto index = static_cast<std::size_t>(m);
+        const auto path = problem_.skeleton(m);
+        if (path.size() <= position || path[position] != blamed ||
+            undone.refined[index] <= static_cast<int>(position)) {
+          continue;
+        }
+        undone.refined[index] = static_cast<int>(position);
+        undone.spent[index] = 0;
+        undone.executions[index].resize(position);
+      }
+      settle(back * culprit.probability, undone);
+    }
     std::vector<std::pair<long, double>> drawn;
     if (!model.execution_chain.empty()) {
       drawn.emplace_back(kAtStart, 1.0);

@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
+#include <limits>
 
 #include "ontime/mdp/mdp.hpp"
 #include "ontime/solve/layered_solver.hpp"
@@ -53,7 +55,9 @@ inline void expect_search_equals_memoised(const Mdp& mdp) {
     BranchAndBoundSearch trialled(mdp);
     const SearchSolution trials = trialled.trials(mdp.start(), [&](std::uint64_t work) { return work >= budget; });
     EXPECT_LE(trials.lower, optimum + OptimalSolver::kTieTolerance);  // as SearchSolver.Trials* says
-    EXPECT_GE(trials.upper, optimum);
+    // (A success probability of 1 may sum to 1 + 1 ulp in the memoised solver, while the bound
+    // is capped at the largest reward: a few ulps of slack.)
+    EXPECT_GE(trials.upper, optimum - 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, optimum));
     const SearchSolution after = trialled.search(mdp.start());
     EXPECT_EQ(after.lower, optimum);
     EXPECT_EQ(after.first_choice, search.first_choice);

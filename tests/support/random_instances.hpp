@@ -16,6 +16,12 @@ Problem random_instance(std::uint64_t seed, int max_skeletons = 4, int max_lengt
 // reward per skeleton (SPEC §8, §9). Same seed, same instance.
 Problem with_random_chains(const Problem& problem, std::uint64_t seed, bool rewards);
 
+// `problem` where every action after the first of its path may backtrack (SPEC §7): a share beta
+// of its attempts (drawn per action, up to 0.6) give up at one or two steps instead of finding,
+// blaming one or two of its ancestors; about a quarter of the actions never do. Same seed, same
+// instance.
+Problem with_backtracking(const Problem& problem, std::uint64_t seed);
+
 // How many of `count` repetitions (random instances, generated keys) a test checks: all of them,
 // or the share named by the environment variable ONTIME_TEST_SHARE (in (0, 1], at least one). The
 // sanitizer run sets 0.25: the first repetitions take the same code paths under the sanitizers at

@@ -358,7 +358,8 @@ class Mdp {
   // Per skeleton and position (offsets_ + k + l, as rest_): the culprit slot of the action there
   // that some action may blame, else -1.
   std::vector<int> slot_at_;
-  // Per culprit slot: the slots of the actions at or below it in the prefix tree (itself first).
+  // Per culprit slot: the slots of the actions at or below it in the prefix tree (itself first),
+  // culprit and timed slots alike.
   std::vector<std::vector<int>> slots_below_;
 };
 
@@ -573,6 +574,9 @@ Status Mdp::apply(S& state, int choice, const Observation& observation) const {
     if (!listed) reject_culprit(action, observation.culprit);
     if constexpr (kHoldsRestore<S>) {
       ++state.time;
+      if constexpr (kHoldsChains<S>) {
+        if (has_chains()) state.chains = observation.chains;  // they move whatever happens
+      }
       backtrack(state, observation.culprit);
       if (state.time >= deadline_ || !any_can_succeed(state)) return Status::failure;
       return Status::running;

@@ -137,8 +137,9 @@ struct State {
   // is not, for every action c whose B_c matters: with backtracking (SPEC §7) the actions some
   // action may blame (by Problem::culprit_slot; B_c is restored by a backtrack to c), with chains
   // or expiry (SPEC §9) the timed actions (by Problem::timed_slot; c starts B_c after its plan is
-  // complete, plus the chain-dependent executions before it). A problem has one kind or neither
-  // (the Mdp refuses both at once); all zero, and unused, without either.
+  // complete, plus the chain-dependent executions before it; their slots follow the culprits'). A
+  // problem with both has both kinds (an action may have a slot of each); a backtrack to c zeroes
+  // the slots of c and of the actions below it. All zero, and unused, without either.
   PerSkeleton<std::uint16_t> restore;
 
   friend bool operator==(const State&, const State&) = default;

@@ -190,8 +190,9 @@ class Problem {
     return blocking_.at(static_cast<std::size_t>(action)).at(static_cast<std::size_t>(state)) != 0;
   }
   // Whether the problem has chains or timed actions (Action::is_timed): its plans' values depend
-  // on when their actions start. The slot of a timed action (State::before holds the static
-  // execution before it on its path there), or -1; how many such slots.
+  // on when their actions start. The slot of a timed action (State::restore holds the static
+  // execution before it on its path there; the timed slots follow the culprit slots), or -1; how
+  // many such slots.
   bool is_timed() const noexcept { return has_chains() || timed_slots_ > 0; }
   int timed_slot(int action) const { return timed_slot_.at(static_cast<std::size_t>(action)); }
   int timed_slot_count() const noexcept { return timed_slots_; }
