@@ -16,6 +16,7 @@
 #include <absl/container/flat_hash_map.h>
 #include <absl/hash/hash.h>
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -229,13 +230,16 @@ inline void require_exact_size(const Mdp& mdp, const std::string& what) {
 // With chains or expiry (SPEC §9): R of a success, from the table of its plan's values over
 // every start (Mdp::execution_table, so each value is execution_value's to the bit), made once
 // per plan. A plan is its skeleton, its ET and the executions before its timed actions, so the
-// tables' number does not grow with the chains' states, and each success costs a look-up.
-// Past kMaxCells cached values (256 MiB) a success is valued without a table. One per thread.
+// tables' number does not grow with the chains' states, and each success costs a look-up. (With
+// backtracking too the culprits' restore values, which a plan's execution never reads, are left
+// out of the key.) Past kMaxCells cached values (256 MiB) a success is valued without a table.
+// One per thread.
 class PlanValues {
  public:
   double reward(const Mdp& mdp, const CompactTimedState& state, int choice) {
     const int k = mdp.completed_skeleton(state, choice);
-    const Key key{static_cast<std::uint16_t>(k), state.execution[static_cast<std::size_t>(k)], state.restore};
+    Key key{static_cast<std::uint16_t>(k), state.execution[static_cast<std::size_t>(k)], state.restore};
+    std::fill_n(key.restore.begin(), mdp.problem().culprit_slot_count(), std::uint16_t{0});
     auto found = tables_.find(key);
     if (found == tables_.end()) {
       if (cells_ > kMaxCells)
@@ -246,6 +250,11 @@ class PlanValues {
     }
     return found->second[static_cast<std::size_t>(state.time) * static_cast<std::size_t>(mdp.joint_chain_states()) +
                          state.chains];
+  }
+
+  // What the tables hold: their values and the map's slots.
+  std::uint64_t bytes() const noexcept {
+    return cells_ * sizeof(double) + tables_.capacity() * (sizeof(Key) + sizeof(std::vector<double>) + 1);
   }
 
  private:

@@ -121,6 +121,8 @@ Cut LayeredSearch<W>::expand(const std::vector<Key>& current, int t, std::vector
     buffer.foreign.resize(static_cast<std::size_t>(ranks_));
   }
   std::vector<BlockOutput> blocks(kChunkBlocks);
+  // With chains or expiry, each thread's table of plan values (made afresh for every chunk).
+  std::vector<std::uint64_t> plan_bytes(threads_, 0);
   const std::uint64_t chunks = max_over_ranks((current.size() + kChunk - 1) / kChunk);
   for (std::uint64_t chunk = 0; chunk < chunks; ++chunk) {
     const std::uint64_t begin = std::min<std::uint64_t>(current.size(), chunk * kChunk);
@@ -162,6 +164,7 @@ Cut LayeredSearch<W>::expand(const std::vector<Key>& current, int t, std::vector
           }
         };
         for (std::uint64_t i = first; i < last; ++i) successors.expand(current[i], t, sink);
+        plan_bytes[thread] = std::max(plan_bytes[thread], successors.plan_bytes());
         dropped_counter_.fetch_add(dropped, std::memory_order_relaxed);
       };
     });
@@ -256,6 +259,7 @@ Cut LayeredSearch<W>::expand(const std::vector<Key>& current, int t, std::vector
     // Caps, agreed by every rank at the end of each chunk.
     std::uint64_t chunk_bytes = foreign_entries.capacity() * (sizeof(std::uint64_t) + sizeof(std::uint32_t) + 1);
     for (const BlockOutput& block : blocks) chunk_bytes += block.codes.capacity() * 4 + block.extras.capacity() * 8;
+    for (const std::uint64_t bytes : plan_bytes) chunk_bytes += bytes;
     for (const ThreadBuffers& buffer : buffers) {
       for (const PendingList& list : buffer.own) chunk_bytes += list.list.capacity() * sizeof(Pending);
       for (const PendingList& list : buffer.foreign) chunk_bytes += list.list.capacity() * sizeof(Pending);

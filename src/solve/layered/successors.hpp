@@ -134,6 +134,8 @@ class Successors {
   void expand(const Key& key, int t, Sink&& sink) {
     walk<true>(key, t, sink);
   }
+  // The bytes of the plan tables the successes' rewards came from so far (chains or expiry).
+  std::uint64_t plan_bytes() const noexcept { return plans_.bytes(); }
   // Calls sink(outcome) for every outcome, with its choice and probability only, in the same
   // order (backward).
   template <class Sink>
