@@ -164,7 +164,7 @@ void add_solve_command(CLI::App& app) {
                     0.0);
   add_number_option(*command, "--gap", options->gap,
                     "Search: no exact solve, but trials of bounded RTDP until the certified interval is at most this "
-                    "wide (or --max-states, --max-seconds end them; default 0: the exact search)",
+                    "wide, at least 1e-9 (or --max-states, --max-seconds end them; default 0: the exact search)",
                     0.0, 1.0);
   add_number_option(*command, "--tolerance", options->tolerance,
                     "Layered, split: drop groups whose clairvoyant chance alone is below this, with their share in "
@@ -181,6 +181,11 @@ void add_solve_command(CLI::App& app) {
                     "Layered: leave out measured times and memory, so that outputs can be compared byte for byte");
   command->callback([options] {
     if (options->gap > 0 && options->method != "search") throw UsageError("--gap is for --method search");
+    if (options->gap > 0 && options->gap < SearchSolveOptions::kFinestGap) {
+      throw UsageError("--gap: 0 for the exact search, or at least " +
+                       fmt::format("{:g}", SearchSolveOptions::kFinestGap) +
+                       " (the finest interval the trials certify; got " + fmt::format("{:g}", options->gap) + ")");
+    }
     const Problem problem = load_problem(options->instance);
     if (problem.skeleton_count() > kMaxExactSkeletons) check_exact_work(problem, 1, options->instance);
     const Mdp mdp(problem);

@@ -1,6 +1,7 @@
 #include "ontime/solve/search_solver.hpp"
 
 #include <absl/container/flat_hash_map.h>
+#include <fmt/format.h>
 #include <pthread.h>
 
 #include <algorithm>
@@ -38,7 +39,7 @@ constexpr double kShareMargin = 1.1;
 // probability times gap (bounded RTDP's tau); the trials end when the start's gap is below
 // kTrialsDone.
 constexpr double kTrialRatio = 32.0;
-constexpr double kTrialsDone = 1e-9;
+constexpr double kTrialsDone = SearchSolveOptions::kFinestGap;
 // The trials' draws until clear(seed) gives others.
 constexpr std::uint64_t kDefaultTrialSeed = 1;
 
@@ -710,6 +711,10 @@ std::uint64_t BranchAndBoundSearch::size() const noexcept {
 }
 
 SearchSolution solve_search(const Mdp& mdp, const SearchSolveOptions& options) {
+  if (!(options.gap == 0.0 || (options.gap >= SearchSolveOptions::kFinestGap && options.gap <= 1.0))) {
+    throw UsageError("gap: 0 for the exact search, or between " + fmt::format("{:g}", SearchSolveOptions::kFinestGap) +
+                     " (the finest interval the trials certify) and 1 (got " + fmt::format("{:g}", options.gap) + ")");
+  }
   BranchAndBoundSearch search(mdp, options.max_states);
   std::function<bool(std::uint64_t)> stop;
   if (options.stop) stop = [&options](std::uint64_t) { return options.stop(); };

@@ -213,6 +213,11 @@ TEST(Cli, SolveBySearchWithAGapGivesANarrowInterval) {
   const auto layered = ontime({"solve", paper("instance1"), "--gap", "0.001"});
   EXPECT_EQ(layered.exit_code, 2);
   EXPECT_NE(layered.err.find("--gap is for --method search"), std::string::npos) << layered.err;
+  // Finer than the trials certify: refused at once rather than stopped wider than asked.
+  const auto too_fine = ontime({"solve", paper("instance1"), "--method", "search", "--gap", "1e-12"});
+  EXPECT_EQ(too_fine.exit_code, 2);
+  EXPECT_NE(too_fine.err.find("--gap: 0 for the exact search, or at least 1e-09"), std::string::npos) << too_fine.err;
+  EXPECT_TRUE(too_fine.out.empty());
 }
 
 // An instance with backtracking: the layered solver by default, the memoised solver's value to

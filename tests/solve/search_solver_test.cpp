@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 
@@ -176,6 +177,21 @@ TEST(SearchSolver, RefusesMoreSkeletonsThanItsKeysHold) {
   const Problem wide = testing::wide_instance(7, kMaxExactSkeletons + 1, 2, 12);
   const Mdp wide_mdp(wide);
   EXPECT_THROW(solve_search(wide_mdp), UsageError);
+}
+
+// A gap finer than the trials certify, negative or NaN is refused; the finest one is met.
+TEST(SearchSolver, RefusesAGapFinerThanTheTrialsCertify) {
+  const Problem problem = testing::paper_instance("instance1");
+  const Mdp mdp(problem);
+  SearchSolveOptions options;
+  for (const double gap : {1e-12, -0.1, 1.5, std::nan("")}) {
+    options.gap = gap;
+    EXPECT_THROW(solve_search(mdp, options), UsageError) << gap;
+  }
+  options.gap = SearchSolveOptions::kFinestGap;
+  const SearchSolution finest = solve_search(mdp, options);
+  EXPECT_LE(finest.upper - finest.lower, SearchSolveOptions::kFinestGap);
+  EXPECT_EQ(finest.stopped_by, "the gap");
 }
 
 }  // namespace

@@ -56,8 +56,12 @@ struct SearchSolveOptions {
   // Checked every few thousand states: once it returns true the search ends as at a cap.
   std::function<bool()> stop;
   // Above 0: no exact search, but trials (BranchAndBoundSearch::trials) until the start's
-  // certified interval is at most this wide, or a cap or the stop ends them.
+  // certified interval is at most this wide, or a cap or the stop ends them. At least
+  // kFinestGap: below it the trials' backups no longer narrow the interval reliably (the bounds
+  // of unsolved successors are widened by 1e-12 against rounding), so solve_search refuses a
+  // finer gap (UsageError) rather than stopping wider than asked; 0 asks for the exact search.
   double gap = 0.0;
+  static constexpr double kFinestGap = 1e-9;
 };
 
 struct SearchSolution {
@@ -96,13 +100,13 @@ class BranchAndBoundSearch {
                         std::uint64_t check_interval = 1);
   // Trials of bounded RTDP (McMahan, Likhachev and Gordon 2005) from `from`, each expanded state
   // one unit of work, until `stop(work)` returns true (checked every `check_interval` units), the
-  // state cap is reached or from's interval is at most `gap` (at least 1e-9) wide. A trial walks down by the
-  // choice of the largest upper end and an outcome drawn in proportion to probability times gap
-  // (from the seed of the last clear(), 1 before any), and backs both ends up along its path:
-  // where the depth-first search spends its work deep in one choice, trials spread it over the
-  // choices that may still be best, so that their lower ends rise. The lower ends are certified
-  // (at most the exact solver's values) and kept like the upper ones; a search() after trials settles choices by them.
-  // Returns from's interval and the choice of the best lower end (exact when `from` was solved before).
+  // state cap is reached or from's interval is at most `gap` (at least SearchSolveOptions::kFinestGap) wide. A trial
+  // walks down by the choice of the largest upper end and an outcome drawn in proportion to probability times gap (from
+  // the seed of the last clear(), 1 before any), and backs both ends up along its path: where the depth-first search
+  // spends its work deep in one choice, trials spread it over the choices that may still be best, so that their lower
+  // ends rise. The lower ends are certified (at most the exact solver's values) and kept like the upper ones; a
+  // search() after trials settles choices by them. Returns from's interval and the choice of the best lower end (exact
+  // when `from` was solved before).
   SearchSolution trials(const State& from, const std::function<bool(std::uint64_t work)>& stop,
                         std::uint64_t check_interval = 1, double gap = 0.0);
   // Forgets what was solved and refined; the trials draw from `seed` on.
@@ -116,7 +120,8 @@ class BranchAndBoundSearch {
   std::unique_ptr<Impl> impl_;
 };
 
-// Solves from mdp.start(). Throws UsageError for more than kMaxExactSkeletons skeletons (or more
+// Solves from mdp.start(). Throws UsageError for a gap that is neither 0 nor within
+// [kFinestGap, 1], for more than kMaxExactSkeletons skeletons (or more
 // blamable actions than the exact solvers' keys hold); ResourceLimitError when ValueBounds'
 // tables are too large.
 SearchSolution solve_search(const Mdp& mdp, const SearchSolveOptions& options = {});
