@@ -158,16 +158,17 @@ TEST(ChangingSkeletons, WithChainsTheStateCarriesTheChainsAndTheExecutionsBefore
   EXPECT_GT(compared, 10);
 }
 
-TEST(ChangingSkeletons, ASkeletonArrivingBehindARefinedTimedActionFindsItsExecutionBefore) {
-  // move (2 steps of execution), then the coffee (its wait depends on the queue, drawn when it
-  // starts), then the meeting; a second way on from the coffee arrives once it is refined.
+// move (2 steps of execution), then the coffee (its wait depends on the queue, drawn when it
+// starts), then the meeting (`meet`: its fields); a second way on from the coffee arrives once it
+// is refined. Returns the state carried over, checked against the replay of the same history.
+State arrival_behind_the_coffee(const std::string& meet) {
   const Problem full = parse_problem(R"({"deadline": 30,
       "chains": {"queue": {"states": ["short", "long"], "start": "long", "transitions": [[0.5, 0.5], [0.5, 0.5]]}},
       "actions": {"move": {"planning": {"pmf": {"1": 1.0}}, "execution": {"pmf": {"2": 1.0}}},
                   "coffee": {"planning": {"pmf": {"1": 1.0}},
                              "execution": {"chain": "queue", "by_state": {"short": {"pmf": {"1": 1.0}},
                                                                           "long": {"pmf": {"6": 1.0}}}}},
-                  "meet": {"planning": {"pmf": {"4": 1.0}}, "execution": {"pmf": {"1": 1.0}}},
+                  "meet": {)" + meet + R"(, "execution": {"pmf": {"1": 1.0}}},
                   "call": {"planning": {"pmf": {"3": 1.0}}, "execution": {"pmf": {"1": 1.0}}}},
       "skeletons": [["move", "coffee", "meet"], ["move", "coffee", "call"]]})",
                                      "coffee.json");
@@ -179,18 +180,31 @@ TEST(ChangingSkeletons, ASkeletonArrivingBehindARefinedTimedActionFindsItsExecut
   std::vector<std::pair<int, Observation>> history{{move, Observation::found(2).with_chains(0)},
                                                    {coffee, Observation::found(5).with_chains(1)}};
   for (const auto& [action, observation] : history) {
-    ASSERT_EQ(session.decide(0).action, session.problem().find_action(full.action(action).id));
+    EXPECT_EQ(session.decide(0).action, session.problem().find_action(full.action(action).id));
     session.report(observation);
   }
-  ASSERT_EQ(session.status(), Status::running);
+  EXPECT_EQ(session.status(), Status::running);
   session.add_skeleton(ids_of(full, 1), {}, full.reward(1));
-  const State& carried = session.state();
+  const State carried = session.state();
   EXPECT_EQ(carried.time, 2);
   EXPECT_EQ(carried.chains, 1);        // long
   EXPECT_EQ(carried.refined[1], 2);    // move and coffee
   EXPECT_EQ(carried.execution[1], 2);  // the move's; the coffee's wait is drawn when it starts
   EXPECT_EQ(carried.restore[static_cast<std::size_t>(full.timed_slot(coffee))], 2);  // the execution before it
   EXPECT_EQ(carried, replayed(full, history));
+  return carried;
+}
+
+TEST(ChangingSkeletons, ASkeletonArrivingBehindARefinedTimedActionFindsItsExecutionBefore) {
+  arrival_behind_the_coffee(R"("planning": {"pmf": {"4": 1.0}})");
+}
+
+// With backtracking too (SPEC §7 with §9): the coffee, timed, is also the culprit the meeting may
+// blame, and the state carried over holds its execution before it in both slots.
+TEST(ChangingSkeletons, ASkeletonArrivingBehindATimedCulpritFindsBothItsSlots) {
+  const State carried = arrival_behind_the_coffee(
+      R"("planning": {"pmf": {"4": 0.5}}, "backtrack": {"pmf": {"2": 0.5}}, "culprits": {"coffee": 1.0})");
+  EXPECT_EQ(carried.restore[0], 2);  // the culprit slot; the timed one, 1, is checked above
 }
 
 TEST(ChangingSkeletons, ARetiredSkeletonLeavesTheOthersAsTheyWere) {
