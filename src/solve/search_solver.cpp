@@ -340,7 +340,13 @@ class BranchAndBound {
     for (const int choice : choice_list_) {
       Choice entry{choice, items_.size(), 0};
       mdp_->for_each_outcome(state, choice, [&](double probability, Status status, const Compact& next) {
-        items_.push_back(Item{probability, status, next, status == Status::running ? policy_.key(next) : Key{}});
+        // Written in place: an Item built aside and copied in costs a store-forwarding stall on
+        // every outcome (the copy reads back words of the temporary just written in parts).
+        Item& item = items_.emplace_back();
+        item.probability = probability;
+        item.status = status;
+        item.next = next;
+        if (status == Status::running) item.key = policy_.key(next);
       });
       entry.end = items_.size();
       choices_.push_back(entry);
