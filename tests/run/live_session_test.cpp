@@ -7,6 +7,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ontime/allocators/allocator_registry.hpp"
@@ -206,6 +207,20 @@ class SlicedWorld final : public World {
   ManualClock clock_;
 };
 
+// The same episodes twice: in hidden worlds on the step clock (2 threads), then live in worlds
+// whose every report takes exactly one slice (1 thread).
+std::pair<MonteCarloResult, MonteCarloResult> model_and_live_episodes(const Problem& problem, const Mdp& mdp,
+                                                                      const AllocatorFactory& factory,
+                                                                      MonteCarloOptions options) {
+  options.threads = 2;
+  MonteCarloResult model = run_episodes(mdp, hidden_worlds(problem), factory, options);
+  options.live = LiveRun{};
+  options.threads = 1;
+  MonteCarloResult live = run_episodes(
+      mdp, [&problem] { return std::make_unique<SlicedWorld>(problem); }, factory, options);
+  return {std::move(model), std::move(live)};
+}
+
 // With exact slices and no time elsewhere, a live session makes the MDP's transitions: the same
 // episodes succeed.
 TEST(LiveSession, ExactSlicesAndInstantDecisionsGiveTheModelsSuccesses) {
@@ -221,12 +236,7 @@ TEST(LiveSession, ExactSlicesAndInstantDecisionsGiveTheModelsSuccesses) {
       // iterations in both runs make the same decisions.
       options.decision_budget = DecisionBudget::iterations(200);
       options.seed = 5;
-      options.threads = 2;
-      const MonteCarloResult model = run_episodes(mdp, hidden_worlds(problem), factory, options);
-      options.live = LiveRun{};
-      options.threads = 1;
-      const MonteCarloResult live = run_episodes(
-          mdp, [&problem] { return std::make_unique<SlicedWorld>(problem); }, factory, options);
+      const auto [model, live] = model_and_live_episodes(problem, mdp, factory, options);
       EXPECT_EQ(live.successes, model.successes);
       EXPECT_EQ(live.model_successes, model.successes);
       EXPECT_EQ(live.model_undecided, 0U);
@@ -249,12 +259,7 @@ TEST(LiveSession, WithChainsExactSlicesAndInstantDecisionsGiveTheModelsEpisodes)
     MonteCarloOptions options;
     options.episodes = 2000;
     options.seed = 5;
-    options.threads = 2;
-    const MonteCarloResult model = run_episodes(mdp, hidden_worlds(problem), factory, options);
-    options.live = LiveRun{};
-    options.threads = 1;
-    const MonteCarloResult live = run_episodes(
-        mdp, [&problem] { return std::make_unique<SlicedWorld>(problem); }, factory, options);
+    const auto [model, live] = model_and_live_episodes(problem, mdp, factory, options);
     EXPECT_GT(model.successes, 1000U);
     EXPECT_EQ(live.successes, model.successes);
     EXPECT_EQ(live.mean_reward, model.mean_reward);
