@@ -136,10 +136,14 @@ class BranchAndBound {
   }
 
   struct Item {
-    double probability = 0.0;
-    Status status = Status::running;
+    // Sets every field but `key` one by one: value-initialising the whole item first (136 bytes
+    // with 16 skeleton slots) costs a block fill per outcome.
+    Item(double p, Status s, const Compact& n) : probability(p), status(s), next(n) {}
+
+    double probability;
+    Status status;
     Compact next;
-    Key key;  // of `next`, when running
+    Key key;  // of `next`, when running, from the first look-up on (most outcomes are never looked up)
     // When running: the interval around V*(next) last looked up (lo < 0: not yet), and whether
     // it is the exact value.
     double lo = -1.0, hi = 1.0;
@@ -194,7 +198,8 @@ class BranchAndBound {
     for (std::size_t c = choice_begin; c < choice_end; ++c) {
       if (!choices_[c].exact) ++choices_cut_;
     }
-    items_.resize(item_begin);
+    // (erase, not resize: an Item has no default.)
+    items_.erase(items_.begin() + static_cast<std::ptrdiff_t>(item_begin), items_.end());
     choices_.resize(choice_begin);
 
     check_cap();
@@ -275,7 +280,7 @@ class BranchAndBound {
       (void)back_up(path_[level - 1]);
     }
     if (!path_.empty()) {
-      items_.resize(path_.front().item_begin);
+      items_.erase(items_.begin() + static_cast<std::ptrdiff_t>(path_.front().item_begin), items_.end());
       choices_.resize(path_.front().choice_begin);
     }
     return go_on;
@@ -294,9 +299,7 @@ class BranchAndBound {
     double lo = 0.0;
     double hi = 0.0;
     for (std::size_t c = level.choice_begin; c < level.choice_end; ++c) {
-      for (std::size_t i = choices_[c].begin; i < choices_[c].end; ++i) {
-        if (items_[i].status == Status::running && !items_[i].exact) table_.prefetch(items_[i].key);
-      }
+      key_and_prefetch(c);
       for (std::size_t i = choices_[c].begin; i < choices_[c].end; ++i) {
         Item& item = items_[i];
         if (item.status != Status::running || item.exact) continue;
@@ -342,11 +345,7 @@ class BranchAndBound {
       mdp_->for_each_outcome(state, choice, [&](double probability, Status status, const Compact& next) {
         // Written in place: an Item built aside and copied in costs a store-forwarding stall on
         // every outcome (the copy reads back words of the temporary just written in parts).
-        Item& item = items_.emplace_back();
-        item.probability = probability;
-        item.status = status;
-        item.next = next;
-        if (status == Status::running) item.key = policy_.key(next);
+        items_.emplace_back(probability, status, next);
       });
       entry.end = items_.size();
       choices_.push_back(entry);
@@ -392,12 +391,37 @@ class BranchAndBound {
     choices_[c].hi = hi;
   }
 
+  // Choice c's upper end from ValueBounds alone (no probe of the table, whose entries are never
+  // above it): sets choices_[c].hi and the running items' hi, and returns the sum.
+  double static_sum(std::size_t c) {
+    double hi = 0.0;
+    for (std::size_t i = choices_[c].begin; i < choices_[c].end; ++i) {
+      Item& item = items_[i];
+      if (item.status == Status::success) {
+        hi += item.probability * success_reward(item.next, choices_[c].choice);
+      } else if (item.status == Status::running) {
+        item.hi = static_upper(item.next);
+        hi += item.probability * item.hi;
+      }
+    }
+    choices_[c].hi = hi;
+    return hi;
+  }
+
+  // Packs the keys of choice c's running successors and prefetches their places in the table.
+  void key_and_prefetch(std::size_t c) {
+    for (std::size_t i = choices_[c].begin; i < choices_[c].end; ++i) {
+      Item& item = items_[i];
+      if (item.status != Status::running || item.exact) continue;
+      item.key = policy_.key(item.next);
+      table_.prefetch(item.key);
+    }
+  }
+
   // Looks up choice c's successors and sums its interval. The table is far larger than the
   // caches: every lookup is prefetched first.
   void bound(std::size_t c, bool lower = true) {
-    for (std::size_t i = choices_[c].begin; i < choices_[c].end; ++i) {
-      if (items_[i].status == Status::running && !items_[i].exact) table_.prefetch(items_[i].key);
-    }
+    key_and_prefetch(c);
     for (std::size_t i = choices_[c].begin; i < choices_[c].end; ++i) {
       if (items_[i].status == Status::running && !items_[i].exact) look_up(items_[i], lower);
     }
@@ -465,6 +489,11 @@ class BranchAndBound {
     double result = 0.0;
     bool failed = false;
     for (std::size_t c = choice_begin; c < choice_end; ++c) {
+      // A choice that ValueBounds alone keeps at or below the target needs no look-up.
+      if (static_sum(c) <= target) {
+        result = std::max(result, choices_[c].hi);
+        continue;
+      }
       bound(c, false);
       if (!failed && choices_[c].hi > target) {
         prove_below(c, target);
@@ -473,7 +502,7 @@ class BranchAndBound {
       result = std::max(result, choices_[c].hi);
     }
     ++tested_;
-    items_.resize(item_begin);
+    items_.erase(items_.begin() + static_cast<std::ptrdiff_t>(item_begin), items_.end());
     choices_.resize(choice_begin);
     result = std::min(result, known);
     if (!held) check_cap();
@@ -512,8 +541,10 @@ class BranchAndBound {
   }
 
   // The next choice to solve, or kNone when the tie rule's verdict is settled (then `best` is the
-  // answer, kNone when there is no choice). `threshold`: what the choice must not pass to be
-  // settled against the best so far when that is exact (else above 1).
+  // answer, kNone when there is no choice). `threshold` (at most 1): the target of an upper test
+  // the choice should get first, where one may settle it without solving it. The verdicts come
+  // from the replay on intervals alone (docs/theory.md, "Branch and bound"); the targets only
+  // steer the work.
   std::size_t pick(std::size_t begin, std::size_t end, std::size_t& best, double& threshold) const {
     best = kNone;
     threshold = 2.0;
@@ -525,23 +556,50 @@ class BranchAndBound {
       if (choices_[c].lo > choices_[first].lo) first = c;
     }
     if (!any_exact) return first;  // the largest lower end
+    // A choice whose lower end passes every earlier choice's upper end by more than the tolerance
+    // is the record at its place, whatever the earlier comparisons decide: the replay starts at
+    // the last such choice (the earlier ones need not be settled among themselves).
+    std::size_t from = begin;
+    double earlier_hi = -1.0;
+    std::size_t best_exact = kNone;  // the exact choice of the largest value (the first on ties)
+    for (std::size_t c = begin; c < end; ++c) {
+      if (choices_[c].exact && (best_exact == kNone || choices_[c].lo > choices_[best_exact].lo)) best_exact = c;
+      if (choices_[c].lo > earlier_hi + OptimalSolver::kTieTolerance) from = c;
+      earlier_hi = std::max(earlier_hi, choices_[c].hi);
+    }
     // The exact solver's replay: the best so far starts below every value.
     double best_lo = -1.0;
     double best_hi = -1.0;
     std::size_t record = kNone;
-    for (std::size_t c = begin; c < end; ++c) {
+    for (std::size_t c = from; c < end; ++c) {
       const Choice& choice = choices_[c];
       if (choice.lo > best_hi + OptimalSolver::kTieTolerance) {
         record = c;
         best_lo = choice.lo;
         best_hi = choice.hi;
       } else if (choice.hi > best_lo + OptimalSolver::kTieTolerance) {
-        // Unsettled (both cannot be exact here): solve the more promising of the two not solved.
-        if (choice.exact) return record;
+        // Unsettled (both cannot be exact here). Against an exact record, test the choice.
         if (choices_[record].exact) {
           threshold = best_lo + OptimalSolver::kTieTolerance;
           return c;
         }
+        // Else first test the two against the best exact choice: one before it that stays below
+        // its value by more than the tolerance cannot be the record there or after it; one after
+        // it that stays at or below its value never passes a record (the record there is at least
+        // that value less the tolerance).
+        if (best_exact != kNone) {
+          for (const std::size_t x : {record, c}) {
+            if (choices_[x].exact || choices_[x].tested) continue;
+            const double target =
+                x < best_exact ? choices_[best_exact].lo - 2.0 * OptimalSolver::kTieTolerance : choices_[best_exact].lo;
+            if (choices_[x].lo <= target) {
+              threshold = target;
+              return x;
+            }
+          }
+        }
+        // Else solve the more promising of the two not solved.
+        if (choice.exact) return record;
         return choices_[record].hi >= choice.hi ? record : c;
       }
     }

@@ -5,8 +5,11 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "ontime/allocators/optimal.hpp"
+#include "ontime/model/instance_io.hpp"
+#include "ontime/solve/layered_solver.hpp"
 #include "ontime/util/error.hpp"
 #include "support/paper.hpp"
 #include "support/random_instances.hpp"
@@ -55,6 +58,68 @@ TEST(SearchSolver, EqualsTheMemoisedSolverBitForBitOnRandomInstances) {
     const Problem problem = testing::random_instance(1000 + seed, 7, 5, 18);
     const Mdp mdp(problem);
     expect_search_equals_memoised(mdp, "deeper, seed " + std::to_string(seed));
+  }
+}
+
+// `problem` with every skeleton followed by a twin: the same actions under other ids, so that the
+// twin's group has the original's distributions and every value of one is a value of the other
+// (choices tie exactly, and the tie rule decides by order).
+Problem with_twin_skeletons(const Problem& problem) {
+  std::vector<Action> actions(problem.actions().begin(), problem.actions().end());
+  const auto originals = static_cast<int>(actions.size());
+  for (int a = 0; a < originals; ++a) {
+    Action twin = problem.action(a);
+    twin.id += "'";
+    actions.push_back(twin);
+  }
+  std::vector<std::vector<int>> skeletons;
+  for (int k = 0; k < problem.skeleton_count(); ++k) {
+    const auto skeleton = problem.skeleton(k);
+    skeletons.emplace_back(skeleton.begin(), skeleton.end());
+    std::vector<int> twin;
+    for (const int a : skeleton) twin.push_back(a + originals);
+    skeletons.push_back(twin);
+  }
+  return {problem.name() + "-twins", problem.deadline(), problem.step_seconds(), actions, skeletons};
+}
+
+TEST(SearchSolver, EqualsTheMemoisedSolverBitForBitWhereChoicesTie) {
+  for (std::uint64_t seed = 1; seed <= 120; ++seed) {
+    const Problem problem = with_twin_skeletons(testing::random_instance(seed, 3, 3, 12));
+    const Mdp mdp(problem);
+    expect_search_equals_memoised(mdp, "seed " + std::to_string(seed));
+  }
+  for (const char* name : {"instance1", "instance3"}) {
+    const Problem problem = with_twin_skeletons(testing::paper_instance(name));
+    const Mdp mdp(problem);
+    expect_search_equals_memoised(mdp, name);
+  }
+}
+
+// Navigation (four skeletons of four moves) with its deadline shortened to `deadline` steps.
+Problem navigation_with_deadline(Steps deadline) {
+  const Problem navigation = load_problem(testing::source_path("data/instances/navigation.json"));
+  std::vector<std::vector<int>> skeletons;
+  for (int k = 0; k < navigation.skeleton_count(); ++k) {
+    skeletons.emplace_back(navigation.skeleton(k).begin(), navigation.skeleton(k).end());
+  }
+  return {"navigation-" + std::to_string(deadline), deadline, navigation.step_seconds(),
+          std::vector<Action>(navigation.actions().begin(), navigation.actions().end()), skeletons};
+}
+
+// Navigation as the layered solver enumerates it (the whole of 22 steps is the benchmark
+// SearchNavigationOptimum's): the same bits and first choice, from a small part of the tree.
+TEST(SearchSolver, EqualsTheLayeredSolverBitForBitOnNavigation) {
+  for (const Steps deadline : {14, 18}) {
+    const Problem problem = navigation_with_deadline(deadline);
+    const Mdp mdp(problem);
+    const LayeredSolution layered = solve_layered(mdp);
+    ASSERT_TRUE(layered.exact) << deadline;
+    const SearchSolution search = solve_search(mdp);
+    ASSERT_TRUE(search.exact) << deadline;
+    EXPECT_EQ(search.lower, layered.lower) << deadline;
+    EXPECT_EQ(search.first_choice, layered.first_choice) << deadline;
+    EXPECT_LT(search.states * 10, layered.states) << deadline;
   }
 }
 
