@@ -394,18 +394,11 @@ class BranchAndBound {
   // Choice c's upper end from ValueBounds alone (no probe of the table, whose entries are never
   // above it): sets choices_[c].hi and the running items' hi, and returns the sum.
   double static_sum(std::size_t c) {
-    double hi = 0.0;
     for (std::size_t i = choices_[c].begin; i < choices_[c].end; ++i) {
-      Item& item = items_[i];
-      if (item.status == Status::success) {
-        hi += item.probability * success_reward(item.next, choices_[c].choice);
-      } else if (item.status == Status::running) {
-        item.hi = static_upper(item.next);
-        hi += item.probability * item.hi;
-      }
+      if (items_[i].status == Status::running) items_[i].hi = static_upper(items_[i].next);
     }
-    choices_[c].hi = hi;
-    return hi;
+    sum_up(c, false);
+    return choices_[c].hi;
   }
 
   // Packs the keys of choice c's running successors and prefetches their places in the table.

@@ -11,7 +11,6 @@
 #include <vector>
 
 #include "ontime/allocators/optimal.hpp"
-#include "ontime/model/instance_io.hpp"
 #include "ontime/solve/value_bounds.hpp"
 #include "ontime/util/error.hpp"
 #include "solve/expectimax.hpp"
@@ -379,13 +378,7 @@ TEST(LayeredSolver, SplitsAndTolerancesGiveTheSameBitsOnOneTwoAndThreeRanks) {
 // forward pass there, with the interval of the layer before.
 TEST(LayeredSolver, AMemoryCapInTheMiddleOfALayerEndsTheForwardPassCleanly) {
   // The navigation instance with a deadline of 16 steps: about 150,000 states, tens of MB.
-  const Problem navigation = load_problem(testing::source_path("data/instances/navigation.json"));
-  std::vector<std::vector<int>> skeletons;
-  for (int k = 0; k < navigation.skeleton_count(); ++k) {
-    skeletons.emplace_back(navigation.skeleton(k).begin(), navigation.skeleton(k).end());
-  }
-  const Problem problem("navigation-16", 16, navigation.step_seconds(),
-                        std::vector<Action>(navigation.actions().begin(), navigation.actions().end()), skeletons);
+  const Problem problem = testing::navigation_with_deadline(16);
   const Mdp mdp(problem);
   const LayeredSolution exact = solve(mdp);
   ASSERT_TRUE(exact.exact);

@@ -8,7 +8,6 @@
 #include <vector>
 
 #include "ontime/allocators/optimal.hpp"
-#include "ontime/model/instance_io.hpp"
 #include "ontime/solve/layered_solver.hpp"
 #include "ontime/util/error.hpp"
 #include "support/paper.hpp"
@@ -96,22 +95,11 @@ TEST(SearchSolver, EqualsTheMemoisedSolverBitForBitWhereChoicesTie) {
   }
 }
 
-// Navigation (four skeletons of four moves) with its deadline shortened to `deadline` steps.
-Problem navigation_with_deadline(Steps deadline) {
-  const Problem navigation = load_problem(testing::source_path("data/instances/navigation.json"));
-  std::vector<std::vector<int>> skeletons;
-  for (int k = 0; k < navigation.skeleton_count(); ++k) {
-    skeletons.emplace_back(navigation.skeleton(k).begin(), navigation.skeleton(k).end());
-  }
-  return {"navigation-" + std::to_string(deadline), deadline, navigation.step_seconds(),
-          std::vector<Action>(navigation.actions().begin(), navigation.actions().end()), skeletons};
-}
-
 // Navigation as the layered solver enumerates it (the whole of 22 steps is the benchmark
 // SearchNavigationOptimum's): the same bits and first choice, from a small part of the tree.
 TEST(SearchSolver, EqualsTheLayeredSolverBitForBitOnNavigation) {
   for (const Steps deadline : {14, 18}) {
-    const Problem problem = navigation_with_deadline(deadline);
+    const Problem problem = testing::navigation_with_deadline(deadline);
     const Mdp mdp(problem);
     const LayeredSolution layered = solve_layered(mdp);
     ASSERT_TRUE(layered.exact) << deadline;

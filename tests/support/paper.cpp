@@ -1,11 +1,24 @@
 #include "support/paper.hpp"
 
+#include <string>
+#include <vector>
+
 #include "ontime/model/instance_io.hpp"
 
 namespace ontime::testing {
 
 std::filesystem::path source_path(const std::string& relative) {
   return std::filesystem::path(ONTIME_SOURCE_DIR) / relative;
+}
+
+Problem navigation_with_deadline(Steps deadline) {
+  const Problem navigation = load_problem(source_path("data/instances/navigation.json"));
+  std::vector<std::vector<int>> skeletons;
+  for (int k = 0; k < navigation.skeleton_count(); ++k) {
+    skeletons.emplace_back(navigation.skeleton(k).begin(), navigation.skeleton(k).end());
+  }
+  return {"navigation-" + std::to_string(deadline), deadline, navigation.step_seconds(),
+          std::vector<Action>(navigation.actions().begin(), navigation.actions().end()), skeletons};
 }
 
 Problem paper_instance(const std::string& name) {
