@@ -21,7 +21,8 @@ Kaplan-Meier) and the oracle:
 - navigation only, the whole TAMP loop (`ontime tamp`, the real planner, skeletons streamed by the
   task planner) in each held-out building with a library of every doorway move: collected there
   (the oracle), predicted by each model, each prediction updated across episodes
-  (`--adapt-strength`), and first-found.
+  (`--adapt-strength`), and first-found. scripts/tamp-learning.py measures the update there on
+  paired episodes, in buildings of its own.
 
 Writes OUT/results.json, OUT/table.md and OUT/heldout.png. Every step is an `ontime` command; the
 same settings give the same numbers (collections count collision checks, not seconds; the TAMP
@@ -160,6 +161,30 @@ class Runner:
         return model
 
 
+def train(args, runner):
+    """Collects the first args.train training worlds, fits the three models on them and the online
+    update's strength of each. Returns (training logs, models, strengths, step seconds)."""
+    train_logs = []
+    for i, seed in enumerate(TRAIN_SEEDS[: args.train]):
+        print(f"training world {i + 1}/{args.train} (seed {seed})", file=sys.stderr)
+        world = runner.world(seed, held_out=False)
+        train_logs.append(runner.collect(world, args.train_trials, "", runner.domain["every_action"])[0])
+    with open(runner.path("worlds", os.path.basename(runner.world(TRAIN_SEEDS[0], False))), encoding="utf-8") as text:
+        step = json.load(text)["collection"]["step_seconds"]
+    models = {kind: runner.fit(train_logs, kind, kind, step) for kind in LEARNED}
+
+    # The prior's strength, on worlds the model was not fitted on: models of the first 80% of the
+    # training worlds, strengths scored on the rest.
+    split = max(1, (4 * len(train_logs)) // 5)
+    strengths = {}
+    for kind in LEARNED:
+        model = runner.fit(train_logs[:split], kind, f"{kind}-validation", step)
+        scored = runner.json(["fit-strength", *train_logs[split:], "--model", model, "--strengths",
+                              "0.5,1,2,5,10,20,50,100,200,500"])
+        strengths[kind] = scored["best"]
+    return train_logs, models, strengths, step
+
+
 def mean(values):
     values = [v for v in values if v is not None]
     return statistics.fmean(values) if values else None
@@ -196,24 +221,7 @@ def main():
         mpi.insert(1, "--allow-run-as-root")
     runner = Runner(args, mpi)
 
-    train_logs = []
-    for i, seed in enumerate(TRAIN_SEEDS[: args.train]):
-        print(f"training world {i + 1}/{args.train} (seed {seed})", file=sys.stderr)
-        world = runner.world(seed, held_out=False)
-        train_logs.append(runner.collect(world, args.train_trials, "", runner.domain["every_action"])[0])
-    with open(runner.path("worlds", os.path.basename(runner.world(TRAIN_SEEDS[0], False))), encoding="utf-8") as text:
-        step = json.load(text)["collection"]["step_seconds"]
-    models = {kind: runner.fit(train_logs, kind, kind, step) for kind in LEARNED}
-
-    # The prior's strength, on worlds the model was not fitted on: models of the first 80% of the
-    # training worlds, strengths scored on the rest.
-    split = max(1, (4 * len(train_logs)) // 5)
-    strengths = {}
-    for kind in LEARNED:
-        model = runner.fit(train_logs[:split], kind, f"{kind}-validation", step)
-        scored = runner.json(["fit-strength", *train_logs[split:], "--model", model, "--strengths",
-                              "0.5,1,2,5,10,20,50,100,200,500"])
-        strengths[kind] = scored["best"]
+    train_logs, models, strengths, step = train(args, runner)
 
     # A run that was stopped continues: the worlds results.json already holds under the same
     # settings are kept, not measured again.
