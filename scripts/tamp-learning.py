@@ -95,31 +95,24 @@ def summarise(args, worlds, strengths):
     count, length = len(worlds), args.episodes
     summary = {}
     for kind in heldout.LEARNED:
-        gap_means, gap_vars = [], []
-        by_episode = [0.0] * length
+        gap_means, gap_vars, gains = [], [], []
         for w in worlds:
-            oracle, fixed = w["oracle"], w["fixed"][kind]
-            paired = [int(o) - int(f) for o, f in zip(oracle, fixed)]
+            paired = [int(o) - int(f) for o, f in zip(w["oracle"], w["fixed"][kind])]
             gap_means.append(statistics.fmean(paired))
             gap_vars.append(statistics.variance(paired) / len(paired))
-            updated = w["updated"][kind]
-            for e in range(length):
-                by_episode[e] += sum(int(updated[s * length + e]) - int(fixed[s * length + e])
-                                     for s in range(args.sequences)) / args.sequences / count
+            # The update's gain in each episode of each sequence: gains[world][sequence][episode].
+            fixed, updated = w["fixed"][kind], w["updated"][kind]
+            gains.append([[int(updated[s * length + e]) - int(fixed[s * length + e]) for e in range(length)]
+                          for s in range(args.sequences)])
+        by_episode = [sum(sum(row[e] for row in world) / args.sequences / count for world in gains)
+                      for e in range(length)]
         gap = statistics.fmean(gap_means)
         rows = []
         for first, end in windows(args):
-            per_world_var = []
-            for w in worlds:
-                fixed, updated = w["fixed"][kind], w["updated"][kind]
-                per_sequence = [statistics.fmean(int(updated[s * length + e]) - int(fixed[s * length + e])
-                                                 for e in range(first - 1, end - 1))
-                                for s in range(args.sequences)]
-                per_world_var.append(statistics.variance(per_sequence) / args.sequences
-                                     if args.sequences > 1 else 0.0)
+            variance = sum(statistics.variance([statistics.fmean(row[first - 1:end - 1]) for row in world])
+                           / args.sequences for world in gains)
             gain = statistics.fmean(by_episode[first - 1:end - 1])
-            rows.append({"episodes": [first, end - 1], "gain": gain,
-                         "gain_se": math.sqrt(sum(per_world_var)) / count,
+            rows.append({"episodes": [first, end - 1], "gain": gain, "gain_se": math.sqrt(variance) / count,
                          "closed": gain / gap if gap > 0 else None})
         summary[kind] = {
             "strength": strengths[kind],
