@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "ontime/domains/manipulation_world.hpp"
+#include "planar_geometry.hpp"
 
 namespace ontime::domains::detail {
 
@@ -30,12 +31,34 @@ struct ReachCount {
   int reached = 0;
 };
 
+// Heights that differ by no more than this are the same surface.
+inline constexpr double kSameHeight = 1e-9;
+// Whether two regions lie on the same top: the same furniture at the same height.
+bool same_surface(const PlacementRegion& a, const PlacementRegion& b);
+// An object's footprint standing at `pose`: its x-y rectangle turned by the yaw.
+std::vector<Point> object_footprint(const MovableObject& object, const ObjectPose& pose);
+
+// An object an earlier action placed in `region`: where in it is not known.
+struct MovedObject {
+  std::size_t object = 0;
+  const PlacementRegion* region = nullptr;
+};
+
 // Draws until `hits` draws have reached `object` or `draws` were made, with every movable object
 // standing at `poses` (the other objects are obstacles): `object` standing at its pose to be
 // picked, or, with `region`, held and placed at a placement drawn uniformly in the region's
 // rectangle and yaw range (a draw whose placement overlaps something does not reach).
+//
+// `moved` (in the order they were placed; the held object among them is skipped): each draw first
+// sets each of them down anew at a placement drawn uniformly in its region's rectangle and yaw
+// range whose footprint overlaps no footprint standing on the same surface (the first of
+// kLayoutTries that does not, else the last), as a refinement's placement would have left it; their
+// poses in `poses` are not used. So the share is over where they may stand, not one guess of it.
+// These placements come from a stream of their own, so the draws of the targets are the same
+// with and without `moved`.
+inline constexpr int kLayoutTries = 100;
 ReachCount count_reaching_draws(const ManipulationWorld& world, const std::vector<ObjectPose>& poses,
-                                std::size_t object, const PlacementRegion* region, int hits, int draws,
-                                std::uint64_t seed);
+                                std::size_t object, const PlacementRegion* region,
+                                const std::vector<MovedObject>& moved, int hits, int draws, std::uint64_t seed);
 
 }  // namespace ontime::domains::detail

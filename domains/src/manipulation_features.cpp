@@ -12,8 +12,8 @@
 namespace ontime::domains {
 namespace {
 
+using detail::kSameHeight;
 using detail::Point;
-constexpr double kSameHeight = 1e-9;
 
 struct Surface {
   std::string furniture;
@@ -34,10 +34,6 @@ const Box3& top_under(const ManipulationWorld& world, const std::string& furnitu
     }
   }
   throw std::invalid_argument(what + " of " + world.name + " stands on no box of '" + furniture + "'");
-}
-
-std::vector<Point> footprint(const MovableObject& object, const ObjectPose& pose) {
-  return detail::rectangle_corners(Rectangle{pose.x, pose.y, object.size[0], object.size[1], pose.yaw});
 }
 
 // A region's rectangle as a convex shape: a polygon, or a segment or a point when it has no area.
@@ -116,7 +112,7 @@ double covered(const std::vector<std::vector<Point>>& footprints, const std::arr
 const std::vector<std::string>& manipulation_feature_names() {
   static const std::vector<std::string> names{
       "is_place",    "object_short", "object_long",       "object_height", "surface_height",  "reach",
-      "nearest_gap", "neighbours",   "approach_occupied", "region_area",   "region_occupied", "log_reach_share"};
+      "nearest_gap", "neighbours",   "approach_occupied", "region_area",   "region_occupied", "log_reach_share_v2"};
   return names;
 }
 
@@ -132,6 +128,7 @@ std::vector<double> manipulation_action_features(const ManipulationWorld& world,
   }
   // Where the context's objects went: the prefix of the first skeleton holding the action.
   std::map<int, int> moved;  // object -> region
+  std::vector<int> placed;   // the moved objects, in the order they were last placed
   bool listed = false;
   for (const auto& skeleton : world.skeletons) {
     const auto found = std::find(skeleton.begin(), skeleton.end(), text);
@@ -139,8 +136,12 @@ std::vector<double> manipulation_action_features(const ManipulationWorld& world,
     listed = true;
     for (auto it = skeleton.begin(); it != found; ++it) {
       const std::optional<ManipulationAction> before = parse_manipulation_action(*it);
-      if (before && before->kind == ManipulationKind::place)
-        moved[world.object_index(before->object)] = world.region_index(before->region);
+      if (before && before->kind == ManipulationKind::place) {
+        const int index = world.object_index(before->object);
+        moved[index] = world.region_index(before->region);
+        std::erase(placed, index);
+        placed.push_back(index);
+      }
     }
     break;
   }
@@ -163,11 +164,11 @@ std::vector<double> manipulation_action_features(const ManipulationWorld& world,
   } else if (const auto went = moved.find(subject); went != moved.end()) {
     const PlacementRegion& there = world.regions[static_cast<std::size_t>(went->second)];
     centre = {(there.min_x + there.max_x) / 2, (there.min_y + there.max_y) / 2};
-    shape = footprint(object, ObjectPose{centre[0], centre[1], 0, 0});
+    shape = detail::object_footprint(object, ObjectPose{centre[0], centre[1], 0, 0});
     region = &there;
   } else {
     centre = {object.pose.x, object.pose.y};
-    shape = footprint(object, object.pose);
+    shape = detail::object_footprint(object, object.pose);
     region = &world.regions[static_cast<std::size_t>(world.region_index(object.region))];
   }
   const std::string what = place ? "region " + region->id : "object " + object.id;
@@ -180,8 +181,8 @@ std::vector<double> manipulation_action_features(const ManipulationWorld& world,
     const auto index = static_cast<int>(j);
     if (index == subject || moved.contains(index)) continue;
     const PlacementRegion& on = world.regions[static_cast<std::size_t>(world.region_index(world.objects[j].region))];
-    if (on.surface != surface.furniture || std::abs(on.height - surface.height) > kSameHeight) continue;
-    others.push_back(footprint(world.objects[j], world.objects[j].pose));
+    if (!detail::same_surface(on, *region)) continue;
+    others.push_back(detail::object_footprint(world.objects[j], world.objects[j].pose));
   }
   double gap = kManipulationGapCap;
   double neighbours = 0;
@@ -208,19 +209,20 @@ std::vector<double> manipulation_action_features(const ManipulationWorld& world,
   }
 
   // Whether the approaches are open, not only how crowded they are: the robot's own target draws
-  // in the world the action starts in, the moved objects at the centres of their regions.
+  // in the world the action starts in, each with the moved objects set down anew somewhere in
+  // their regions (a refinement leaves them wherever its placement landed, which the world file
+  // cannot say; one guess, such as the region's centre, can block an approach that is open
+  // wherever else they stand).
   std::vector<ObjectPose> poses;
-  for (std::size_t j = 0; j < world.objects.size(); ++j) {
-    const auto went = moved.find(static_cast<int>(j));
-    if (went == moved.end()) {
-      poses.push_back(world.objects[j].pose);
-      continue;
-    }
-    const PlacementRegion& there = world.regions[static_cast<std::size_t>(went->second)];
-    poses.push_back({(there.min_x + there.max_x) / 2, (there.min_y + there.max_y) / 2, world.resting_z(j, there), 0});
+  poses.reserve(world.objects.size());
+  for (const MovableObject& standing : world.objects) poses.push_back(standing.pose);
+  std::vector<detail::MovedObject> layout;
+  layout.reserve(placed.size());
+  for (const int index : placed) {
+    layout.push_back({static_cast<std::size_t>(index), &world.regions[static_cast<std::size_t>(moved.at(index))]});
   }
   const detail::ReachCount reach =
-      detail::count_reaching_draws(world, poses, static_cast<std::size_t>(subject), place ? region : nullptr,
+      detail::count_reaching_draws(world, poses, static_cast<std::size_t>(subject), place ? region : nullptr, layout,
                                    kManipulationReachHits, kManipulationReachDraws, kManipulationReachSeed);
   const double reach_share = static_cast<double>(reach.reached) / reach.drawn;
   const double log_reach_share = std::log10(std::max(reach_share, kManipulationReachShareFloor));
