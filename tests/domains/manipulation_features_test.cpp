@@ -190,7 +190,7 @@ void add_ring_around_a(ordered_json& json) {
   json["objects"]["S2"] = {{"size", {0.04, 0.052, 0.3}}, {"on", "P"}, {"pose", {1.56, 2.6, 0}}};
 }
 
-// log_reach_share: A alone on the table is reached by some of the robot's own target draws; walled in
+// log_reach_share_v2: A alone on the table is reached by some of the robot's own target draws; walled in
 // by eight taller boxes 1 cm from it, by none of 100,000 (no finger fits beside it and no
 // side is open), although its gaps and neighbour count say only "crowded".
 TEST(ManipulationFeatures, TheReachShareSeesAClosedApproach) {
@@ -213,7 +213,7 @@ TEST(ManipulationFeatures, TheReachShareSeesAClosedApproach) {
             std::log10(kManipulationReachShareFloor));
 }
 
-// log_reach_share with a context: A is taken from (2.2, 2.5) and placed in W, a row along the
+// log_reach_share_v2 with a context: A is taken from (2.2, 2.5) and placed in W, a row along the
 // table (x 1.1-1.9 at y 2.6) whose centre is the empty slot in the ring of add_ring_around_a. Set
 // down at W's centre, A would stand walled in and no draw would reach it (the share the guess at
 // the centre gave: the floor, for a pick the refinement finds). A refinement sets A down where it
