@@ -24,6 +24,9 @@ Kaplan-Meier) and the oracle:
   (`--adapt-strength`), and first-found. scripts/tamp-learning.py measures the update there on
   paired episodes, in buildings of its own.
 
+`--seeds FIRST-LAST --decisions-only` measures other worlds (a spent round, again with new
+features) on the scores and dp-rerun alone.
+
 Writes OUT/results.json, OUT/table.md and OUT/heldout.png. Every step is an `ontime` command; the
 same settings give the same numbers (collections count collision checks, not seconds; the TAMP
 loop runs on the modelled clock).
@@ -212,9 +215,21 @@ def main():
     parser.add_argument("--tamp-sequences", type=int, default=20, help="TAMP sequences that learn, per building")
     parser.add_argument("--no-tamp", action="store_true", help="leave out the TAMP loop")
     parser.add_argument("--mpi", type=int, default=0, help="collect over this many MPI ranks (mpirun -np N)")
+    parser.add_argument("--seeds", help="held-out worlds FIRST-LAST instead of the domain's (e.g. a spent round "
+                        "measured again with new features); none may be a training seed")
+    parser.add_argument("--decisions-only", action="store_true",
+                        help="scores and dp-rerun only: no optimal allocator, online update or TAMP loop")
     args = parser.parse_args()
+    held_out_seeds = HELD_OUT_SEEDS[args.domain]
+    if args.seeds is not None:
+        first, _, last = args.seeds.partition("-")
+        if not (first.isdigit() and last.isdigit() and int(first) <= int(last)):
+            parser.error(f"--seeds {args.seeds}: FIRST-LAST, two whole numbers, FIRST <= LAST")
+        held_out_seeds = range(int(first), int(last) + 1)
+        if set(held_out_seeds) & set(TRAIN_SEEDS):
+            parser.error(f"--seeds {args.seeds}: overlaps the training worlds {TRAIN_SEEDS[0]}-{TRAIN_SEEDS[-1]}")
     args.out = args.out or f"heldout-{args.domain}"
-    tamp = args.domain == "navigation" and not args.no_tamp
+    tamp = args.domain == "navigation" and not args.no_tamp and not args.decisions_only
     for folder in ("worlds", "logs", "oracles", "models", "predicted", "libraries"):
         os.makedirs(os.path.join(args.out, folder), exist_ok=True)
     mpi = ["mpirun", "--oversubscribe", "-np", str(args.mpi)] if args.mpi > 0 else []
@@ -233,7 +248,7 @@ def main():
             previous = json.load(text)
         if previous.get("settings") == vars(args) and previous.get("strengths") == strengths:
             done = {w["seed"]: w for w in previous["worlds"]}
-    for i, seed in enumerate(HELD_OUT_SEEDS[args.domain][: args.held_out]):
+    for i, seed in enumerate(held_out_seeds[: args.held_out]):
         print(f"held-out world {i + 1}/{args.held_out} (seed {seed})", file=sys.stderr)
         if seed in done:
             worlds.append(done[seed])
@@ -253,9 +268,9 @@ def main():
         for kind, instance in instances.items():
             result["scores"][kind] = runner.json(["score", instance, log])
             # The optimal allocator only where its state cap allows (None otherwise).
-            evaluation = runner.json(["evaluate", oracle, "--belief", instance, "--solver", "optimal", "--exact",
-                                      "--episodes", 100, "--no-timing", "--max-states", args.optimal_states],
-                                     may_exceed=True)
+            evaluation = None if args.decisions_only else runner.json(
+                ["evaluate", oracle, "--belief", instance, "--solver", "optimal", "--exact", "--episodes", 100,
+                 "--no-timing", "--max-states", args.optimal_states], may_exceed=True)
             result["optimal"][kind] = None if evaluation is None else evaluation["exact_success_probability"]
             # dp-rerun exactly where the states its plan reaches fit under the cap; elsewhere (a
             # belief that spreads effort over many skeletons reaches many states) its success rate
@@ -270,7 +285,7 @@ def main():
                 evaluation = runner.json(["evaluate", oracle, "--belief", instance, "--solver", "dp-rerun",
                                           "--episodes", args.sampled_episodes, "--no-timing"])
                 result["dp-rerun"][kind] = evaluation["success_rate"]
-            if kind != "oracle":
+            if kind != "oracle" and not args.decisions_only:
                 # The success rate by episode over many sequences (an exact value per sequence and
                 # episode would cost an exact evaluation of each posterior's plan).
                 adapted = runner.json(["adapt", oracle, "--belief", instance, "--solver", "dp-rerun", "--strength",
@@ -325,6 +340,7 @@ def summarise(args, runner, strengths, worlds, tamp):
         }
         if kind != "oracle":
             summary[kind]["strength"] = strengths[kind]
+        if kind != "oracle" and not args.decisions_only:
             summary[kind]["adapt"] = [mean(w["adapt"][kind][e] for w in worlds) for e in range(args.adapt_episodes)]
         if tamp:
             summary[kind]["tamp"] = mean(w["tamp"][kind] for w in worlds)
@@ -346,12 +362,13 @@ def summarise(args, runner, strengths, worlds, tamp):
                      + (f"{s['optimal']:.4f} |" if s["optimal"] is not None else "- |"))
     sampled = [f"{w['seed']} ({', '.join(w['sampled'])})" for w in worlds if w.get("sampled")]
     lines.append("")
-    lines.append("Sampled where the exact evaluation passed its state cap: " + ("; ".join(sampled) if sampled else "none")
-                 + ".")
+    lines.append("Sampled where the exact evaluation passed its state cap: "
+                 + ("; ".join(sampled) if sampled else "none") + ".")
     oracle = summary["oracle"]["dp-rerun"]
-    lines += ["", f"| prior (strength) | episode 1 | episode {args.adapt_episodes} | oracle | gap closed |",
-              "|---|---|---|---|---|"]
-    for kind in LEARNED:
+    if not args.decisions_only:
+        lines += ["", f"| prior (strength) | episode 1 | episode {args.adapt_episodes} | oracle | gap closed |",
+                  "|---|---|---|---|---|"]
+    for kind in LEARNED if not args.decisions_only else ():
         s = summary[kind]
         first, last = s["adapt"][0], s["adapt"][-1]
         closed = f"{(last - first) / (oracle - first):.0%}" if oracle - first > 1e-9 else "-"
@@ -384,9 +401,10 @@ def plot(args, runner, summary, worlds, tamp):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt  # pylint: disable=import-outside-toplevel
 
-    panels = 3 if tamp else 2
-    figure, axes = plt.subplots(1, panels, figsize=(5 * panels + 1, 3.6),
+    panels = 1 if args.decisions_only else 3 if tamp else 2
+    figure, axes = plt.subplots(1, panels, figsize=(5 * panels + 1, 3.6), squeeze=False,
                                 gridspec_kw={"width_ratios": [3] + [2] * (panels - 1)})
+    axes = axes[0]
     axis = axes[0]
     order = sorted(range(len(worlds)), key=lambda i: worlds[i]["dp-rerun"]["oracle"])
     for kind, marker in zip(BELIEFS, ("o", "D", "s", "^")):
