@@ -368,11 +368,11 @@ def summarise(args, runner, strengths, worlds, tamp):
     if not args.decisions_only:
         lines += ["", f"| prior (strength) | episode 1 | episode {args.adapt_episodes} | oracle | gap closed |",
                   "|---|---|---|---|---|"]
-    for kind in LEARNED if not args.decisions_only else ():
-        s = summary[kind]
-        first, last = s["adapt"][0], s["adapt"][-1]
-        closed = f"{(last - first) / (oracle - first):.0%}" if oracle - first > 1e-9 else "-"
-        lines.append(f"| {NAMES[kind]} ({s['strength']:g}) | {first:.4f} | {last:.4f} | {oracle:.4f} | {closed} |")
+        for kind in LEARNED:
+            s = summary[kind]
+            first, last = s["adapt"][0], s["adapt"][-1]
+            closed = f"{(last - first) / (oracle - first):.0%}" if oracle - first > 1e-9 else "-"
+            lines.append(f"| {NAMES[kind]} ({s['strength']:g}) | {first:.4f} | {last:.4f} | {oracle:.4f} | {closed} |")
     if tamp:
         tail = max(1, args.adapt_episodes // 2)
         lines += ["", f"| library | TAMP success ({args.tamp_episodes} episodes per building) | learning: episode 1 | "
