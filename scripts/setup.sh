@@ -25,6 +25,12 @@ packages=(
   # is only ever started by scripts/cluster/slurm-up.sh, after this.)
   openmpi-bin libopenmpi-dev libpmix-dev bc
   munge slurmctld slurmd slurm-client
+  # The documentation site (scripts/docs.sh): Doxygen's XML of the headers, Sphinx with MyST,
+  # Breathe, Furo and copy buttons; the tutorial notebook executed (nbsphinx, nbconvert, ipykernel;
+  # pandoc converts its Markdown cells); headless Chromium driven over DevTools (python3-websocket)
+  # and linkchecker for the site's checks.
+  doxygen python3-sphinx python3-myst-parser python3-breathe furo python3-sphinx-copybutton
+  python3-nbsphinx python3-nbconvert python3-ipykernel pandoc chromium python3-websocket linkchecker
 )
 
 missing=()

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Sets up the machine, checks the C++ formatting (clang-format, .clang-format), builds OnTime
 # with warnings as errors and runs every test (the C++ suites, then the Python package's pytest suite, then the
-# MPI and SLURM check of scripts/cluster/check.sh); then clang-tidy over OnTime's sources
+# MPI and SLURM check of scripts/cluster/check.sh, then the documentation site and its browser
+# test, scripts/docs.sh --check); then clang-tidy over OnTime's sources
 # (.clang-tidy), the Python package installed by pip and the Debian package built, installed and
 # removed (both from build/); then the core alone without OMPL, FCL and KDL (build-core/: build,
 # the tool's refusals, install, consumer; compiled by clang, file by file, its warnings errors
@@ -29,6 +30,10 @@ step ctest --preset release --label-regex python --verbose
 # Split over MPI ranks (mpirun, and srun on a single-node SLURM cluster brought up for it): the
 # same files as one process, byte for byte, and no work lost when a rank dies.
 step ./scripts/cluster/check.sh build/ontime
+# The documentation site, built with warnings as errors (every public header and Python name, the
+# tutorial executed against build/python), opened in headless Chromium (pages, images, search;
+# screenshots kept in build/docs/screenshots) and checked by linkchecker, offline.
+step ./scripts/docs.sh --check build
 # Static analysis: no finding of .clang-tidy's checks in src/, include/, apps/, domains/ (python/src/: see the script).
 step ./scripts/clang-tidy.sh
 # Installing: pip install --no-build-isolation . (reusing build/), then the .deb of cpack.
