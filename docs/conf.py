@@ -208,7 +208,26 @@ def _literal_blocks_in_docstrings(app, what, name, obj, options, lines):
     lines[:] = out
 
 
+# Debian's furo imports normalize.css from the web server's /javascript/ folder (Debian's shared
+# JavaScript, which only a server set up with javascript-common has). The site carries its own
+# copy instead, from the same package (node-normalize.css), next to furo.css.
+NORMALIZE = pathlib.Path("/usr/share/javascript/normalize.css/normalize.css")
+
+
+def _bundle_normalize_css(app, exception):
+    if exception is not None or app.builder.format != "html":
+        return
+    styles = pathlib.Path(app.outdir) / "_static/styles"
+    furo_css = styles / "furo.css"
+    text = furo_css.read_text()
+    if "@import url(/javascript/normalize.css/normalize.css);" in text:
+        (styles / "normalize.css").write_text(NORMALIZE.read_text())
+        furo_css.write_text(text.replace("@import url(/javascript/normalize.css/normalize.css);",
+                                         "@import url(normalize.css);"))
+
+
 def setup(app):
     app.connect("builder-inited", _write_cpp_pages)
     app.connect("source-read", _link_folders)
     app.connect("autodoc-process-docstring", _literal_blocks_in_docstrings)
+    app.connect("build-finished", _bundle_normalize_css)

@@ -121,9 +121,12 @@ class Browser:
             time.sleep(0.2)
         raise AssertionError(f"{url}: not ready within {timeout} s ({ready})")
 
-    def screenshot(self, path: pathlib.Path, full_page: bool = False):
+    def screenshot(self, path: pathlib.Path, full_page: bool = False, top: float | None = None):
+        """The viewport, the whole page (up to 6000 px), or 900 px of the page from `top`."""
         params = {"format": "png"}
-        if full_page:
+        if top is not None:
+            params.update(captureBeyondViewport=True, clip={"x": 0, "y": top, "width": 1280, "height": 900, "scale": 1})
+        elif full_page:
             size = self.call("Page.getLayoutMetrics")["cssContentSize"]
             params.update(captureBeyondViewport=True,
                           clip={"x": 0, "y": 0, "width": 1280, "height": min(size["height"], 6000), "scale": 1})
@@ -197,13 +200,15 @@ def main() -> int:
                   "C++ allocators page: DpRerunAllocator and dp_rerun.hpp's description")
             check("Before every step, evaluates PS(k, l_k, CT, ET_k)" in text,
                   "C++ allocators page: the header comment's text")
-            check(browser.evaluate(
+            top = browser.evaluate(
                 "(() => { const d = Array.from(document.querySelectorAll('dt.sig'))"
                 ".find(e => /class\\s+DpRerunAllocator/.test(e.innerText));"
-                " if (d) window.scrollTo(0, d.getBoundingClientRect().top + window.scrollY - 80); return Boolean(d); })()"),
-                "C++ allocators page: DpRerunAllocator's declaration")
-            time.sleep(0.5)  # let the scrolled page paint before the screenshot
-            browser.screenshot(shots / "api-cpp-allocators.png")
+                " return d ? d.getBoundingClientRect().top + window.scrollY : null; })()")
+            check(top is not None, "C++ allocators page: DpRerunAllocator's declaration")
+            # From the header's section: its description, then the class.
+            section = browser.evaluate("document.getElementById('ontime-allocators-dp-rerun-hpp')"
+                                       ".getBoundingClientRect().top + window.scrollY")
+            browser.screenshot(shots / "api-cpp-allocators.png", top=max(0, min(section, top - 300)))
 
             # The Python reference: ontime.solve with its signature and docstring.
             browser.open(f"{base}/api/python.html")

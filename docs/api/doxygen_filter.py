@@ -51,16 +51,29 @@ def doc_lines(block: list[tuple[str, str]], file_doc: bool) -> list[str]:
     """The Doxygen form of one comment block (a list of (indent, text)), as many lines."""
     texts = [text[1:] if text.startswith(" ") else text for _, text in block]
     prose_indent = min((len(t) - len(t.lstrip()) for t in texts if t.strip()), default=0)
+    deeper = [bool(t.strip()) and len(t) - len(t.lstrip()) >= prose_indent + 2 for t in texts]
+    # Each run of code lines loses its common indentation (Doxygen keeps the rest as written).
+    code_indent = [0] * len(texts)
+    i = 0
+    while i < len(texts):
+        if deeper[i]:
+            j = i
+            while j < len(texts) and (deeper[j] or not texts[j].strip()):
+                j += 1
+            common = min(len(t) - len(t.lstrip()) for t in texts[i:j] if t.strip())
+            code_indent[i:j] = [common] * (j - i)
+            i = j
+        else:
+            i += 1
     out = []
     in_code = False
     for i, text in enumerate(texts):
         indent = block[i][0]
-        deeper = text.strip() and len(text) - len(text.lstrip()) >= prose_indent + 2
-        body = text
-        if deeper and not in_code:
-            body = "@code{.unparsed} " + text
+        body = text[code_indent[i]:] if deeper[i] else text
+        if deeper[i] and not in_code:
+            body = "@code{.unparsed}" + body
             in_code = True
-        elif not deeper and in_code and text.strip():
+        elif not deeper[i] and in_code and text.strip():
             # Close the code block at the end of the previous line.
             out[-1] += " @endcode"
             in_code = False
