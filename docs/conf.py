@@ -226,8 +226,22 @@ def _bundle_normalize_css(app, exception):
                                          "@import url(normalize.css);"))
 
 
+def _check_every_python_name_is_documented(app, exception):
+    """The Python reference lists every name of `ontime.__all__` (autodoc skips silently what it
+    cannot document, e.g. a constant without a docstring)."""
+    if exception is not None:
+        return
+    import ontime
+    documented = set(app.env.get_domain("py").objects)
+    missing = [name for name in ontime.__all__ if f"ontime.{name}" not in documented]
+    if missing:
+        from sphinx.errors import ExtensionError
+        raise ExtensionError("names of ontime.__all__ missing from docs/api/python.md: " + ", ".join(missing))
+
+
 def setup(app):
     app.connect("builder-inited", _write_cpp_pages)
     app.connect("source-read", _link_folders)
     app.connect("autodoc-process-docstring", _literal_blocks_in_docstrings)
     app.connect("build-finished", _bundle_normalize_css)
+    app.connect("build-finished", _check_every_python_name_is_documented)
