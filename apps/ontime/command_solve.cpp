@@ -15,6 +15,7 @@
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/model/instance_io.hpp"
 #include "ontime/report/report.hpp"
+#include "ontime/solve/concurrent_solver.hpp"
 #include "ontime/solve/layered_solver.hpp"
 #include "ontime/solve/search_solver.hpp"
 #include "ontime/util/atomic_file.hpp"
@@ -26,6 +27,7 @@ namespace {
 struct SolveOptions {
   std::string instance;
   std::string method = "layered";
+  std::string act;  // empty: the instance's own mode
   std::size_t max_states = 0;
   std::uint64_t max_memory_mib = 0;
   std::uint64_t max_disk_mib = 0;
@@ -55,6 +57,23 @@ void run_memoised(const SolveOptions& options, const Problem& problem, const Mdp
   solve.solution.states = solver.states();
   solve.solution.first_choice = solver.best_choice(mdp.start()).value_or(-1);
   solve.seconds = seconds;
+  fmt::print("{}", options.json ? report::to_json(solve) + "\n" : report::to_text(solve));
+}
+
+// Acting while planning (SPEC §10): the memoised solver of its MDP.
+void run_concurrent(const SolveOptions& options, const Problem& problem) {
+  const std::size_t max_states = options.max_states != 0 ? options.max_states : ConcurrentSolver::kDefaultMaxStates;
+  const ConcurrentMdp mdp(problem);
+  check_memory_for(flag_spelling()("max-states"), ConcurrentSolver::max_bytes(problem, max_states));
+  const auto started = std::chrono::steady_clock::now();
+  ConcurrentSolver solver(mdp, max_states);
+  report::ConcurrentSolve solve{.instance = options.instance, .problem = &problem};
+  solve.value = solver.solve(mdp.start());
+  solve.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  const std::optional<ConcurrentSolver::Move> first = solver.best_move(mdp.start());
+  solve.first_choice = first && !first->is_start() ? first->refine : -1;
+  solve.states = solver.states();
+  solve.timing = !options.no_timing;
   fmt::print("{}", options.json ? report::to_json(solve) + "\n" : report::to_text(solve));
 }
 
@@ -150,6 +169,14 @@ void add_solve_command(CLI::App& app) {
                    "solving only the states the "
                    "bounds cannot settle)")
       ->check(CLI::IsMember({"layered", "split", "memoised", "search"}));
+  CLI::Option* method_option = command->get_option("--method");
+  command
+      ->add_option("--act", options->act,
+                   "plan-first (the robot executes a skeleton once it is refined in full; SPEC §2) or concurrent (it "
+                   "executes refined actions while the rest is planned, and chooses when to start each; SPEC §10); "
+                   "default: the instance's \"acting\", plan-first when it has none. Concurrent is solved by the "
+                   "memoised solver (the default method then)")
+      ->check(CLI::IsMember({"plan-first", "concurrent"}));
   add_number_option(*command, "--max-states", options->max_states,
                     "Cap on states: layered and search give an interval past it, memoised stops with an error "
                     "(default: none for layered, 10000000 for memoised and search)",
@@ -179,14 +206,34 @@ void add_solve_command(CLI::App& app) {
   command->add_flag("--json", options->json, "Print JSON");
   command->add_flag("--no-timing", options->no_timing,
                     "Layered: leave out measured times and memory, so that outputs can be compared byte for byte");
-  command->callback([options] {
+  command->callback([options, command, method_option] {
     if (options->gap > 0 && options->method != "search") throw UsageError("--gap is for --method search");
     if (options->gap > 0 && options->gap < SearchSolveOptions::kFinestGap) {
       throw UsageError("--gap: 0 for the exact search, or at least " +
                        fmt::format("{:g}", SearchSolveOptions::kFinestGap) +
                        " (the finest interval the trials certify; got " + fmt::format("{:g}", options->gap) + ")");
     }
-    const Problem problem = load_problem(options->instance);
+    Problem problem = load_problem(options->instance);
+    if (!options->act.empty()) problem = problem.with_acting(*parse_acting(options->act));
+    if (problem.acting() == Acting::concurrent) {
+      if (method_option->count() > 0 && options->method != "memoised") {
+        throw UsageError("--method " + options->method +
+                         ": acting while planning (concurrent, SPEC §10) is solved by --method memoised only so far");
+      }
+      for (const char* flag :
+           {"--policy", "--tolerance", "--scratch", "--max-memory-mib", "--max-disk-mib", "--max-seconds"}) {
+        if (command->get_option(flag)->count() > 0) {
+          throw UsageError(std::string(flag) +
+                           " is for the layered solver and the search, which do not solve "
+                           "acting while planning (concurrent, SPEC §10) yet");
+        }
+      }
+      if (split_over_ranks(job_ranks())) {
+        throw UsageError("acting while planning (concurrent, SPEC §10) is solved in one process: no MPI ranks");
+      }
+      run_concurrent(*options, problem);
+      return;
+    }
     if (problem.skeleton_count() > kMaxExactSkeletons) check_exact_work(problem, 1, options->instance);
     const Mdp mdp(problem);
     if (options->method == "memoised") {

@@ -176,6 +176,22 @@ void bind_model(py::module_& m) {
                              "Whether some skeleton's reward is not 1 at every finish (the objective is then the "
                              "expected reward, else the success probability).")
       .def_property_readonly("skeleton_count", &Problem::skeleton_count)
+      .def_property_readonly(
+          "acting", [](const Problem& p) { return std::string(acting_name(p.acting())); },
+          "When the robot may execute refined actions (SPEC §10): 'plan-first' (the instance's default) or "
+          "'concurrent' (it executes refined actions while the rest is planned).")
+      .def(
+          "with_acting",
+          [](const Problem& p, const py::object& acting) {
+            const std::optional<Acting> mode =
+                py::isinstance<py::str>(acting) ? parse_acting(acting.cast<std::string>()) : std::nullopt;
+            if (!mode) {
+              throw UsageError("acting must be 'plan-first' or 'concurrent' (got " + std::string(py::repr(acting)) +
+                               ")");
+            }
+            return std::make_shared<Problem>(p.with_acting(*mode));
+          },
+          py::arg("acting"), "This problem with another acting mode ('plan-first' or 'concurrent'), the rest kept.")
       .def("find_action", &Problem::find_action, py::arg("id"), "Index of the action with this id, or -1.")
       .def("__repr__", [](const Problem& p) {
         return "ontime.Problem('" + p.name() + "', deadline=" + std::to_string(p.deadline()) + ", " +

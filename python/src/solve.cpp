@@ -9,6 +9,7 @@
 
 #include "bindings.hpp"
 #include "ontime/report/report.hpp"
+#include "ontime/solve/concurrent_solver.hpp"
 #include "ontime/solve/knapsack.hpp"
 #include "ontime/solve/layered_solver.hpp"
 #include "ontime/solve/optimal_solver.hpp"
@@ -18,6 +19,31 @@
 #include "ontime/util/memory.hpp"
 
 namespace ontime::python {
+namespace {
+
+// The problem `source` names (a Problem, an Mdp's problem, or an instance path), with the acting
+// mode `act` when given ("plan-first" or "concurrent").
+std::shared_ptr<const Problem> problem_to_solve(const py::object& source, const std::optional<std::string>& act) {
+  std::shared_ptr<const Problem> problem;
+  if (py::isinstance<MdpHandle>(source)) {
+    problem = source.cast<std::shared_ptr<MdpHandle>>()->problem;
+  } else if (py::isinstance<Problem>(source)) {
+    problem = source.cast<std::shared_ptr<Problem>>();
+  } else if (py::isinstance<py::str>(source) || py::hasattr(source, "__fspath__")) {
+    // Read as a problem, not an Mdp: an instance whose "acting" is concurrent makes no Mdp.
+    const std::string path = py::str(py::module_::import("os").attr("fspath")(source));
+    const py::gil_scoped_release release;
+    problem = std::make_shared<const Problem>(load_problem(path));
+  } else {
+    problem = to_mdp(source)->problem;  // raises the error that names what `problem` may be
+  }
+  if (!act) return problem;
+  const std::optional<Acting> acting = parse_acting(*act);
+  if (!acting) throw UsageError("act must be 'plan-first' or 'concurrent' (got '" + *act + "')");
+  return acting == problem->acting() ? problem : std::make_shared<const Problem>(problem->with_acting(*acting));
+}
+
+}  // namespace
 
 void bind_solve(py::module_& m) {
   m.def(
@@ -46,8 +72,43 @@ void bind_solve(py::module_& m) {
          Number<std::uint64_t, "max_memory_mib", 0, (std::uint64_t{1} << 40)> max_memory_mib,
          Number<std::uint64_t, "max_disk_mib", 0, (std::uint64_t{1} << 40)> max_disk_mib, const py::object& scratch,
          const py::object& policy, Number<int, "policy_layers", 1, 1'000'000> policy_layers,
-         Number<double, "gap", 0.0, 1.0> gap) {
-        const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
+         Number<double, "gap", 0.0, 1.0> gap, const py::object& act_given) {
+        if (!act_given.is_none() && !py::isinstance<py::str>(act_given)) {
+          throw UsageError("act must be 'plan-first' or 'concurrent' (got " + std::string(py::repr(act_given)) + ")");
+        }
+        const std::optional<std::string> act =
+            act_given.is_none() ? std::nullopt : std::optional<std::string>(act_given.cast<std::string>());
+        // An Mdp is plan-first by construction; anything else is read as a problem with its mode.
+        const std::shared_ptr<const Problem> chosen =
+            act || !py::isinstance<MdpHandle>(problem) ? problem_to_solve(problem, act) : nullptr;
+        if (chosen && chosen->acting() == Acting::concurrent) {
+          if (method_given && *method_given != "memoised") {
+            throw UsageError("method '" + *method_given +
+                             "': acting while planning (act='concurrent', SPEC §10) is solved by method='memoised' "
+                             "only so far");
+          }
+          if (tolerance > 0 || max_memory_mib > 0 || max_disk_mib > 0 || !scratch.is_none() || !policy.is_none() ||
+              gap > 0) {
+            throw UsageError(
+                "tolerance, max_memory_mib, max_disk_mib, scratch, policy and gap are for the layered solver and the "
+                "search, which do not solve acting while planning (act='concurrent', SPEC §10) yet");
+          }
+          check_memory_for("max_states", ConcurrentSolver::max_bytes(*chosen, max_states));
+          report::ConcurrentSolve solve{.instance = instance_label(problem, *chosen), .problem = chosen.get()};
+          const ConcurrentMdp concurrent(*chosen);
+          run_interruptibly([&](const std::function<bool()>& stop, Progress&) {
+            const auto started = std::chrono::steady_clock::now();
+            ConcurrentSolver solver(concurrent, max_states);
+            solver.set_stop(stop);
+            solve.value = solver.solve(concurrent.start());
+            solve.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+            const std::optional<ConcurrentSolver::Move> first = solver.best_move(concurrent.start());
+            solve.first_choice = first && !first->is_start() ? first->refine : -1;
+            solve.states = solver.states();
+          });
+          return json_object(report::to_json(solve));
+        }
+        const std::shared_ptr<MdpHandle> mdp = chosen ? std::make_shared<MdpHandle>(chosen) : to_mdp(problem);
         const std::string method = method_given.value_or("layered");
         if (gap > 0 && method != "search") throw UsageError("gap is for method='search'");
         if (method != "layered" && method != "split" && method != "memoised" && method != "search") {
@@ -123,7 +184,7 @@ void bind_solve(py::module_& m) {
       py::arg("problem"), py::arg("max_states") = OptimalSolver::kDefaultMaxStates, py::arg("threads") = 0,
       py::kw_only(), py::arg("method") = py::none(), py::arg("tolerance") = 0.0, py::arg("max_memory_mib") = 0,
       py::arg("max_disk_mib") = 0, py::arg("scratch") = py::none(), py::arg("policy") = py::none(),
-      py::arg("policy_layers") = 1, py::arg("gap") = 0.0,
+      py::arg("policy_layers") = 1, py::arg("gap") = 0.0, py::arg("act") = py::none(),
       "The exact optimal success probability (or expected reward) and first choice (the layered solver), as "
       "`ontime solve --json` reports them; where a cap cuts the whole tree, a "
       "certified interval [lower_bound, upper_bound] "
@@ -140,7 +201,10 @@ void bind_solve(py::module_& m) {
       "runs trials of bounded RTDP until the certified interval is at most `gap` wide (`ontime solve --gap`). For an "
       "instance with backtracking neither "
       "a split nor a tolerance applies (UsageError), and "
-      "a cap's interval comes from bounds that count a give-up as a success.");
+      "a cap's interval comes from bounds that count a give-up as a success. act='concurrent' (or an instance "
+      "whose \"acting\" is concurrent) solves acting while planning (SPEC §10: the robot executes refined actions "
+      "while the rest is planned) with the memoised solver of that model, as `ontime solve --act concurrent`; the "
+      "result then has \"acting\": \"concurrent\". act='plan-first' reads any instance as plan-first.");
 }
 
 }  // namespace ontime::python

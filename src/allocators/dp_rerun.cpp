@@ -111,4 +111,28 @@ AllocatorKind dp_rerun_kind() {
       }};
 }
 
+ConcurrentDpRerunPolicy::ConcurrentDpRerunPolicy(const ConcurrentMdp& mdp, Aggregation aggregation)
+    : mdp_(&mdp), values_(mdp, aggregation) {}
+
+ConcurrentMdp::Move ConcurrentDpRerunPolicy::choose(const ConcurrentState& state) {
+  const Problem& problem = mdp_->problem();
+  int best = -1;
+  double best_value = -1.0;
+  for (int k = 0; k < mdp_->skeleton_count(); ++k) {
+    if (!ConcurrentMdp::is_live(state, k)) continue;
+    const double value = values_.value(state, k);
+    if (value > best_value + 1e-12) {
+      best_value = value;
+      best = k;
+    }
+  }
+  if (best < 0) return {};  // nothing can finish: every move is as good
+  const int depth = mdp_->executed_depth(state);
+  const int refined = ConcurrentMdp::refined(state, best);
+  if (ConcurrentMdp::robot_left(state) == 0 && refined > depth)
+    return {problem.action_at(best, depth), ConcurrentMdp::kWait};
+  if (refined < problem.skeleton_length(best)) return {-1, best};
+  return {};
+}
+
 }  // namespace ontime

@@ -30,6 +30,15 @@ Steps least_chain_execution(const Action& action) {
 
 Mdp::Mdp(const Problem& problem)
     : problem_(&problem), skeleton_count_(problem.skeleton_count()), deadline_(problem.deadline()) {
+  // This MDP is SPEC §2's, plan first: a problem whose robot acts while planning (SPEC §10) has
+  // other states and transitions (ConcurrentMdp), and reading it as plan-first would give numbers
+  // of another model under its name.
+  if (problem.acting() != Acting::plan_first) {
+    throw UsageError(problem.name() +
+                     " acts while planning (acting \"concurrent\", SPEC §10): only the exact solver of that model "
+                     "(ontime solve, --method memoised) takes it so far; the other solvers, the allocators, "
+                     "evaluation and sessions take plan-first instances (--act plan-first)");
+  }
   const auto deadline = static_cast<std::size_t>(deadline_);
   const auto action_count = static_cast<std::size_t>(problem.action_count());
 

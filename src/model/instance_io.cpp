@@ -42,8 +42,9 @@ class InstanceReader {
     const Json root = detail::parse_json_strict<Json>(text, source_);
     if (!root.is_object())
       fail("top level", "an instance must be a JSON object (got " + detail::describe_json_type(root) + ")");
-    check_keys(root, "",
-               {"name", "description", "deadline", "step_seconds", "chains", "actions", "skeletons", "rewards"});
+    check_keys(
+        root, "",
+        {"name", "description", "deadline", "step_seconds", "acting", "chains", "actions", "skeletons", "rewards"});
 
     std::string name = std::filesystem::path(source_).stem().string();
     if (root.contains("name")) name = string_at(root["name"], "name");
@@ -75,6 +76,17 @@ class InstanceReader {
       }
     }
 
+    Acting acting = Acting::plan_first;
+    if (root.contains("acting")) {
+      const Json& value = root["acting"];
+      if (!value.is_string()) {
+        fail("acting", "must be \"plan-first\" or \"concurrent\" (got " + detail::describe_json_type(value) + ")");
+      }
+      const std::optional<Acting> parsed = parse_acting(value.get_ref<const std::string&>());
+      if (!parsed) fail("acting", "must be \"plan-first\" or \"concurrent\" (got " + value.dump() + ")");
+      acting = *parsed;
+    }
+
     std::vector<ExogenousChain> chains;
     if (root.contains("chains")) chains = read_chains(root["chains"]);
     std::vector<Action> actions = read_actions(root, chains);
@@ -83,7 +95,8 @@ class InstanceReader {
     if (root.contains("rewards")) rewards = read_rewards(root["rewards"], skeletons.size());
     try {
       return Problem(std::move(name), static_cast<Steps>(*deadline), step_seconds, std::move(actions),
-                     std::move(skeletons), std::move(description), std::move(rewards), std::move(chains));
+                     std::move(skeletons), std::move(description), std::move(rewards), std::move(chains))
+          .with_acting(acting);
     } catch (const ChainRuleError& error) {
       // Chains are checked as they are read; what is left are the actions' references to them.
       fail(error.action().empty() ? detail::json_member("chains", error.chain())
@@ -424,6 +437,8 @@ std::string problem_to_json(const Problem& problem) {
   if (!problem.description().empty()) root["description"] = problem.description();
   root["deadline"] = problem.deadline();
   root["step_seconds"] = problem.step_seconds();
+  // Written only when it is not the default, so that a plan-first instance reads and writes as before.
+  if (problem.acting() != Acting::plan_first) root["acting"] = std::string(acting_name(problem.acting()));
   if (problem.has_chains()) {
     Json chains = Json::object();
     for (const ExogenousChain& chain : problem.chains()) {

@@ -244,6 +244,16 @@ int Problem::find_action(std::string_view id) const noexcept {
   return -1;
 }
 
+std::string_view acting_name(Acting acting) noexcept {
+  return acting == Acting::concurrent ? "concurrent" : "plan-first";
+}
+
+std::optional<Acting> parse_acting(std::string_view name) noexcept {
+  if (name == "plan-first") return Acting::plan_first;
+  if (name == "concurrent") return Acting::concurrent;
+  return std::nullopt;
+}
+
 std::string_view action_base_id(std::string_view id) noexcept {
   const std::size_t hash = id.rfind('#');
   if (hash == std::string_view::npos || hash == 0 || hash + 1 == id.size()) return id;

@@ -260,6 +260,42 @@ std::string to_json(const Solve& solve) {
   return dump(out);
 }
 
+std::string to_json(const ConcurrentSolve& solve) {
+  const Problem& problem = *solve.problem;
+  Json out;
+  out["instance"] = solve.instance;
+  out["name"] = problem.name();
+  out["method"] = "memoised";
+  out["acting"] = std::string(acting_name(Acting::concurrent));
+  out[problem.has_rewards() ? "optimal_expected_reward" : "optimal_success_probability"] = solve.value;
+  out["lower_bound"] = solve.value;
+  out["upper_bound"] = solve.value;
+  out["exact"] = true;
+  out["states"] = solve.states;
+  if (solve.timing) out["seconds"] = solve.seconds;
+  out["first_choice"] = solve.first_choice;
+  out["first_action"] = solve.first_choice >= 0 ? problem.action(problem.action_at(solve.first_choice, 0)).id : "";
+  return dump(out);
+}
+
+std::string to_text(const ConcurrentSolve& solve) {
+  const Problem& problem = *solve.problem;
+  std::string out = fmt::format("instance                     {} ({}), deadline {}, {} skeletons\n", solve.instance,
+                                problem.name(), problem.deadline(), problem.skeleton_count());
+  out += "acting                       concurrent: the robot executes refined actions while the rest is planned\n";
+  const char* objective = problem.has_rewards() ? "optimal expected reward    " : "optimal success probability";
+  out += fmt::format("{}  {:.6f}\n", objective, solve.value);
+  if (solve.first_choice >= 0) {
+    out += fmt::format("first choice                 skeleton {} (refine {})\n", solve.first_choice,
+                       problem.action(problem.action_at(solve.first_choice, 0)).id);
+  } else {
+    out += "first choice                 none (no skeleton can meet the deadline)\n";
+  }
+  out += fmt::format("states                       {}\n", solve.states);
+  if (solve.timing) out += fmt::format("time                         {:.4f} s\n", solve.seconds);
+  return out;
+}
+
 std::string to_text(const Solve& solve) {
   const LayeredSolution& solution = solve.solution;
   const Problem& problem = *solve.problem;

@@ -7,6 +7,7 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <regex>
 #include <string>
 #include <utility>
@@ -38,6 +39,51 @@ TEST(Cli, SolveReportsTheFigureOneOptimum) {
   EXPECT_EQ(out["first_choice"].get<int>(), 0);
   EXPECT_GT(out["states"].get<int>(), 0);
   EXPECT_TRUE(out.contains("seconds"));
+}
+
+// Acting while planning (SPEC §10): --act concurrent, or the instance's "acting", solves its MDP;
+// what does not take that mode yet refuses it with exit 2, naming the rule.
+TEST(Cli, SolveActsWhilePlanningWhenAsked) {
+  const auto plan_first = ontime({"solve", paper("instance1"), "--json", "--act", "plan-first"});
+  ASSERT_EQ(plan_first.exit_code, 0) << plan_first.err;
+  EXPECT_NEAR(json::parse(plan_first.out)["optimal_success_probability"].get<double>(), 0.942, 1e-12);
+  const auto concurrent = ontime({"solve", paper("instance1"), "--json", "--act", "concurrent"});
+  ASSERT_EQ(concurrent.exit_code, 0) << concurrent.err;
+  const json out = json::parse(concurrent.out);
+  EXPECT_EQ(out["acting"], "concurrent");
+  EXPECT_EQ(out["method"], "memoised");
+  EXPECT_NEAR(out["optimal_success_probability"].get<double>(), 1.0, 1e-12);
+  EXPECT_TRUE(out["exact"].get<bool>());
+  EXPECT_GT(out["states"].get<int>(), 0);
+
+  // The same from the instance's own field.
+  const std::string instance = (scratch("acting") / "instance1.json").string();
+  {
+    std::ifstream in(paper("instance1"));
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    text.insert(text.find('{') + 1, R"("acting": "concurrent",)");
+    std::ofstream(instance) << text;
+  }
+  const auto from_file = ontime({"solve", instance, "--json", "--no-timing"});
+  ASSERT_EQ(from_file.exit_code, 0) << from_file.err;
+  EXPECT_EQ(json::parse(from_file.out)["optimal_success_probability"], out["optimal_success_probability"]);
+  const auto overridden = ontime({"solve", instance, "--json", "--act", "plan-first"});
+  ASSERT_EQ(overridden.exit_code, 0) << overridden.err;
+  EXPECT_NEAR(json::parse(overridden.out)["optimal_success_probability"].get<double>(), 0.942, 1e-12);
+
+  const std::vector<std::pair<std::vector<std::string>, std::string>> refused{
+      {{"solve", instance, "--method", "layered"}, "solved by --method memoised only"},
+      {{"solve", instance, "--method", "search"}, "solved by --method memoised only"},
+      {{"solve", instance, "--tolerance", "0.1"}, "--tolerance is for the layered solver"},
+      {{"solve", instance, "--max-seconds", "5"}, "--max-seconds is for the layered solver"},
+      {{"evaluate", instance, "--solver", "dp-rerun", "--episodes", "10"}, "acts while planning"},
+      {{"solve", paper("instance1"), "--act", "interleaved"}, "--act"},
+  };
+  for (const auto& [arguments, message] : refused) {
+    const auto result = ontime(arguments);
+    EXPECT_EQ(result.exit_code, 2) << arguments[1] << " " << arguments.back() << ": " << result.err;
+    EXPECT_NE(result.err.find(message), std::string::npos) << result.err;
+  }
 }
 
 TEST(Cli, KnapsackReductionWritesASolvableInstance) {

@@ -304,6 +304,21 @@ namespace {
 
 // Rewards (SPEC §8): a number or {"value", "per_step"} per skeleton; written back as read, and not
 // written at all when every skeleton is worth 1.
+TEST(InstanceIo, TheActingModeReadsAndWritesBack) {
+  const Problem plan_first = testing::paper_instance("instance4");
+  EXPECT_EQ(plan_first.acting(), Acting::plan_first);
+  // The default is not written, so that a plan-first instance writes as it did before the field.
+  EXPECT_EQ(problem_to_json(plan_first).find("acting"), std::string::npos);
+  const Problem concurrent = plan_first.with_acting(Acting::concurrent);
+  const std::string text = problem_to_json(concurrent);
+  EXPECT_NE(text.find(R"("acting": "concurrent")"), std::string::npos) << text;
+  EXPECT_EQ(parse_problem(text, "written").acting(), Acting::concurrent);
+  EXPECT_EQ(problem_to_json(parse_problem(text, "written")), text);
+  std::string spelled = problem_to_json(plan_first);
+  spelled.insert(1, R"("acting": "plan-first",)");
+  EXPECT_EQ(parse_problem(spelled, "spelled").acting(), Acting::plan_first);
+}
+
 TEST(InstanceIo, RewardsReadAndWriteBack) {
   const std::string text = R"({"deadline": 6, "actions": {
       "a": {"planning": {"pmf": {"1": 1.0}}, "execution": {"pmf": {"1": 1.0}}},

@@ -4,7 +4,6 @@
 
 #include <cstdint>
 #include <limits>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -22,25 +21,11 @@
 namespace ontime {
 namespace {
 
-// `problem` with a random reward per skeleton: a value in [0.2, 1], and for about half of them a
-// fall per step that keeps the reward at the deadline at or above 0.
-Problem with_random_rewards(const Problem& problem, std::uint64_t seed) {
-  std::mt19937_64 generator(seed);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::vector<SkeletonReward> rewards;
-  for (int k = 0; k < problem.skeleton_count(); ++k) {
-    SkeletonReward reward{0.2 + 0.8 * unit(generator), 0.0};
-    if (unit(generator) < 0.5) reward.per_step = reward.value * unit(generator) / problem.deadline();
-    rewards.push_back(reward);
-  }
-  return problem.with_rewards(rewards);
-}
-
 TEST(Rewards, TheOptimumIsTheReferenceSolversExpectedReward) {
   int falling = 0;
   const int count = testing::repetitions_to_check(200);
   for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
-    const Problem problem = with_random_rewards(testing::random_instance(seed, 4, 3, 10), seed);
+    const Problem problem = testing::with_random_rewards(testing::random_instance(seed, 4, 3, 10), seed);
     ASSERT_TRUE(problem.has_rewards());
     for (const SkeletonReward& reward : problem.rewards()) falling += reward.per_step > 0 ? 1 : 0;
     const Mdp mdp(problem);
@@ -52,7 +37,7 @@ TEST(Rewards, TheOptimumIsTheReferenceSolversExpectedReward) {
 
 TEST(Rewards, SearchAndLayeredSolversEqualTheMemoisedOneBitForBit) {
   for (std::uint64_t seed = 1; seed <= 150; ++seed) {
-    const Problem problem = with_random_rewards(testing::random_instance(seed, 5, 4, 14), 7 * seed);
+    const Problem problem = testing::with_random_rewards(testing::random_instance(seed, 5, 4, 14), 7 * seed);
     const Mdp mdp(problem);
     OptimalSolver memoised(mdp);
     const double optimum = memoised.solve(mdp.start());
@@ -72,7 +57,7 @@ TEST(Rewards, EveryCapsIntervalHoldsTheExpectedReward) {
   // stands: both intervals must hold the optimum with rewards as without.
   int cut = 0;
   for (std::uint64_t seed = 1; seed <= 60; ++seed) {
-    const Problem problem = with_random_rewards(testing::random_instance(seed, 6, 5, 16), 11 * seed);
+    const Problem problem = testing::with_random_rewards(testing::random_instance(seed, 6, 5, 16), 11 * seed);
     const Mdp mdp(problem);
     OptimalSolver memoised(mdp);
     const double optimum = memoised.solve(mdp.start());
@@ -119,7 +104,7 @@ TEST(Rewards, ExplicitUnitRewardsAreNoRewards) {
 
 TEST(Rewards, TheBoundsHoldTheOptimumAndTheCommitBoundIsAPolicysValue) {
   for (std::uint64_t seed = 1; seed <= 120; ++seed) {
-    const Problem problem = with_random_rewards(testing::random_instance(seed, 4, 3, 12), seed + 500);
+    const Problem problem = testing::with_random_rewards(testing::random_instance(seed, 4, 3, 12), seed + 500);
     const Mdp mdp(problem);
     const ValueBounds bounds(mdp);
     OptimalSolver solver(mdp);
@@ -144,7 +129,7 @@ TEST(Rewards, EquationOneOfAOneSkeletonProblemIsItsExpectedReward) {
     const Problem base = testing::random_instance(seed, 1, 4, 12);
     if (base.skeleton_count() != 1) continue;
     ++checked;
-    const Problem problem = with_random_rewards(base, seed);
+    const Problem problem = testing::with_random_rewards(base, seed);
     const Mdp mdp(problem);
     const ContiguousSuccessTable table(mdp, Aggregation::sum);
     EXPECT_NEAR(table.success_probability(mdp.start(), 0), testing::ReferenceSolver(problem).optimum(), 1e-12)
@@ -177,7 +162,7 @@ TEST(Rewards, BrokenRewardsAreRefusedWithTheSkeletonAndTheRule) {
 }
 
 TEST(Rewards, TheLayeredSolverRefusesADropOrASplitOfRewards) {
-  const Problem problem = with_random_rewards(testing::paper_instance("instance3"), 3);
+  const Problem problem = testing::with_random_rewards(testing::paper_instance("instance3"), 3);
   testing::expect_layered_refuses_a_tolerance_and_a_split(Mdp(problem));
 }
 

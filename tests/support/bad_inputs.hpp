@@ -22,6 +22,8 @@ inline const std::array kBadInputs{
     BadInput{"top_level_array.json", "top level", "must be a JSON object"},
     BadInput{"unknown_top_key.json", "deadlines", "unknown key"},
     BadInput{"name_not_string.json", "name", "must be a string"},
+    BadInput{"acting_unknown.json", "acting", "must be \"plan-first\" or \"concurrent\" (got \"interleaved\")"},
+    BadInput{"acting_not_string.json", "acting", "must be \"plan-first\" or \"concurrent\" (got a boolean)"},
     BadInput{"missing_deadline.json", "top level", "missing required key 'deadline'"},
     BadInput{"deadline_zero.json", "deadline", "between 1 and 10000"},
     BadInput{"deadline_too_large.json", "deadline", "between 1 and 10000"},

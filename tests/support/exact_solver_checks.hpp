@@ -16,6 +16,13 @@
 
 namespace ontime::testing {
 
+// The plan-first optimum of `problem` (SPEC §2), by the memoised solver.
+inline double memoised_optimum(const Problem& problem) {
+  const Mdp mdp(problem);
+  OptimalSolver solver(mdp);
+  return solver.solve(mdp.start());
+}
+
 // The layered solver on 1 and 2 threads: the memoised solver's value to the bit, its first
 // choice and state count, and the policy of the first 3 layers holds whole states (they solve
 // to its values and choices).

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -162,6 +163,18 @@ Problem with_backtracking(const Problem& problem, std::uint64_t seed) {
 Problem wide_instance(std::uint64_t seed, int skeleton_count, int max_length, Steps deadline) {
   SplitMix64 generator(seed);
   return build_instance(generator, "wide-" + std::to_string(skeleton_count), deadline, skeleton_count, max_length);
+}
+
+Problem with_random_rewards(const Problem& problem, std::uint64_t seed) {
+  std::mt19937_64 generator(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<SkeletonReward> rewards;
+  for (int k = 0; k < problem.skeleton_count(); ++k) {
+    SkeletonReward reward{0.2 + 0.8 * unit(generator), 0.0};
+    if (unit(generator) < 0.5) reward.per_step = reward.value * unit(generator) / problem.deadline();
+    rewards.push_back(reward);
+  }
+  return problem.with_rewards(rewards);
 }
 
 int repetitions_to_check(int count) {

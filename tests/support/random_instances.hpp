@@ -22,6 +22,11 @@ Problem with_random_chains(const Problem& problem, std::uint64_t seed, bool rewa
 // instance.
 Problem with_backtracking(const Problem& problem, std::uint64_t seed);
 
+// `problem` with a random reward per skeleton (SPEC §8): a value in [0.2, 1], and for about half
+// of them a fall per step that keeps the reward at the deadline at or above 0. Same seed, same
+// rewards.
+Problem with_random_rewards(const Problem& problem, std::uint64_t seed);
+
 // How many of `count` repetitions (random instances, generated keys) a test checks: all of them,
 // or the share named by the environment variable ONTIME_TEST_SHARE (in (0, 1], at least one). The
 // sanitizer run sets 0.25: the first repetitions take the same code paths under the sanitizers at

@@ -22,7 +22,9 @@
 #include <vector>
 
 #include "ontime/allocators/allocator.hpp"
+#include "ontime/mdp/concurrent_mdp.hpp"
 #include "ontime/solve/backtracking_success.hpp"
+#include "ontime/solve/concurrent_contiguous_success.hpp"
 #include "ontime/solve/contiguous_success.hpp"
 #include "ontime/solve/timed_contiguous_success.hpp"
 
@@ -56,6 +58,28 @@ class DpRerunAllocator final : public Allocator {
   std::unique_ptr<BacktrackingSuccess> backtracking_;
   std::unique_ptr<TimedContiguousSuccess> timed_;
   std::vector<int> worked_on_;  // skeletons with steps spent on their current action (scratch)
+};
+
+// `dp-rerun` when the robot acts while planning (SPEC §10), with the eager commit rule. Before
+// every move it values each live skeleton by Eq. (1) for acting while planning
+// (ConcurrentContiguousSuccess: the robot runs the skeleton's refined actions back to back while the
+// rest is planned) and follows the best (ties: lowest index): while the robot is idle and the
+// best skeleton's next action to execute is refined, it starts it (committing to the skeletons
+// through it); otherwise it spends the step on the best skeleton's next action, or waits when that
+// skeleton is refined in full. A stationary policy of ConcurrentMdp (ConcurrentSolver evaluates it
+// exactly); not yet an allocator of the registry, whose allocators decide plan-first.
+// Cost: per move, one Eq. (1) query per live skeleton: a sum over at most D - CT planning steps of
+// memoised values.
+class ConcurrentDpRerunPolicy {
+ public:
+  // The policy for `mdp`, Eq. (1) combining sharing skeletons by `aggregation` (sum: Table I's).
+  explicit ConcurrentDpRerunPolicy(const ConcurrentMdp& mdp, Aggregation aggregation = Aggregation::sum);
+  // The move in a state where some skeleton is live: a start or a step, as above.
+  ConcurrentMdp::Move choose(const ConcurrentState& state);
+
+ private:
+  const ConcurrentMdp* mdp_;
+  ConcurrentContiguousSuccess values_;
 };
 
 }  // namespace ontime

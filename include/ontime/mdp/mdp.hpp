@@ -106,6 +106,8 @@ class Mdp {
   // What least_need returns for a skeleton that cannot succeed whatever the time left.
   static constexpr std::int64_t kUnreachableNeed = std::int64_t{1} << 40;
 
+  // Throws UsageError for a problem whose robot acts while planning (Problem::acting() concurrent,
+  // SPEC §10): that is ConcurrentMdp's model (ontime/mdp/concurrent_mdp.hpp).
   explicit Mdp(const Problem& problem);
 
   const Problem& problem() const noexcept { return *problem_; }

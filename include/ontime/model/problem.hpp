@@ -9,6 +9,8 @@
 // discarded. A Problem is immutable once built and validated.
 
 #include <cstddef>
+#include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -21,6 +23,15 @@
 #include "ontime/util/random.hpp"
 
 namespace ontime {
+
+// When the robot may execute refined actions (SPEC §10). plan_first, the paper's premise and the
+// default: a skeleton is executed once every one of its actions is refined. concurrent: the robot
+// executes refined actions while the planner refines the rest, and chooses when to start each one.
+enum class Acting : std::uint8_t { plan_first, concurrent };
+// The mode's name in instances and on the command line: "plan-first" or "concurrent".
+std::string_view acting_name(Acting acting) noexcept;
+// The mode named `name`, or nullopt for any other text.
+std::optional<Acting> parse_acting(std::string_view name) noexcept;
 
 // An earlier action an attempt that backtracks blames (SPEC §7), with its probability.
 struct Culprit {
@@ -223,16 +234,30 @@ class Problem {
 
   // The skeletons as lists of action indices (a copy, e.g. to build a changed problem).
   std::vector<std::vector<int>> skeleton_lists() const { return skeletons_; }
+  // When the robot may execute refined actions (SPEC §10): the instance's "acting", plan-first by
+  // default. Every solver, allocator and session built on Mdp takes plan-first problems only
+  // (Mdp's constructor refuses the other mode); ConcurrentMdp models concurrent ones.
+  Acting acting() const noexcept { return acting_; }
+  // This problem with another acting mode, everything else kept.
+  Problem with_acting(Acting acting) const {
+    Problem copy = *this;
+    copy.acting_ = acting;
+    return copy;
+  }
   // This problem (name, deadline, step, skeletons, description, rewards, chains) with other actions, in
   // the same order: e.g. other distributions for the same ids. Throws UsageError as the
   // constructor does.
   Problem with_actions(std::vector<Action> actions) const {
-    return {name_, deadline_, step_seconds_, std::move(actions), skeletons_, description_, rewards_, chains_};
+    Problem copy{name_, deadline_, step_seconds_, std::move(actions), skeletons_, description_, rewards_, chains_};
+    copy.acting_ = acting_;
+    return copy;
   }
   // This problem with other rewards (SPEC §8; none: 1 for every skeleton), its chains kept. Throws
   // RewardError or UsageError as the constructor does.
   Problem with_rewards(std::vector<SkeletonReward> rewards) const {
-    return {name_, deadline_, step_seconds_, actions_, skeletons_, description_, std::move(rewards), chains_};
+    Problem copy{name_, deadline_, step_seconds_, actions_, skeletons_, description_, std::move(rewards), chains_};
+    copy.acting_ = acting_;
+    return copy;
   }
 
  private:
@@ -244,6 +269,7 @@ class Problem {
   std::vector<std::vector<int>> skeletons_;
   std::vector<SkeletonReward> rewards_;
   std::vector<ExogenousChain> chains_;
+  Acting acting_ = Acting::plan_first;
   std::vector<int> execution_chain_;
   std::vector<int> blocking_chain_;
   std::vector<std::vector<char>> blocking_;

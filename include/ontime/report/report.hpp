@@ -68,6 +68,22 @@ std::string to_text(const Solve& solve);
 // its choice and the bounds of its value.
 std::string policy_lines(const Solve& solve);
 
+// The exact optimum of acting while planning (SPEC §10, ConcurrentSolver): its value, the first
+// move (always a refinement: nothing is refined at the start), the states solved.
+struct ConcurrentSolve {
+  std::string instance = {};
+  const Problem* problem = nullptr;
+  double value = 0;
+  int first_choice = -1;  // the skeleton refined first, -1 when none can finish by the deadline
+  std::size_t states = 0;
+  double seconds = 0;
+  bool timing = true;
+};
+// Its JSON (`ontime solve --act concurrent --json`): the memoised solve's keys and "acting".
+std::string to_json(const ConcurrentSolve& solve);
+// Its text: the instance, the acting mode, the optimum, the first choice, the states.
+std::string to_text(const ConcurrentSolve& solve);
+
 // Table I's layout (run/table.hpp).
 std::string to_json(const Table& table);
 // A heading line, the Markdown table (one row per instance, the mean decision time of each

@@ -1,0 +1,233 @@
+#pragma once
+// The acting-while-planning MDP of SPEC §10: one planner and one robot body work at once.
+//
+// The planner spends each step on one action, as in SPEC §2 (the hazard, then an execution time
+// drawn when the motion is found). Meanwhile the robot executes refined actions one at a time
+// along the executed prefix E, a node of the skeletons' prefix tree: it is either idle at E or
+// executing E's last action with r steps left. While it is idle it may start a refined child c of
+// E (a move that takes no time: E becomes E + c, r the execution time of c) or wait. Starting c
+// commits the robot: the skeletons not through c are dropped. The episode succeeds when the robot
+// starts the last action of a skeleton k and finishes it by the deadline D, at step f, with the
+// reward R_k(f) of SPEC §8 (1 without rewards); it fails when no skeleton can finish by D.
+//
+// A state is a short array of 16-bit words (ConcurrentState), in this order:
+//   CT; r (0: the robot is idle); E (0: nothing executed, else 1 + the index of E's last action);
+//   per skeleton l_k (kDropped once it is not through E or cannot finish by D) and PT_k; per
+//   action its execution time x_a (D + 1 for too slow or never) while it is refined, below E and
+//   on a live skeleton, kUnknown otherwise.
+// States are canonical: what cannot change the value (dropped skeletons, executions no live
+// skeleton will run) holds fixed values, so that states with equal futures are equal. A skeleton
+// is live when it is through E and its earliest finish (below) is at most D; once dropped it
+// never comes back (the earliest finish never decreases).
+//
+// Moves: a start (robot idle; a refined child of E on a live skeleton), instantaneous; a step:
+// the planner refines the next action of one group of live skeletons sharing it (or idles,
+// kWait), the robot executes one step, CT grows by one. Within a step both work at once; a motion
+// found in the step from CT to CT + 1 can start at CT + 1 at the earliest.
+//
+// Backtracking (SPEC §7) and exogenous chains or expiry (SPEC §9) are not modelled here yet: the
+// constructor refuses them (UsageError naming the rule).
+//
+// Cost: a move copies and canonicalises one state, O(K * A_max + A) word operations; the tables
+// (hazards, execution outcomes: the plan-first Mdp's, so that both models read the same numbers
+// to the bit) are built once.
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "ontime/mdp/mdp.hpp"
+#include "ontime/model/problem.hpp"
+
+namespace ontime {
+
+// A state of SPEC §10, the words described above.
+using ConcurrentState = std::vector<std::uint16_t>;
+
+class ConcurrentMdp {
+ public:
+  // An execution time that is not known (not refined, or no live skeleton will run it).
+  static constexpr std::uint16_t kUnknown = 0xFFFF;
+  // l_k of a skeleton that is dropped (not through E, or unable to finish by the deadline).
+  static constexpr std::uint16_t kDropped = 0xFFFF;
+  // The step choice in which the planner idles (the robot still executes).
+  static constexpr int kWait = -1;
+  // CT, PT and the saturated D + 1 fit a word and stay apart from kUnknown.
+  static_assert(Problem::kMaxDeadline + 1 < kUnknown);
+
+  // One move: a start of `start` (an action index), or a step refining skeleton `refine`'s next
+  // action (kWait: the planner idles).
+  struct Move {
+    int start = -1;
+    int refine = kWait;
+    // Whether the move starts an action (else it is a step).
+    bool is_start() const noexcept { return start >= 0; }
+    friend bool operator==(const Move&, const Move&) = default;
+  };
+
+  // Any acting mode is read as concurrent (the model of this class). Throws UsageError when the
+  // problem has backtracking (SPEC §7), or chains or actions that expire (SPEC §9).
+  explicit ConcurrentMdp(const Problem& problem);
+  ~ConcurrentMdp();
+  ConcurrentMdp(const ConcurrentMdp&) = delete;
+  ConcurrentMdp& operator=(const ConcurrentMdp&) = delete;
+
+  // The problem, read plan-first (the acting mode is this class's), its deadline D and its K.
+  const Problem& problem() const noexcept { return *problem_; }
+  // The deadline D in steps.
+  Steps deadline() const noexcept { return deadline_; }
+  // The number of skeletons K.
+  int skeleton_count() const noexcept { return skeleton_count_; }
+
+  // The start: CT 0, the robot idle, nothing executed or refined (canonical).
+  ConcurrentState start() const;
+
+  // CT: the steps used.
+  static Steps time(const ConcurrentState& state) noexcept { return state[0]; }
+  // r: the steps the robot still needs for the action it executes, 0 while it is idle.
+  static Steps robot_left(const ConcurrentState& state) noexcept { return state[1]; }
+  // The last action of E, -1 while nothing has been started.
+  static int executed(const ConcurrentState& state) noexcept { return static_cast<int>(state[2]) - 1; }
+  // Whether skeleton k is through E and can still finish by D.
+  static bool is_live(const ConcurrentState& state, int k) noexcept { return refined_word(state, k) != kDropped; }
+  // l_k of a live skeleton: its actions refined.
+  static int refined(const ConcurrentState& state, int k) noexcept { return refined_word(state, k); }
+  // PT_k of a live skeleton: the steps spent on its next action.
+  Steps spent(const ConcurrentState& state, int k) const noexcept {
+    return state[kHeader + static_cast<std::size_t>(skeleton_count_ + k)];
+  }
+  // x_a, or kUnknown.
+  std::uint16_t execution(const ConcurrentState& state, int action) const noexcept {
+    return state[kHeader + 2 * static_cast<std::size_t>(skeleton_count_) + static_cast<std::size_t>(action)];
+  }
+  // Whether some skeleton can still finish by D (else the state is worth 0).
+  bool any_live(const ConcurrentState& state) const noexcept;
+  // Position of E's last action + 1: how many actions of a skeleton through E have been started.
+  int executed_depth(const ConcurrentState& state) const noexcept;
+  // When the robot is free if it runs live skeleton k's refined actions after E back to back from
+  // now: CT + r + their execution times.
+  std::int64_t robot_free(const ConcurrentState& state, int k) const noexcept;
+  // The plan-first Mdp of the same problem: its hazards and execution outcomes are this model's.
+  const Mdp& plan_first_mdp() const noexcept { return mdp_; }
+
+  // The earliest step at which live skeleton k can finish: the robot free at CT + r, then each
+  // action of k after E in order, started when the robot is free and the action refined (now,
+  // for a refined one; for the rest, the planner on k alone with each action's fastest planning,
+  // the current one's given PT_k) and run for its execution (the fastest for an unrefined one).
+  // A lower bound on every finish of k; the finish of executing k as soon as possible once k is
+  // refined. Mdp::kUnreachableNeed or more when k cannot finish at all.
+  std::int64_t earliest_finish(const ConcurrentState& state, int k) const noexcept;
+
+  // The children of E the robot may start now (refined, on a live skeleton), ascending; empty
+  // while it executes.
+  std::vector<int> startable(const ConcurrentState& state) const;
+  // The start that is as good as every other move (docs/theory.md, "Acting while planning"): the
+  // robot is idle and every live skeleton goes through one child c of E, which is refined; -1
+  // otherwise.
+  int forced_start(const ConcurrentState& state) const noexcept;
+
+  // What starting `action` (a startable child of E) leads to: the end of the episode, when it is
+  // the last action of a live skeleton (`reward`: R_k at its finish, 0 past the deadline), or
+  // `next` (canonical). Throws UsageError when the action is not startable.
+  struct StartOutcome {
+    bool ends = false;
+    double reward = 0;
+    ConcurrentState next;
+  };
+  // Starts `action` in `state`: the end of the episode or the next state, as above.
+  StartOutcome start_action(const ConcurrentState& state, int action) const;
+
+  // The step choices worth considering: one per group of live skeletons sharing their next action
+  // (named by the lowest index), ascending; empty when no live skeleton has an action left to
+  // refine (the planner can only wait). Refining never lowers the value (docs/theory.md), so an
+  // idle planner is worth considering only then.
+  ChoiceList refine_choices(const ConcurrentState& state) const;
+
+  // Calls visit(probability, next) for every outcome of one step in which the planner refines
+  // skeleton `choice`'s next action (or idles, kWait), `next` canonical. Outcomes of zero
+  // probability are skipped. Throws UsageError for a choice that is not live with work left.
+  template <class Visitor>
+  void for_each_step_outcome(const ConcurrentState& state, int choice, Visitor&& visit) const;
+
+  // Without rewards (SPEC §8): whether some live skeleton is refined in full. Its earliest finish
+  // is then at most D, and executing it as soon as possible succeeds: the state is worth 1.
+  bool certain_success(const ConcurrentState& state) const noexcept;
+
+ private:
+  static constexpr std::size_t kHeader = 3;
+
+  static std::uint16_t refined_word(const ConcurrentState& state, int k) noexcept {
+    return state[kHeader + static_cast<std::size_t>(k)];
+  }
+  static std::uint16_t& refined_word(ConcurrentState& state, int k) noexcept {
+    return state[kHeader + static_cast<std::size_t>(k)];
+  }
+  std::uint16_t& spent_word(ConcurrentState& state, int k) const noexcept {
+    return state[kHeader + static_cast<std::size_t>(skeleton_count_ + k)];
+  }
+  std::uint16_t& execution_word(ConcurrentState& state, int action) const noexcept {
+    return state[kHeader + 2 * static_cast<std::size_t>(skeleton_count_) + static_cast<std::size_t>(action)];
+  }
+  bool through_executed(const ConcurrentState& state, int k) const noexcept;
+  // Drops the skeletons that are not live and forgets the executions no live skeleton runs.
+  void canonicalise(ConcurrentState& state) const;
+  [[noreturn]] static void reject_choice(int choice);
+
+  std::unique_ptr<const Problem> problem_;  // the problem, plan-first, so that mdp_ can read it
+  Mdp mdp_;                                 // its hazards and execution outcomes
+  Steps deadline_;
+  int skeleton_count_;
+  int action_count_;
+  // Per action and PT in [0, D]: the fewest further steps until its motion can be found, kNever
+  // when it cannot (the planning PMF's next positive step after PT).
+  std::vector<Steps> next_finish_;
+  std::vector<Steps> fastest_execution_;  // per action; kNever when none is finite
+};
+
+template <class Visitor>
+void ConcurrentMdp::for_each_step_outcome(const ConcurrentState& state, int choice, Visitor&& visit) const {
+  ConcurrentState next = state;
+  ++next[0];
+  if (next[1] > 0) --next[1];
+  if (choice == kWait) {
+    canonicalise(next);
+    visit(1.0, static_cast<const ConcurrentState&>(next));
+    return;
+  }
+  if (choice < 0 || choice >= skeleton_count_ || !is_live(state, choice) ||
+      refined(state, choice) >= problem_->skeleton_length(choice)) {
+    reject_choice(choice);
+  }
+  const int action = problem_->action_at(choice, refined(state, choice));
+  const Steps pt = spent(state, choice);
+  const double found = mdp_.hazard(action, pt);
+  // The live skeletons whose next action is `action` share it (SPEC §1): one step for all of them.
+  const auto for_group = [&](auto&& change) {
+    for (const int m : problem_->members(action)) {
+      if (is_live(state, m) && refined(state, m) < problem_->skeleton_length(m) &&
+          problem_->action_at(m, refined(state, m)) == action) {
+        change(m);
+      }
+    }
+  };
+  if (found < 1.0) {
+    ConcurrentState missed = next;
+    for_group([&](int m) { ++spent_word(missed, m); });
+    canonicalise(missed);
+    visit(1.0 - found, static_cast<const ConcurrentState&>(missed));
+  }
+  if (found > 0.0) {
+    for (const Mdp::ExecutionOutcome& outcome : mdp_.execution_outcomes(action)) {
+      ConcurrentState refined_state = next;
+      execution_word(refined_state, action) = static_cast<std::uint16_t>(outcome.steps);
+      for_group([&](int m) {
+        ++refined_word(refined_state, m);
+        spent_word(refined_state, m) = 0;
+      });
+      canonicalise(refined_state);
+      visit(found * outcome.probability, static_cast<const ConcurrentState&>(refined_state));
+    }
+  }
+}
+
+}  // namespace ontime

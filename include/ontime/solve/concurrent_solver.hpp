@@ -1,0 +1,83 @@
+#pragma once
+// The exact solver of the acting-while-planning MDP (SPEC §10): expectimax over the reachable
+// states of ConcurrentMdp, memoised.
+//
+// Computes V*(s), the maximum expected reward (the success probability without rewards), over
+// every policy that chooses, at each state, a start (while the robot is idle: a refined child of
+// what it executed, on a live skeleton) or a step (the planner refines one group of live
+// skeletons sharing their next action, or idles when none has work left), and the move that
+// attains it.
+//
+// Guarantees: the value is exact up to floating-point rounding; the moves left out are never
+// better (docs/theory.md, "Acting while planning"): an idle planner while some live skeleton has
+// work left, any move but the start when every live skeleton goes on through one refined child of
+// what the robot executed (ConcurrentMdp::forced_start), and, without rewards, any move once a
+// live skeleton is refined in full (ConcurrentMdp::certain_success: worth 1). Plan-first is one
+// policy of this MDP, so V* is at least the plan-first optimum (OptimalSolver) of the same problem.
+// Ties (values within kTieTolerance) go to the first move in this order: the steps, ascending by
+// skeleton, then waiting, then the starts, ascending by action; so the robot starts an action
+// only when starting is worth more than planning on while it waits.
+//
+// Cost: time and memory linear in the reachable states, which grow with the skeletons, the
+// deadline and the execution times the robot may still run (one word each, per refined action);
+// each state costs its words (3 + 2K + A, two bytes each) and a hash-table slot. The solver stops
+// with ResourceLimitError past `max_states` states, never by running out of memory, and walks the
+// states with an explicit stack (no recursion), so any deadline is safe.
+
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <optional>
+
+#include "ontime/mdp/concurrent_mdp.hpp"
+
+namespace ontime {
+
+class ConcurrentSolver {
+ public:
+  static constexpr double kTieTolerance = 1e-12;
+  static constexpr std::size_t kDefaultMaxStates = 10'000'000;
+
+  using Move = ConcurrentMdp::Move;
+  // A stationary policy: the move it makes in a running state (a start the state allows, or a
+  // step on a live skeleton with work left, or kWait).
+  using Policy = std::function<Move(const ConcurrentState&)>;
+
+  // The optimum of `mdp`, holding at most `max_states` states (ResourceLimitError past them).
+  explicit ConcurrentSolver(const ConcurrentMdp& mdp, std::size_t max_states = kDefaultMaxStates);
+  // Exact evaluation of `policy` instead of the optimum: solve() then gives V^policy, walking the
+  // states the policy reaches (no move is left out or forced, and no state is worth 1 before the
+  // policy's plan ends; a step asked for at the deadline ends the episode, worth 0). A move the
+  // state does not allow throws UsageError.
+  ConcurrentSolver(const ConcurrentMdp& mdp, Policy policy, std::size_t max_states = kDefaultMaxStates);
+  ~ConcurrentSolver();
+  ConcurrentSolver(const ConcurrentSolver&) = delete;
+  ConcurrentSolver& operator=(const ConcurrentSolver&) = delete;
+
+  // V*(root); solves every state reachable from it that is not known yet. Throws
+  // ResourceLimitError at the state cap and Cancelled when the stop condition holds (the states
+  // solved so far are kept).
+  double solve(const ConcurrentState& root);
+
+  // The best move in a state already solved that is not terminal, or nullopt.
+  std::optional<Move> best_move(const ConcurrentState& state) const;
+
+  // A condition checked every few thousand states while solving.
+  void set_stop(std::function<bool()> stop);
+
+  // States memoised so far.
+  std::size_t states() const noexcept;
+  // The most memory a solve of `problem` may hold under a cap of `max_states` states: each
+  // state's words and hash-table slot, the table's power-of-two growth, the old and the new
+  // table while it grows, and the stack of states waiting for their successors.
+  static double max_bytes(const Problem& problem, std::size_t max_states);
+  // The MDP solved.
+  const ConcurrentMdp& mdp() const noexcept { return *mdp_; }
+
+ private:
+  struct Impl;
+  const ConcurrentMdp* mdp_;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace ontime

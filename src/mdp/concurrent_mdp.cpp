@@ -1,0 +1,213 @@
+#include "ontime/mdp/concurrent_mdp.hpp"
+
+#include <algorithm>
+#include <string>
+
+namespace ontime {
+namespace {
+
+const Problem& refuse_unmodelled(const Problem& problem) {
+  const std::string rule = " with acting \"concurrent\" (SPEC §10) is not modelled yet: solve " + problem.name() +
+                           " plan-first (--act plan-first)";
+  if (problem.has_backtracking()) throw UsageError(problem.name() + ": backtracking (SPEC §7)" + rule);
+  if (problem.is_timed())
+    throw UsageError(problem.name() + ": exogenous chains or actions that expire (SPEC §9)" + rule);
+  return problem;
+}
+
+}  // namespace
+
+ConcurrentMdp::ConcurrentMdp(const Problem& problem)
+    : problem_(std::make_unique<const Problem>(refuse_unmodelled(problem).with_acting(Acting::plan_first))),
+      mdp_(*problem_),
+      deadline_(problem.deadline()),
+      skeleton_count_(problem.skeleton_count()),
+      action_count_(problem.action_count()) {
+  const auto deadline = static_cast<std::size_t>(deadline_);
+  next_finish_.assign(static_cast<std::size_t>(action_count_) * (deadline + 1), kNever);
+  fastest_execution_.assign(static_cast<std::size_t>(action_count_), kNever);
+  for (int a = 0; a < action_count_; ++a) {
+    const auto row = static_cast<std::size_t>(a) * (deadline + 1);
+    // Planning steps past D cannot finish within the deadline: only steps up to D count.
+    Steps next_positive = kNever;
+    for (Steps pt = deadline_; pt >= 0; --pt) {
+      next_finish_[row + static_cast<std::size_t>(pt)] = next_positive == kNever ? kNever : next_positive - pt;
+      if (pt >= 1 && problem_->action(a).planning.pmf(pt) > 0) next_positive = pt;
+    }
+    for (const Mdp::ExecutionOutcome& outcome : mdp_.execution_outcomes(a)) {
+      if (outcome.steps <= deadline_ && outcome.probability > 0) {
+        fastest_execution_[static_cast<std::size_t>(a)] =
+            std::min(fastest_execution_[static_cast<std::size_t>(a)], outcome.steps);
+      }
+    }
+  }
+}
+
+ConcurrentMdp::~ConcurrentMdp() = default;
+
+ConcurrentState ConcurrentMdp::start() const {
+  ConcurrentState state(
+      kHeader + 2 * static_cast<std::size_t>(skeleton_count_) + static_cast<std::size_t>(action_count_), 0);
+  for (int a = 0; a < action_count_; ++a) execution_word(state, a) = kUnknown;
+  canonicalise(state);
+  return state;
+}
+
+bool ConcurrentMdp::any_live(const ConcurrentState& state) const noexcept {
+  for (int k = 0; k < skeleton_count_; ++k) {
+    if (is_live(state, k)) return true;
+  }
+  return false;
+}
+
+int ConcurrentMdp::executed_depth(const ConcurrentState& state) const noexcept {
+  const int last = executed(state);
+  return last < 0 ? 0 : problem_->position(last) + 1;
+}
+
+std::int64_t ConcurrentMdp::robot_free(const ConcurrentState& state, int k) const noexcept {
+  std::int64_t free = std::int64_t{time(state)} + robot_left(state);
+  for (int j = executed_depth(state); j < refined(state, k); ++j) free += execution(state, problem_->action_at(k, j));
+  return free;
+}
+
+bool ConcurrentMdp::through_executed(const ConcurrentState& state, int k) const noexcept {
+  const int last = executed(state);
+  if (last < 0) return true;
+  const auto members = problem_->members(last);
+  return std::binary_search(members.begin(), members.end(), k);
+}
+
+std::int64_t ConcurrentMdp::earliest_finish(const ConcurrentState& state, int k) const noexcept {
+  const auto stride = static_cast<std::size_t>(deadline_) + 1;
+  const int length = problem_->skeleton_length(k);
+  const int refined_count = refined(state, k);
+  std::int64_t robot_free = std::int64_t{time(state)} + robot_left(state);
+  std::int64_t planned = time(state);  // the planner, on k alone
+  for (int j = executed_depth(state); j < length; ++j) {
+    const int action = problem_->action_at(k, j);
+    if (j < refined_count) {
+      robot_free += execution(state, action);  // refined: it can start as soon as the robot is free
+      continue;
+    }
+    const Steps pt = j == refined_count ? spent(state, k) : 0;
+    const Steps planning = pt > deadline_
+                               ? kNever
+                               : next_finish_[static_cast<std::size_t>(action) * stride + static_cast<std::size_t>(pt)];
+    const Steps fastest = fastest_execution_[static_cast<std::size_t>(action)];
+    if (planning == kNever || fastest == kNever) return Mdp::kUnreachableNeed;
+    planned += planning;
+    robot_free = std::max(robot_free, planned) + fastest;
+  }
+  return robot_free;
+}
+
+void ConcurrentMdp::canonicalise(ConcurrentState& state) const {
+  const int depth = executed_depth(state);
+  for (int k = 0; k < skeleton_count_; ++k) {
+    if (!is_live(state, k)) continue;
+    if (!through_executed(state, k) || problem_->skeleton_length(k) <= depth || earliest_finish(state, k) > deadline_) {
+      refined_word(state, k) = kDropped;
+      spent_word(state, k) = 0;
+    }
+  }
+  for (int a = 0; a < action_count_; ++a) {
+    if (execution(state, a) == kUnknown) continue;
+    const int position = problem_->position(a);
+    bool runs = false;
+    if (position >= depth) {
+      for (const int k : problem_->members(a)) {
+        if (is_live(state, k) && position < refined(state, k)) {
+          runs = true;
+          break;
+        }
+      }
+    }
+    if (!runs) execution_word(state, a) = kUnknown;
+  }
+}
+
+std::vector<int> ConcurrentMdp::startable(const ConcurrentState& state) const {
+  std::vector<int> children;
+  if (robot_left(state) > 0) return children;
+  const int depth = executed_depth(state);
+  for (int k = 0; k < skeleton_count_; ++k) {
+    if (!is_live(state, k) || refined(state, k) <= depth) continue;
+    const int child = problem_->action_at(k, depth);
+    if (std::find(children.begin(), children.end(), child) == children.end()) children.push_back(child);
+  }
+  std::sort(children.begin(), children.end());
+  return children;
+}
+
+int ConcurrentMdp::forced_start(const ConcurrentState& state) const noexcept {
+  if (robot_left(state) > 0) return -1;
+  const int depth = executed_depth(state);
+  int child = -1;
+  for (int k = 0; k < skeleton_count_; ++k) {
+    if (!is_live(state, k)) continue;
+    if (refined(state, k) <= depth) return -1;  // a live skeleton whose next execution is not refined yet
+    const int next = problem_->action_at(k, depth);
+    if (child >= 0 && next != child) return -1;
+    child = next;
+  }
+  return child;
+}
+
+ConcurrentMdp::StartOutcome ConcurrentMdp::start_action(const ConcurrentState& state, int action) const {
+  const std::vector<int> children = startable(state);
+  if (!std::binary_search(children.begin(), children.end(), action)) {
+    throw UsageError("action " + std::to_string(action) +
+                     " cannot be started now: the robot starts a refined action just after what it has executed, "
+                     "on a skeleton that can still finish, and only while it is idle");
+  }
+  StartOutcome outcome;
+  const std::uint16_t steps = execution(state, action);
+  const std::int64_t finish = std::int64_t{time(state)} + steps;
+  const int position = problem_->position(action);
+  for (const int k : problem_->members(action)) {
+    if (is_live(state, k) && problem_->skeleton_length(k) == position + 1) {
+      // The last action of k: its execution ends the episode (SPEC §10).
+      outcome.ends = true;
+      if (finish <= deadline_) {
+        outcome.reward = problem_->has_rewards() ? problem_->reward_at(k, static_cast<Steps>(finish)) : 1.0;
+      }
+      return outcome;
+    }
+  }
+  outcome.next = state;
+  outcome.next[1] = steps;
+  outcome.next[2] = static_cast<std::uint16_t>(action + 1);
+  canonicalise(outcome.next);
+  return outcome;
+}
+
+ChoiceList ConcurrentMdp::refine_choices(const ConcurrentState& state) const {
+  ChoiceList choices;
+  for (int k = 0; k < skeleton_count_; ++k) {
+    if (!is_live(state, k) || refined(state, k) >= problem_->skeleton_length(k)) continue;
+    const int action = problem_->action_at(k, refined(state, k));
+    bool first = true;
+    for (const int other : choices) {
+      if (problem_->action_at(other, refined(state, other)) == action) first = false;
+    }
+    if (first) choices.push_back(k);
+  }
+  return choices;
+}
+
+bool ConcurrentMdp::certain_success(const ConcurrentState& state) const noexcept {
+  if (problem_->has_rewards()) return false;
+  for (int k = 0; k < skeleton_count_; ++k) {
+    if (is_live(state, k) && refined(state, k) == problem_->skeleton_length(k)) return true;
+  }
+  return false;
+}
+
+void ConcurrentMdp::reject_choice(int choice) {
+  throw UsageError("skeleton " + std::to_string(choice) +
+                   " cannot be refined in this state: it is dropped (not through what the robot executed, or unable "
+                   "to finish by the deadline) or has nothing left to refine");
+}
+
+}  // namespace ontime
