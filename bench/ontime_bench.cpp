@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ontime/ontime.hpp"
@@ -169,6 +170,61 @@ void BM_DpRerunTables(benchmark::State& bench) {
   bench.SetLabel(problem.name());
 }
 BENCHMARK(BM_DpRerunTables)->DenseRange(1, 5)->Unit(benchmark::kMicrosecond);
+
+// dp-rerun's moves when the robot acts while planning (SPEC §10), in the states its own
+// `episodes` episodes visit (each drawn from the model's outcomes), cycled through.
+void BM_ConcurrentDpRerunDecision(benchmark::State& bench) {
+  const ontime::Problem problem = paper(static_cast<int>(bench.range(0)));
+  const ontime::ConcurrentMdp mdp(problem);
+  ontime::ConcurrentDpRerunPolicy policy(mdp);
+  std::vector<ontime::ConcurrentState> states;
+  ontime::SplitMix64 generator(9);
+  std::vector<std::pair<double, ontime::ConcurrentState>> outcomes;
+  for (int episode = 0; episode < 2000; ++episode) {
+    ontime::ConcurrentState state = mdp.start();
+    while (mdp.any_live(state)) {
+      states.push_back(state);
+      const ontime::ConcurrentMdp::Move move = policy.choose(state);
+      if (move.is_start()) {
+        ontime::ConcurrentMdp::StartOutcome started = mdp.start_action(state, move.start);
+        if (started.ends) break;
+        state = std::move(started.next);
+        continue;
+      }
+      if (ontime::ConcurrentMdp::time(state) >= mdp.deadline()) break;
+      outcomes.clear();
+      mdp.for_each_step_outcome(state, move.refine, [&](double probability, const ontime::ConcurrentState& next) {
+        outcomes.emplace_back(probability, next);
+      });
+      state = outcomes[ontime::sample_index(
+                           outcomes.size(), [&](std::size_t i) { return outcomes[i].first; }, generator)]
+                  .second;
+    }
+  }
+  std::size_t next = 0;
+  for (auto _ : bench) {
+    benchmark::DoNotOptimize(policy.choose(states[next]));
+    next = next + 1 == states.size() ? 0 : next + 1;
+  }
+  bench.counters["states"] = static_cast<double>(states.size());
+  bench.SetLabel(problem.name());
+}
+BENCHMARK(BM_ConcurrentDpRerunDecision)->DenseRange(1, 5);
+
+// The exact optimum of acting while planning (SPEC §10) by the memoised solver of its MDP.
+void BM_ConcurrentSolve(benchmark::State& bench) {
+  const ontime::Problem problem = paper(static_cast<int>(bench.range(0)));
+  const ontime::ConcurrentMdp mdp(problem);
+  std::size_t states = 0;
+  for (auto _ : bench) {
+    ontime::ConcurrentSolver solver(mdp);
+    benchmark::DoNotOptimize(solver.solve(mdp.start()));
+    states = solver.states();
+  }
+  bench.counters["states"] = static_cast<double>(states);
+  bench.SetLabel(problem.name());
+}
+BENCHMARK(BM_ConcurrentSolve)->DenseRange(0, 5)->Unit(benchmark::kMicrosecond);
 
 void BM_OptimalSolve(benchmark::State& bench) {
   const ontime::Problem problem = paper(static_cast<int>(bench.range(0)));

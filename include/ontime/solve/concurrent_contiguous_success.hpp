@@ -20,9 +20,8 @@
 // over the execution support. No table is built up front, so a long deadline costs only what
 // its queries reach.
 
-#include <absl/container/flat_hash_map.h>
-
 #include <cstdint>
+#include <unordered_map>
 
 #include "ontime/mdp/concurrent_mdp.hpp"
 #include "ontime/solve/contiguous_success.hpp"
@@ -50,7 +49,7 @@ class ConcurrentContiguousSuccess {
   const ConcurrentMdp* mdp_;
   Aggregation aggregation_;
   Steps deadline_;
-  absl::flat_hash_map<std::uint64_t, double> fresh_;  // (k, l, T, w) packed
+  std::unordered_map<std::uint64_t, double> fresh_;  // (k, l, T, w) packed
 };
 
 }  // namespace ontime
