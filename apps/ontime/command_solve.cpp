@@ -63,6 +63,8 @@ void run_memoised(const SolveOptions& options, const Problem& problem, const Mdp
 // Acting while planning (SPEC §10): the memoised solver of its MDP.
 void run_concurrent(const SolveOptions& options, const Problem& problem) {
   const std::size_t max_states = options.max_states != 0 ? options.max_states : ConcurrentSolver::kDefaultMaxStates;
+  // The exact solvers' limits (skeletons) hold in this mode too.
+  check_exact_work(problem, 1, options.instance, flag_spelling());
   const ConcurrentMdp mdp(problem);
   check_memory_for(flag_spelling()("max-states"), ConcurrentSolver::max_bytes(problem, max_states));
   const auto started = std::chrono::steady_clock::now();

@@ -93,6 +93,7 @@ void bind_solve(py::module_& m) {
                 "tolerance, max_memory_mib, max_disk_mib, scratch, policy and gap are for the layered solver and the "
                 "search, which do not solve acting while planning (act='concurrent', SPEC §10) yet");
           }
+          check_exact_work(*chosen, 1, instance_label(problem, *chosen), python_spelling());
           check_memory_for("max_states", ConcurrentSolver::max_bytes(*chosen, max_states));
           report::ConcurrentSolve solve{.instance = instance_label(problem, *chosen), .problem = chosen.get()};
           const ConcurrentMdp concurrent(*chosen);

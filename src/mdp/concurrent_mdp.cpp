@@ -1,6 +1,7 @@
 #include "ontime/mdp/concurrent_mdp.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <string>
 
 namespace ontime {
@@ -183,15 +184,17 @@ ConcurrentMdp::StartOutcome ConcurrentMdp::start_action(const ConcurrentState& s
 }
 
 ChoiceList ConcurrentMdp::refine_choices(const ConcurrentState& state) const {
+  // One choice per next action, marked as met in a scratch array (per thread, sized once), so
+  // that a wide problem costs O(K), not O(K^2).
+  thread_local std::vector<std::uint8_t> met;
+  met.assign(static_cast<std::size_t>(action_count_), 0);
   ChoiceList choices;
   for (int k = 0; k < skeleton_count_; ++k) {
     if (!is_live(state, k) || refined(state, k) >= problem_->skeleton_length(k)) continue;
-    const int action = problem_->action_at(k, refined(state, k));
-    bool first = true;
-    for (const int other : choices) {
-      if (problem_->action_at(other, refined(state, other)) == action) first = false;
-    }
-    if (first) choices.push_back(k);
+    const auto action = static_cast<std::size_t>(problem_->action_at(k, refined(state, k)));
+    if (met[action] != 0) continue;
+    met[action] = 1;
+    choices.push_back(k);
   }
   return choices;
 }
