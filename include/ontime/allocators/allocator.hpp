@@ -30,6 +30,7 @@ class Allocator {
  public:
   virtual ~Allocator() = default;
 
+  // The kind's name, as the registry and the command line spell it: "dp-rerun", "round-robin".
   virtual std::string_view name() const noexcept = 0;
 
   // Starts a new episode from the start state; `seed` seeds any randomness of the episode.

@@ -44,9 +44,11 @@ enum class Capability : std::uint32_t {
 class Capabilities {
  public:
   constexpr Capabilities() noexcept = default;
+  // The set of the capabilities listed.
   constexpr Capabilities(std::initializer_list<Capability> list) noexcept {
     for (const Capability capability : list) bits_ |= static_cast<std::uint32_t>(capability);
   }
+  // Whether `capability` is in the set.
   constexpr bool has(Capability capability) const noexcept {
     return (bits_ & static_cast<std::uint32_t>(capability)) != 0;
   }
@@ -57,9 +59,11 @@ class Capabilities {
   std::uint32_t bits_ = 0;
 };
 
+// The capability's name: "stationary", "needs-policy", ... (as Capabilities::names spells it).
 std::string_view to_string(Capability capability) noexcept;
 
 enum class ParameterType { integer, real, text, choice, path };
+// The type's name: "integer", "real", "text", "choice" or "path".
 std::string_view to_string(ParameterType type) noexcept;
 
 struct Parameter {
@@ -98,9 +102,13 @@ struct Parameter {
 class ParameterValues {
  public:
   ParameterValues() = default;
+  // The values given as {name, value} pairs.
   ParameterValues(std::initializer_list<std::pair<const std::string, std::string>> values) : values_(values) {}
+  // Sets (or replaces) the value of parameter `name`.
   void set(std::string name, std::string value) { values_[std::move(name)] = std::move(value); }
+  // The value given for `name`, or null when none was.
   const std::string* find(std::string_view name) const;
+  // Every value given, by name.
   const std::map<std::string, std::string, std::less<>>& all() const noexcept { return values_; }
 
  private:
@@ -112,6 +120,7 @@ struct AllocatorKind;
 // A kind's view of the values: checked, defaults filled in.
 class ParameterReader {
  public:
+  // Reads `values` as `kind` declares its parameters; both must outlive the reader.
   ParameterReader(const AllocatorKind& kind, const ParameterValues& values) : kind_(&kind), values_(&values) {}
   // Whether the value was given (not defaulted).
   bool given(std::string_view name) const;
@@ -171,6 +180,7 @@ struct AllocatorKind {
   std::function<AllocatorFactory(const Mdp& mdp, const ParameterReader& parameters)> make;
   AllocatorNeeds needs = {};
 
+  // Whether the kind lists `counter` among the counters it reports (needs.counters).
   bool declares_counter(std::string_view counter) const;
 };
 

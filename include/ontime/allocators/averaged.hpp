@@ -44,6 +44,7 @@ struct AveragedPlan {
 
 class AveragedAllocator final : public Allocator {
  public:
+  // Follows the optimum of `plan`, shared with the other allocators of its factory.
   explicit AveragedAllocator(std::shared_ptr<const AveragedPlan> plan);
 
   std::string_view name() const noexcept override { return "averaged"; }

@@ -37,9 +37,13 @@ class DecisionBudget {
   // About 31 years: longer times cannot end a search first.
   static constexpr double kUnlimitedSeconds = 1e9;
 
+  // Whether any limit or stop condition is set (else the allocator's default budget applies).
   bool is_set() const noexcept { return iterations_ || seconds_ || stop_; }
+  // The iteration limit, if any.
   std::optional<std::uint64_t> max_iterations() const noexcept { return iterations_; }
+  // The wall-clock limit in seconds, if any (kUnlimitedSeconds or more never ends first).
   std::optional<double> max_seconds() const noexcept { return seconds_; }
+  // The stop condition, or an empty function when there is none.
   const std::function<bool()>& stop_condition() const noexcept { return stop_; }
 
  private:
@@ -52,6 +56,7 @@ class DecisionBudget {
 // on its own (the allocator passes its default budget instead).
 class BudgetMonitor {
  public:
+  // Starts the clock of a time budget now: the decision's seconds count from here.
   explicit BudgetMonitor(const DecisionBudget& budget) noexcept;
 
   // True once `iterations_done` (>= 1) iterations exhaust the budget. Reads the clock only

@@ -15,12 +15,15 @@ namespace ontime {
 
 class DpAllocator final : public Allocator {
  public:
+  // Builds the ContiguousSuccessTable of `mdp` and picks the skeleton with the largest PS.
   explicit DpAllocator(const Mdp& mdp);
+  // Refines `chosen_skeleton`, picked before (the factory picks once for all its allocators).
   explicit DpAllocator(int chosen_skeleton) noexcept : chosen_(chosen_skeleton) {}
 
   std::string_view name() const noexcept override { return "dp"; }
   int choose(const State&) override { return chosen_; }
 
+  // The skeleton refined for the whole episode.
   int chosen_skeleton() const noexcept { return chosen_; }
 
  private:

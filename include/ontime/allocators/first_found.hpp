@@ -34,6 +34,7 @@ class FirstFoundAllocator final : public Allocator {
   std::string_view name() const noexcept override { return "first-found"; }
   int choose(const State& state) override;
 
+  // The budget of the first round, in steps per action per attempt.
   std::uint64_t budget() const noexcept { return budget_; }
 
  private:

@@ -13,11 +13,13 @@ namespace ontime {
 
 class GreedyAllocator final : public Allocator {
  public:
+  // Picks the skeleton with the smallest sum of mean planning and execution times in `mdp`.
   explicit GreedyAllocator(const Mdp& mdp);
 
   std::string_view name() const noexcept override { return "greedy"; }
   int choose(const State&) override { return chosen_; }
 
+  // The skeleton refined for the whole episode.
   int chosen_skeleton() const noexcept { return chosen_; }
 
  private:

@@ -21,6 +21,7 @@
 
 namespace ontime {
 
+// Whether the state alone rules skeleton k out, as above.
 inline bool known_dead(const Mdp& mdp, const State& state, int k) noexcept {
   if (mdp.next_action(state, k) < 0) return true;
   return std::int64_t{state.time} + 1 + state.execution[static_cast<std::size_t>(k)] > mdp.deadline();

@@ -100,8 +100,11 @@ class MctsAllocator final : public Allocator {
     std::uint32_t visits;
     double value;
   };
+  // One entry per choice at the root of the last search, in tree order; empty before any search.
   std::vector<RootChoice> root_choices() const;
+  // The decision and chance nodes the tree holds now.
   std::size_t tree_nodes() const noexcept { return nodes_.size() + edges_.size(); }
+  // The bytes the tree's storage holds now (capacities, not sizes): what `max_tree_bytes` caps.
   std::size_t tree_bytes() const noexcept;
 
  private:

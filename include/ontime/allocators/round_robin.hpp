@@ -9,6 +9,7 @@ namespace ontime {
 
 class RoundRobinAllocator final : public Allocator {
  public:
+  // Cycles over `skeleton_count` skeletons (K >= 1).
   explicit RoundRobinAllocator(int skeleton_count) noexcept : skeleton_count_(skeleton_count) {}
 
   std::string_view name() const noexcept override { return "round-robin"; }

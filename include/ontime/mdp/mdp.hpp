@@ -36,6 +36,7 @@ namespace ontime {
 // a longer list (wide problems only) moves to the heap.
 class ChoiceList {
  public:
+  // Appends skeleton index `choice` (below 65536), moving the list to the heap past kInlineSkeletons.
   void push_back(int choice) {
     if (size_ < inline_.size()) {
       inline_[size_] = static_cast<std::uint16_t>(choice);
@@ -45,10 +46,15 @@ class ChoiceList {
     }
     ++size_;
   }
+  // The i-th skeleton index; i must be below size().
   int operator[](std::size_t i) const noexcept { return begin()[i]; }
+  // How many choices the list holds.
   std::size_t size() const noexcept { return size_; }
+  // Whether the list holds no choice.
   bool empty() const noexcept { return size_ == 0; }
+  // The first choice, inline or on the heap; valid until the next push_back.
   const std::uint16_t* begin() const noexcept { return size_ > inline_.size() ? heap_.data() : inline_.data(); }
+  // One past the last choice.
   const std::uint16_t* end() const noexcept { return begin() + size_; }
 
  private:
@@ -65,9 +71,13 @@ struct Observation {
   // motion and everything refined after it are discarded; -1: no backtrack. Never with `refined`.
   int culprit = -1;
 
+  // The step ended with no motion found and no backtrack.
   static constexpr Observation not_yet() noexcept { return {}; }
+  // A motion was found, to execute in `execution_steps` steps (may be kNever).
   static constexpr Observation found(Steps execution_steps) noexcept { return {true, execution_steps, -1}; }
+  // The attempt gave up and blames the action at index `culprit_action`.
   static constexpr Observation backtracked(int culprit_action) noexcept { return {false, 0, culprit_action}; }
+  // Whether the attempt backtracked (a culprit is named).
   bool is_backtrack() const noexcept { return culprit >= 0; }
   // Exogenous chains (SPEC §9): the chains' joint state after the step (Mdp::joint_chain_state);
   // ignored without chains.
@@ -110,10 +120,14 @@ class Mdp {
   // SPEC §10): that is ConcurrentMdp's model (ontime/mdp/concurrent_mdp.hpp).
   explicit Mdp(const Problem& problem);
 
+  // The problem the MDP models (it must outlive the Mdp).
   const Problem& problem() const noexcept { return *problem_; }
+  // The number of skeletons, K.
   int skeleton_count() const noexcept { return skeleton_count_; }
+  // The deadline D in steps.
   Steps deadline() const noexcept { return deadline_; }
 
+  // The initial state: time 0, nothing refined or spent, the chains in their start states.
   State start() const {
     State state(static_cast<std::size_t>(skeleton_count_),
                 static_cast<std::size_t>(problem_->culprit_slot_count() + problem_->timed_slot_count()));
@@ -142,6 +156,7 @@ class Mdp {
     std::uint16_t next;
     double probability;
   };
+  // Every joint state the chains may move to from `joint` in one step (probabilities summing to 1).
   std::span<const ChainStep> chain_steps(std::uint16_t joint) const noexcept {
     return {chain_steps_.data() + chain_step_offsets_[joint], chain_steps_.data() + chain_step_offsets_[joint + 1U]};
   }

@@ -35,6 +35,7 @@ inline constexpr int kMaxExactSkeletons = kInlineSkeletons;
 template <class T>
 class PerSkeleton {
  public:
+  // Room for kInlineSkeletons skeletons, inline, every value zero.
   PerSkeleton() noexcept : data_(inline_.data()) {}
   // Zero values for `count` skeletons.
   explicit PerSkeleton(std::size_t count) : PerSkeleton() {
@@ -78,15 +79,19 @@ class PerSkeleton {
   }
   ~PerSkeleton() = default;
 
+  // Skeleton k's value; k must be below capacity().
   T& operator[](std::size_t k) noexcept {
     assert(k < capacity());
     return data_[k];
   }
+  // Skeleton k's value; k must be below capacity().
   const T& operator[](std::size_t k) const noexcept {
     assert(k < capacity());
     return data_[k];
   }
+  // The first value; capacity() values follow.
   T* data() noexcept { return data_; }
+  // The first value; capacity() values follow.
   const T* data() const noexcept { return data_; }
   // Skeletons this object has room for.
   std::size_t capacity() const noexcept { return heap_ ? heap_count_ : inline_.size(); }

@@ -38,9 +38,11 @@ class Distribution {
   // cumulative[t] is P(T <= t). Throws UsageError when it decreases or leaves [0, 1].
   static Distribution from_cdf(const std::vector<double>& cumulative);
 
+  // P(T = t); 0 outside the listed steps (the "never" mass is never()).
   double pmf(Steps t) const noexcept;
   double cdf(Steps t) const noexcept;       // P(T <= t)
   double survival(Steps t) const noexcept;  // P(T > t), "never" included
+  // The "never" mass, 1 minus the listed steps' mass.
   double never() const noexcept { return never_; }
 
   // P(T = spent + 1 | T > spent): the chance that one more step finishes, after `spent`
@@ -62,6 +64,7 @@ class Distribution {
   Steps quantile(double u) const noexcept;
 
   template <class Generator>
+  // A step drawn from the distribution with `generator`: quantile of a uniform draw, or kNever.
   Steps sample(Generator& generator) const {
     return quantile(uniform01(generator));
   }

@@ -28,6 +28,7 @@ struct ExogenousChain {
   int start = 0;  // index into states
   std::vector<std::vector<double>> transitions;
 
+  // The number of states of the chain.
   int state_count() const noexcept { return static_cast<int>(states.size()); }
   // The index of the state named `state`, or -1.
   int state_index(std::string_view state) const noexcept;
@@ -45,6 +46,7 @@ struct ChainFault {
   std::string place;
   std::string rule;
 };
+// The first rule `chain` breaks, or nullopt when it is valid.
 std::optional<ChainFault> find_chain_fault(const ExogenousChain& chain);
 
 // Reads a chain file; InputError naming the file, the place and the rule (another format or

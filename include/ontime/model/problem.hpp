@@ -82,15 +82,20 @@ struct Action {
 // instance files map it to its JSON place.
 class ChainRuleError : public UsageError {
  public:
+  // Message "chain 'c': rule", or "action 'a', field: rule" when `action` is not empty.
   ChainRuleError(std::string chain, std::string action, std::string field, const std::string& rule)
       : UsageError((action.empty() ? "chain '" + chain + "'" : "action '" + action + "', " + field) + ": " + rule),
         chain_(std::move(chain)),
         action_(std::move(action)),
         field_(std::move(field)),
         rule_(rule) {}
+  // The chain named (empty when the rule is an action's).
   const std::string& chain() const noexcept { return chain_; }
-  const std::string& action() const noexcept { return action_; }  // empty: the rule is the chain's
+  // The action's id; empty: the rule is the chain's.
+  const std::string& action() const noexcept { return action_; }
+  // The action's field the rule is about ("execution", "expires"); empty for a chain's rule.
   const std::string& field() const noexcept { return field_; }
+  // The rule broken, as text.
   const std::string& rule() const noexcept { return rule_; }
 
  private:
@@ -116,9 +121,12 @@ struct SkeletonReward {
 // A UsageError like the other rules; instance files map it to its JSON place.
 class RewardError : public UsageError {
  public:
+  // Message "skeleton k's reward: rule".
   RewardError(int skeleton, const std::string& rule)
       : UsageError("skeleton " + std::to_string(skeleton) + "'s reward: " + rule), skeleton_(skeleton), rule_(rule) {}
+  // The index of the skeleton whose reward breaks the rule.
   int skeleton() const noexcept { return skeleton_; }
+  // The rule broken, as text.
   const std::string& rule() const noexcept { return rule_; }
 
  private:
@@ -131,13 +139,17 @@ class RewardError : public UsageError {
 // so that code building problems catches it as any; instance files map it to its JSON place.
 class BacktrackingError : public UsageError {
  public:
+  // Message "action 'a', culprit 'c': rule" (without the culprit when it is empty).
   BacktrackingError(std::string action, std::string culprit, const std::string& rule)
       : UsageError("action '" + action + "'" + (culprit.empty() ? "" : ", culprit '" + culprit + "'") + ": " + rule),
         action_(std::move(action)),
         culprit_(std::move(culprit)),
         rule_(rule) {}
+  // The id of the action whose backtracking breaks the rule.
   const std::string& action() const noexcept { return action_; }
+  // The id of the culprit named; empty when the rule is about the backtrack distribution.
   const std::string& culprit() const noexcept { return culprit_; }
+  // The rule broken, as text.
   const std::string& rule() const noexcept { return rule_; }
 
  private:
@@ -164,19 +176,29 @@ class Problem {
           std::vector<std::vector<int>> skeletons, std::string description = {},
           std::vector<SkeletonReward> rewards = {}, std::vector<ExogenousChain> chains = {});
 
+  // The instance's name.
   const std::string& name() const noexcept { return name_; }
+  // Free text about the instance; may be empty.
   const std::string& description() const noexcept { return description_; }
+  // The deadline D in steps, 1 to kMaxDeadline.
   Steps deadline() const noexcept { return deadline_; }
+  // The duration of one step in seconds.
   double step_seconds() const noexcept { return step_seconds_; }
 
+  // Every action, indexed as the skeletons index them.
   std::span<const Action> actions() const noexcept { return actions_; }
+  // The action at `index`; throws std::out_of_range outside [0, action_count()).
   const Action& action(int index) const { return actions_.at(static_cast<std::size_t>(index)); }
+  // How many actions, used by skeletons or not.
   int action_count() const noexcept { return static_cast<int>(actions_.size()); }
   // Index of the action with this id, or -1.
   int find_action(std::string_view id) const noexcept;
 
+  // How many skeletons, K.
   int skeleton_count() const noexcept { return static_cast<int>(skeletons_.size()); }
+  // Skeleton k as action indices, first to last; throws std::out_of_range outside [0, K).
   std::span<const int> skeleton(int k) const { return skeletons_.at(static_cast<std::size_t>(k)); }
+  // The number of actions of skeleton k, l_k.
   int skeleton_length(int k) const { return static_cast<int>(skeleton(k).size()); }
   // The action at position l (0-based) of skeleton k.
   int action_at(int k, int l) const { return skeleton(k)[static_cast<std::size_t>(l)]; }
@@ -225,11 +247,15 @@ class Problem {
     int action;
     double probability;
   };
+  // Whether some action may backtrack (some action is a culprit).
   bool has_backtracking() const noexcept { return culprit_slots_ > 0; }
+  // The culprits `action` blames when it backtracks; empty when it never does.
   std::span<const CulpritIndex> culprits(int action) const {
     return culprit_indices_.at(static_cast<std::size_t>(action));
   }
+  // The slot of `action` in State::restore, or -1 when it is no action's culprit.
   int culprit_slot(int action) const { return culprit_slot_.at(static_cast<std::size_t>(action)); }
+  // How many culprit slots (actions some action blames).
   int culprit_slot_count() const noexcept { return culprit_slots_; }
 
   // The skeletons as lists of action indices (a copy, e.g. to build a changed problem).
@@ -299,6 +325,7 @@ struct AttemptEnd {
   Steps step = kNever;
   bool found = false;  // a motion; else the attempt backtracked
 };
+// The end of one attempt at `action` as above, for the uniform draw `u` in [0, 1).
 AttemptEnd draw_attempt_end(const Action& action, double u, Steps spent = 0, Steps last = kNever);
 
 // The earlier action an attempt at `action` that backtracks blames, drawn with the culprits'

@@ -40,14 +40,17 @@ enum class Aggregation {
   self,  // only k' = k: each skeleton on its own (used by `dp`)
 };
 
+// The aggregation's name: "sum", "max" or "self".
 std::string_view to_string(Aggregation aggregation) noexcept;
 // Parses "sum", "max" or "self"; throws UsageError otherwise.
 Aggregation parse_aggregation(std::string_view text);
 
 class ContiguousSuccessTable {
  public:
+  // Builds the tables for `mdp` (which must outlive it). Throws UsageError with chains or expiry.
   ContiguousSuccessTable(const Mdp& mdp, Aggregation aggregation);
 
+  // How the tables combine sharing skeletons.
   Aggregation aggregation() const noexcept { return aggregation_; }
 
   // PS(k, l, CT, ET) with `spent` steps already on action l of k and used = CT + ET.

@@ -37,11 +37,15 @@ class OptimalSolver {
   static constexpr double kTieTolerance = 1e-12;
   static constexpr std::size_t kDefaultMaxStates = 10'000'000;
 
+  // Solves nothing yet; the Mdp must outlive the solver, which holds at most `max_states` states.
   explicit OptimalSolver(const Mdp& mdp, std::size_t max_states = kDefaultMaxStates);
+  // Frees the memoised states.
   ~OptimalSolver();
   OptimalSolver(const OptimalSolver&) = delete;
   OptimalSolver& operator=(const OptimalSolver&) = delete;
+  // Takes over the other solver's states; the other may then only be destroyed or assigned.
   OptimalSolver(OptimalSolver&&) noexcept;
+  // Takes over the other solver's states, freeing this one's.
   OptimalSolver& operator=(OptimalSolver&&) noexcept;
 
   // V*(state) for a running state; solves every state reachable from it that is not yet
