@@ -75,9 +75,13 @@ class BoostedTimeModel final : public ConditionalTimeModel {
   // XGBoost's boosters (never, planning, execution), opaque outside the library.
   struct Boosters;
 
+  // The kind's name in model files and options: "boosted".
   static const std::string& kind_name();
+  // A model from its parts: what fit computes, or the model file's reader reads back. `rows` and `worlds`
+  // count the training data's rows and worlds.
   BoostedTimeModel(std::vector<std::string> feature_names, double step_seconds, Steps horizon, std::size_t rows,
                    std::size_t worlds, BoostedParameters parameters, std::unique_ptr<Boosters> boosters);
+  // Frees the boosters (defined where XGBoost's handles are known).
   ~BoostedTimeModel() override;
   BoostedTimeModel(const BoostedTimeModel&) = delete;
   BoostedTimeModel& operator=(const BoostedTimeModel&) = delete;
@@ -87,7 +91,9 @@ class BoostedTimeModel final : public ConditionalTimeModel {
   static std::unique_ptr<BoostedTimeModel> fit(const ConditionalData& data, std::vector<std::string> feature_names,
                                                Steps horizon, const BoostedSettings& settings);
 
+  // The kind, kind_name(): "boosted".
   const std::string& kind() const noexcept override { return kind_name(); }
+  // The fit's settings, the planning unit u, the execution's sigma and the fit's log-likelihood.
   const BoostedParameters& parameters() const noexcept { return parameters_; }
 
  private:

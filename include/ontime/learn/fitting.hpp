@@ -66,7 +66,10 @@ struct AttemptEstimate {
   Distribution backtrack;         // all "never" without backtracks
   std::vector<Culprit> culprits;  // empty without backtracks
 };
+// The estimators of planning and backtracking described above (estimate_planning's result and errors without
+// backtracks); UsageError also for a backtracked attempt that names no blamed action.
 AttemptEstimate estimate_attempts(const PlanningSample& sample, Steps deadline, double laplace = 0);
+// The execution estimator described above; UsageError as estimate_planning, or for a negative time.
 Distribution estimate_execution(std::span<const Steps> execution_steps, Steps deadline, double laplace = 0);
 
 struct FitOptions {

@@ -43,13 +43,20 @@ struct HazardParameters {
 
 class HazardTimeModel final : public ConditionalTimeModel {
  public:
+  // The kind's name in model files and options: "hazard".
   static const std::string& kind_name();
+  // A model from its parts: what fit computes, or the model file's reader reads back. `rows` and `worlds`
+  // count the training data's rows and worlds.
   HazardTimeModel(std::vector<std::string> feature_names, double step_seconds, Steps horizon, std::size_t rows,
                   std::size_t worlds, HazardParameters parameters);
+  // Fits `data` as above, with the ridge penalty `ridge` (>= 0) and `bins` baseline levels over 1..horizon,
+  // log-spaced (0: one per step; at most the horizon); the caller (fit_conditional_model) checks both.
   static std::unique_ptr<HazardTimeModel> fit(const ConditionalData& data, std::vector<std::string> feature_names,
                                               Steps horizon, double ridge, int bins);
 
+  // The kind, kind_name(): "hazard".
   const std::string& kind() const noexcept override { return kind_name(); }
+  // The fitted weights, standardisation and bins, and the fit's summary.
   const HazardParameters& parameters() const noexcept { return parameters_; }
 
  private:

@@ -60,7 +60,9 @@ class OnlineBelief {
   // The planning distribution believed for the action `id` names (UsageError if unknown).
   Distribution planning(std::string_view id) const;
 
+  // The prior instance, as given.
   const Problem& prior() const noexcept { return prior_; }
+  // The prior's worth in attempts, for every action.
   double strength() const noexcept { return strength_; }
   // Attempts observed so far (those with effort).
   std::size_t observations() const noexcept { return observations_; }

@@ -41,8 +41,11 @@ class PlanningPosterior {
   double predictive_found(Steps t) const;
   double predictive_cut_off(Steps c) const;
 
+  // H: the last step of the posterior; later steps are "never".
   Steps horizon() const noexcept { return static_cast<Steps>(alpha_.size()) - 1; }
+  // s: the prior's worth in attempts.
   double strength() const noexcept { return strength_; }
+  // Attempts observed so far, found or cut off.
   std::size_t observations() const noexcept { return observations_; }
 
  private:

@@ -16,14 +16,21 @@ namespace ontime {
 
 class PooledTimeModel final : public ConditionalTimeModel {
  public:
+  // The kind's name in model files and options: "pooled".
   static const std::string& kind_name();
+  // A model from its parts: what fit computes, or the model file's reader reads back. `rows` and `worlds`
+  // count the training data's rows and worlds.
   PooledTimeModel(std::vector<std::string> feature_names, double step_seconds, Steps horizon, std::size_t rows,
                   std::size_t worlds, Distribution planning, Distribution execution);
+  // Fits `data` as above, over steps 1..horizon.
   static std::unique_ptr<PooledTimeModel> fit(const ConditionalData& data, std::vector<std::string> feature_names,
                                               Steps horizon);
 
+  // The kind, kind_name(): "pooled".
   const std::string& kind() const noexcept override { return kind_name(); }
+  // The planning distribution every prediction returns.
   const Distribution& planning() const noexcept { return planning_; }
+  // The execution distribution every prediction returns.
   const Distribution& execution() const noexcept { return execution_; }
 
  private:

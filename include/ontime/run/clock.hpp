@@ -44,6 +44,7 @@ class SteadyClock final : public Clock {
 // A clock that stands still until advanced.
 class ManualClock final : public Clock {
  public:
+  // A clock that reads `start` seconds until advanced.
   explicit ManualClock(double start = 0.0) noexcept : now_(start) {}
   double now() const override { return now_; }
   // Throws UsageError for a negative or non-finite step (time never runs backwards).

@@ -35,6 +35,7 @@ namespace ontime {
 class DecisionTimer {
  public:
   virtual ~DecisionTimer() = default;
+  // Called once per decision, with its duration.
   virtual void record(std::int64_t nanoseconds) = 0;
 };
 
@@ -140,7 +141,9 @@ struct LatencySummary {
 // 1/128 (0.8%) of the true sample value. Histograms of several threads merge exactly.
 class LatencyHistogram {
  public:
+  // Adds one duration; a negative one counts as 0.
   void add(std::int64_t nanoseconds) noexcept;
+  // Adds every duration of `other`, as if each had been added here.
   void merge(const LatencyHistogram& other) noexcept;
   // The quantile of rank round(q (n - 1)) of the n durations added, as LatencySummary's.
   LatencySummary summary() const;

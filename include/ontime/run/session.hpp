@@ -218,9 +218,13 @@ class Session {
   // Whether some skeleton can still succeed from the current state.
   bool can_succeed() const { return mdp_->any_can_succeed(state_); }
 
+  // Where the episode stands: running, then success or failure once it has ended.
   Status status() const noexcept { return status_; }
+  // The current MDP state (for a live session, derived from the seconds gone).
   const State& state() const noexcept { return state_; }
+  // The MDP the session steps through.
   const Mdp& mdp() const noexcept { return *mdp_; }
+  // The MDP's problem.
   const Problem& problem() const noexcept { return mdp_->problem(); }
   // The skeleton to execute after success, -1 before.
   int solution() const noexcept { return solution_; }
@@ -238,6 +242,7 @@ class Session {
   // The same, moved out (the episode runner's result takes it when the session is done).
   std::vector<ActionAttempt> take_attempts() noexcept { return std::move(attempts_); }
 
+  // Whether the session runs on a Clock's seconds (made with one) rather than on steps.
   bool is_live() const noexcept { return clock_ != nullptr; }
   // Whether an allocator decides (choose()) rather than the caller (decide()).
   bool has_allocator() const noexcept { return allocator_ != nullptr; }

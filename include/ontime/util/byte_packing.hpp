@@ -19,22 +19,27 @@ namespace ontime {
 
 class BytePacker {
  public:
+  // Appends the bytes of `value` as they are in memory.
   template <class T>
   void put(const T& value) {
     static_assert(std::is_trivially_copyable_v<T>);
     bytes_.append(reinterpret_cast<const char*>(&value), sizeof(T));
   }
+  // Appends the length of `text` (8 bytes) and its characters.
   void put_string(std::string_view text) {
     put<std::uint64_t>(text.size());
     bytes_.append(text);
   }
+  // Appends the number of values (8 bytes) and their bytes as they are in memory.
   template <class T>
   void put_vector(const std::vector<T>& values) {
     static_assert(std::is_trivially_copyable_v<T>);
     put<std::uint64_t>(values.size());
     bytes_.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
   }
+  // The bytes written so far.
   const std::string& bytes() const noexcept { return bytes_; }
+  // The bytes written, moved out; the packer is left empty.
   std::string take() noexcept { return std::move(bytes_); }
 
  private:
@@ -45,7 +50,9 @@ class BytePacker {
 // (which only a bug can cause: the packer and the reader are one build).
 class ByteUnpacker {
  public:
+  // Reads `bytes`, which must outlive the unpacker.
   explicit ByteUnpacker(std::string_view bytes) noexcept : bytes_(bytes) {}
+  // The next value, written by put<T>.
   template <class T>
   T get() {
     static_assert(std::is_trivially_copyable_v<T>);
@@ -53,11 +60,13 @@ class ByteUnpacker {
     std::memcpy(&value, take(sizeof(T)), sizeof(T));
     return value;
   }
+  // The next string, written by put_string.
   std::string get_string() {
     const auto size = get<std::uint64_t>();
     const char* data = take(size);
     return std::string(data, size);
   }
+  // The next vector, written by put_vector<T>.
   template <class T>
   std::vector<T> get_vector() {
     static_assert(std::is_trivially_copyable_v<T>);
@@ -67,6 +76,7 @@ class ByteUnpacker {
     if (size > 0) std::memcpy(values.data(), take(size * sizeof(T)), size * sizeof(T));
     return values;
   }
+  // Whether every byte has been read.
   bool done() const noexcept { return bytes_.empty(); }
 
  private:

@@ -15,10 +15,14 @@ namespace ontime {
 // and the rule that was broken.
 class InputError : public std::runtime_error {
  public:
+  // Message "source: place: rule" (control bytes written `\u00XX`, so that it stays one line).
   InputError(std::string source, std::string place, std::string rule);
 
+  // Where the data came from, usually a file path.
   const std::string& source() const noexcept { return source_; }
+  // The place inside it: a JSON path or a line and column.
   const std::string& place() const noexcept { return place_; }
+  // The rule the data broke.
   const std::string& rule() const noexcept { return rule_; }
 
  private:

@@ -18,11 +18,15 @@ class SplitMix64 {
  public:
   using result_type = std::uint64_t;
 
+  // The generator whose state starts at `seed`; any value is a valid seed.
   explicit constexpr SplitMix64(std::uint64_t seed) noexcept : state_(seed) {}
 
+  // The smallest value a draw returns (UniformRandomBitGenerator).
   static constexpr result_type min() noexcept { return 0; }
+  // The largest value a draw returns: every 64-bit value may come.
   static constexpr result_type max() noexcept { return std::numeric_limits<result_type>::max(); }
 
+  // The next 64-bit draw; advances the state by one step.
   constexpr result_type operator()() noexcept {
     std::uint64_t z = (state_ += 0x9e3779b97f4a7c15ULL);
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;

@@ -41,9 +41,12 @@ struct RankUnits {
   std::uint64_t first = 0;
   std::uint64_t stride = 1;
   std::uint64_t count = 0;  // how many units the rank takes
+  // The rank's i-th unit (i < count): first + i * stride.
   std::uint64_t unit(std::uint64_t i) const noexcept { return first + i * stride; }
 };
+// The units of `count` that rank `rank` of `size` (>= 1) takes.
 RankUnits rank_units(std::uint64_t count, int rank, int size) noexcept;
+// The same for this process's rank of `ranks`; every unit for null (one process).
 inline RankUnits rank_units(std::uint64_t count, const Ranks* ranks) noexcept {
   return ranks == nullptr ? RankUnits{0, 1, count} : rank_units(count, ranks->rank(), ranks->size());
 }

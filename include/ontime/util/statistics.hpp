@@ -28,6 +28,7 @@ struct MeanInterval {
   double mean = 0;
   double ci95 = 0;
 };
+// The mean and half-width above from the sums (of sum_units); zeros for a count below 1.
 inline MeanInterval mean_interval_of_units(double units, double square_units, double count) {
   MeanInterval out;
   if (!(count >= 1)) return out;
@@ -54,8 +55,11 @@ class Statistics {
   // Adds every counter of `other` under its own rule.
   void merge(const Statistics& other);
 
+  // The value of counter `name`, or nullopt when it was never added.
   std::optional<double> find(std::string_view name) const noexcept;
+  // Every counter, in the order of first addition.
   const std::vector<Counter>& counters() const noexcept { return counters_; }
+  // Whether no counter was added.
   bool empty() const noexcept { return counters_.empty(); }
 
  private:
