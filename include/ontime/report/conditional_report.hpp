@@ -30,7 +30,9 @@ struct ScoreReport {
   AttemptScoreOptions options;
   AttemptScores scores;
 };
+// The JSON object of `ontime score --json`, with the members above.
 std::string attempt_scores_json(const ScoreReport& report);
+// The text of `ontime score`: the same for people.
 std::string attempt_scores_text(const ScoreReport& report);
 
 }  // namespace ontime::report

@@ -43,7 +43,10 @@ struct Evaluation {
   std::optional<RegretEstimate> regret = {};  // with_regret's estimate of V* - V^pi
   bool timing = true;                         // decision times and run time
 };
+// Its JSON (`ontime evaluate --json`): the solver and its parameters, the instance, the Monte Carlo result and
+// the exact value when computed.
 std::string to_json(const Evaluation& evaluation);
+// Its text (`ontime evaluate`): the same for people.
 std::string to_text(const Evaluation& evaluation);
 
 // The exact optimum or a certified interval (the layered solver), or the memoised solver's
@@ -62,7 +65,10 @@ struct Solve {
   bool timing = true;
   bool stats = false;  // states (and times) per layer
 };
+// Its JSON (`ontime solve --json`): the instance, the method, the optimum or its bounds, the first choice, and the
+// states per layer when `stats`.
 std::string to_json(const Solve& solve);
+// Its text (`ontime solve`): the same for people.
 std::string to_text(const Solve& solve);
 // The policy of the first layers (LayeredSolveOptions::policy_layers): one JSON line per state,
 // its choice and the bounds of its value.
@@ -104,7 +110,9 @@ struct Training {
   std::optional<double> exact = {};
   std::optional<double> exact_reward = {};  // the expected reward too, for an instance with rewards (SPEC §8)
 };
+// Its JSON (`ontime train --json`): the instance, the files written, the training's size and the exact value.
 std::string to_json(const Training& training);
+// Its text (`ontime train`): the same for people.
 std::string to_text(const Training& training);
 
 // A study (run/experiments.hpp) as the CSV that python/plot_study.py draws: compute-time, one

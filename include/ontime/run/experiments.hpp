@@ -49,6 +49,7 @@ struct ComputeTimeStudy {
   MonteCarloResult searcher;
   MonteCarloResult reference;
 };
+// Runs `settings.episodes` episodes of each allocator on `mdp`, the searcher within its default budget.
 ComputeTimeStudy compute_time_study(const Mdp& mdp, const StudySettings& settings);
 
 // Fig. 5: the searcher given exactly the reference's measured time per decision.
@@ -57,6 +58,8 @@ struct EqualTimeStudy {
   MonteCarloResult reference;
   MonteCarloResult searcher;
 };
+// Measures the reference's mean seconds per decision, then runs the episodes of each allocator, the searcher
+// within that time per decision.
 EqualTimeStudy equal_time_study(const Mdp& mdp, const StudySettings& settings);
 
 // Fig. 6: the searcher's success against log10 of a multiplier of the reference's time per
@@ -72,6 +75,8 @@ struct AnytimeStudy {
   MonteCarloResult reference;
   std::vector<AnytimePoint> points;
 };
+// The reference's time per decision, its episodes and the exact optimum, then the searcher's episodes at that
+// time times 10^m for each m of `log10_multipliers` (each within [-3, 9], else UsageError).
 AnytimeStudy anytime_study(const Mdp& mdp, const std::vector<double>& log10_multipliers, const StudySettings& settings);
 
 // A study over several instances: one of the three above on each, in order.

@@ -48,6 +48,7 @@ struct TreeAction {
   int parent = -1;
   bool fallback_start = false;
 };
+// The prefix tree of `skeletons` (action ids) as described above.
 std::vector<TreeAction> skeleton_tree(const std::vector<std::vector<std::string>>& skeletons);
 
 // Domain::every_action() as actions without parents: those that may start at the initial
@@ -95,6 +96,8 @@ struct CollectionResult {
 // or skeleton_tree(domain.skeletons()); UsageError when that is empty.
 std::vector<TreeAction> collection_actions(const Domain& domain, const CollectionOptions& options);
 
+// Runs the collection described at the top: `options.trials` attempts of each of collection_actions(domain,
+// options), logged in that order. UsageError as collection_actions, or when features cannot be recorded.
 CollectionResult collect(const Domain& domain, const CollectionOptions& options);
 
 // One refined motion per action of a skeleton, executed one after the other from the domain's

@@ -64,6 +64,7 @@ class CollectionJournal {
   CollectionJournal(const CollectionJournal&) = delete;
   CollectionJournal& operator=(const CollectionJournal&) = delete;
 
+  // The journal's path, as given (with ranks, rank r writes part_path(path(), r)).
   const std::filesystem::path& path() const noexcept { return path_; }
   // The trials read when the journal was opened.
   const std::vector<JournalTrial>& finished() const noexcept { return finished_; }

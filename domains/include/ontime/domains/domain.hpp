@@ -42,7 +42,9 @@ class Refinement {
   // stopped; once found or given up, it returns at once.
   virtual RefinementStatus advance(double limit_seconds) = 0;
 
+  // Where the attempt stands: working, found or backtrack (given up).
   virtual RefinementStatus status() const = 0;
+  // The effort the attempt has spent so far.
   virtual const EffortMeter& effort() const = 0;
 
   // Once found: the seconds the robot needs to execute the motion, the configuration it ends
@@ -91,6 +93,7 @@ class Domain {
  public:
   virtual ~Domain() = default;
 
+  // The domain's name: "navigation", "manipulation".
   virtual const std::string& name() const = 0;
   // Plan skeletons, as action ids; actions shared by a common prefix are refined once.
   virtual const std::vector<std::vector<std::string>>& skeletons() const = 0;

@@ -30,8 +30,10 @@ struct EffortSettings {
 // Counts the effort of one refinement. Not thread-safe: one meter per refinement.
 class EffortMeter {
  public:
+  // A meter at zero effort, counting in the unit of `settings`.
   explicit EffortMeter(EffortSettings settings) : settings_(settings) {}
 
+  // Counts one collision check.
   void count_check() noexcept { ++checks_; }
   // Work that is not a collision check but costs as much as `checks` of them (an IK solve).
   void count_checks(std::uint64_t checks) noexcept { checks_ += checks; }
@@ -48,6 +50,7 @@ class EffortMeter {
   // whole number of checks, so the comparison is exact.
   bool reached(double limit_seconds) const;
 
+  // The unit and the checker's nominal speed.
   const EffortSettings& settings() const noexcept { return settings_; }
 
  private:

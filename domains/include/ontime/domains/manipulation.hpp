@@ -45,6 +45,7 @@ struct KitchenState {
 
 class ManipulationDomain final : public Domain {
  public:
+  // The domain of `world`, a world file already read and checked.
   explicit ManipulationDomain(ManipulationWorld world);
 
   const std::string& name() const override { return name_; }
@@ -67,6 +68,7 @@ class ManipulationDomain final : public Domain {
   const std::vector<std::string>& feature_names() const override;
   std::vector<double> action_features(const std::string& action) const override;
 
+  // The world the domain refines in.
   const ManipulationWorld& world() const noexcept { return world_; }
 
   // Configuration <-> state: [x, y, theta, 7 arm joints, held, then x, y, z, yaw per object].

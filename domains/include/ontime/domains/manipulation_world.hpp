@@ -45,6 +45,7 @@ struct PlacementRegion {
   double height = 0;    // the top of the surface
   double min_x = 0, min_y = 0, max_x = 0, max_y = 0;
   double yaw_low = 0, yaw_high = 0;  // placements are drawn with a yaw in [low, high]
+  // Whether (x, y) lies in the rectangle, its edges included.
   bool contains(double x, double y) const noexcept { return x >= min_x && x <= max_x && y >= min_y && y <= max_y; }
 };
 
@@ -105,7 +106,9 @@ struct ManipulationWorld {
   CollectionDefaults collection;
   std::vector<std::vector<std::string>> skeletons;
 
+  // The index of the movable object with this id, or -1.
   int object_index(std::string_view id) const noexcept;
+  // The index of the placement region with this id, or -1.
   int region_index(std::string_view id) const noexcept;
   // The resting height of an object's centre on a region.
   double resting_z(std::size_t object, const PlacementRegion& region) const noexcept {

@@ -13,6 +13,7 @@ namespace ontime::domains {
 
 class NavigationDomain final : public Domain {
  public:
+  // The domain of `world`, a world file already read and checked.
   explicit NavigationDomain(NavigationWorld world);
 
   const std::string& name() const override { return name_; }
@@ -34,6 +35,7 @@ class NavigationDomain final : public Domain {
   // Room paths in order of length (room_path_planners, task_planner.hpp).
   TaskPlannerFactory task_planners(int max_skeletons) const override;
 
+  // The world the domain refines in.
   const NavigationWorld& world() const noexcept { return world_; }
 
   // The execution time of a motion through these poses (drive_seconds at the robot's speeds).

@@ -22,6 +22,7 @@ namespace ontime::domains {
 struct Room {
   std::string id;
   double min_x = 0, min_y = 0, max_x = 0, max_y = 0;
+  // Whether (x, y) lies strictly inside the room (its walls excluded).
   bool contains(double x, double y) const noexcept { return x > min_x && x < max_x && y > min_y && y < max_y; }
 };
 

@@ -51,6 +51,7 @@ struct PlannerWorldOptions {
 // machine and under any load (reports).
 class NominalPlanningClock final : public Clock {
  public:
+  // `thinking`: the model that charges the allocator's decisions; none: they take real time.
   explicit NominalPlanningClock(std::optional<ThinkingModel> thinking = std::nullopt) : thinking_(thinking) {}
   double now() const override { return thinking_ ? modelled_ : steady_.now() + offset_; }
   // A planner call took `real_seconds` and counts as `nominal_seconds`.

@@ -85,6 +85,7 @@ class Pr2Arm {
   // enough to skip hopeless IK solves.
   bool may_reach(const Transform& target) const noexcept;
 
+  // Whether every joint lies within its limits, bounds included (false for NaN).
   static bool within_limits(const ArmJoints& joints) noexcept;
 
  private:

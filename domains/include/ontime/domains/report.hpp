@@ -53,7 +53,9 @@ struct Tamp {
   const TampResult* result = nullptr;
   std::string picture_files = {};  // text: the files the drawn episode went to
 };
+// Its JSON (`ontime tamp --json`): the settings, the success rate, the skeletons found and the mean charges.
 std::string to_json(const Tamp& tamp);
+// Its text (`ontime tamp`): the same for people.
 std::string to_text(const Tamp& tamp);
 // The drawn episode: {"episode", "drawing", "timeline_csv"}.
 std::string picture_json(const TampPicture& picture);
@@ -68,7 +70,9 @@ struct Run {
   std::optional<std::uint64_t> timeline_episode = {};  // text: the episode whose timeline was drawn
   std::string timeline_files = {};                     // and where
 };
+// Its JSON (`ontime run --json`): the settings, the success rate and the effort of the episodes.
 std::string to_json(const Run& run);
+// Its text (`ontime run`): the same for people.
 std::string to_text(const Run& run);
 
 // A collection and its fit (collect_and_fit.hpp); the result must hold the fit (the root rank's).
@@ -78,7 +82,9 @@ struct Collection {
   const CollectAndFitOptions* options = nullptr;
   const CollectAndFitResult* result = nullptr;
 };
+// Its JSON (`ontime collect --json`): the settings, the attempts and motions found, the files written.
 std::string to_json(const Collection& collection);
+// Its text (`ontime collect`): the same for people.
 std::string to_text(const Collection& collection);
 
 }  // namespace ontime::domains::report

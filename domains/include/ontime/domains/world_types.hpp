@@ -23,6 +23,7 @@ double drive_seconds(const std::vector<Pose>& poses, double linear_speed, double
 // turned by `angle` radians.
 struct Rectangle {
   double x = 0, y = 0, length = 0, width = 0, angle = 0;
+  // The four corners (x, y), counterclockwise from the one at (-length/2, -width/2) in the rectangle's axes.
   std::array<std::array<double, 2>, 4> corners() const;
 };
 
