@@ -15,7 +15,7 @@ namespace ontime {
 
 class DpAllocator final : public Allocator {
  public:
-  // Builds the ContiguousSuccessTable of `mdp` and picks the skeleton with the largest PS.
+  // Computes PS(k, 0, 0, 0) (or its extension, as above) of every skeleton of `mdp` and picks the largest.
   explicit DpAllocator(const Mdp& mdp);
   // Refines `chosen_skeleton`, picked before (the factory picks once for all its allocators).
   explicit DpAllocator(int chosen_skeleton) noexcept : chosen_(chosen_skeleton) {}

@@ -39,7 +39,7 @@ class BytePacker {
   }
   // The bytes written so far.
   const std::string& bytes() const noexcept { return bytes_; }
-  // The bytes written, moved out; the packer is left empty.
+  // The bytes written, moved out of the packer.
   std::string take() noexcept { return std::move(bytes_); }
 
  private:
