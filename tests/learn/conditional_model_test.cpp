@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <nlohmann/json.hpp>
 #include <numbers>
 
 #include "ontime/learn/fitting.hpp"
@@ -232,6 +233,20 @@ TEST(ConditionalTimeModel, RefusesBadFeaturesAndBadFiles) {
   refused(replaced("\"kind\": \"hazard\"", "\"kind\": \"forest\""), "kind");
   refused(replaced("\"execution_sigma\"", "\"sigma\""), "parameters.execution_sigma");
   refused(replaced("\"horizon\": 2", "\"horizon\": 0"), "horizon");
+  // Whole numbers follow the instance reader's rules: 2^32 + 1 is not truncated to the version 1,
+  // nor 2^32 + 2 to the horizon 2; `1.0` and `2.0` are whole numbers.
+  refused(replaced("\"version\": 1", "\"version\": 4294967297"), "version");
+  refused(replaced("\"horizon\": 2", "\"horizon\": 4294967298"), "horizon");
+  refused(replaced("\"horizon\": 2", "\"horizon\": 2.5"), "horizon");
+  nlohmann::ordered_json wide_bin = nlohmann::ordered_json::parse(text);
+  wide_bin["parameters"]["bin_end"][0] = 4294967297LL;  // 1 in 32 bits
+  refused(wide_bin.dump(2), "parameters.bin_end");
+  nlohmann::ordered_json written_as_floats = nlohmann::ordered_json::parse(text);
+  written_as_floats["version"] = 1.0;
+  written_as_floats["horizon"] = 2.0;
+  const auto whole = parse_conditional_model(written_as_floats.dump(2), "m.json");
+  EXPECT_EQ(whole->horizon(), 2);
+  EXPECT_EQ(whole->to_json(), text);
 }
 
 TEST(ConditionalTimeModel, PredictsALibraryCutAtTheDeadline) {

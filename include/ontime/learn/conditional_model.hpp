@@ -99,6 +99,14 @@ struct ConditionalFitOptions {
   double aft_scale = 1;
 };
 
+class ConditionalTimeModel;
+
+// The rows of planner logs scored or updated with `model` (its step): as load_conditional_data,
+// and an InputError naming the first log when its records carry another number of features than
+// the model takes (`model_file` names the model in the message).
+ConditionalData load_conditional_data_for(const ConditionalTimeModel& model, std::string_view model_file,
+                                          std::span<const std::filesystem::path> logs);
+
 class ConditionalTimeModel {
  public:
   // The model file's format and the version this build reads and writes.
