@@ -84,6 +84,22 @@ using Threads = Number<unsigned, "threads", 0, 1024>;
 using Iterations = Number<std::uint64_t, "iterations", 1>;
 using Seconds = Number<double, "seconds", 0.0>;
 
+// ---- object arguments that know their name ----
+// pybind11 passes None to a std::shared_ptr parameter as an empty pointer (the call would then
+// dereference it) and answers an object of another type with a TypeError listing signatures. A
+// parameter declared as Required<T, "name"> takes only a T (a class the module binds) and raises
+// UsageError naming the parameter and the class otherwise.
+template <class T, ParameterName Name>
+struct Required {
+  std::shared_ptr<T> pointer;  // never empty once loaded
+  T& operator*() const noexcept { return *pointer; }
+  T* operator->() const noexcept { return pointer.get(); }
+  operator const std::shared_ptr<T>&() const noexcept { return pointer; }  // NOLINT: used as the pointer it holds
+};
+
+// "parameter 'NAME': must be a CLASS (got WHAT)" as a UsageError.
+[[noreturn]] void refuse_object(const char* name, py::handle expected_type, py::handle got);
+
 // An Mdp with the Problem it refers to (an Mdp keeps a reference only).
 struct MdpHandle {
   explicit MdpHandle(std::shared_ptr<const Problem> p) : problem(std::move(p)), mdp(*problem) {}
@@ -254,6 +270,25 @@ struct type_caster<ontime::python::Number<T, Name, Min, Max>> {
     } else {
       return pybind11::float_(static_cast<double>(number.value)).release();
     }
+  }
+};
+
+template <class T, ontime::python::ParameterName Name>
+struct type_caster<ontime::python::Required<T, Name>> {
+  using Value = ontime::python::Required<T, Name>;
+  PYBIND11_TYPE_CASTER(Value, const_name("object"));
+
+  bool load(handle source, bool /*convert*/) {
+    const pybind11::type expected = pybind11::type::of<T>();
+    if (!source || source.is_none() || !isinstance(source, expected)) {
+      ontime::python::refuse_object(Name.text, expected, source);
+    }
+    value.pointer = pybind11::cast<std::shared_ptr<T>>(source);
+    return true;
+  }
+
+  static handle cast(const Value& object, return_value_policy policy, handle parent) {
+    return make_caster<std::shared_ptr<T>>::cast(object.pointer, policy, parent);
   }
 };
 

@@ -127,7 +127,7 @@ void bind_domains(py::module_& m) {
 
   m.def(
       "collect",
-      [](const std::shared_ptr<DomainHandle>& domain, Number<std::uint64_t, "trials", 1> trials, Seed seed,
+      [](const Required<DomainHandle, "domain">& domain, Number<std::uint64_t, "trials", 1> trials, Seed seed,
          Threads threads, const std::string& effort, ChecksPerSecond checks_per_second, StepSeconds step_seconds,
          BudgetSteps budget_steps, bool every_action, bool features, const py::object& progress) {
         const domains::CollectAndFitOptions request = collect_request(
@@ -156,7 +156,7 @@ void bind_domains(py::module_& m) {
 
   m.def(
       "collect_and_fit",
-      [](const std::shared_ptr<DomainHandle>& domain, const py::object& log, const py::object& instance,
+      [](const Required<DomainHandle, "domain">& domain, const py::object& log, const py::object& instance,
          Number<std::uint64_t, "trials", 1> trials, Seed seed, Threads threads, const std::string& effort,
          ChecksPerSecond checks_per_second, StepSeconds step_seconds,
          Number<Steps, "deadline", 0, Problem::kMaxDeadline> deadline, BudgetSteps budget_steps,
@@ -195,7 +195,7 @@ void bind_domains(py::module_& m) {
 
   m.def(
       "run",
-      [](const std::shared_ptr<DomainHandle>& domain, const py::object& problem, const std::string& solver,
+      [](const Required<DomainHandle, "domain">& domain, const py::object& problem, const std::string& solver,
          Episodes episodes, Seed seed, Threads threads, const std::string& effort, ChecksPerSecond checks_per_second,
          bool independent_starts, bool exact, bool live, DecisionShare decision_share, const py::object& belief,
          const py::object& progress, const py::kwargs& kwargs) {
@@ -251,7 +251,7 @@ void bind_domains(py::module_& m) {
 
   m.def(
       "tamp",
-      [](const std::shared_ptr<DomainHandle>& domain, const py::object& library, const std::string& solver,
+      [](const Required<DomainHandle, "domain">& domain, const py::object& library, const std::string& solver,
          Number<double, "deadline", 1e-9> deadline, Number<std::uint64_t, "episodes", 1> episodes, Seed seed,
          Threads threads, const std::string& effort, Number<double, "task_seconds", 0.0, 1e6> task_seconds,
          Number<int, "arrival_period", 1, 10'000> arrival_period,
@@ -331,7 +331,7 @@ void bind_domains(py::module_& m) {
 
   m.def(
       "map_data",
-      [](const std::shared_ptr<DomainHandle>& domain, Seed seed) {
+      [](const Required<DomainHandle, "domain">& domain, Seed seed) {
         domains::MapDrawing drawing;
         {
           const py::gil_scoped_release release;
@@ -349,7 +349,7 @@ void bind_domains(py::module_& m) {
 
   m.def(
       "features",
-      [](const std::shared_ptr<DomainHandle>& domain, const std::string& action) {
+      [](const Required<DomainHandle, "domain">& domain, const std::string& action) {
         std::vector<double> values;
         try {
           values = domain->loaded.domain->action_features(action);
@@ -363,7 +363,7 @@ void bind_domains(py::module_& m) {
 
   m.def(
       "predict",
-      [](const std::shared_ptr<DomainHandle>& domain, const std::shared_ptr<ConditionalTimeModel>& model,
+      [](const Required<DomainHandle, "domain">& domain, const Required<ConditionalTimeModel, "model">& model,
          Number<Steps, "deadline", 0, Problem::kMaxDeadline> deadline, bool library, const std::string& name,
          Threads threads) {
         domains::PredictOptions options;

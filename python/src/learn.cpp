@@ -170,7 +170,8 @@ void bind_conditional(py::module_& m) {
 
   m.def(
       "fit_strength",
-      [](const Model& model, const std::vector<py::object>& logs, const std::vector<double>& strengths) {
+      [](const Required<ConditionalTimeModel, "model">& model, const std::vector<py::object>& logs,
+         const std::vector<double>& strengths) {
         if (logs.empty()) throw UsageError("logs: give at least one planner log");
         std::vector<std::filesystem::path> paths;
         for (const py::object& log : logs) {
@@ -180,7 +181,7 @@ void bind_conditional(py::module_& m) {
         std::size_t attempts = 0;
         {
           const py::gil_scoped_release release;
-          const ConditionalData data = load_conditional_data(paths, model->step_seconds());
+          const ConditionalData data = load_conditional_data_for(*model, "given", paths);
           attempts = data.rows();
           scores = score_prior_strengths(*model, data, strengths);
         }

@@ -46,6 +46,12 @@ void refuse_number(const char* name, const std::string& rule, py::handle got) {
   throw UsageError("parameter '" + std::string(name) + "': " + rule + " (got " + shown + ")");
 }
 
+void refuse_object(const char* name, py::handle expected_type, py::handle got) {
+  const std::string shown = got.is_none() ? "None" : "a " + std::string(py::str(py::type::of(got).attr("__name__")));
+  throw UsageError("parameter '" + std::string(name) + "': must be a " +
+                   std::string(py::str(expected_type.attr("__name__"))) + " (got " + shown + ")");
+}
+
 std::string instance_label(const py::object& source, const Problem& problem) {
   if (py::isinstance<py::str>(source) || py::hasattr(source, "__fspath__")) {
     return py::str(py::module_::import("os").attr("fspath")(source));

@@ -214,9 +214,9 @@ void bind_run(py::module_& m) {
       "    if session.status == ontime.Status.success: execute(session.solution)\n\n"
       "`iterations` / `seconds` set the per-decision budget of an anytime allocator (mcts) for every decision; "
       "choose() may override it for one. The allocator must not serve another session at the same time.")
-      .def(py::init([](std::shared_ptr<AllocatorHandle> allocator, Seed seed, std::optional<Iterations> iterations,
-                       std::optional<Seconds> seconds) {
-             return std::make_unique<SessionHandle>(std::move(allocator), seed, budget_of(iterations, seconds));
+      .def(py::init([](const Required<AllocatorHandle, "allocator">& allocator, Seed seed,
+                       std::optional<Iterations> iterations, std::optional<Seconds> seconds) {
+             return std::make_unique<SessionHandle>(allocator.pointer, seed, budget_of(iterations, seconds));
            }),
            py::arg("allocator"), py::arg("seed") = 0, py::kw_only(), py::arg("iterations") = py::none(),
            py::arg("seconds") = py::none())
