@@ -1,6 +1,7 @@
 // Inputs made to break the tool: nesting without end in every kind of JSON file it reads (an
-// instance, a planner log, a chain log, a model file). Each is refused with exit 2 and one line
-// naming the file, the place and the rule.
+// instance, a planner log, a chain log, a model file), and boosted models whose boosters would
+// crash or hang XGBoost. Each is refused with exit 2 and one line naming the file, the place and
+// the rule.
 
 #include <gtest/gtest.h>
 
@@ -101,6 +102,47 @@ TEST(Cli, DeepNestingIsRefusedInEveryFileKindAtItsPlace) {
                                     "\"version\": " + std::string(255, '[') + std::string(255, ']') + ","));
   expect_refused_probe({"fit-strength", train, "--model", nested, "--strengths", "1"}, nested, "version",
                        "(got [[[...]]])");
+}
+
+// A boosted model whose planning booster has a cycle of children (prediction would loop forever)
+// or a child beyond its nodes (read out of bounds): refused before XGBoost reads it.
+TEST(Cli, ABoostedModelWithABrokenTreeIsRefused) {
+  const auto dir = scratch("broken-booster");
+  const std::string train = (dir / "train.jsonl").string();
+  std::string rows;
+  for (int i = 0; i < 40; ++i) {
+    rows += "{\"action\": \"a\", \"planning_seconds\": " + std::to_string(1 + i % 4) +
+            ", \"found\": " + (i % 3 == 0 ? "false" : "true, \"execution_seconds\": 1") +
+            ", \"world\": \"t\", \"features\": [" + std::to_string(i % 4) + "]}\n";
+  }
+  write_probe(train, rows);
+  const std::string model = (dir / "model.json").string();
+  const auto fitted =
+      ontime({"fit", train, "--conditional", "boosted", "--step", "1", "--trees", "2", "--depth", "2", "-o", model});
+  ASSERT_EQ(fitted.exit_code, 0) << fitted.err;
+  json file = json::parse(read_file(model));
+  json booster = json::parse(file["parameters"]["planning_booster"].get<std::string>());
+  json& tree = booster["learner"]["gradient_booster"]["model"]["trees"][0];
+  ASSERT_GE(tree["left_children"].size(), 3u) << "a tree of one leaf: nothing to break";
+  const auto refused = [&](const std::string& name, const std::string& member, const json& value,
+                           const std::string& rule) {
+    json broken = booster;
+    broken["learner"]["gradient_booster"]["model"]["trees"][0][member][0] = value;
+    json bad = file;
+    bad["parameters"]["planning_booster"] = broken.dump();
+    const std::string path = (dir / name).string();
+    write_probe(path, bad.dump(2));
+    expect_refused_probe(
+        {"fit-strength", train, "--model", path, "--strengths", "1"}, path, "parameters.planning_booster",
+        "not a booster OnTime reads: at learner.gradient_booster.model.trees[0]." + member + "[0]: " + rule);
+  };
+  refused("cycle.json", "left_children", 0,
+          "a child must be a node from 1 to " + std::to_string(tree["left_children"].size() - 1) +
+              ", or -1 for both children of a leaf (got 0)");
+  refused("beyond.json", "right_children", 1'000'000,
+          "a child must be a node from 1 to " + std::to_string(tree["left_children"].size() - 1) +
+              ", or -1 for both children of a leaf (got 1000000)");
+  refused("split.json", "split_indices", 5, "must be a feature index below 1 (got 5)");
 }
 
 }  // namespace
