@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -143,6 +144,33 @@ TEST(Cli, ABoostedModelWithABrokenTreeIsRefused) {
           "a child must be a node from 1 to " + std::to_string(tree["left_children"].size() - 1) +
               ", or -1 for both children of a leaf (got 1000000)");
   refused("split.json", "split_indices", 5, "must be a feature index below 1 (got 5)");
+}
+
+// SIGTERM, SIGINT or SIGHUP while an output is being written (a chain of 4,001 states: 64 MB):
+// the command dies of the signal and leaves neither its temporary file nor a partial output. The
+// signal is sent once the temporary file is seen.
+TEST(Cli, AnOutputInterruptedWhileWrittenLeavesNoTemporaryFile) {
+  const auto dir = scratch("interrupted-output");
+  const std::string log = (dir / "queue.jsonl").string();
+  write_probe(log,
+              "{\"sequence\": \"mon\", \"step\": 0, \"state\": 0}\n{\"sequence\": \"mon\", \"step\": 1, "
+              "\"state\": 1}\n");
+  const auto out = dir / "out";
+  std::filesystem::create_directories(out);
+  const auto temporary_seen = [&out] {
+    std::error_code error;
+    for (const auto& entry : std::filesystem::directory_iterator(out, error)) {
+      if (entry.path().filename().string().starts_with(".chain.json.tmp-")) return true;
+    }
+    return false;
+  };
+  for (const int signal_number : {SIGTERM, SIGINT, SIGHUP}) {
+    const auto stopped = testing::run_process({ONTIME_CLI, "fit-chain", log, "--kind", "birth-death", "--capacity",
+                                               "4000", "-o", (out / "chain.json").string()},
+                                              temporary_seen, signal_number);
+    EXPECT_EQ(stopped.exit_code, 128 + signal_number) << stopped.err;
+    EXPECT_TRUE(std::filesystem::is_empty(out)) << signal_number;
+  }
 }
 
 }  // namespace
