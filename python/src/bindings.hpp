@@ -151,8 +151,11 @@ struct DecisionView {
   std::shared_ptr<const Problem> problem;
 };
 
-// An MdpHandle from a Problem, an Mdp or a path to an instance file (loaded).
-std::shared_ptr<MdpHandle> to_mdp(const py::object& source);
+// An MdpHandle from a Problem, an Mdp or a path to an instance file (loaded); UsageError naming
+// `parameter` for anything else.
+std::shared_ptr<MdpHandle> to_mdp(const py::object& source, const char* parameter = "problem");
+// The text of a path argument (str or os.PathLike); UsageError naming `parameter` for anything else.
+std::string path_argument(const py::handle& value, const char* parameter);
 // The instance's file name when `source` is a path, else the problem's name (the `instance` field
 // of the results, as the command line reports it).
 std::string instance_label(const py::object& source, const Problem& problem);
@@ -240,7 +243,10 @@ struct type_caster<ontime::python::Number<T, Name, Min, Max>> {
     if constexpr (std::is_integral_v<T>) {
       if (!PyIndex_Check(object)) ontime::python::refuse_number(Name.text, rule, source);
       const auto whole = reinterpret_steal<pybind11::int_>(PyNumber_Index(object));
-      if (!whole) throw error_already_set();
+      if (!whole) {
+        PyErr_Clear();  // e.g. a numpy array of several numbers
+        ontime::python::refuse_number(Name.text, rule, source);
+      }
       if (whole < pybind11::int_(Min) || whole > pybind11::int_(Max))
         ontime::python::refuse_number(Name.text, rule, source);
       value.value = pybind11::cast<T>(whole);

@@ -40,8 +40,6 @@ struct DomainHandle {
   domains::LoadedDomain loaded;
 };
 
-std::string path_text(const py::object& path) { return py::str(py::module_::import("os").attr("fspath")(path)); }
-
 // Progress and Ctrl-C of a long library call: `progress` and `stop` hooks for run_interruptibly.
 struct Hooks {
   std::function<void(std::uint64_t, std::uint64_t)> progress;
@@ -116,7 +114,7 @@ void bind_domains(py::module_& m) {
       [](const std::string& name, const py::object& world_file) {
         auto handle = std::make_shared<DomainHandle>();
         handle->name = name;
-        handle->world_file = path_text(world_file);
+        handle->world_file = path_argument(world_file, "world_file");
         const py::gil_scoped_release release;
         handle->loaded = domains::load_domain(name, handle->world_file);
         return handle;
@@ -167,9 +165,9 @@ void bind_domains(py::module_& m) {
         options.deadline = deadline;
         options.laplace = laplace;
         options.log_format = log_format;
-        options.log = path_text(log);
-        options.instance = path_text(instance);
-        if (!checkpoint.is_none()) options.checkpoint = path_text(checkpoint);
+        options.log = path_argument(log, "log");
+        options.instance = path_argument(instance, "instance");
+        if (!checkpoint.is_none()) options.checkpoint = path_argument(checkpoint, "checkpoint");
         options.resume = resume;
         domains::CollectAndFitResult result;
         run_interruptibly(
@@ -204,7 +202,7 @@ void bind_domains(py::module_& m) {
         std::shared_ptr<MdpHandle> believed;
         domains::PlannerRunOptions options;
         if (!belief.is_none()) {
-          believed = to_mdp(belief);
+          believed = to_mdp(belief, "belief");
           try {
             (void)with_distributions_of(*mdp->problem, *believed->problem);
           } catch (const UsageError& error) {
@@ -267,7 +265,7 @@ void bind_domains(py::module_& m) {
         if (clock == "real" && (decision_seconds || iteration_seconds)) {
           throw UsageError("decision_seconds and iteration_seconds need clock='model'");
         }
-        const std::shared_ptr<MdpHandle> mdp = to_mdp(library);
+        const std::shared_ptr<MdpHandle> mdp = to_mdp(library, "library");
         domains::TampOptions options;
         options.solver = solver;
         options.parameters = parameter_values(kwargs);
@@ -415,7 +413,7 @@ void bind_domains(py::module_& m) {
         options.skeletons = skeletons;
         options.seed = seed;
         if (name) options.name = *name;
-        const std::string path = path_text(output);
+        const std::string path = path_argument(output, "output");
         domains::GeneratedWorld world;
         {
           const py::gil_scoped_release release;
@@ -462,7 +460,7 @@ void bind_domains(py::module_& m) {
         options.max_clutter = max_clutter;
         options.classes = classes;
         if (name) options.name = *name;
-        const std::string path = path_text(output);
+        const std::string path = path_argument(output, "output");
         domains::GeneratedKitchen kitchen;
         {
           const py::gil_scoped_release release;

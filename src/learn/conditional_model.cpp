@@ -204,7 +204,9 @@ std::unique_ptr<ConditionalTimeModel> fit_conditional_model(const ConditionalDat
   }
   if (options.kind == PooledTimeModel::kind_name()) return PooledTimeModel::fit(data, std::move(names), horizon);
   if (options.kind == HazardTimeModel::kind_name()) {
-    if (!(options.ridge >= 0 && std::isfinite(options.ridge))) throw UsageError("the ridge must be a number >= 0");
+    if (!(options.ridge >= 0 && options.ridge <= ConditionalFitOptions::kMaxRidge)) {
+      throw UsageError("the ridge must be a number from 0 to 1e6");
+    }
     if (options.bins < 0 || options.bins > horizon) {
       throw UsageError("the bins must be between 0 and the horizon (" + std::to_string(horizon) + ")");
     }

@@ -213,6 +213,9 @@ TEST(ConditionalTimeModel, RefusesBadFeaturesAndBadFiles) {
   one_name.feature_names = {"only one"};
   EXPECT_THROW(fit_conditional_model(data, one_name), UsageError);
   EXPECT_THROW(fit_conditional_model(data, options("hazard", 0, 0, -1)), UsageError);
+  // A ridge of 1e10 made NLopt fail (an internal error); above 1e6 it is refused.
+  EXPECT_THROW(fit_conditional_model(data, options("hazard", 0, 0, 1e10)), UsageError);
+  EXPECT_NO_THROW(fit_conditional_model(data, options("hazard", 0, 0, 1e6)));
 
   const std::string text = model->to_json();
   const auto refused = [](const std::string& bad, const std::string& place) {

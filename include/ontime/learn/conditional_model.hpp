@@ -82,7 +82,10 @@ struct ConditionalFitOptions {
   std::vector<std::string> feature_names;  // as many as the data's features; empty: f1, f2, ...
   Steps horizon = 0;                       // steps predicted; 0: the largest planning step of the data
   // hazard: L2 penalty on the standardised feature weights (not on the baseline).
-  double ridge = 1e-3;
+  double ridge = 1e-3;  // 0 to kMaxRidge
+  // The largest ridge: beyond it the penalty alone sets the weights (to 0), and NLopt's L-BFGS fails
+  // on some of the objective's scales (a ridge of 1e10 did, 1e12 did not).
+  static constexpr double kMaxRidge = 1e6;
   // hazard: baseline bins over 1..horizon (each bin one hazard level); 0: one per step.
   int bins = 0;
   // boosted: boosting rounds (the trees of each booster, 1 to 10000), a tree's largest depth (1 to
