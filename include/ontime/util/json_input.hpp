@@ -58,8 +58,10 @@ inline constexpr std::size_t kMaxJsonDepth = 256;
 
 namespace json_quote {
 
+// Recursive, but at most two levels deep: containers below the second are abbreviated.
 template <class Json>
-void append(std::string& out, const Json& value, std::size_t depth, std::size_t limit) {
+void append(std::string& out, const Json& value, std::size_t depth,  // NOLINT(misc-no-recursion)
+            std::size_t limit) {
   if (out.size() > limit) return;
   if (!value.is_array() && !value.is_object()) {
     // A number, a boolean, null or a string: a string of a million characters is cut below.
