@@ -1,5 +1,6 @@
 #include "ontime/learn/conditional_model.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -45,10 +46,19 @@ ConditionalData conditional_data(std::span<const RefinementAttempt> attempts, do
                        "has " + std::to_string(attempt.features.size()) + " features, the first record " +
                            std::to_string(data.feature_count));
     }
+    for (std::size_t f = 0; f < attempt.features.size(); ++f) {
+      if (!(std::abs(attempt.features[f]) <= ConditionalData::kMaxFeature)) {
+        throw InputError(std::string(source), record_place(i) + ": features[" + std::to_string(f) + "]",
+                         "a feature must be within [-1e15, 1e15] (the boosted kind computes in 32-bit floats and "
+                         "the hazard kind squares the features)");
+      }
+    }
     data.features.insert(data.features.end(), attempt.features.begin(), attempt.features.end());
     data.found.push_back(attempt.found ? 1 : 0);
-    data.planning.push_back(attempt.found ? steps_to_complete(attempt.planning_seconds, step_seconds)
-                                          : whole_steps_within(attempt.planning_seconds, step_seconds));
+    // Rounded as `fit` rounds them: a motion found within no time took its first step.
+    data.planning.push_back(attempt.found
+                                ? std::max<Steps>(1, steps_to_complete(attempt.planning_seconds, step_seconds))
+                                : whole_steps_within(attempt.planning_seconds, step_seconds));
     data.execution_seconds.push_back(attempt.found ? attempt.execution_seconds : 0.0);
     data.worlds.push_back(attempt.world.value_or(""));
     data.actions.push_back(attempt.action);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <numbers>
 
@@ -106,6 +107,46 @@ TEST(ConditionalData, StepsAsFittingCountsThemAndEveryRecordNeedsFeatures) {
   } catch (const InputError& error) {
     EXPECT_EQ(error.source(), "log.jsonl");
     EXPECT_EQ(error.place(), "record 2");
+  }
+}
+
+// A motion found in no time took its first step, as `fit` counts it; features beyond 1e15 in
+// magnitude are refused naming the record and the feature; features at the bound fit every kind,
+// and each model written reads back.
+TEST(ConditionalData, ZeroPlanningTimesAreOneStepAndHugeFeaturesAreRefused) {
+  const std::vector<RefinementAttempt> log{featured_attempt("a", 0.0, true, 1.0, {1e15}),
+                                           featured_attempt("a", 2.0, true, 1.0, {-1e15}),
+                                           featured_attempt("a", 3.0, false, 0, {0.0})};
+  const ConditionalData data = conditional_data(log, 1.0, "log");
+  EXPECT_EQ(data.planning[0], 1);
+  ConditionalData three = data;
+  for (int copy = 0; copy < 2; ++copy) {
+    const ConditionalData more = conditional_data(log, 1.0, "log");
+    three.features.insert(three.features.end(), more.features.begin(), more.features.end());
+    three.planning.insert(three.planning.end(), more.planning.begin(), more.planning.end());
+    three.found.insert(three.found.end(), more.found.begin(), more.found.end());
+    three.execution_seconds.insert(three.execution_seconds.end(), more.execution_seconds.begin(),
+                                   more.execution_seconds.end());
+    three.worlds.insert(three.worlds.end(), more.worlds.begin(), more.worlds.end());
+    three.actions.insert(three.actions.end(), more.actions.begin(), more.actions.end());
+  }
+  for (const std::string kind : {"pooled", "hazard", "boosted"}) {
+    ConditionalFitOptions fit = options(kind);
+    fit.trees = 2;
+    const auto model = fit_conditional_model(three, fit);
+    EXPECT_EQ(model->predict(std::vector<double>{1e15}).planning.pmf(0), 0.0) << kind;
+    EXPECT_EQ(parse_conditional_model(model->to_json(), "m.json")->to_json(), model->to_json()) << kind;
+  }
+  for (const double huge : {1e16, -1e308, std::numeric_limits<double>::max()}) {
+    std::vector<RefinementAttempt> bad = log;
+    bad[1].features = {huge};
+    try {
+      conditional_data(bad, 1.0, "log.jsonl");
+      ADD_FAILURE() << huge;
+    } catch (const InputError& error) {
+      EXPECT_EQ(error.place(), "record 2: features[0]");
+      EXPECT_NE(error.rule().find("within [-1e15, 1e15]"), std::string::npos);
+    }
   }
 }
 

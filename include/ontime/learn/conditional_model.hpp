@@ -43,6 +43,8 @@ struct ConditionalData {
   std::vector<std::string> worlds;        // the record's world ("" when it names none)
   std::vector<std::string> actions;
   double step_seconds = 1;
+  // The largest magnitude of a feature (conditional_data refuses larger ones).
+  static constexpr double kMaxFeature = 1e15;
 
   std::size_t rows() const noexcept { return planning.size(); }
   std::span<const double> row(std::size_t i) const noexcept {
