@@ -12,7 +12,8 @@ if command -v ninja >/dev/null 2>&1 && [ ! -f build-fuzz/CMakeCache.txt ]; then 
 # 174 s on 2 cores); the release build compiles the same sources file by file.
 cmake -S . -B build-fuzz "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_UNITY_BUILD=ON \
   -DONTIME_BUILD_FUZZERS=ON -DONTIME_BUILD_APPS=OFF -DONTIME_BUILD_BENCHMARKS=OFF -DBUILD_TESTING=OFF
-cmake --build build-fuzz --parallel "$(nproc)" --target instance_fuzzer planner_log_fuzzer ompl_benchmark_log_fuzzer
+cmake --build build-fuzz --parallel "$(nproc)" --target instance_fuzzer planner_log_fuzzer ompl_benchmark_log_fuzzer \
+  conditional_model_fuzzer chain_fuzzer
 
 run() {
   local target="$1"; shift
@@ -20,6 +21,13 @@ run() {
   (cd build-fuzz && "./fuzz/$target" -max_total_time="$seconds" -print_final_stats=1 -timeout=10 -max_len=8192 \
      -rss_limit_mb=4096 "corpus/$target" "$@" 2>&1 | tail -n 25)
 }
-run instance_fuzzer ../data/instances/paper ../data/instances/backtracking ../tests/data/bad ../tests/data/fuzz_regressions ../data/knapsack
+run instance_fuzzer ../data/instances/paper ../data/instances/backtracking ../data/instances/chains \
+  ../data/instances/rewards ../tests/data/bad ../tests/data/fuzz_regressions ../data/knapsack
 run planner_log_fuzzer ../tests/data/bad_logs ../tests/data/fuzz_regressions ../fuzz/seeds/planner_log
 run ompl_benchmark_log_fuzzer ../tests/data/bad_ompl_logs ../fuzz/seeds/ompl_benchmark_log
+run conditional_model_fuzzer ../fuzz/seeds/conditional_model
+# The chain fuzzer's first byte picks the reader: seeds are prefixed ("0": a chain file, "1": a log).
+mkdir -p build-fuzz/seeds/chain
+for seed in fuzz/seeds/chain/*.chain.json; do { printf 0; cat "$seed"; } > "build-fuzz/seeds/chain/$(basename "$seed")"; done
+for seed in fuzz/seeds/chain/*.jsonl; do { printf 1; cat "$seed"; } > "build-fuzz/seeds/chain/$(basename "$seed")"; done
+run chain_fuzzer seeds/chain

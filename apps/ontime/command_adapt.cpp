@@ -8,6 +8,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "common.hpp"
@@ -110,14 +113,31 @@ void add_fit_strength_command(CLI::App& app) {
   command->add_option("LOG", options->logs, "Planner logs of worlds the model was not fitted on, with features")
       ->required();
   command->add_option("--model", options->model, "Conditional time model (ontime fit --conditional)")->required();
-  command->add_option("--strengths", options->strengths, "Strengths to score (attempts), comma-separated")
-      ->delimiter(',')
-      ->capture_default_str();
+  // Each strength through the command line's number parser (CLI11's own reads 0x10 as 16 and
+  // drops the empty item of `1,,2`).
+  command
+      ->add_option_function<std::string>(
+          "--strengths",
+          [options](const std::string& text) {
+            options->strengths.clear();
+            std::size_t begin = 0;
+            while (true) {
+              const std::size_t comma = std::min(text.find(',', begin), text.size());
+              options->strengths.push_back(cli::parse_real_option("--strengths",
+                                                                  std::string_view(text).substr(begin, comma - begin),
+                                                                  cli::kPositive, std::numeric_limits<double>::max()));
+              if (comma == text.size()) break;
+              begin = comma + 1;
+            }
+          },
+          "Strengths to score (attempts), comma-separated")
+      ->type_name("REAL,...")
+      ->default_str("0.5,1,2,5,10,20,50,100,200");
   command->add_flag("--json", options->json, "Print JSON");
   command->callback([options] {
     const std::unique_ptr<ConditionalTimeModel> model = load_conditional_model(options->model);
     std::vector<std::filesystem::path> logs(options->logs.begin(), options->logs.end());
-    const ConditionalData data = load_conditional_data(logs, model->step_seconds());
+    const ConditionalData data = load_conditional_data_for(*model, options->model, logs);
     const std::vector<StrengthScore> scores = score_prior_strengths(*model, data, options->strengths);
     const auto best = std::min_element(scores.begin(), scores.end(),
                                        [](const StrengthScore& a, const StrengthScore& b) { return a.nll < b.nll; });

@@ -188,7 +188,7 @@ void add_fit_command(CLI::App& app) {
                     "--conditional: steps predicted (0: the longest planning time of the logs)", Steps{0},
                     Problem::kMaxDeadline);
   add_number_option(*command, "--ridge", options->conditional.ridge,
-                    "--conditional hazard: L2 penalty on the feature weights", 0.0);
+                    "--conditional hazard: L2 penalty on the feature weights", 0.0, ConditionalFitOptions::kMaxRidge);
   add_number_option(*command, "--bins", options->conditional.bins,
                     "--conditional hazard: baseline hazard levels (0: one per step)", 0, Problem::kMaxDeadline);
   add_number_option(*command, "--trees", options->conditional.trees,

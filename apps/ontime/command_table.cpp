@@ -5,8 +5,14 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string_view>
+#include <vector>
 
 #include "common.hpp"
 #include "memory_limits.hpp"
@@ -16,6 +22,54 @@
 #include "ontime/util/error.hpp"
 
 namespace ontime::cli {
+namespace {
+
+// The time left of a table from the cost of each column's episodes: the episodes run row by row,
+// column by column (episodes per cell), and an episode of one solver may cost 50,000 of
+// another's (mcts against dp), so the share done alone misleads by orders of magnitude. Each
+// column's seconds per episode is measured on its own episodes; until every column with
+// episodes left has run some, there is no estimate.
+class TableTimeLeft {
+ public:
+  TableTimeLeft(std::uint64_t episodes, std::size_t columns)
+      : episodes_(episodes), seconds_(columns, 0.0), counted_(columns, 0), last_(std::chrono::steady_clock::now()) {}
+
+  std::optional<double> seconds_left(std::uint64_t done, std::uint64_t total) {
+    const auto now = std::chrono::steady_clock::now();
+    if (episodes_ == 0 || seconds_.empty()) return std::nullopt;
+    if (done > done_) {
+      // The time since the last report is the column's whose cell holds the last episode done.
+      const std::size_t column = column_of(done - 1);
+      seconds_[column] += std::chrono::duration<double>(now - last_).count();
+      counted_[column] += done - done_;
+      done_ = done;
+    }
+    last_ = now;
+    double left = 0;
+    for (std::uint64_t at = done; at < total;) {
+      const std::uint64_t cell_end = (at / episodes_ + 1) * episodes_;
+      const std::uint64_t here = std::min(cell_end, total) - at;
+      const std::size_t column = column_of(at);
+      if (counted_[column] == 0) return std::nullopt;
+      left += seconds_[column] / static_cast<double>(counted_[column]) * static_cast<double>(here);
+      at += here;
+    }
+    return left;
+  }
+
+ private:
+  std::size_t column_of(std::uint64_t episode) const {
+    return static_cast<std::size_t>((episode / episodes_) % seconds_.size());
+  }
+
+  std::uint64_t episodes_;
+  std::vector<double> seconds_;         // by column: time spent on its episodes
+  std::vector<std::uint64_t> counted_;  // by column: its episodes done
+  std::uint64_t done_ = 0;
+  std::chrono::steady_clock::time_point last_;
+};
+
+}  // namespace
 
 void add_table_command(CLI::App& app) {
   struct Options {
@@ -71,7 +125,10 @@ void add_table_command(CLI::App& app) {
     }
     check_table_request(instances, table, flag_spelling());
     ProgressBar bar("table");
-    table.progress = [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); };
+    TableTimeLeft time_left(table.episodes, table.solvers.size());
+    table.progress = [&bar, &time_left](std::uint64_t done, std::uint64_t total) {
+      bar.update(done, total, time_left.seconds_left(done, total));
+    };
     const Table measured = measure_table(instances, table);
     table.progress = nullptr;
     if (options->json) {

@@ -190,14 +190,26 @@ void ProgressBar::status(std::string_view text) {
 }
 
 void ProgressBar::update(std::uint64_t done, std::uint64_t total) {
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+  update(done, total,
+         done == 0 ? std::nullopt
+                   : std::optional<double>(elapsed * static_cast<double>(total - std::min(done, total)) /
+                                           static_cast<double>(done)));
+}
+
+void ProgressBar::update(std::uint64_t done, std::uint64_t total, std::optional<double> seconds_left) {
   if (mode_ == Mode::off || total == 0) return;
   const int percent = static_cast<int>(100 * std::min(done, total) / total);
   if (mode_ == Mode::lines) {
     if (done == 0 || !line_due()) return;
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
-    const double left = elapsed * static_cast<double>(total - std::min(done, total)) / static_cast<double>(done);
-    fmt::print(stderr, "ontime {}: {}/{} ({}%), {} elapsed, about {} left\n", label_, done, total, percent,
-               progress_duration(elapsed), progress_duration(left));
+    if (seconds_left) {
+      fmt::print(stderr, "ontime {}: {}/{} ({}%), {} elapsed, about {} left\n", label_, done, total, percent,
+                 progress_duration(elapsed), progress_duration(*seconds_left));
+    } else {
+      fmt::print(stderr, "ontime {}: {}/{} ({}%), {} elapsed\n", label_, done, total, percent,
+                 progress_duration(elapsed));
+    }
     std::fflush(stderr);
     return;
   }

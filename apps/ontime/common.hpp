@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -98,7 +99,11 @@ class ProgressBar {
   ~ProgressBar();
   ProgressBar(const ProgressBar&) = delete;
   ProgressBar& operator=(const ProgressBar&) = delete;
+  // The time left estimated from the share done (items of one cost).
   void update(std::uint64_t done, std::uint64_t total);
+  // The time left as the caller estimates it; none printed without one (nullopt: too early to
+  // tell, e.g. items of a kind whose cost nothing has measured yet).
+  void update(std::uint64_t done, std::uint64_t total, std::optional<double> seconds_left);
   // For work whose total is not known in advance: the label and `text` on one line, redrawn.
   void status(std::string_view text);
 

@@ -14,6 +14,7 @@
 
 #include "cluster_job.hpp"
 #include "common.hpp"
+#include "ontime/util/atomic_file.hpp"
 #include "ontime/util/error.hpp"
 
 namespace {
@@ -59,6 +60,8 @@ std::pair<int, std::string> run(int& argc, char**& argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // An interrupted command leaves no temporary file of an output behind (util/atomic_file.hpp).
+  ontime::remove_temporaries_on_signal(true);
   const auto [code, message] = run(argc, argv);
   return ontime::cli::leave_cluster_job(code, message.empty() ? nullptr : message.c_str());
 }

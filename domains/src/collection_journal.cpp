@@ -88,8 +88,9 @@ std::size_t read_part(const std::filesystem::path& path, const Json& expected, c
         if (!value.is_object() || !value.contains(key) || value[key] != wanted) {
           throw InputError(source, place,
                            "the checkpoint of another collection ('" + key + "' is " +
-                               (value.is_object() && value.contains(key) ? value[key].dump() : std::string("missing")) +
-                               " there, " + wanted.dump() + " here); delete it to start over");
+                               (value.is_object() && value.contains(key) ? ontime::detail::quote_json(value[key])
+                                                                         : std::string("missing")) +
+                               " there, " + ontime::detail::quote_json(wanted) + " here); delete it to start over");
         }
       }
     } else {

@@ -66,7 +66,7 @@ class WorldFields {
 
   double positive(const Json& value, const std::string& path) const {
     const double result = finite(value, path);
-    if (!(result > 0)) fail(path, "must be a positive number (got " + value.dump() + ")");
+    if (!(result > 0)) fail(path, "must be a positive number (got " + ontime::detail::quote_json(value) + ")");
     return result;
   }
 

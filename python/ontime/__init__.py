@@ -20,6 +20,7 @@ from __future__ import annotations
 import json
 import operator
 import os
+import sys
 from typing import Any, Iterable, Mapping, Optional, Sequence, Union
 
 from ._ontime import (  # noqa: F401  (re-exported)
@@ -66,6 +67,7 @@ from ._ontime import (  # noqa: F401  (re-exported)
     train_ppo,
 )
 from . import _ontime
+from ._arguments import name_wrong_arguments as _name_wrong_arguments
 
 __version__ = "0.1.0"
 
@@ -183,14 +185,33 @@ Problem.from_dict = staticmethod(_problem_from_dict)
 Problem.to_dict = _problem_to_dict
 
 
-def _records_text(records: Iterable[Mapping[str, Any]]) -> str:
+def _json_value(value: Any) -> Any:
+    """numpy arrays and scalars (features) as lists and numbers; anything else is no JSON value."""
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    raise TypeError(f"a {type(value).__name__} is not a JSON value")
+
+
+def _iterable(value: Any, parameter: str, what: str) -> Iterable[Any]:
+    """`value` when it can be iterated (and is no str), else UsageError naming the parameter."""
+    if isinstance(value, (str, bytes, Mapping)) or not hasattr(value, "__iter__"):
+        raise UsageError(f"parameter '{parameter}': must be {what} (got "
+                         f"{'None' if value is None else 'a ' + type(value).__name__})")
+    return value
+
+
+def _records_text(records: Iterable[Mapping[str, Any]], parameter: str = "records") -> str:
     lines = []
-    for number, record in enumerate(records, start=1):
+    for number, record in enumerate(_iterable(records, parameter, "a list of records (dicts)"), start=1):
         _check_nesting(record, f"<records>: record {number}")
-        if not isinstance(record, Mapping):
-            lines.append(json.dumps(record) if isinstance(record, (list, str, int, float)) else "null")
-        else:
-            lines.append(json.dumps(dict(record), allow_nan=True))
+        try:
+            if not isinstance(record, Mapping):
+                lines.append(json.dumps(record, default=_json_value)
+                             if isinstance(record, (list, str, int, float)) else "null")
+            else:
+                lines.append(json.dumps(dict(record), allow_nan=True, default=_json_value))
+        except (TypeError, ValueError) as error:
+            raise InputError(f"<records>: record {number}: cannot be written as JSON: {error}") from None
     return "".join(line + "\n" for line in lines)
 
 
@@ -198,7 +219,7 @@ def write_planner_log(records: Iterable[Mapping[str, Any]], path: PathLike) -> N
     """Writes planner-log records (dicts with action, planning_seconds, found, execution_seconds when
     found) as a log file (JSON Lines, docs/formats.md), atomically. Every record is checked by the
     rules of a log file; InputError names the record as `<records>, line N`."""
-    _ontime._save_planner_log(_records_text(records), "<records>", os.fspath(path))
+    _ontime._save_planner_log(_records_text(records), "<records>", path)
 
 
 def fit(records_or_path: Union[PathLike, Iterable[Mapping[str, Any]]], *, step: float, deadline: int,
@@ -214,12 +235,16 @@ def fit(records_or_path: Union[PathLike, Iterable[Mapping[str, Any]]], *, step: 
     # Files are read by the library's own readers (limits, encodings, places in messages), records
     # and skeleton lists given in Python are read as the text of such files.
     log_is_path = isinstance(records_or_path, (str, os.PathLike))
-    log = os.fspath(records_or_path) if log_is_path else _records_text(records_or_path)
+    log = os.fspath(records_or_path) if log_is_path else _records_text(records_or_path, "records_or_path")
     skeletons_is_path = isinstance(skeletons, (str, os.PathLike))
-    skeleton_data = (os.fspath(skeletons) if skeletons_is_path
-                     else json.dumps({"skeletons": [list(s) for s in skeletons]}))
-    return _ontime._fit(log, log_is_path, skeleton_data, skeletons_is_path, float(step), int(deadline),
-                        float(laplace), name, description)
+    skeleton_data = (os.fspath(skeletons) if skeletons_is_path else json.dumps(
+        {"skeletons": [list(_iterable(s, "skeletons", "a list of action ids"))
+                       for s in _iterable(skeletons, "skeletons", "a path or a list of skeletons")]},
+        default=_json_value))
+    # Numbers as given: the extension checks and names them (a float for a whole number is refused,
+    # never truncated).
+    return _ontime._fit(log, log_is_path, skeleton_data, skeletons_is_path, step, deadline, laplace, name,
+                        description)
 
 
 def fit_conditional(records_or_paths: Union[PathLike, Sequence[PathLike], Iterable[Mapping[str, Any]]], *,
@@ -238,7 +263,7 @@ def fit_conditional(records_or_paths: Union[PathLike, Sequence[PathLike], Iterab
     `learning_rate`, `min_child_weight`, `aft_distribution`, `aft_scale`): conditional_model_kinds()."""
     if domain is not None and feature_names is not None:
         raise UsageError("give domain or feature_names, not both")
-    names = list(feature_names) if feature_names is not None else []
+    names = list(_iterable(feature_names, "feature_names", "a list of names")) if feature_names is not None else []
     if domain is not None:
         from . import domains as _domains_module
         if not _domains_module.available:
@@ -247,12 +272,12 @@ def fit_conditional(records_or_paths: Union[PathLike, Sequence[PathLike], Iterab
     if isinstance(records_or_paths, (str, os.PathLike)):
         logs, are_paths = [os.fspath(records_or_paths)], True
     else:
-        items = list(records_or_paths)
+        items = list(_iterable(records_or_paths, "records_or_paths", "a path, a list of paths or a list of records"))
         are_paths = bool(items) and all(isinstance(item, (str, os.PathLike)) for item in items)
-        logs = [os.fspath(item) for item in items] if are_paths else [_records_text(items)]
-    return _ontime._fit_conditional(logs, are_paths, float(step), kind, names, int(horizon), float(ridge), int(bins),
-                                    int(trees), int(depth), float(learning_rate), float(min_child_weight),
-                                    str(aft_distribution), float(aft_scale))
+        logs = [os.fspath(item) for item in items] if are_paths else [_records_text(items, "records_or_paths")]
+    # Numbers as given: the extension checks and names them (horizon=1.5 is refused, not truncated).
+    return _ontime._fit_conditional(logs, are_paths, step, kind, names, horizon, ridge, bins, trees, depth,
+                                    learning_rate, min_child_weight, aft_distribution, aft_scale)
 
 
 def fit_chain(logs_or_sequences: Union[PathLike, Sequence[PathLike], Sequence[Sequence[Union[int, str]]]], *,
@@ -266,13 +291,16 @@ def fit_chain(logs_or_sequences: Union[PathLike, Sequence[PathLike], Sequence[Se
     if isinstance(logs_or_sequences, (str, os.PathLike)):
         logs, sequences = [os.fspath(logs_or_sequences)], []
     else:
-        items = list(logs_or_sequences)
+        items = list(_iterable(logs_or_sequences, "logs_or_sequences", "a path, a list of paths or of sequences"))
         if items and all(isinstance(item, (str, os.PathLike)) for item in items):
             logs, sequences = [os.fspath(item) for item in items], []
         else:
-            logs, sequences = [], [[_state_name(state) for state in sequence] for sequence in items]
-    listed = [_state_name(state) for state in states] if states is not None else []
-    return _ontime._fit_chain(logs, sequences, kind, name, float(prior), listed, capacity)
+            what = "a list of paths or of sequences of states"
+            logs, sequences = [], [[_state_name(state) for state in _iterable(sequence, "logs_or_sequences", what)]
+                                   for sequence in items]
+    listed = [_state_name(state) for state in _iterable(states, "states", "a list of states")] \
+        if states is not None else []
+    return _ontime._fit_chain(logs, sequences, kind, name, prior, listed, capacity)
 
 
 def _state_name(state: Union[int, str]) -> str:
@@ -283,6 +311,11 @@ def _state_name(state: Union[int, str]) -> str:
         raise UsageError(f"a state is a name (str) or a whole number >= 0 (got {state!r})")
     return str(operator.index(state))
 
+
+# Arguments of the wrong type raise UsageError naming the parameter (ontime/_arguments.py): the
+# functions of this module and the extension's own, which the functions above call.
+_name_wrong_arguments(_ontime)
+_name_wrong_arguments(sys.modules[__name__])
 
 from . import env  # noqa: E402,F401  (ontime.env.EffortAllocationEnv)
 from . import domains  # noqa: E402,F401  (ontime.domains, when built)

@@ -13,6 +13,9 @@ function the command line calls, with its defaults, and returns what its --json 
                                  episodes=10, clock="model")           # as `ontime tamp --json`
 """
 
+import sys
+
+from ._arguments import name_wrong_arguments as _name_wrong_arguments
 from ._ontime import domains as _domains
 
 available: bool = bool(_domains.available)
@@ -23,6 +26,10 @@ if available:
         Domain, collect, collect_and_fit, feature_names, features, load, map_data, names, predict, run, tamp)
     from ._ontime.domains import generate_kitchen as _generate_kitchen
     from ._ontime.domains import generate_world as _generate_building
+
+    # Arguments of the wrong type raise UsageError naming the parameter (ontime/_arguments.py); before
+    # the generators' table below takes the functions.
+    _name_wrong_arguments(sys.modules[__name__])
     __all__ = ["Domain", "available", "collect", "collect_and_fit", "feature_names", "features", "generate_world",
                "load", "map_data", "names", "predict", "run", "tamp"]
 
@@ -44,7 +51,7 @@ if available:
         max_boxes, skeletons=0, seed=1, name). domain="manipulation": a kitchen table scene with its goal and skeletons
         (tables=2, regions=3, region_min=0.2, region_max=0.35, targets=2, min_objects=6, max_objects=9,
         min_clutter=1, max_clutter=2, classes=["cup", "box", "bottle"], seed=1, name)."""
-        if domain not in _GENERATORS:
+        if not isinstance(domain, str) or domain not in _GENERATORS:
             raise UsageError(f"domain must be 'navigation' or 'manipulation' (got {domain!r})")
         generate, known = _GENERATORS[domain]
         for option in options:

@@ -69,7 +69,7 @@ void bind_allocators(py::module_& m) {
   m.def(
       "make_allocator",
       [](const py::object& mdp, const std::string& name, const py::kwargs& kwargs) {
-        return make_allocator_handle(to_mdp(mdp), name, parameter_values(kwargs));
+        return make_allocator_handle(to_mdp(mdp, "mdp"), name, parameter_values(kwargs));
       },
       py::arg("mdp"), py::arg("name"),
       "Makes the allocator `name` of the registry for an Mdp (or a Problem, or an instance path), with its "

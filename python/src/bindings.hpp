@@ -84,6 +84,22 @@ using Threads = Number<unsigned, "threads", 0, 1024>;
 using Iterations = Number<std::uint64_t, "iterations", 1>;
 using Seconds = Number<double, "seconds", 0.0>;
 
+// ---- object arguments that know their name ----
+// pybind11 passes None to a std::shared_ptr parameter as an empty pointer (the call would then
+// dereference it) and answers an object of another type with a TypeError listing signatures. A
+// parameter declared as Required<T, "name"> takes only a T (a class the module binds) and raises
+// UsageError naming the parameter and the class otherwise.
+template <class T, ParameterName Name>
+struct Required {
+  std::shared_ptr<T> pointer;  // never empty once loaded
+  T& operator*() const noexcept { return *pointer; }
+  T* operator->() const noexcept { return pointer.get(); }
+  operator const std::shared_ptr<T>&() const noexcept { return pointer; }  // NOLINT: used as the pointer it holds
+};
+
+// "parameter 'NAME': must be a CLASS (got WHAT)" as a UsageError.
+[[noreturn]] void refuse_object(const char* name, py::handle expected_type, py::handle got);
+
 // An Mdp with the Problem it refers to (an Mdp keeps a reference only).
 struct MdpHandle {
   explicit MdpHandle(std::shared_ptr<const Problem> p) : problem(std::move(p)), mdp(*problem) {}
@@ -135,8 +151,11 @@ struct DecisionView {
   std::shared_ptr<const Problem> problem;
 };
 
-// An MdpHandle from a Problem, an Mdp or a path to an instance file (loaded).
-std::shared_ptr<MdpHandle> to_mdp(const py::object& source);
+// An MdpHandle from a Problem, an Mdp or a path to an instance file (loaded); UsageError naming
+// `parameter` for anything else.
+std::shared_ptr<MdpHandle> to_mdp(const py::object& source, const char* parameter = "problem");
+// The text of a path argument (str or os.PathLike); UsageError naming `parameter` for anything else.
+std::string path_argument(const py::handle& value, const char* parameter);
 // The instance's file name when `source` is a path, else the problem's name (the `instance` field
 // of the results, as the command line reports it).
 std::string instance_label(const py::object& source, const Problem& problem);
@@ -224,7 +243,10 @@ struct type_caster<ontime::python::Number<T, Name, Min, Max>> {
     if constexpr (std::is_integral_v<T>) {
       if (!PyIndex_Check(object)) ontime::python::refuse_number(Name.text, rule, source);
       const auto whole = reinterpret_steal<pybind11::int_>(PyNumber_Index(object));
-      if (!whole) throw error_already_set();
+      if (!whole) {
+        PyErr_Clear();  // e.g. a numpy array of several numbers
+        ontime::python::refuse_number(Name.text, rule, source);
+      }
       if (whole < pybind11::int_(Min) || whole > pybind11::int_(Max))
         ontime::python::refuse_number(Name.text, rule, source);
       value.value = pybind11::cast<T>(whole);
@@ -254,6 +276,25 @@ struct type_caster<ontime::python::Number<T, Name, Min, Max>> {
     } else {
       return pybind11::float_(static_cast<double>(number.value)).release();
     }
+  }
+};
+
+template <class T, ontime::python::ParameterName Name>
+struct type_caster<ontime::python::Required<T, Name>> {
+  using Value = ontime::python::Required<T, Name>;
+  PYBIND11_TYPE_CASTER(Value, const_name("object"));
+
+  bool load(handle source, bool /*convert*/) {
+    const pybind11::type expected = pybind11::type::of<T>();
+    if (!source || source.is_none() || !isinstance(source, expected)) {
+      ontime::python::refuse_object(Name.text, expected, source);
+    }
+    value.pointer = pybind11::cast<std::shared_ptr<T>>(source);
+    return true;
+  }
+
+  static handle cast(const Value& object, return_value_policy policy, handle parent) {
+    return make_caster<std::shared_ptr<T>>::cast(object.pointer, policy, parent);
   }
 };
 

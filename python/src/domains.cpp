@@ -40,8 +40,6 @@ struct DomainHandle {
   domains::LoadedDomain loaded;
 };
 
-std::string path_text(const py::object& path) { return py::str(py::module_::import("os").attr("fspath")(path)); }
-
 // Progress and Ctrl-C of a long library call: `progress` and `stop` hooks for run_interruptibly.
 struct Hooks {
   std::function<void(std::uint64_t, std::uint64_t)> progress;
@@ -116,7 +114,7 @@ void bind_domains(py::module_& m) {
       [](const std::string& name, const py::object& world_file) {
         auto handle = std::make_shared<DomainHandle>();
         handle->name = name;
-        handle->world_file = path_text(world_file);
+        handle->world_file = path_argument(world_file, "world_file");
         const py::gil_scoped_release release;
         handle->loaded = domains::load_domain(name, handle->world_file);
         return handle;
@@ -127,7 +125,7 @@ void bind_domains(py::module_& m) {
 
   m.def(
       "collect",
-      [](const std::shared_ptr<DomainHandle>& domain, Number<std::uint64_t, "trials", 1> trials, Seed seed,
+      [](const Required<DomainHandle, "domain">& domain, Number<std::uint64_t, "trials", 1> trials, Seed seed,
          Threads threads, const std::string& effort, ChecksPerSecond checks_per_second, StepSeconds step_seconds,
          BudgetSteps budget_steps, bool every_action, bool features, const py::object& progress) {
         const domains::CollectAndFitOptions request = collect_request(
@@ -156,7 +154,7 @@ void bind_domains(py::module_& m) {
 
   m.def(
       "collect_and_fit",
-      [](const std::shared_ptr<DomainHandle>& domain, const py::object& log, const py::object& instance,
+      [](const Required<DomainHandle, "domain">& domain, const py::object& log, const py::object& instance,
          Number<std::uint64_t, "trials", 1> trials, Seed seed, Threads threads, const std::string& effort,
          ChecksPerSecond checks_per_second, StepSeconds step_seconds,
          Number<Steps, "deadline", 0, Problem::kMaxDeadline> deadline, BudgetSteps budget_steps,
@@ -167,9 +165,9 @@ void bind_domains(py::module_& m) {
         options.deadline = deadline;
         options.laplace = laplace;
         options.log_format = log_format;
-        options.log = path_text(log);
-        options.instance = path_text(instance);
-        if (!checkpoint.is_none()) options.checkpoint = path_text(checkpoint);
+        options.log = path_argument(log, "log");
+        options.instance = path_argument(instance, "instance");
+        if (!checkpoint.is_none()) options.checkpoint = path_argument(checkpoint, "checkpoint");
         options.resume = resume;
         domains::CollectAndFitResult result;
         run_interruptibly(
@@ -195,7 +193,7 @@ void bind_domains(py::module_& m) {
 
   m.def(
       "run",
-      [](const std::shared_ptr<DomainHandle>& domain, const py::object& problem, const std::string& solver,
+      [](const Required<DomainHandle, "domain">& domain, const py::object& problem, const std::string& solver,
          Episodes episodes, Seed seed, Threads threads, const std::string& effort, ChecksPerSecond checks_per_second,
          bool independent_starts, bool exact, bool live, DecisionShare decision_share, const py::object& belief,
          const py::object& progress, const py::kwargs& kwargs) {
@@ -204,7 +202,7 @@ void bind_domains(py::module_& m) {
         std::shared_ptr<MdpHandle> believed;
         domains::PlannerRunOptions options;
         if (!belief.is_none()) {
-          believed = to_mdp(belief);
+          believed = to_mdp(belief, "belief");
           try {
             (void)with_distributions_of(*mdp->problem, *believed->problem);
           } catch (const UsageError& error) {
@@ -251,7 +249,7 @@ void bind_domains(py::module_& m) {
 
   m.def(
       "tamp",
-      [](const std::shared_ptr<DomainHandle>& domain, const py::object& library, const std::string& solver,
+      [](const Required<DomainHandle, "domain">& domain, const py::object& library, const std::string& solver,
          Number<double, "deadline", 1e-9> deadline, Number<std::uint64_t, "episodes", 1> episodes, Seed seed,
          Threads threads, const std::string& effort, Number<double, "task_seconds", 0.0, 1e6> task_seconds,
          Number<int, "arrival_period", 1, 10'000> arrival_period,
@@ -267,7 +265,7 @@ void bind_domains(py::module_& m) {
         if (clock == "real" && (decision_seconds || iteration_seconds)) {
           throw UsageError("decision_seconds and iteration_seconds need clock='model'");
         }
-        const std::shared_ptr<MdpHandle> mdp = to_mdp(library);
+        const std::shared_ptr<MdpHandle> mdp = to_mdp(library, "library");
         domains::TampOptions options;
         options.solver = solver;
         options.parameters = parameter_values(kwargs);
@@ -331,7 +329,7 @@ void bind_domains(py::module_& m) {
 
   m.def(
       "map_data",
-      [](const std::shared_ptr<DomainHandle>& domain, Seed seed) {
+      [](const Required<DomainHandle, "domain">& domain, Seed seed) {
         domains::MapDrawing drawing;
         {
           const py::gil_scoped_release release;
@@ -349,7 +347,7 @@ void bind_domains(py::module_& m) {
 
   m.def(
       "features",
-      [](const std::shared_ptr<DomainHandle>& domain, const std::string& action) {
+      [](const Required<DomainHandle, "domain">& domain, const std::string& action) {
         std::vector<double> values;
         try {
           values = domain->loaded.domain->action_features(action);
@@ -363,7 +361,7 @@ void bind_domains(py::module_& m) {
 
   m.def(
       "predict",
-      [](const std::shared_ptr<DomainHandle>& domain, const std::shared_ptr<ConditionalTimeModel>& model,
+      [](const Required<DomainHandle, "domain">& domain, const Required<ConditionalTimeModel, "model">& model,
          Number<Steps, "deadline", 0, Problem::kMaxDeadline> deadline, bool library, const std::string& name,
          Threads threads) {
         domains::PredictOptions options;
@@ -415,7 +413,7 @@ void bind_domains(py::module_& m) {
         options.skeletons = skeletons;
         options.seed = seed;
         if (name) options.name = *name;
-        const std::string path = path_text(output);
+        const std::string path = path_argument(output, "output");
         domains::GeneratedWorld world;
         {
           const py::gil_scoped_release release;
@@ -462,7 +460,7 @@ void bind_domains(py::module_& m) {
         options.max_clutter = max_clutter;
         options.classes = classes;
         if (name) options.name = *name;
-        const std::string path = path_text(output);
+        const std::string path = path_argument(output, "output");
         domains::GeneratedKitchen kitchen;
         {
           const py::gil_scoped_release release;

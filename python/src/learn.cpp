@@ -67,8 +67,7 @@ void bind_conditional(py::module_& m) {
       .def(
           "save",
           [](const ConditionalTimeModel& model, const py::object& path) {
-            write_file_atomically(std::string(py::str(py::module_::import("os").attr("fspath")(path))),
-                                  model.to_json());
+            write_file_atomically(path_argument(path, "path"), model.to_json());
           },
           py::arg("path"), "Writes the model file (atomically).");
 
@@ -76,7 +75,8 @@ void bind_conditional(py::module_& m) {
       "_fit_conditional",
       [](const std::vector<std::string>& logs, bool are_paths, Number<double, "step", 0.0> step,
          const std::string& kind, const std::vector<std::string>& feature_names,
-         Number<Steps, "horizon", 0, Problem::kMaxDeadline> horizon, Number<double, "ridge", 0.0> ridge,
+         Number<Steps, "horizon", 0, Problem::kMaxDeadline> horizon,
+         Number<double, "ridge", 0.0, ConditionalFitOptions::kMaxRidge> ridge,
          Number<int, "bins", 0, Problem::kMaxDeadline> bins, Number<int, "trees", 1, 10000> trees,
          Number<int, "depth", 1, 16> depth, Number<double, "learning_rate", 0.0, 1.0> learning_rate,
          Number<double, "min_child_weight", 0.0> min_child_weight, const std::string& aft_distribution,
@@ -131,7 +131,7 @@ void bind_conditional(py::module_& m) {
       "    ... drive it ...\n"
       "    belief.observe(session.problem, session.attempts)")
       .def(py::init([](const py::object& prior, Number<double, "strength", 1e-9, 1e9> strength) {
-             return OnlineBelief(*to_mdp(prior)->problem, strength);
+             return OnlineBelief(*to_mdp(prior, "prior")->problem, strength);
            }),
            py::arg("prior"), py::arg("strength"))
       .def(
@@ -152,7 +152,7 @@ void bind_conditional(py::module_& m) {
       .def(
           "believed_for",
           [](const OnlineBelief& belief, const py::object& structure) {
-            return belief.believed_for(*to_mdp(structure)->problem);
+            return belief.believed_for(*to_mdp(structure, "structure")->problem);
           },
           py::arg("structure"),
           "`structure`'s skeletons with the believed distributions, each action by its id or base id.")
@@ -163,24 +163,23 @@ void bind_conditional(py::module_& m) {
 
   m.def(
       "load_conditional_model",
-      [](const py::object& path) {
-        return Model(load_conditional_model(std::string(py::str(py::module_::import("os").attr("fspath")(path)))));
-      },
+      [](const py::object& path) { return Model(load_conditional_model(path_argument(path, "path"))); },
       py::arg("path"), "Reads a model file (`ontime fit --conditional`); InputError names the place and rule.");
 
   m.def(
       "fit_strength",
-      [](const Model& model, const std::vector<py::object>& logs, const std::vector<double>& strengths) {
+      [](const Required<ConditionalTimeModel, "model">& model, const std::vector<py::object>& logs,
+         const std::vector<double>& strengths) {
         if (logs.empty()) throw UsageError("logs: give at least one planner log");
         std::vector<std::filesystem::path> paths;
         for (const py::object& log : logs) {
-          paths.emplace_back(std::string(py::str(py::module_::import("os").attr("fspath")(log))));
+          paths.emplace_back(path_argument(log, "logs"));
         }
         std::vector<StrengthScore> scores;
         std::size_t attempts = 0;
         {
           const py::gil_scoped_release release;
-          const ConditionalData data = load_conditional_data(paths, model->step_seconds());
+          const ConditionalData data = load_conditional_data_for(*model, "given", paths);
           attempts = data.rows();
           scores = score_prior_strengths(*model, data, strengths);
         }
@@ -289,7 +288,7 @@ void bind_learn(py::module_& m) {
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
         if (logs.empty()) throw UsageError("logs: give at least one planner log");
         std::vector<std::string> paths;
-        for (const py::object& log : logs) paths.emplace_back(py::str(py::module_::import("os").attr("fspath")(log)));
+        for (const py::object& log : logs) paths.emplace_back(path_argument(log, "logs"));
         report::ScoreReport report{.instance = instance_label(problem, *mdp->problem),
                                    .logs = paths,
                                    .problem = mdp->problem.get(),
@@ -319,7 +318,7 @@ void bind_learn(py::module_& m) {
       [](const py::object& problem, const py::object& path, Number<std::uint64_t, "attempts", 1> attempts, Seed seed,
          std::optional<Number<Steps, "cutoff", 1>> cutoff) {
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
-        const std::string file = py::str(py::module_::import("os").attr("fspath")(path));
+        const std::string file = path_argument(path, "path");
         LogSamplingOptions options;
         options.attempts_per_action = attempts;
         options.seed = seed;
@@ -338,7 +337,7 @@ void bind_learn(py::module_& m) {
       [](const py::object& problem, const py::object& out, Episodes episodes, Seed seed, const py::object& progress) {
         check_episodes(episodes);
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
-        const std::string path = py::str(py::module_::import("os").attr("fspath")(out));
+        const std::string path = path_argument(out, "out");
         std::optional<PpoTraining> training;
         run_interruptibly(
             [&](const std::function<bool()>& stop, Progress& counters) {

@@ -177,7 +177,7 @@ void bind_live(py::module_& m) {
       .def(
           "revise_distributions",
           [](LiveSessionHandle& h, const py::object& beliefs) {
-            const std::shared_ptr<MdpHandle> source = to_mdp(beliefs);
+            const std::shared_ptr<MdpHandle> source = to_mdp(beliefs, "beliefs");
             session_call([&] { h.session.revise_distributions(*source->problem); });
             h.current = std::make_shared<const Problem>(h.session.problem());
           },

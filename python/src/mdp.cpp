@@ -56,7 +56,9 @@ void bind_mdp(py::module_& m) {
 
   py::class_<MdpHandle, std::shared_ptr<MdpHandle>>(
       m, "Mdp", "The effort-allocation MDP of a problem (SPEC §2), with its precomputed tables.")
-      .def(py::init([](std::shared_ptr<Problem> problem) { return std::make_shared<MdpHandle>(std::move(problem)); }),
+      .def(py::init([](const Required<Problem, "problem">& problem) {
+             return std::make_shared<MdpHandle>(problem.pointer);
+           }),
            py::arg("problem"))
       .def_property_readonly("problem", [](const MdpHandle& h) { return std::const_pointer_cast<Problem>(h.problem); })
       .def_property_readonly("skeleton_count", [](const MdpHandle& h) { return h.mdp.skeleton_count(); })

@@ -127,10 +127,7 @@ void bind_model(py::module_& m) {
           "to_json", [](const Problem& p) { return problem_to_json(p); },
           "The instance as JSON text (PMF form, sorted keys), readable back by from_json.")
       .def(
-          "save",
-          [](const Problem& p, const py::object& path) {
-            save_problem(p, std::string(py::str(py::module_::import("os").attr("fspath")(path))));
-          },
+          "save", [](const Problem& p, const py::object& path) { save_problem(p, path_argument(path, "path")); },
           py::arg("path"), "Writes the instance file atomically (the old file or the whole new one, never a mix).")
       .def_property_readonly("name", &Problem::name)
       .def_property_readonly("description", &Problem::description)
@@ -201,7 +198,7 @@ void bind_model(py::module_& m) {
   m.def(
       "load_problem",
       [](const py::object& path) {
-        const std::string file = py::str(py::module_::import("os").attr("fspath")(path));
+        const std::string file = path_argument(path, "path");
         const py::gil_scoped_release release;
         return std::make_shared<Problem>(load_problem(file));
       },
@@ -217,7 +214,7 @@ void bind_model(py::module_& m) {
   m.def(
       "read_planner_log",
       [](const py::object& path) {
-        const std::string file = py::str(py::module_::import("os").attr("fspath")(path));
+        const std::string file = path_argument(path, "path");
         std::vector<RefinementAttempt> attempts;
         {
           const py::gil_scoped_release release;
@@ -232,10 +229,11 @@ void bind_model(py::module_& m) {
 
   m.def(
       "_save_planner_log",
-      [](const std::string& text, const std::string& source, const std::string& path) {
+      [](const std::string& text, const std::string& source, const py::object& path) {
+        const std::string file = path_argument(path, "path");
         const std::vector<RefinementAttempt> attempts = parse_planner_log(text, source);
         const py::gil_scoped_release release;
-        save_planner_log(attempts, path);
+        save_planner_log(attempts, file);
       },
       py::arg("text"), py::arg("source"), py::arg("path"));
 
@@ -279,17 +277,12 @@ void bind_model(py::module_& m) {
       .def("to_json", &chain_to_json, "The chain file's text.")
       .def(
           "save",
-          [](const ExogenousChain& chain, const py::object& path) {
-            save_chain(chain, std::string(py::str(py::module_::import("os").attr("fspath")(path))));
-          },
+          [](const ExogenousChain& chain, const py::object& path) { save_chain(chain, path_argument(path, "path")); },
           py::arg("path"), "Writes the chain file (atomically).");
 
   m.def(
-      "load_chain",
-      [](const py::object& path) {
-        return load_chain(std::string(py::str(py::module_::import("os").attr("fspath")(path))));
-      },
-      py::arg("path"), "Reads a chain file (`ontime fit-chain`'s output); InputError naming the place and the rule.");
+      "load_chain", [](const py::object& path) { return load_chain(path_argument(path, "path")); }, py::arg("path"),
+      "Reads a chain file (`ontime fit-chain`'s output); InputError naming the place and the rule.");
 }
 
 }  // namespace ontime::python

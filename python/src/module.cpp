@@ -18,7 +18,7 @@
 
 namespace ontime::python {
 
-std::shared_ptr<MdpHandle> to_mdp(const py::object& source) {
+std::shared_ptr<MdpHandle> to_mdp(const py::object& source, const char* parameter) {
   if (py::isinstance<MdpHandle>(source)) return source.cast<std::shared_ptr<MdpHandle>>();
   if (py::isinstance<Problem>(source)) return std::make_shared<MdpHandle>(source.cast<std::shared_ptr<Problem>>());
   if (py::isinstance<py::str>(source) || py::hasattr(source, "__fspath__")) {
@@ -30,13 +30,32 @@ std::shared_ptr<MdpHandle> to_mdp(const py::object& source) {
     }
     return std::make_shared<MdpHandle>(std::move(problem));
   }
-  throw py::type_error("expected an ontime.Problem, an ontime.Mdp or the path of an instance file, got " +
-                       std::string(py::str(py::type::of(source).attr("__name__"))));
+  throw UsageError(
+      "parameter '" + std::string(parameter) +
+      "': must be an ontime.Problem, an ontime.Mdp or the path of an instance file (got " +
+      (source.is_none() ? std::string("None") : "a " + std::string(py::str(py::type::of(source).attr("__name__")))) +
+      ")");
+}
+
+std::string path_argument(const py::handle& value, const char* parameter) {
+  if (!py::isinstance<py::str>(value) && !py::hasattr(value, "__fspath__")) {
+    throw UsageError(
+        "parameter '" + std::string(parameter) + "': must be a path (str or os.PathLike) (got " +
+        (value.is_none() ? std::string("None") : "a " + std::string(py::str(py::type::of(value).attr("__name__")))) +
+        ")");
+  }
+  const py::object text = py::module_::import("os").attr("fspath")(value);
+  if (!py::isinstance<py::str>(text)) {
+    throw UsageError("parameter '" + std::string(parameter) + "': must be a path of text, not bytes");
+  }
+  return text.cast<std::string>();
 }
 
 void refuse_number(const char* name, const std::string& rule, py::handle got) {
   std::string shown;
-  if (PyBool_Check(got.ptr())) {
+  if (got.is_none()) {
+    shown = "None";
+  } else if (PyBool_Check(got.ptr())) {
     shown = "a bool";
   } else if (py::isinstance<py::int_>(got) || py::isinstance<py::float_>(got)) {
     shown = py::str(got);
@@ -44,6 +63,12 @@ void refuse_number(const char* name, const std::string& rule, py::handle got) {
     shown = "a " + std::string(py::str(py::type::of(got).attr("__name__")));
   }
   throw UsageError("parameter '" + std::string(name) + "': " + rule + " (got " + shown + ")");
+}
+
+void refuse_object(const char* name, py::handle expected_type, py::handle got) {
+  const std::string shown = got.is_none() ? "None" : "a " + std::string(py::str(py::type::of(got).attr("__name__")));
+  throw UsageError("parameter '" + std::string(name) + "': must be a " +
+                   std::string(py::str(expected_type.attr("__name__"))) + " (got " + shown + ")");
 }
 
 std::string instance_label(const py::object& source, const Problem& problem) {
@@ -69,6 +94,9 @@ ParameterValues parameter_values(const py::kwargs& kwargs) {
       text = py::str(value);
     } else if (py::hasattr(value, "__fspath__")) {
       text = py::str(py::module_::import("os").attr("fspath")(value));
+    } else if (py::hasattr(value, "__len__")) {  // a numpy array has __index__ and __float__, but many numbers
+      throw UsageError("parameter '" + name + "': expected a number, text or a path, got a " +
+                       std::string(py::str(py::type::of(value).attr("__name__"))));
     } else if (py::hasattr(value, "__index__")) {  // numpy integers
       text = py::str(py::int_(py::reinterpret_borrow<py::object>(value)));
     } else if (py::hasattr(value, "__float__")) {  // numpy floats

@@ -214,9 +214,9 @@ void bind_run(py::module_& m) {
       "    if session.status == ontime.Status.success: execute(session.solution)\n\n"
       "`iterations` / `seconds` set the per-decision budget of an anytime allocator (mcts) for every decision; "
       "choose() may override it for one. The allocator must not serve another session at the same time.")
-      .def(py::init([](std::shared_ptr<AllocatorHandle> allocator, Seed seed, std::optional<Iterations> iterations,
-                       std::optional<Seconds> seconds) {
-             return std::make_unique<SessionHandle>(std::move(allocator), seed, budget_of(iterations, seconds));
+      .def(py::init([](const Required<AllocatorHandle, "allocator">& allocator, Seed seed,
+                       std::optional<Iterations> iterations, std::optional<Seconds> seconds) {
+             return std::make_unique<SessionHandle>(allocator.pointer, seed, budget_of(iterations, seconds));
            }),
            py::arg("allocator"), py::arg("seed") = 0, py::kw_only(), py::arg("iterations") = py::none(),
            py::arg("seconds") = py::none())
@@ -378,8 +378,8 @@ void bind_run(py::module_& m) {
         // The allocator's own instance: the problem's skeletons with the belief's distributions.
         std::shared_ptr<MdpHandle> planned = mdp;
         if (!belief.is_none()) {
-          planned = std::make_shared<MdpHandle>(
-              std::make_shared<const Problem>(with_distributions_of(*mdp->problem, *to_mdp(belief)->problem)));
+          planned = std::make_shared<MdpHandle>(std::make_shared<const Problem>(
+              with_distributions_of(*mdp->problem, *to_mdp(belief, "belief")->problem)));
         }
         const ParameterValues values = parameter_values(kwargs);
         std::optional<AllocatorFactory> factory;
@@ -419,7 +419,7 @@ void bind_run(py::module_& m) {
          Number<std::uint64_t, "sequences", 1, 10'000'000> sequences, Seed seed, Threads threads, bool exact,
          const py::kwargs& kwargs) {
         const std::shared_ptr<MdpHandle> truth = to_mdp(problem);
-        const std::shared_ptr<MdpHandle> prior = to_mdp(belief);
+        const std::shared_ptr<MdpHandle> prior = to_mdp(belief, "belief");
         AdaptationOptions options;
         options.solver = solver;
         options.parameters = parameter_values(kwargs);
@@ -498,7 +498,7 @@ void bind_run(py::module_& m) {
               row_parameters[key] = value;
             }
           }
-          const std::shared_ptr<MdpHandle> mdp = to_mdp(source);
+          const std::shared_ptr<MdpHandle> mdp = to_mdp(source, "instances");
           const std::string label = instance_label(source, *mdp->problem);
           const bool is_file = py::isinstance<py::str>(source) || py::hasattr(source, "__fspath__");
           rows.push_back(
@@ -555,7 +555,7 @@ void bind_run(py::module_& m) {
         std::vector<StudyInstance> rows;
         for (const py::handle source : instances) {
           const auto object = py::reinterpret_borrow<py::object>(source);
-          const std::shared_ptr<MdpHandle> mdp = to_mdp(object);
+          const std::shared_ptr<MdpHandle> mdp = to_mdp(object, "instances");
           const std::string label = instance_label(object, *mdp->problem);
           const bool is_file = py::isinstance<py::str>(object) || py::hasattr(object, "__fspath__");
           rows.push_back({*mdp->problem, label, is_file ? std::filesystem::path(label).stem().string() : label});

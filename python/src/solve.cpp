@@ -50,8 +50,7 @@ void bind_solve(py::module_& m) {
       "reduce_knapsack",
       [](const py::object& knapsack, const std::optional<std::string>& name) {
         const bool is_file = py::isinstance<py::str>(knapsack) || py::hasattr(knapsack, "__fspath__");
-        const std::string source =
-            is_file ? std::string(py::str(py::module_::import("os").attr("fspath")(knapsack))) : "<knapsack>";
+        const std::string source = is_file ? path_argument(knapsack, "knapsack") : "<knapsack>";
         const std::string text =
             is_file ? std::string() : std::string(py::str(py::module_::import("json").attr("dumps")(knapsack)));
         const py::gil_scoped_release release;
@@ -155,7 +154,7 @@ void bind_solve(py::module_& m) {
         options.threads = threads;
         options.tolerance = tolerance;
         options.split = method == "split" ? SplitMode::always : SplitMode::fallback;
-        if (!scratch.is_none()) options.scratch_directory = py::str(py::module_::import("os").attr("fspath")(scratch));
+        if (!scratch.is_none()) options.scratch_directory = path_argument(scratch, "scratch");
         if (max_memory_mib > 0) {
           check_memory_for("max_memory_mib", static_cast<double>(max_memory_mib) * 1048576.0);
           options.max_memory_bytes = max_memory_mib << 20;
@@ -177,8 +176,7 @@ void bind_solve(py::module_& m) {
           solve.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
         });
         if (!policy.is_none()) {
-          write_file_atomically(std::string(py::str(py::module_::import("os").attr("fspath")(policy))),
-                                report::policy_lines(solve));
+          write_file_atomically(path_argument(policy, "policy"), report::policy_lines(solve));
         }
         return json_object(report::to_json(solve));
       },

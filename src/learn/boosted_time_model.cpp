@@ -16,6 +16,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "learn/booster_check.hpp"
 #include "learn/conditional_kinds.hpp"
 #include "ontime/util/error.hpp"
 #include "util/portable_math.hpp"
@@ -562,6 +563,10 @@ std::unique_ptr<ConditionalTimeModel> read_boosted_model(const ParameterReader& 
   const std::size_t F = header.feature_names.size();
   const auto booster = [&](const std::string& key, const std::string& objective, const BoostedSettings* aft) {
     const std::string text = reader.text(key);
+    // Checked whole before XGBoost, which trusts what it reads (learn/booster_check.hpp).
+    if (const auto fault = booster_fault(text, F)) {
+      reader.fail(key, "not a booster OnTime reads: at " + fault->place + ": " + fault->rule);
+    }
     try {
       return loaded_booster(text, objective, F, aft);
     } catch (const XGBoostFailure& failure) {

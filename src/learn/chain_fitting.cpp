@@ -53,14 +53,14 @@ ObservedState read_observation(const ObservationJson& record, const std::string&
   ObservedState observation;
   if (record.contains("sequence")) {
     if (!record["sequence"].is_string()) {
-      fail("sequence", "must be a string naming the sequence (got " + record["sequence"].dump() + ")");
+      fail("sequence", "must be a string naming the sequence (got " + detail::quote_json(record["sequence"]) + ")");
     }
     observation.sequence = record["sequence"].get<std::string>();
   }
   if (!record.contains("step")) fail("", "missing required key 'step'");
   const std::optional<std::int64_t> step =
       detail::json_whole_number(record["step"], 0, std::numeric_limits<std::int64_t>::max() / 2);
-  if (!step) fail("step", "must be a whole number of steps >= 0 (got " + record["step"].dump() + ")");
+  if (!step) fail("step", "must be a whole number of steps >= 0 (got " + detail::quote_json(record["step"]) + ")");
   observation.step = *step;
   if (!record.contains("state")) fail("", "missing required key 'state'");
   const ObservationJson& state = record["state"];
@@ -70,7 +70,7 @@ ObservedState read_observation(const ObservationJson& record, const std::string&
   } else {
     const std::optional<std::int64_t> number =
         detail::json_whole_number(state, 0, std::numeric_limits<std::int64_t>::max());
-    if (!number) fail("state", "must be a state's name or a whole number >= 0 (got " + state.dump() + ")");
+    if (!number) fail("state", "must be a state's name or a whole number >= 0 (got " + detail::quote_json(state) + ")");
     observation.state = std::to_string(*number);
   }
   return observation;

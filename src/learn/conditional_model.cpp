@@ -1,7 +1,11 @@
 #include "ontime/learn/conditional_model.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <map>
+#include <optional>
 #include <set>
 
 #include "learn/conditional_kinds.hpp"
@@ -42,10 +46,19 @@ ConditionalData conditional_data(std::span<const RefinementAttempt> attempts, do
                        "has " + std::to_string(attempt.features.size()) + " features, the first record " +
                            std::to_string(data.feature_count));
     }
+    for (std::size_t f = 0; f < attempt.features.size(); ++f) {
+      if (!(std::abs(attempt.features[f]) <= ConditionalData::kMaxFeature)) {
+        throw InputError(std::string(source), record_place(i) + ": features[" + std::to_string(f) + "]",
+                         "a feature must be within [-1e15, 1e15] (the boosted kind computes in 32-bit floats and "
+                         "the hazard kind squares the features)");
+      }
+    }
     data.features.insert(data.features.end(), attempt.features.begin(), attempt.features.end());
     data.found.push_back(attempt.found ? 1 : 0);
-    data.planning.push_back(attempt.found ? steps_to_complete(attempt.planning_seconds, step_seconds)
-                                          : whole_steps_within(attempt.planning_seconds, step_seconds));
+    // Rounded as `fit` rounds them: a motion found within no time took its first step.
+    data.planning.push_back(attempt.found
+                                ? std::max<Steps>(1, steps_to_complete(attempt.planning_seconds, step_seconds))
+                                : whole_steps_within(attempt.planning_seconds, step_seconds));
     data.execution_seconds.push_back(attempt.found ? attempt.execution_seconds : 0.0);
     data.worlds.push_back(attempt.world.value_or(""));
     data.actions.push_back(attempt.action);
@@ -76,6 +89,18 @@ ConditionalData load_conditional_data(std::span<const std::filesystem::path> log
     append(data.execution_seconds, part.execution_seconds);
     append(data.worlds, part.worlds);
     append(data.actions, part.actions);
+  }
+  return data;
+}
+
+ConditionalData load_conditional_data_for(const ConditionalTimeModel& model, std::string_view model_file,
+                                          std::span<const std::filesystem::path> logs) {
+  ConditionalData data = load_conditional_data(logs, model.step_seconds());
+  // Every log has the first one's feature count (load_conditional_data): a mismatch is its first record's.
+  if (data.feature_count != model.feature_count()) {
+    throw InputError(logs.front().string(), "record 1",
+                     "has " + std::to_string(data.feature_count) + " features, the model " + std::string(model_file) +
+                         " takes " + std::to_string(model.feature_count()));
   }
   return data;
 }
@@ -189,7 +214,9 @@ std::unique_ptr<ConditionalTimeModel> fit_conditional_model(const ConditionalDat
   }
   if (options.kind == PooledTimeModel::kind_name()) return PooledTimeModel::fit(data, std::move(names), horizon);
   if (options.kind == HazardTimeModel::kind_name()) {
-    if (!(options.ridge >= 0 && std::isfinite(options.ridge))) throw UsageError("the ridge must be a number >= 0");
+    if (!(options.ridge >= 0 && options.ridge <= ConditionalFitOptions::kMaxRidge)) {
+      throw UsageError("the ridge must be a number from 0 to 1e6");
+    }
     if (options.bins < 0 || options.bins > horizon) {
       throw UsageError("the bins must be between 0 and the horizon (" + std::to_string(horizon) + ")");
     }
@@ -252,8 +279,10 @@ std::vector<int> ParameterReader::whole_numbers(const std::string& key) const {
   if (!value.is_array() || value.empty()) fail(key, "must be a non-empty array of whole numbers");
   std::vector<int> out;
   for (const ModelJson& item : value) {
-    if (!item.is_number_integer()) fail(key, "must hold whole numbers only");
-    out.push_back(item.get<int>());
+    const auto number =
+        detail::json_whole_number(item, std::numeric_limits<int>::min(), std::numeric_limits<int>::max());
+    if (!number) fail(key, "must hold whole numbers of 32 bits only");
+    out.push_back(static_cast<int>(*number));
   }
   return out;
 }
@@ -270,11 +299,13 @@ std::unique_ptr<ConditionalTimeModel> parse_conditional_model(std::string_view t
   if (!json.contains("format") || json["format"] != std::string(ConditionalTimeModel::kFormat)) {
     fail("format", "not a conditional time model (expected \"" + std::string(ConditionalTimeModel::kFormat) + "\")");
   }
-  if (!json.contains("version") || !json["version"].is_number_integer() ||
-      json["version"].get<int>() != ConditionalTimeModel::kVersion) {
+  // Whole numbers by the instance reader's rules (`1` or `1.0`; nothing truncated to 32 bits).
+  if (!json.contains("version") ||
+      detail::json_whole_number(json["version"], std::numeric_limits<std::int64_t>::min(),
+                                std::numeric_limits<std::int64_t>::max()) != ConditionalTimeModel::kVersion) {
     fail("version", "this OnTime reads version " + std::to_string(ConditionalTimeModel::kVersion) +
-                        " of the model format (got " + (json.contains("version") ? json["version"].dump() : "none") +
-                        ")");
+                        " of the model format (got " +
+                        (json.contains("version") ? detail::quote_json(json["version"]) : "none") + ")");
   }
   detail::ModelHeader header;
   if (!json.contains("feature_names") || !json["feature_names"].is_array())
@@ -288,11 +319,10 @@ std::unique_ptr<ConditionalTimeModel> parse_conditional_model(std::string_view t
     fail("step_seconds", "must be a positive number of seconds");
   }
   header.step_seconds = json["step_seconds"].get<double>();
-  if (!json.contains("horizon") || !json["horizon"].is_number_integer() || json["horizon"].get<Steps>() < 1 ||
-      json["horizon"].get<Steps>() > Problem::kMaxDeadline) {
-    fail("horizon", "must be a whole number of steps from 1 to " + std::to_string(Problem::kMaxDeadline));
-  }
-  header.horizon = json["horizon"].get<Steps>();
+  const auto horizon =
+      json.contains("horizon") ? detail::json_whole_number(json["horizon"], 1, Problem::kMaxDeadline) : std::nullopt;
+  if (!horizon) fail("horizon", "must be a whole number of steps from 1 to " + std::to_string(Problem::kMaxDeadline));
+  header.horizon = static_cast<Steps>(*horizon);
   if (json.contains("training") && json["training"].is_object()) {
     const ModelJson& training = json["training"];
     if (training.contains("rows") && training["rows"].is_number_unsigned())

@@ -17,6 +17,8 @@ Distribution Distribution::from_pmf(std::vector<double> masses) {
   }
   double total = 0;
   for (const double mass : masses) {
+    // NaN named as such (std::to_string writes "-nan" or "nan" by its sign bit).
+    if (std::isnan(mass)) throw UsageError("a probability is not a number (NaN)");
     if (!(mass >= 0.0 && mass <= 1.0)) {
       throw UsageError("probability outside [0, 1]: " + std::to_string(mass));
     }

@@ -96,12 +96,12 @@ ExogenousChain read_chain_fields(const nlohmann::ordered_json& object, const std
     fail(at("states"), "must be an array of state names (got " + describe_json_type(states) + ")");
   for (std::size_t i = 0; i < states.size(); ++i) {
     if (!states[i].is_string()) {
-      fail(json_index(at("states"), i), "a state's name is a string (got " + states[i].dump() + ")");
+      fail(json_index(at("states"), i), "a state's name is a string (got " + detail::quote_json(states[i]) + ")");
     }
     chain.states.push_back(states[i].get<std::string>());
   }
   const ChainJson& start = object["start"];
-  if (!start.is_string()) fail(at("start"), "must be a state's name (got " + start.dump() + ")");
+  if (!start.is_string()) fail(at("start"), "must be a state's name (got " + detail::quote_json(start) + ")");
   chain.start = chain.state_index(start.get<std::string>());
   if (chain.start < 0) fail(at("start"), "'" + start.get<std::string>() + "' is not one of the chain's states");
   const ChainJson& rows = object["transitions"];
@@ -112,7 +112,7 @@ ExogenousChain read_chain_fields(const nlohmann::ordered_json& object, const std
     std::vector<double> row;
     for (std::size_t j = 0; j < rows[i].size(); ++j) {
       if (!rows[i][j].is_number()) {
-        fail(json_index(place, j), "a transition probability is a number (got " + rows[i][j].dump() + ")");
+        fail(json_index(place, j), "a transition probability is a number (got " + detail::quote_json(rows[i][j]) + ")");
       }
       row.push_back(rows[i][j].get<double>());
     }
@@ -138,13 +138,13 @@ ExogenousChain parse_chain(std::string_view text, std::string_view source) {
   }
   if (!root.contains("version") || !root["version"].is_number_integer() || root["version"].get<int>() != kVersion) {
     fail("version", "this OnTime reads version " + std::to_string(kVersion) + " of the chain format (got " +
-                        (root.contains("version") ? root["version"].dump() : "none") + ")");
+                        (root.contains("version") ? detail::quote_json(root["version"]) : "none") + ")");
   }
   for (const char* key : {"name", "states", "start", "transitions"}) {
     if (!root.contains(key)) fail("top level", std::string("missing required key '") + key + "'");
   }
   if (!root["name"].is_string() || root["name"].get<std::string>().empty()) {
-    fail("name", "must be a non-empty string (got " + root["name"].dump() + ")");
+    fail("name", "must be a non-empty string (got " + detail::quote_json(root["name"]) + ")");
   }
   return detail::read_chain_fields(root, "", root["name"].get<std::string>(), name);
 }

@@ -57,11 +57,11 @@ class InstanceReader {
     const bool whole =
         deadline_json.is_number_integer() ||
         (deadline_json.is_number_float() && std::trunc(deadline_json.get<double>()) == deadline_json.get<double>());
-    if (!whole) fail("deadline", "must be a whole number of steps (got " + deadline_json.dump() + ")");
+    if (!whole) fail("deadline", "must be a whole number of steps (got " + detail::quote_json(deadline_json) + ")");
     const std::optional<std::int64_t> deadline = detail::json_whole_number(deadline_json, 1, Problem::kMaxDeadline);
     if (!deadline) {
       fail("deadline", "must be between 1 and " + std::to_string(Problem::kMaxDeadline) + " steps (got " +
-                           deadline_json.dump() + ")");
+                           detail::quote_json(deadline_json) + ")");
     }
 
     double step_seconds = 1.0;
@@ -72,7 +72,7 @@ class InstanceReader {
       if (!(std::isfinite(step_seconds) && step_seconds > 0 && step_seconds <= kMaxStepSeconds)) {
         fail("step_seconds",
              "must be a positive number of seconds, at most 1e300 so that times in seconds stay finite (got " +
-                 value.dump() + ")");
+                 detail::quote_json(value) + ")");
       }
     }
 
@@ -195,7 +195,8 @@ class InstanceReader {
                                Action& action) const {
     check_keys(value, path, {"chain", "by_state"});
     if (!value["chain"].is_string()) {
-      fail(detail::json_member(path, "chain"), "must be a chain's name (got " + value["chain"].dump() + ")");
+      fail(detail::json_member(path, "chain"),
+           "must be a chain's name (got " + detail::quote_json(value["chain"]) + ")");
     }
     action.execution_chain = value["chain"].get<std::string>();
     if (!value.contains("by_state")) fail(path, "missing required key 'by_state'");
@@ -238,7 +239,7 @@ class InstanceReader {
       if (!after) {
         fail(detail::json_member(path, "after"), "must be a whole number of steps between 0 and " +
                                                      std::to_string(Problem::kMaxDeadline) + " (got " +
-                                                     value["after"].dump() + ")");
+                                                     detail::quote_json(value["after"]) + ")");
       }
       action.start_by = static_cast<Steps>(*after);
     }
@@ -247,7 +248,8 @@ class InstanceReader {
     }
     if (value.contains("chain")) {
       if (!value["chain"].is_string()) {
-        fail(detail::json_member(path, "chain"), "must be a chain's name (got " + value["chain"].dump() + ")");
+        fail(detail::json_member(path, "chain"),
+             "must be a chain's name (got " + detail::quote_json(value["chain"]) + ")");
       }
       action.blocking_chain = value["chain"].get<std::string>();
       const Json& states = value["states"];
@@ -258,7 +260,7 @@ class InstanceReader {
       for (std::size_t i = 0; i < states.size(); ++i) {
         if (!states[i].is_string()) {
           fail(detail::json_index(detail::json_member(path, "states"), i),
-               "a state's name is a string (got " + states[i].dump() + ")");
+               "a state's name is a string (got " + detail::quote_json(states[i]) + ")");
         }
         action.blocking_states.push_back(states[i].get<std::string>());
       }
@@ -337,7 +339,7 @@ class InstanceReader {
       fail(path, "a probability must be a number (got " + detail::describe_json_type(value) + ")");
     const double probability = value.get<double>();
     if (!(probability >= 0.0 && probability <= 1.0 + Distribution::kSumTolerance)) {
-      fail(path, "a probability must be within [0, 1] (got " + value.dump() + ")");
+      fail(path, "a probability must be within [0, 1] (got " + detail::quote_json(value) + ")");
     }
     return std::min(probability, 1.0);
   }

@@ -52,7 +52,8 @@ class LineReader {
     if (record.contains("backtrack")) {
       const Json& blamed = record["backtrack"];
       if (!blamed.is_string() || blamed.get<std::string>().empty()) {
-        fail("backtrack", "must be a non-empty string naming the earlier action blamed (got " + blamed.dump() + ")");
+        fail("backtrack",
+             "must be a non-empty string naming the earlier action blamed (got " + detail::quote_json(blamed) + ")");
       }
       if (attempt.found) fail("backtrack", "an attempt that backtracked found no motion ('found' must be false)");
       if (blamed.get<std::string>() == attempt.action) fail("backtrack", "an action cannot blame itself");
@@ -61,7 +62,7 @@ class LineReader {
     if (record.contains("world")) {
       const Json& world = record["world"];
       if (!world.is_string() || world.get<std::string>().empty()) {
-        fail("world", "must be a non-empty string naming the world (got " + world.dump() + ")");
+        fail("world", "must be a non-empty string naming the world (got " + detail::quote_json(world) + ")");
       }
       attempt.world = world.get<std::string>();
     }
@@ -74,7 +75,7 @@ class LineReader {
       for (std::size_t i = 0; i < features.size(); ++i) {
         const Json& value = features[i];
         if (!value.is_number() || !std::isfinite(value.get<double>())) {
-          fail(detail::json_index("features", i), "must be a finite number (got " + value.dump() + ")");
+          fail(detail::json_index("features", i), "must be a finite number (got " + detail::quote_json(value) + ")");
         }
         attempt.features.push_back(value.get<double>());
       }
@@ -98,7 +99,7 @@ class LineReader {
     if (!value.is_number()) fail(key, "must be a number of seconds (got " + detail::describe_json_type(value) + ")");
     const double result = value.get<double>();
     if (!(std::isfinite(result) && result >= 0))
-      fail(key, "must be a finite number of seconds >= 0 (got " + value.dump() + ")");
+      fail(key, "must be a finite number of seconds >= 0 (got " + detail::quote_json(value) + ")");
     return result;
   }
 
@@ -107,7 +108,7 @@ class LineReader {
     if (value.is_number_unsigned()) return value.get<std::uint64_t>();
     const std::optional<std::int64_t> number =
         detail::json_whole_number(value, 0, std::numeric_limits<std::int64_t>::max());
-    if (!number) fail(key, "must be a whole number >= 0 (got " + value.dump() + ")");
+    if (!number) fail(key, "must be a whole number >= 0 (got " + detail::quote_json(value) + ")");
     return static_cast<std::uint64_t>(*number);
   }
 

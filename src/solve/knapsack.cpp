@@ -22,10 +22,11 @@ std::int64_t positive_integer(const Json& value, const std::string& source, cons
   const std::optional<std::int64_t> whole = detail::json_whole_number(value, std::numeric_limits<std::int64_t>::min(),
                                                                       std::numeric_limits<std::int64_t>::max());
   if (!whole || *whole < 1)
-    throw InputError(source, path, "must be a positive whole number (got " + value.dump() + ")");
+    throw InputError(source, path, "must be a positive whole number (got " + detail::quote_json(value) + ")");
   const std::int64_t number = *whole;
   if (number > maximum) {
-    throw InputError(source, path, "must be at most " + std::to_string(maximum) + " (got " + value.dump() + ")");
+    throw InputError(source, path,
+                     "must be at most " + std::to_string(maximum) + " (got " + detail::quote_json(value) + ")");
   }
   return number;
 }

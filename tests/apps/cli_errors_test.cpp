@@ -114,6 +114,31 @@ TEST(Cli, ProgressLinesInALogAndNoneWhenQuiet) {
   EXPECT_NE(bad.err.find("ONTIME_PROGRESS_SECONDS: must be a number of seconds"), std::string::npos) << bad.err;
 }
 
+// table: an mcts episode costs thousands of dp-rerun ones, so the time left is estimated from each
+// column's own episodes, and not at all while a column with episodes left has run none (the
+// share done alone said "about 0s left" a second into a table of minutes).
+TEST(Cli, TheTablesTimeLeftWaitsForEveryColumnsCost) {
+  const auto result =
+      testing::run_process({"/usr/bin/env", "ONTIME_PROGRESS_SECONDS=0", ONTIME_CLI, "table", paper("instance1"),
+                            paper("instance2"), "--solvers", "dp-rerun,mcts", "--episodes", "100", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const std::regex line(
+      R"(ontime table: (\d+)/400 \(\d+%\), \d+[hms](\d+[ms])? elapsed(, about \d+[hms](\d+[ms])? left)?)");
+  std::istringstream in(result.err);
+  std::size_t without = 0, with = 0;
+  for (std::string text; std::getline(in, text);) {
+    std::smatch match;
+    ASSERT_TRUE(std::regex_match(text, match, line)) << text;
+    const std::uint64_t done = std::stoull(match[1]);
+    const bool estimated = match[3].matched;
+    // Through the first row's dp-rerun column (episodes 1 to 100) mcts has run nothing.
+    EXPECT_EQ(estimated, done > 100) << text;
+    ++(estimated ? with : without);
+  }
+  EXPECT_GT(without, 0U);
+  EXPECT_GT(with, 0U);
+}
+
 // A thread count no system can start is refused by name before any work (collect aborted and
 // study failed as an internal error in the middle of their work).
 TEST(Cli, ThreadCountsBeyondTheLimitAreUsageErrors) {

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -174,6 +175,45 @@ TEST(Cli, FitStrengthScoresEachStrengthOnUnseenLogs) {
                     "--strengths", "0"})
                 .exit_code,
             2);
+}
+
+// Two records of one world with one feature, for fit-strength.
+const std::string kStrengthLog =
+    "{\"action\": \"a\", \"planning_seconds\": 2, \"found\": false, \"world\": \"t\", \"features\": [0]}\n"
+    "{\"action\": \"a\", \"planning_seconds\": 1, \"found\": true, \"execution_seconds\": 1, \"world\": \"t\", "
+    "\"features\": [0]}\n";
+
+// fit-strength: each strength read by the command line's number parser, and a log of another
+// feature count than the model's refused naming the log.
+TEST(Cli, FitStrengthReadsItsStrengthsExactlyAndNamesALogOfOtherFeatures) {
+  const auto dir = scratch("fit-strength-numbers");
+  const std::string train = (dir / "train.jsonl").string();
+  write_text(train, kStrengthLog);
+  const std::string model = (dir / "model.json").string();
+  ASSERT_EQ(ontime({"fit", train, "--conditional", "pooled", "--step", "1", "-o", model}).exit_code, 0);
+  for (const std::string strengths : {"0x10", "1,,2", "1,", "", "nan", "inf", "-1", "0", "1e999", "2 "}) {
+    const auto result = ontime({"fit-strength", train, "--model", model, "--strengths", strengths});
+    EXPECT_EQ(result.exit_code, 2) << strengths << ": " << result.err;
+    EXPECT_NE(result.err.find("--strengths"), std::string::npos) << strengths << ": " << result.err;
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+  }
+  const auto read = ontime({"fit-strength", train, "--model", model, "--strengths", "0.5,16,1e3", "--json"});
+  ASSERT_EQ(read.exit_code, 0) << read.err;
+  const json scores = json::parse(read.out)["scores"];
+  ASSERT_EQ(scores.size(), 3u);
+  EXPECT_EQ(scores[0]["strength"].get<double>(), 0.5);
+  EXPECT_EQ(scores[1]["strength"].get<double>(), 16.0);
+  EXPECT_EQ(scores[2]["strength"].get<double>(), 1000.0);
+
+  const std::string wide = (dir / "wide.jsonl").string();
+  std::string two_features = kStrengthLog;
+  for (std::size_t at = two_features.find("[0]"); at != std::string::npos; at = two_features.find("[0]", at)) {
+    two_features.replace(at, 3, "[0, 1]");
+  }
+  write_text(wide, two_features);
+  const auto refused = ontime({"fit-strength", wide, "--model", model});
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_EQ(refused.err, "ontime: error: " + wide + ": record 1: has 2 features, the model " + model + " takes 1\n");
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <thread>
@@ -269,10 +270,10 @@ TEST(BoostedTimeModel, RefusesBadSettingsAndBadFiles) {
     return nlohmann::ordered_json::parse(text)["parameters"][key].get<std::string>();
   };
   refused(with("never_booster", booster("never_booster").substr(0, 300)), "parameters.never_booster",
-          "XGBoost failed to read the booster");
-  refused(with("never_booster", "{}"), "parameters.never_booster", "XGBoost failed to read the booster");
-  refused(with("planning_booster", "{\"learner\": 3}"), "parameters.planning_booster",
-          "XGBoost failed to read the booster");
+          "not a booster OnTime reads: at line 1, column 301: invalid JSON");
+  refused(with("never_booster", "{}"), "parameters.never_booster", "not a booster OnTime reads: at version: missing");
+  refused(with("planning_booster", "{\"version\": [1, 7, 4], \"learner\": 3}"), "parameters.planning_booster",
+          "at learner: must be an object");
   refused(with("planning_booster", 3), "parameters.planning_booster", "must be a string");
   refused(with("execution_booster", booster("never_booster")), "parameters.execution_booster",
           "objective binary:logistic, not reg:squarederror");
@@ -286,7 +287,101 @@ TEST(BoostedTimeModel, RefusesBadSettingsAndBadFiles) {
   refused(replaced("\"planning_unit\": ", "\"planning_unit\": 99"), "parameters.planning_unit",
           "from 1 to the horizon");
   // The features of another model.
-  refused(replaced("\"f2\"", "\"f2\", \"f3\""), "parameters.never_booster", "2 features, the model has 3");
+  refused(replaced("\"f2\"", "\"f2\", \"f3\""), "parameters.never_booster",
+          "at learner.learner_model_param.num_feature: must be 3 (the model's feature count; got 2)");
+}
+
+// Boosters crafted to break XGBoost's reader (out-of-range and negative children, a cycle, split
+// indices beyond the features, counts that disagree, nesting without end): each is refused at
+// its member with the place inside the booster, before XGBoost reads it.
+TEST(BoostedTimeModel, ABoosterBreakingARuleIsRefusedBeforeXGBoostReadsIt) {
+  const GroupTruth truth{{0.1, 0.4}, {0.4, 0.1}, {6}};
+  const std::string text = fit_conditional_model(sample_groups(truth, 100, 6), boosted("normal", 3))->to_json();
+  using Json = nlohmann::ordered_json;
+  const Json file = Json::parse(text);
+  const Json planning = Json::parse(file["parameters"]["planning_booster"].get<std::string>());
+  const std::string trees = "learner.gradient_booster.model.trees";
+  ASSERT_EQ(planning["learner"]["gradient_booster"]["model"]["trees"].size(), 3u);
+  const Json& tree = planning["learner"]["gradient_booster"]["model"]["trees"][1];
+  const auto nodes = tree["left_children"].size();
+  ASSERT_GE(nodes, 3u);  // a split and its two leaves at least
+  ASSERT_EQ(tree["left_children"][0], 1);
+  const auto refused = [&](const std::function<void(Json&)>& change, const std::string& place,
+                           const std::string& rule) {
+    Json booster = planning;
+    change(booster);
+    Json bad = file;
+    bad["parameters"]["planning_booster"] = booster.dump();
+    try {
+      parse_conditional_model(bad.dump(2), "m.json");
+      ADD_FAILURE() << "accepted: " << place;
+    } catch (const InputError& error) {
+      EXPECT_EQ(error.place(), "parameters.planning_booster") << error.what();
+      EXPECT_EQ(error.rule(), "not a booster OnTime reads: at " + place + ": " + rule) << error.what();
+    }
+  };
+  const auto in_tree = [](Json& booster) -> Json& {
+    return booster["learner"]["gradient_booster"]["model"]["trees"][1];
+  };
+  const std::string n = std::to_string(nodes);
+  refused([&](Json& b) { in_tree(b)["left_children"][0] = nodes; }, trees + "[1].left_children[0]",
+          "a child must be a node from 1 to " + std::to_string(nodes - 1) +
+              ", or -1 for both children of a leaf (got " + n + ")");
+  refused(
+      [&](Json& b) { in_tree(b)["right_children"][0] = -7; }, trees + "[1].right_children[0]",
+      "a child must be a node from 1 to " + std::to_string(nodes - 1) + ", or -1 for both children of a leaf (got -7)");
+  refused(
+      [&](Json& b) { in_tree(b)["left_children"][0] = 0; }, trees + "[1].left_children[0]",
+      "a child must be a node from 1 to " + std::to_string(nodes - 1) + ", or -1 for both children of a leaf (got 0)");
+  // Node 1 made a child of itself (a cycle), or of the root twice.
+  refused(
+      [&](Json& b) {
+        in_tree(b)["left_children"][1] = 1;
+        in_tree(b)["right_children"][1] = in_tree(b)["right_children"][0];
+      },
+      trees + "[1].left_children[1]", "node 1 is reached twice from the root (the children must form a tree)");
+  refused([&](Json& b) { in_tree(b)["right_children"][0] = 1; }, trees + "[1].right_children[0]",
+          "the two children of a node must differ");
+  refused([&](Json& b) { in_tree(b)["parents"][1] = 2; }, trees + "[1].parents[1]",
+          "must be 0, the node whose child it is (got 2)");
+  refused([&](Json& b) { in_tree(b)["split_indices"][0] = 2; }, trees + "[1].split_indices[0]",
+          "must be a feature index below 2 (got 2)");
+  refused([&](Json& b) { in_tree(b)["split_indices"][0] = 4294967296LL; }, trees + "[1].split_indices[0]",
+          "must be a whole number within 32 bits (got 4294967296)");
+  refused([&](Json& b) { in_tree(b)["split_conditions"][2] = "nan"; }, trees + "[1].split_conditions[2]",
+          "must be a finite number (got \"nan\")");
+  refused([&](Json& b) { in_tree(b)["left_children"].erase(in_tree(b)["left_children"].size() - 1); },
+          trees + "[1].left_children",
+          "must hold one entry per node: " + n + " (tree_param.num_nodes), not " + std::to_string(nodes - 1));
+  refused([&](Json& b) { in_tree(b)["tree_param"]["num_nodes"] = "999999999"; }, trees + "[1].loss_changes",
+          "must hold one entry per node: 999999999 (tree_param.num_nodes), not " + n);
+  refused([&](Json& b) { in_tree(b)["tree_param"]["num_nodes"] = 3; }, trees + "[1].tree_param.num_nodes",
+          "must be a whole number written as text (got 3)");
+  refused([&](Json& b) { in_tree(b)["id"] = 0; }, trees + "[1].id", "must be the tree's position in trees, 1 (got 0)");
+  refused([&](Json& b) { b["learner"]["gradient_booster"]["model"]["tree_info"].erase(2); },
+          "learner.gradient_booster.model.tree_info", "must hold one entry per tree: 3, not 2");
+  refused([&](Json& b) { b["learner"]["gradient_booster"]["model"]["gbtree_model_param"]["num_trees"] = "4"; },
+          "learner.gradient_booster.model.gbtree_model_param.num_trees", "must be 3 (the trees given; got 4)");
+  refused([&](Json& b) { b["learner"]["gradient_booster"]["model"]["trees"].erase(2); },
+          "learner.gradient_booster.model.gbtree_model_param.num_trees", "must be 2 (the trees given; got 3)");
+  refused([&](Json& b) { b["learner"]["gradient_booster"]["name"] = "dart"; }, "learner.gradient_booster.name",
+          "must be \"gbtree\" (got \"dart\")");
+  refused([&](Json& b) { b["learner"]["learner_model_param"]["base_score"] = "inf"; },
+          "learner.learner_model_param.base_score", "must be a finite number written as text (got \"inf\")");
+  // Nesting without end inside the booster's text: refused by the parser, which does not recurse.
+  Json deep = file;
+  deep["parameters"]["planning_booster"] = "{\"version\": " + std::string(300'000, '[');
+  try {
+    parse_conditional_model(deep.dump(2), "m.json");
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.place(), "parameters.planning_booster");
+    EXPECT_EQ(error.rule(),
+              "not a booster OnTime reads: at line 1, column 268: invalid JSON: arrays and objects nested more than "
+              "256 levels deep (the limit of OnTime's files)");
+  }
+  // The booster as fitted reads back.
+  EXPECT_NO_THROW(parse_conditional_model(file.dump(2), "m.json"));
 }
 
 TEST(BoostedTimeModel, PredictsALibraryInOneCall) {

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <nlohmann/json.hpp>
 #include <numbers>
 
 #include "ontime/learn/fitting.hpp"
@@ -105,6 +107,46 @@ TEST(ConditionalData, StepsAsFittingCountsThemAndEveryRecordNeedsFeatures) {
   } catch (const InputError& error) {
     EXPECT_EQ(error.source(), "log.jsonl");
     EXPECT_EQ(error.place(), "record 2");
+  }
+}
+
+// A motion found in no time took its first step, as `fit` counts it; features beyond 1e15 in
+// magnitude are refused naming the record and the feature; features at the bound fit every kind,
+// and each model written reads back.
+TEST(ConditionalData, ZeroPlanningTimesAreOneStepAndHugeFeaturesAreRefused) {
+  const std::vector<RefinementAttempt> log{featured_attempt("a", 0.0, true, 1.0, {1e15}),
+                                           featured_attempt("a", 2.0, true, 1.0, {-1e15}),
+                                           featured_attempt("a", 3.0, false, 0, {0.0})};
+  const ConditionalData data = conditional_data(log, 1.0, "log");
+  EXPECT_EQ(data.planning[0], 1);
+  ConditionalData three = data;
+  for (int copy = 0; copy < 2; ++copy) {
+    const ConditionalData more = conditional_data(log, 1.0, "log");
+    three.features.insert(three.features.end(), more.features.begin(), more.features.end());
+    three.planning.insert(three.planning.end(), more.planning.begin(), more.planning.end());
+    three.found.insert(three.found.end(), more.found.begin(), more.found.end());
+    three.execution_seconds.insert(three.execution_seconds.end(), more.execution_seconds.begin(),
+                                   more.execution_seconds.end());
+    three.worlds.insert(three.worlds.end(), more.worlds.begin(), more.worlds.end());
+    three.actions.insert(three.actions.end(), more.actions.begin(), more.actions.end());
+  }
+  for (const std::string kind : {"pooled", "hazard", "boosted"}) {
+    ConditionalFitOptions fit = options(kind);
+    fit.trees = 2;
+    const auto model = fit_conditional_model(three, fit);
+    EXPECT_EQ(model->predict(std::vector<double>{1e15}).planning.pmf(0), 0.0) << kind;
+    EXPECT_EQ(parse_conditional_model(model->to_json(), "m.json")->to_json(), model->to_json()) << kind;
+  }
+  for (const double huge : {1e16, -1e308, std::numeric_limits<double>::max()}) {
+    std::vector<RefinementAttempt> bad = log;
+    bad[1].features = {huge};
+    try {
+      conditional_data(bad, 1.0, "log.jsonl");
+      ADD_FAILURE() << huge;
+    } catch (const InputError& error) {
+      EXPECT_EQ(error.place(), "record 2: features[0]");
+      EXPECT_NE(error.rule().find("within [-1e15, 1e15]"), std::string::npos);
+    }
   }
 }
 
@@ -212,6 +254,9 @@ TEST(ConditionalTimeModel, RefusesBadFeaturesAndBadFiles) {
   one_name.feature_names = {"only one"};
   EXPECT_THROW(fit_conditional_model(data, one_name), UsageError);
   EXPECT_THROW(fit_conditional_model(data, options("hazard", 0, 0, -1)), UsageError);
+  // A ridge of 1e10 made NLopt fail (an internal error); above 1e6 it is refused.
+  EXPECT_THROW(fit_conditional_model(data, options("hazard", 0, 0, 1e10)), UsageError);
+  EXPECT_NO_THROW(fit_conditional_model(data, options("hazard", 0, 0, 1e6)));
 
   const std::string text = model->to_json();
   const auto refused = [](const std::string& bad, const std::string& place) {
@@ -232,6 +277,20 @@ TEST(ConditionalTimeModel, RefusesBadFeaturesAndBadFiles) {
   refused(replaced("\"kind\": \"hazard\"", "\"kind\": \"forest\""), "kind");
   refused(replaced("\"execution_sigma\"", "\"sigma\""), "parameters.execution_sigma");
   refused(replaced("\"horizon\": 2", "\"horizon\": 0"), "horizon");
+  // Whole numbers follow the instance reader's rules: 2^32 + 1 is not truncated to the version 1,
+  // nor 2^32 + 2 to the horizon 2; `1.0` and `2.0` are whole numbers.
+  refused(replaced("\"version\": 1", "\"version\": 4294967297"), "version");
+  refused(replaced("\"horizon\": 2", "\"horizon\": 4294967298"), "horizon");
+  refused(replaced("\"horizon\": 2", "\"horizon\": 2.5"), "horizon");
+  nlohmann::ordered_json wide_bin = nlohmann::ordered_json::parse(text);
+  wide_bin["parameters"]["bin_end"][0] = 4294967297LL;  // 1 in 32 bits
+  refused(wide_bin.dump(2), "parameters.bin_end");
+  nlohmann::ordered_json written_as_floats = nlohmann::ordered_json::parse(text);
+  written_as_floats["version"] = 1.0;
+  written_as_floats["horizon"] = 2.0;
+  const auto whole = parse_conditional_model(written_as_floats.dump(2), "m.json");
+  EXPECT_EQ(whole->horizon(), 2);
+  EXPECT_EQ(whole->to_json(), text);
 }
 
 TEST(ConditionalTimeModel, PredictsALibraryCutAtTheDeadline) {

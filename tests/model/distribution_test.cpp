@@ -85,6 +85,12 @@ TEST(Distribution, RejectsInvalidMasses) {
   EXPECT_THROW(Distribution::from_pmf({0.0, 1.5}), UsageError);
   EXPECT_THROW(Distribution::from_pmf({0.6, 0.6}), UsageError);
   EXPECT_THROW(Distribution::from_pmf({std::nan("")}), UsageError);
+  try {
+    Distribution::from_pmf({0.5, -std::nan("")});
+    ADD_FAILURE() << "accepted";
+  } catch (const UsageError& error) {
+    EXPECT_STREQ(error.what(), "a probability is not a number (NaN)");
+  }
   EXPECT_NO_THROW(Distribution::from_pmf({0.5, 0.5 + 1e-10}));
 }
 

@@ -43,6 +43,8 @@ struct ConditionalData {
   std::vector<std::string> worlds;        // the record's world ("" when it names none)
   std::vector<std::string> actions;
   double step_seconds = 1;
+  // The largest magnitude of a feature (conditional_data refuses larger ones).
+  static constexpr double kMaxFeature = 1e15;
 
   std::size_t rows() const noexcept { return planning.size(); }
   std::span<const double> row(std::size_t i) const noexcept {
@@ -82,7 +84,10 @@ struct ConditionalFitOptions {
   std::vector<std::string> feature_names;  // as many as the data's features; empty: f1, f2, ...
   Steps horizon = 0;                       // steps predicted; 0: the largest planning step of the data
   // hazard: L2 penalty on the standardised feature weights (not on the baseline).
-  double ridge = 1e-3;
+  double ridge = 1e-3;  // 0 to kMaxRidge
+  // The largest ridge: beyond it the penalty alone sets the weights (to 0), and NLopt's L-BFGS fails
+  // on some of the objective's scales (a ridge of 1e10 did, 1e12 did not).
+  static constexpr double kMaxRidge = 1e6;
   // hazard: baseline bins over 1..horizon (each bin one hazard level); 0: one per step.
   int bins = 0;
   // boosted: boosting rounds (the trees of each booster, 1 to 10000), a tree's largest depth (1 to
@@ -98,6 +103,14 @@ struct ConditionalFitOptions {
   std::string aft_distribution = "normal";
   double aft_scale = 1;
 };
+
+class ConditionalTimeModel;
+
+// The rows of planner logs scored or updated with `model` (its step): as load_conditional_data,
+// and an InputError naming the first log when its records carry another number of features than
+// the model takes (`model_file` names the model in the message).
+ConditionalData load_conditional_data_for(const ConditionalTimeModel& model, std::string_view model_file,
+                                          std::span<const std::filesystem::path> logs);
 
 class ConditionalTimeModel {
  public:

@@ -35,6 +35,13 @@ class AtomicFileWriter {
   std::string temporary_;         // empty when writing directly to a device or FIFO
   int descriptor_ = -1;
   bool committed_ = false;
+  int slot_ = -1;  // in the table of temporary files removed on a signal (remove_temporaries_on_signal)
 };
+
+// With `enable`, a termination signal (SIGINT, SIGTERM, SIGHUP, SIGQUIT) removes the temporary
+// file of every AtomicFileWriter (and write_file_atomically) alive, then takes its course (the
+// handler there before, else the end of the process). The command line enables it; a Python
+// interpreter does not (Ctrl-C there is an exception, and the writer's destructor removes the file).
+void remove_temporaries_on_signal(bool enable);
 
 }  // namespace ontime

@@ -49,6 +49,66 @@ inline std::string json_member(const std::string& parent, std::string_view key) 
   return parent.empty() ? segment : parent + "." + segment;
 }
 
+// The deepest nesting of arrays and objects within each other that a file of OnTime's may have.
+// Its formats need fewer than 10 levels (a boosted model's booster, the deepest, about 8); 256 is
+// also the limit of the dicts and lists the Python package is given (python/ontime). The limit keeps every later walk
+// of a document (a copy, a comparison, quoting a value in a message) within a bounded depth: nlohmann's parser does not
+// recurse, but those walks do, and 300,000 nested '[' would exhaust the stack.
+inline constexpr std::size_t kMaxJsonDepth = 256;
+
+namespace json_quote {
+
+// Recursive, but at most two levels deep: containers below the second are abbreviated.
+template <class Json>
+void append(std::string& out, const Json& value, std::size_t depth,  // NOLINT(misc-no-recursion)
+            std::size_t limit) {
+  if (out.size() > limit) return;
+  if (!value.is_array() && !value.is_object()) {
+    // A number, a boolean, null or a string: a string of a million characters is cut below.
+    std::string text = value.dump(-1, ' ', false, Json::error_handler_t::replace);
+    if (text.size() > limit) text.resize(limit + 1);  // beyond the limit: quote_json marks the cut
+    out += text;
+    return;
+  }
+  const bool array = value.is_array();
+  if (value.empty()) {
+    out += array ? "[]" : "{}";
+    return;
+  }
+  // Two levels shown; deeper containers are abbreviated, so that quoting recurses at most twice.
+  if (depth >= 2) {
+    out += array ? "[...]" : "{...}";
+    return;
+  }
+  out += array ? '[' : '{';
+  bool first = true;
+  for (auto item = value.begin(); item != value.end(); ++item) {
+    if (!first) out += ", ";
+    first = false;
+    if (out.size() > limit) break;
+    if (!array) out += Json(item.key()).dump(-1, ' ', false, Json::error_handler_t::replace) + ": ";
+    append(out, item.value(), depth + 1, limit);
+  }
+  out += array ? ']' : '}';
+}
+
+}  // namespace json_quote
+
+// `value` as JSON text for an error message ("got ..."), cut to about 80 characters ("..." marks
+// the cut) and two levels of nesting: a message never grows with the input, and quoting never
+// recurses more than twice.
+template <class Json>
+std::string quote_json(const Json& value) {
+  constexpr std::size_t kLimit = 80;
+  std::string out;
+  json_quote::append(out, value, 0, kLimit);
+  if (out.size() > kLimit) {
+    out.resize(kLimit);
+    out += "...";
+  }
+  return out;
+}
+
 // "null", "a boolean", "a number", "a string", "an array" or "an object", for messages.
 template <class Json>
 std::string describe_json_type(const Json& value) {
@@ -123,6 +183,10 @@ class StrictJsonBuilder {
   using binary_t = typename Json::binary_t;
 
   StrictJsonBuilder(std::string_view text, const std::string& source) : text_(text), source_(source) {}
+
+  // Raised by a container that would be nested deeper than kMaxJsonDepth; parse_json_strict
+  // finds its place in the text (the SAX events carry no position).
+  struct TooDeep {};
 
   Json take() { return std::move(root_); }
 
@@ -201,6 +265,7 @@ class StrictJsonBuilder {
   }
 
   bool open(Json container) {
+    if (frames_.size() >= kMaxJsonDepth) throw TooDeep{};
     frames_.push_back(Frame{place(std::move(container)), {}, {}});
     return true;
   }
@@ -227,6 +292,33 @@ class StrictJsonBuilder {
   std::vector<Frame> frames_;
 };
 
+// The offset of the first '[' or '{' of `text` nested `depth` levels deep (counted from 0 at
+// the top level), outside strings; text.size() if none. The text before it must be valid JSON
+// so far (as the parser has found when it stops there): strings are then closed and escapes
+// complete.
+inline std::size_t deep_container_offset(std::string_view text, std::size_t depth) {
+  std::size_t open = 0;
+  bool in_string = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\') {
+        ++i;
+      } else if (c == '"') {
+        in_string = false;
+      }
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (open == depth) return i;
+      ++open;
+    } else if ((c == ']' || c == '}') && open > 0) {
+      --open;
+    }
+  }
+  return text.size();
+}
+
 // Parses JSON text in time linear in its size; malformed text (a NUL byte among it) raises
 // InputError at `line L, column C`, and a key that appears twice in one object raises
 // InputError at its path.
@@ -237,7 +329,13 @@ Json parse_json_strict(std::string_view text, const std::string& source) {
     throw InputError(source, text_place(text, nul), "invalid JSON: a NUL byte (\\u0000) is not allowed in JSON text");
   }
   StrictJsonBuilder<Json> builder(text, source);
-  Json::sax_parse(text.begin(), text.end(), &builder);  // JSON, strict: nothing may follow the value
+  try {
+    Json::sax_parse(text.begin(), text.end(), &builder);  // JSON, strict: nothing may follow the value
+  } catch (const typename StrictJsonBuilder<Json>::TooDeep&) {
+    throw InputError(source, text_place(text, deep_container_offset(text, kMaxJsonDepth)),
+                     "invalid JSON: arrays and objects nested more than " + std::to_string(kMaxJsonDepth) +
+                         " levels deep (the limit of OnTime's files)");
+  }
   return builder.take();
 }
 
