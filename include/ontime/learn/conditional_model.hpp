@@ -46,7 +46,9 @@ struct ConditionalData {
   // The largest magnitude of a feature (conditional_data refuses larger ones).
   static constexpr double kMaxFeature = 1e15;
 
+  // The attempts: one row each.
   std::size_t rows() const noexcept { return planning.size(); }
+  // Row i's features (feature_count of them).
   std::span<const double> row(std::size_t i) const noexcept {
     return std::span<const double>(features).subspan(i * feature_count, feature_count);
   }
@@ -77,6 +79,7 @@ struct ConditionalModelKind {
   std::vector<ConditionalParameter> parameters;
 };
 
+// Every kind of conditional model, with its declared parameters, in the order the tools list them.
 const std::vector<ConditionalModelKind>& conditional_model_kinds();
 
 struct ConditionalFitOptions {
@@ -119,13 +122,20 @@ class ConditionalTimeModel {
   static constexpr int kVersion = 1;
 
   virtual ~ConditionalTimeModel() = default;
+  // The kind's name, as conditional_model_kinds() lists it ("hazard", "boosted", "pooled").
   virtual const std::string& kind() const noexcept = 0;
 
+  // The features a prediction takes, by name, in order (a world's feature vector must match).
   const std::vector<std::string>& feature_names() const noexcept { return feature_names_; }
+  // How many features a prediction takes.
   std::size_t feature_count() const noexcept { return feature_names_.size(); }
+  // Seconds of one step of the training data (the predicted distributions are in these steps).
   double step_seconds() const noexcept { return step_seconds_; }
+  // Steps predicted: planning over 1..horizon, execution over 0..horizon, the rest "never".
   Steps horizon() const noexcept { return horizon_; }
+  // The attempts it was fitted on.
   std::size_t training_rows() const noexcept { return training_rows_; }
+  // The worlds those attempts came from.
   std::size_t training_worlds() const noexcept { return training_worlds_; }
 
   // Throws UsageError for a vector of the wrong length or with a number that is not finite.

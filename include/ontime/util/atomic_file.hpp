@@ -22,12 +22,16 @@ void write_file_atomically(const std::filesystem::path& path, std::string_view c
 // Errors as for write_file_atomically, from the constructor, write() or commit().
 class AtomicFileWriter {
  public:
+  // Opens the temporary file beside `path` (or `path` itself for a device or FIFO).
   explicit AtomicFileWriter(const std::filesystem::path& path);
+  // Without commit(): removes the temporary file, leaving the target as it was.
   ~AtomicFileWriter();
   AtomicFileWriter(const AtomicFileWriter&) = delete;
   AtomicFileWriter& operator=(const AtomicFileWriter&) = delete;
 
+  // Appends `piece` to what is written.
   void write(std::string_view piece);
+  // Flushes the file to disk and renames it over the target (a device or FIFO: closes it); once, last.
   void commit();
 
  private:
