@@ -19,6 +19,7 @@
 #include <system_error>
 
 #include "ontime/util/error.hpp"
+#include "util/signal_handoff.hpp"
 
 namespace ontime {
 namespace {
@@ -113,17 +114,7 @@ extern "C" void remove_scratch_and_end(int signal_number) {
   }
   // The signal takes its course: the handler that was there before (e.g. OutputSet's, which
   // removes staged outputs and ends the process), else death by the signal.
-  for (std::size_t i = 0; i < std::size(kSignals); ++i) {
-    if (kSignals[i] == signal_number) ::sigaction(signal_number, &previous_actions[i], nullptr);
-  }
-  sigset_t only;
-  sigemptyset(&only);
-  sigaddset(&only, signal_number);
-  ::pthread_sigmask(SIG_UNBLOCK, &only, nullptr);
-  ::raise(signal_number);
-  ::signal(signal_number, SIG_DFL);
-  ::raise(signal_number);
-  ::_exit(128 + signal_number);
+  detail::hand_signal_on(signal_number, kSignals, previous_actions, std::size(kSignals));
 }
 
 sigset_t signal_set() {

@@ -16,6 +16,7 @@
 #include <string>
 
 #include "ontime/util/error.hpp"
+#include "util/signal_handoff.hpp"
 
 namespace ontime {
 namespace {
@@ -89,17 +90,7 @@ extern "C" void remove_temporaries_and_end(int signal_number) {
   }
   // The signal takes its course: the handler that was there before (another one's cleanup, which
   // ends the process in turn), else death by the signal.
-  for (std::size_t i = 0; i < std::size(kSignals); ++i) {
-    if (kSignals[i] == signal_number) ::sigaction(signal_number, &previous_actions[i], nullptr);
-  }
-  sigset_t only;
-  sigemptyset(&only);
-  sigaddset(&only, signal_number);
-  ::pthread_sigmask(SIG_UNBLOCK, &only, nullptr);
-  ::raise(signal_number);
-  ::signal(signal_number, SIG_DFL);
-  ::raise(signal_number);
-  ::_exit(128 + signal_number);
+  detail::hand_signal_on(signal_number, kSignals, previous_actions, std::size(kSignals));
 }
 
 // The termination signals blocked for the life of the object (so that a temporary file and its
