@@ -210,24 +210,13 @@ def _named_error(error: TypeError, args: tuple, kwargs: dict) -> Optional[Except
 
 
 def _wrapped(function: Callable, method: bool) -> Callable:
-    if method:
-        @functools.wraps(function)
-        def call_method(self, *args, **kwargs):
-            try:
-                return function(self, *args, **kwargs)
-            except TypeError as error:
-                named = _named_error(error, args, kwargs)
-                if named is None:
-                    raise
-                raise named from None
-        return call_method
-
     @functools.wraps(function)
     def call(*args, **kwargs):
         try:
             return function(*args, **kwargs)
         except TypeError as error:
-            named = _named_error(error, args, kwargs)
+            # A method's first argument is its object: the parameters are the arguments after it.
+            named = _named_error(error, args[1:] if method else args, kwargs)
             if named is None:
                 raise
             raise named from None
