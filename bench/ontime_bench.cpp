@@ -176,7 +176,7 @@ BENCHMARK(BM_DpRerunTables)->DenseRange(1, 5)->Unit(benchmark::kMicrosecond);
 void BM_ConcurrentDpRerunDecision(benchmark::State& bench) {
   const ontime::Problem problem = paper(static_cast<int>(bench.range(0)));
   const ontime::ConcurrentMdp mdp(problem);
-  ontime::ConcurrentDpRerunPolicy policy(mdp);
+  ontime::ConcurrentDpRerunAllocator policy(mdp);
   std::vector<ontime::ConcurrentState> states;
   ontime::SplitMix64 generator(9);
   std::vector<std::pair<double, ontime::ConcurrentState>> outcomes;

@@ -240,14 +240,14 @@ std::vector<std::string> AllocatorRegistry::kinds_with_parameter(std::string_vie
   return out;
 }
 
-AllocatorFactory AllocatorRegistry::make_factory(std::string_view name, const Mdp& mdp,
-                                                 const ParameterValues& values) const {
-  const AllocatorKind& kind = find(name);
-  const std::vector<Parameter> declared = parameters();
+namespace {
+
+// Checks every value given against its declaration, as make_factory does.
+void check_values(const AllocatorRegistry& kinds, const ParameterValues& values) {
+  const std::vector<Parameter> declared = kinds.parameters();
   for (const auto& entry : values.all()) {
     // A named reference, not a structured binding: clang 14 cannot capture bindings in a lambda.
     const std::string& given = entry.first;
-    const std::string& value = entry.second;
     const auto parameter =
         std::find_if(declared.begin(), declared.end(), [&](const Parameter& p) { return p.name == given; });
     if (parameter == declared.end()) {
@@ -256,14 +256,45 @@ AllocatorFactory AllocatorRegistry::make_factory(std::string_view name, const Md
       for (const Parameter& p : declared) known.push_back(p.name);
       throw unknown_name_error("allocator parameter", given, known);
     }
-    parameter->check(value);
+    parameter->check(entry.second);
   }
+}
+
+}  // namespace
+
+AllocatorFactory AllocatorRegistry::make_factory(std::string_view name, const Mdp& mdp,
+                                                 const ParameterValues& values) const {
+  const AllocatorKind& kind = find(name);
+  check_values(*this, values);
   if (mdp.is_timed() && !kind.capabilities.has(Capability::chains)) {
     throw UsageError(
         fmt::format("allocator '{}' does not take instances with exogenous chains or expiry (SPEC §9) yet; {} do",
                     kind.name, fmt::join(names({Capability::chains}, {}), ", ")));
   }
   return kind.make(mdp, ParameterReader(kind, values));
+}
+
+ConcurrentAllocatorFactory AllocatorRegistry::make_concurrent_factory(std::string_view name, const ConcurrentMdp& mdp,
+                                                                      const ParameterValues& values) const {
+  const AllocatorKind& kind = find(name);
+  check_values(*this, values);
+  if (!kind.acts_while_planning()) {
+    throw UsageError(fmt::format(
+        "allocator '{}' does not act while planning (SPEC §10) yet: it has no commit rule; {} do (--act plan-first "
+        "takes every allocator)",
+        kind.name, fmt::join(acting_names(), ", ")));
+  }
+  const ParameterReader reader(kind, values);
+  if (kind.make_concurrent) return kind.make_concurrent(mdp, reader);
+  return eager_commit_factory(mdp, kind.make(mdp.plan_first_mdp(), reader));
+}
+
+std::vector<std::string> AllocatorRegistry::acting_names() const {
+  std::vector<std::string> out;
+  for (const AllocatorKind& kind : kinds_) {
+    if (kind.acts_while_planning()) out.push_back(kind.name);
+  }
+  return out;
 }
 
 DecisionBudget AllocatorRegistry::decision_budget(std::string_view name, const ParameterValues& values) const {
@@ -348,6 +379,11 @@ AllocatorRegistry& allocator_registry() {
     return built_in;
   }();
   return registry;
+}
+
+ConcurrentAllocatorFactory make_concurrent_allocator_factory(std::string_view name, const ConcurrentMdp& mdp,
+                                                             const ParameterValues& values) {
+  return allocator_registry().make_concurrent_factory(name, mdp, values);
 }
 
 AllocatorFactory make_allocator_factory(std::string_view name, const Mdp& mdp, const ParameterValues& values) {

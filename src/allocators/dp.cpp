@@ -4,6 +4,7 @@
 
 #include "ontime/allocators/allocator_registry.hpp"
 #include "ontime/solve/backtracking_success.hpp"
+#include "ontime/solve/concurrent_contiguous_success.hpp"
 #include "ontime/solve/timed_contiguous_success.hpp"
 
 namespace ontime {
@@ -49,6 +50,23 @@ AllocatorKind dp_kind() {
           .make = [](const Mdp& mdp, const ParameterReader&) -> AllocatorFactory {
             const int chosen = DpAllocator(mdp).chosen_skeleton();
             return [chosen] { return std::make_unique<DpAllocator>(chosen); };
+          },
+          .commit_rule =
+              "eager along the one skeleton most likely to succeed alone acting while planning (Eq. (1) "
+              "acting while planning, from the start)",
+          .make_concurrent = [](const ConcurrentMdp& mdp, const ParameterReader&) -> ConcurrentAllocatorFactory {
+            ConcurrentContiguousSuccess values(mdp, Aggregation::self);
+            const ConcurrentState start = mdp.start();
+            int chosen = 0;
+            double best = -1;
+            for (int k = 0; k < mdp.skeleton_count(); ++k) {
+              const double value = ConcurrentMdp::is_live(start, k) ? values.value(start, k) : 0.0;
+              if (value > best) {
+                best = value;
+                chosen = k;
+              }
+            }
+            return eager_commit_factory(mdp, [chosen] { return std::make_unique<DpAllocator>(chosen); });
           }};
 }
 

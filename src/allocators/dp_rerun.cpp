@@ -108,13 +108,21 @@ AllocatorKind dp_rerun_kind() {
         }
         auto table = std::make_shared<const ContiguousSuccessTable>(mdp, aggregation);
         return [model = &mdp, table] { return std::make_unique<DpRerunAllocator>(*model, table); };
+      },
+      .commit_rule =
+          "eager along the best skeleton by Eq. (1) acting while planning (its refined actions run "
+          "back to back while the rest is planned)",
+      .make_concurrent = [](const ConcurrentMdp& mdp, const ParameterReader& parameters) -> ConcurrentAllocatorFactory {
+        const Aggregation aggregation = parse_aggregation(parameters.text("aggregation"));
+        return
+            [model = &mdp, aggregation] { return std::make_unique<ConcurrentDpRerunAllocator>(*model, aggregation); };
       }};
 }
 
-ConcurrentDpRerunPolicy::ConcurrentDpRerunPolicy(const ConcurrentMdp& mdp, Aggregation aggregation)
+ConcurrentDpRerunAllocator::ConcurrentDpRerunAllocator(const ConcurrentMdp& mdp, Aggregation aggregation)
     : mdp_(&mdp), values_(mdp, aggregation) {}
 
-ConcurrentMdp::Move ConcurrentDpRerunPolicy::choose(const ConcurrentState& state) {
+ConcurrentMdp::Move ConcurrentDpRerunAllocator::choose(const ConcurrentState& state) {
   const Problem& problem = mdp_->problem();
   int best = -1;
   double best_value = -1.0;

@@ -37,7 +37,8 @@ AllocatorKind first_found_kind() {
         return [model = &mdp, budget = parameters.integer("budget")] {
           return std::make_unique<FirstFoundAllocator>(*model, budget);
         };
-      }};
+      },
+      .commit_rule = kEagerCommitRule};
 }
 
 }  // namespace ontime

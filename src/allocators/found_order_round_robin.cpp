@@ -27,7 +27,8 @@ AllocatorKind found_order_round_robin_kind() {
       .parameters = {},
       .make = [](const Mdp& mdp, const ParameterReader&) -> AllocatorFactory {
         return [model = &mdp] { return std::make_unique<FoundOrderRoundRobinAllocator>(*model); };
-      }};
+      },
+      .commit_rule = kEagerCommitRule};
 }
 
 }  // namespace ontime

@@ -44,7 +44,8 @@ AllocatorKind greedy_kind() {
           .parameters = {},
           .make = [](const Mdp& mdp, const ParameterReader&) -> AllocatorFactory {
             return [model = &mdp] { return std::make_unique<GreedyAllocator>(*model); };
-          }};
+          },
+          .commit_rule = kEagerCommitRule};
 }
 
 }  // namespace ontime

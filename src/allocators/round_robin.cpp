@@ -11,7 +11,8 @@ AllocatorKind round_robin_kind() {
           .parameters = {},
           .make = [](const Mdp& mdp, const ParameterReader&) -> AllocatorFactory {
             return [count = mdp.skeleton_count()] { return std::make_unique<RoundRobinAllocator>(count); };
-          }};
+          },
+          .commit_rule = kEagerCommitRule};
 }
 
 }  // namespace ontime

@@ -158,7 +158,8 @@ AllocatorKind thompson_kind() {
           .parameters = {},
           .make = [](const Mdp& mdp, const ParameterReader&) -> AllocatorFactory {
             return [model = &mdp] { return std::make_unique<ThompsonAllocator>(*model); };
-          }};
+          },
+          .commit_rule = kEagerCommitRule};
 }
 
 }  // namespace ontime

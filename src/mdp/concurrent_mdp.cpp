@@ -199,6 +199,62 @@ ChoiceList ConcurrentMdp::refine_choices(const ConcurrentState& state) const {
   return choices;
 }
 
+ConcurrentState ConcurrentMdp::step(const ConcurrentState& state, int choice, const Observation& observation) const {
+  if (observation.is_backtrack()) {
+    throw UsageError(
+        "a backtrack cannot be reported when acting while planning (SPEC §10): backtracking (SPEC §7) "
+        "is not modelled in this mode");
+  }
+  if (time(state) >= deadline_) {
+    throw UsageError("no step is left at the deadline (step " + std::to_string(deadline_) + ")");
+  }
+  ConcurrentState next = state;
+  ++next[0];
+  if (next[1] > 0) --next[1];
+  if (choice == kWait) {
+    if (observation.refined) throw UsageError("a motion cannot be found in a step in which the planner idles");
+    canonicalise(next);
+    return next;
+  }
+  if (choice < 0 || choice >= skeleton_count_ || !is_live(state, choice) ||
+      refined(state, choice) >= problem_->skeleton_length(choice)) {
+    reject_choice(choice);
+  }
+  const int action = problem_->action_at(choice, refined(state, choice));
+  if (observation.refined) {
+    const Steps saturated = std::min<Steps>(observation.execution, deadline_ + 1);
+    execution_word(next, action) = static_cast<std::uint16_t>(saturated);
+  }
+  // The live skeletons whose next action is `action` share the step (SPEC §1).
+  for (const int m : problem_->members(action)) {
+    if (!is_live(state, m) || refined(state, m) >= problem_->skeleton_length(m) ||
+        problem_->action_at(m, refined(state, m)) != action) {
+      continue;
+    }
+    if (observation.refined) {
+      ++refined_word(next, m);
+      spent_word(next, m) = 0;
+    } else {
+      ++spent_word(next, m);
+    }
+  }
+  canonicalise(next);
+  return next;
+}
+
+int ConcurrentMdp::complete_plan(const ConcurrentState& state) const noexcept {
+  for (int k = 0; k < skeleton_count_; ++k) {
+    if (is_live(state, k) && refined(state, k) == problem_->skeleton_length(k)) return k;
+  }
+  return -1;
+}
+
+ConcurrentMdp::Move ConcurrentMdp::run_complete_plan(const ConcurrentState& state) const {
+  const int k = complete_plan(state);
+  if (k < 0 || robot_left(state) > 0) return {};
+  return {problem_->action_at(k, executed_depth(state)), kWait};
+}
+
 bool ConcurrentMdp::certain_success(const ConcurrentState& state) const noexcept {
   if (problem_->has_rewards()) return false;
   for (int k = 0; k < skeleton_count_; ++k) {

@@ -8,6 +8,7 @@
 #include <mutex>
 #include <vector>
 
+#include "ontime/run/concurrent_session.hpp"
 #include "ontime/run/session.hpp"
 #include "ontime/util/byte_packing.hpp"
 #include "ontime/util/error.hpp"
@@ -83,6 +84,7 @@ struct RewardSum {
 // What one thread of run_episodes keeps until the threads' results are merged.
 struct ThreadRun {
   std::unique_ptr<Allocator> allocator;
+  std::unique_ptr<ConcurrentAllocator> concurrent_allocator;  // acting while planning (SPEC §10)
   std::unique_ptr<World> world;
   RecordingTimer timer;
   std::uint64_t successes = 0;
@@ -162,6 +164,32 @@ EpisodeResult drive(Session& session, World& world, const DecisionBudget& budget
   return result;
 }
 
+// The loop of concurrent episodes (SPEC §10): the allocator's moves through the session, a start
+// carried out at once, a step in the world, until the session ends.
+EpisodeResult drive_concurrent(ConcurrentSession& session, World& world, DecisionTimer* timer) {
+  EpisodeResult result;
+  while (session.status() == Status::running) {
+    ConcurrentDecision decision;
+    if (timer != nullptr) {
+      const auto start = std::chrono::steady_clock::now();
+      decision = session.choose();
+      const auto stop = std::chrono::steady_clock::now();
+      timer->record(std::chrono::duration_cast<std::chrono::nanoseconds>(stop - start).count());
+    } else {
+      decision = session.choose();
+    }
+    ++result.decisions;
+    if (!decision.is_start() && session.status() == Status::running) session.carry_out(world);
+  }
+  result.status = session.status();
+  result.solution = session.solution();
+  result.reward = session.reward();
+  result.steps_used = session.steps_used();
+  result.skeletons = session.mdp().skeleton_count();
+  result.attempts = session.take_attempts();
+  return result;
+}
+
 const Clock& clock_of(const World& world) {
   static const SteadyClock steady_clock;
   return world.clock() != nullptr ? *world.clock() : steady_clock;
@@ -210,6 +238,13 @@ EpisodeResult run_streaming_episode(const StreamingRun& streaming, World& world,
     result.problem = std::make_shared<const Problem>(session.problem());
   }
   return result;
+}
+
+EpisodeResult run_concurrent_episode(const ConcurrentMdp& mdp, ConcurrentAllocator& allocator, World& world,
+                                     std::uint64_t seed, DecisionTimer* timer) {
+  world.begin_episode(seed);
+  ConcurrentSession session(mdp, allocator, stream_seed(seed, 1));
+  return drive_concurrent(session, world, timer);
 }
 
 std::size_t LatencyHistogram::bucket_of(std::uint64_t nanoseconds) noexcept {
@@ -381,12 +416,16 @@ void merge_ranks(const Ranks& ranks, RankPart& part, const std::string& episodes
   part = std::move(merged);
 }
 
-// Runs the episodes of run_episodes and run_streaming_episodes on threads (this rank's share of
-// them when options.ranks splits the run): `run_one(run, seed)` runs one episode with the
-// thread's world (and allocator, when `allocators` is given).
-template <class RunOne>
-MonteCarloResult run_many(const WorldFactory& worlds, const AllocatorFactory* allocators,
-                          const MonteCarloOptions& options, const RunOne& run_one) {
+// The thread's allocator from `allocators`.
+void equip(ThreadRun& run, const AllocatorFactory& allocators) { run.allocator = allocators(); }
+void equip(ThreadRun& run, const ConcurrentAllocatorFactory& allocators) { run.concurrent_allocator = allocators(); }
+
+// Runs the episodes of run_episodes, run_streaming_episodes and run_concurrent_episodes on threads
+// (this rank's share of them when options.ranks splits the run): `run_one(run, seed)` runs one
+// episode with the thread's world (and allocator, when `allocators` is given).
+template <class Factory, class RunOne>
+MonteCarloResult run_many(const WorldFactory& worlds, const Factory* allocators, const MonteCarloOptions& options,
+                          const RunOne& run_one) {
   const auto started = std::chrono::steady_clock::now();
   const bool split = split_over_ranks(options.ranks);
   // The units handed out are whole sequences (one episode each unless sequence_length says more).
@@ -410,7 +449,7 @@ MonteCarloResult run_many(const WorldFactory& worlds, const AllocatorFactory* al
   std::mutex packed_mutex;
   for_each_block(count, options.threads, block, [&](unsigned thread) {
     ThreadRun& run = runs[thread];
-    if (allocators != nullptr) run.allocator = (*allocators)();
+    if (allocators != nullptr) equip(run, *allocators);
     run.world = worlds();
     return [&](std::uint64_t begin, std::uint64_t end) {
       for (std::uint64_t local = 0; local < (end - begin) * length; ++local) {
@@ -453,6 +492,7 @@ MonteCarloResult run_many(const WorldFactory& worlds, const AllocatorFactory* al
     part.decisions.merge(run.timer.decisions);
     part.episode_totals.merge(run.timer.episodes);
     if (run.allocator) run.allocator->collect_statistics(part.statistics);
+    if (run.concurrent_allocator) run.concurrent_allocator->collect_statistics(part.statistics);
     if (run.world) run.world->collect_statistics(part.world_statistics);
     part.live_nanoseconds.add(run.live_nanoseconds);
     part.model_successes += run.model_successes;
@@ -494,9 +534,22 @@ MonteCarloResult run_episodes(const Mdp& mdp, const WorldFactory& worlds, const 
 
 MonteCarloResult run_streaming_episodes(const StreamingRun& streaming, const WorldFactory& worlds,
                                         const MonteCarloOptions& options) {
-  return run_many(worlds, nullptr, options, [&](ThreadRun& run, std::uint64_t seed) {
-    return run_streaming_episode(streaming, *run.world, seed, options.decision_budget,
-                                 options.time_decisions ? &run.timer : nullptr, options.live);
+  return run_many(worlds, static_cast<const AllocatorFactory*>(nullptr), options,
+                  [&](ThreadRun& run, std::uint64_t seed) {
+                    return run_streaming_episode(streaming, *run.world, seed, options.decision_budget,
+                                                 options.time_decisions ? &run.timer : nullptr, options.live);
+                  });
+}
+
+MonteCarloResult run_concurrent_episodes(const ConcurrentMdp& mdp, const WorldFactory& worlds,
+                                         const ConcurrentAllocatorFactory& allocators,
+                                         const MonteCarloOptions& options) {
+  if (options.live) {
+    throw UsageError("live episodes acting while planning (SPEC §10) are not there yet: run them on the step clock");
+  }
+  return run_many(worlds, &allocators, options, [&](ThreadRun& run, std::uint64_t seed) {
+    return run_concurrent_episode(mdp, *run.concurrent_allocator, *run.world, seed,
+                                  options.time_decisions ? &run.timer : nullptr);
   });
 }
 

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "ontime/run/simulator.hpp"
+#include "ontime/solve/concurrent_solver.hpp"
 #include "ontime/util/error.hpp"
 #include "solve/expectimax.hpp"
 
@@ -84,6 +85,37 @@ ExactEvaluation evaluate_exactly(const Mdp& mdp, Allocator& allocator, std::size
     // The same policy (a stationary allocator chooses by the state alone) valued with reward 1.
     const Problem unit = mdp.problem().with_rewards({});
     const Mdp success(unit);
+    result.success_probability = value_in(success).first;
+  }
+  return result;
+}
+
+MonteCarloResult run_monte_carlo(const ConcurrentMdp& mdp, const ConcurrentAllocatorFactory& factory,
+                                 const MonteCarloOptions& options) {
+  return run_concurrent_episodes(mdp, hidden_worlds(mdp.problem()), factory, options);
+}
+
+ExactEvaluation evaluate_exactly(const ConcurrentMdp& mdp, ConcurrentAllocator& allocator, std::size_t max_states,
+                                 const std::function<bool()>& stop) {
+  if (!allocator.is_stationary()) {
+    throw UsageError("exact evaluation needs an allocator whose move depends only on the state; '" +
+                     std::string(allocator.name()) + "' does not (use Monte Carlo)");
+  }
+  allocator.begin_episode(0);
+  const auto value_in = [&](const ConcurrentMdp& model) {
+    ConcurrentSolver solver(
+        model, [&](const ConcurrentState& state) { return allocator.choose(state); }, max_states);
+    solver.set_stop(stop);
+    const double value = solver.solve(model.start());
+    return std::make_pair(value, solver.states());
+  };
+  ExactEvaluation result;
+  std::tie(result.expected_reward, result.states) = value_in(mdp);
+  result.success_probability = result.expected_reward;
+  if (mdp.problem().has_rewards()) {
+    // The same moves valued with reward 1: the allocator chooses by the state alone, and the
+    // states (which hold no reward) are the same in both models.
+    const ConcurrentMdp success(mdp.problem().with_rewards({}));
     result.success_probability = value_in(success).first;
   }
   return result;

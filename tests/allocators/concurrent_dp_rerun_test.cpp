@@ -27,7 +27,7 @@ struct Figures {
 // The policy's exact value, by the solver's policy mode.
 double policy_value(const Problem& problem) {
   const ConcurrentMdp mdp(problem);
-  ConcurrentDpRerunPolicy policy(mdp);
+  ConcurrentDpRerunAllocator policy(mdp);
   ConcurrentSolver evaluation(mdp, [&](const ConcurrentState& state) { return policy.choose(state); });
   return evaluation.solve(mdp.start());
 }
@@ -41,7 +41,7 @@ Figures figures(const Problem& problem) {
 // The mean reward of `episodes` episodes of the policy, each drawn from the model's outcomes.
 double sampled_value(const Problem& problem, std::uint64_t episodes, std::uint64_t seed) {
   const ConcurrentMdp mdp(problem);
-  ConcurrentDpRerunPolicy policy(mdp);
+  ConcurrentDpRerunAllocator policy(mdp);
   SplitMix64 generator(seed);
   double total = 0;
   std::vector<std::pair<double, ConcurrentState>> outcomes;

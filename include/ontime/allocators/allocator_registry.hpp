@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "ontime/allocators/allocator.hpp"
+#include "ontime/allocators/concurrent_allocator.hpp"
 #include "ontime/allocators/decision_budget.hpp"
 #include "ontime/mdp/mdp.hpp"
 #include "ontime/util/memory.hpp"
@@ -179,7 +180,16 @@ struct AllocatorKind {
   // cannot serve (e.g. a policy trained for another instance), ResourceLimitError at a cap.
   std::function<AllocatorFactory(const Mdp& mdp, const ParameterReader& parameters)> make;
   AllocatorNeeds needs = {};
+  // Acting while planning (SPEC §10): the commit rule in a line (when the robot starts an action,
+  // dropping the skeletons not through it); empty when the kind decides plan-first only.
+  std::string commit_rule = {};
+  // A factory of allocators for a ConcurrentMdp (which must outlive it). Null with a commit rule:
+  // the eager rule (EagerCommitAllocator) around the allocators `make` makes for its plan-first Mdp.
+  std::function<ConcurrentAllocatorFactory(const ConcurrentMdp& mdp, const ParameterReader& parameters)>
+      make_concurrent = {};
 
+  // Whether the kind acts while planning (has a commit rule).
+  bool acts_while_planning() const noexcept { return !commit_rule.empty(); }
   // Whether the kind lists `counter` among the counters it reports (needs.counters).
   bool declares_counter(std::string_view counter) const;
 };
@@ -203,6 +213,13 @@ class AllocatorRegistry {
   // Checks every value given against its declaration (UsageError for an undeclared name or a
   // bad value), then makes the factory.
   AllocatorFactory make_factory(std::string_view name, const Mdp& mdp, const ParameterValues& values = {}) const;
+
+  // The same for a problem acting while planning (SPEC §10): the kind's own concurrent allocators
+  // or its eager rule. Throws UsageError for a kind without a commit rule, naming those with one.
+  ConcurrentAllocatorFactory make_concurrent_factory(std::string_view name, const ConcurrentMdp& mdp,
+                                                     const ParameterValues& values = {}) const;
+  // Names of the kinds that act while planning, in registration order.
+  std::vector<std::string> acting_names() const;
 
   // The budget of each decision that `values` ask of kind `name` (unset when they ask for none,
   // or when the kind takes no budget). Throws UsageError for a bad value.
@@ -235,6 +252,15 @@ AllocatorRegistry& allocator_registry();
 // Iterations per search in `statistics` of an allocator of `kind`, when the kind declares both
 // counters (a searcher); nothing otherwise, or when it ran no search.
 std::optional<double> iterations_per_search(const AllocatorKind& kind, const Statistics& statistics);
+
+// The commit rule of the kinds that choose a skeleton plan-first (EagerCommitAllocator).
+inline constexpr const char* kEagerCommitRule =
+    "eager: starts the next action of the skeleton it chooses as soon as that action is refined and the robot is "
+    "idle; a complete plan runs at once";
+
+// Shorthand for allocator_registry().make_concurrent_factory(...).
+ConcurrentAllocatorFactory make_concurrent_allocator_factory(std::string_view name, const ConcurrentMdp& mdp,
+                                                             const ParameterValues& values = {});
 
 // Shorthand for allocator_registry().make_factory(...).
 AllocatorFactory make_allocator_factory(std::string_view name, const Mdp& mdp, const ParameterValues& values = {});

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "ontime/allocators/allocator.hpp"
+#include "ontime/allocators/concurrent_allocator.hpp"
 #include "ontime/mdp/concurrent_mdp.hpp"
 #include "ontime/solve/backtracking_success.hpp"
 #include "ontime/solve/concurrent_contiguous_success.hpp"
@@ -66,16 +67,16 @@ class DpRerunAllocator final : public Allocator {
 // rest is planned) and follows the best (ties: lowest index): while the robot is idle and the
 // best skeleton's next action to execute is refined, it starts it (committing to the skeletons
 // through it); otherwise it spends the step on the best skeleton's next action, or waits when that
-// skeleton is refined in full. A stationary policy of ConcurrentMdp (ConcurrentSolver evaluates it
-// exactly); not yet an allocator of the registry, whose allocators decide plan-first.
+// skeleton is refined in full. Stationary: ConcurrentSolver's policy mode values it exactly.
 // Cost: per move, one Eq. (1) query per live skeleton: a sum over at most D - CT planning steps of
-// memoised values.
-class ConcurrentDpRerunPolicy {
+// memoised values (memoised per allocator, so each thread's allocator has its own memo).
+class ConcurrentDpRerunAllocator final : public ConcurrentAllocator {
  public:
-  // The policy for `mdp`, Eq. (1) combining sharing skeletons by `aggregation` (sum: Table I's).
-  explicit ConcurrentDpRerunPolicy(const ConcurrentMdp& mdp, Aggregation aggregation = Aggregation::sum);
+  // The allocator for `mdp`, Eq. (1) combining sharing skeletons by `aggregation` (sum: Table I's).
+  explicit ConcurrentDpRerunAllocator(const ConcurrentMdp& mdp, Aggregation aggregation = Aggregation::sum);
+  std::string_view name() const noexcept override { return "dp-rerun"; }
   // The move in a state where some skeleton is live: a start or a step, as above.
-  ConcurrentMdp::Move choose(const ConcurrentState& state);
+  ConcurrentMdp::Move choose(const ConcurrentState& state) override;
 
  private:
   const ConcurrentMdp* mdp_;

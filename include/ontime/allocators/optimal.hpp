@@ -10,7 +10,9 @@
 #include <memory>
 
 #include "ontime/allocators/allocator.hpp"
+#include "ontime/allocators/concurrent_allocator.hpp"
 #include "ontime/mdp/mdp.hpp"
+#include "ontime/solve/concurrent_solver.hpp"
 #include "ontime/solve/optimal_solver.hpp"
 
 namespace ontime {
@@ -42,6 +44,27 @@ class OptimalAllocator final : public Allocator {
   const Mdp* mdp_;
   std::shared_ptr<const OptimalSolver> solved_;
   std::unique_ptr<OptimalSolver> private_;
+};
+
+// `optimal` acting while planning (SPEC §10): follows ConcurrentSolver's best move, and runs a
+// complete plan at once (ConcurrentMdp::run_complete_plan, optimal where the solver stops at a
+// certain success). Its commit rule is the optimum's: the robot starts an action exactly when
+// starting is worth more than planning on while it waits. The solve from the start is shared by
+// the allocators of one factory; a state outside it (a session driven elsewhere by its caller) is
+// solved on demand by a private solver under the same cap. Cost: one hash lookup per move.
+class ConcurrentOptimalAllocator final : public ConcurrentAllocator {
+ public:
+  // Follows `solved` (which has solved mdp.start()); `max_states` caps a private solve.
+  ConcurrentOptimalAllocator(const ConcurrentMdp& mdp, std::shared_ptr<const ConcurrentSolver> solved,
+                             std::size_t max_states);
+  std::string_view name() const noexcept override { return "optimal"; }
+  ConcurrentMdp::Move choose(const ConcurrentState& state) override;
+
+ private:
+  const ConcurrentMdp* mdp_;
+  std::shared_ptr<const ConcurrentSolver> solved_;
+  std::size_t max_states_;
+  std::unique_ptr<ConcurrentSolver> private_;
 };
 
 }  // namespace ontime

@@ -149,6 +149,22 @@ class ConcurrentMdp {
   template <class Visitor>
   void for_each_step_outcome(const ConcurrentState& state, int choice, Visitor&& visit) const;
 
+  // The step in which the planner refines skeleton `choice`'s next action (or idles, kWait) and
+  // `observation` is what it revealed (a world's answer): the canonical next state, the same as
+  // for_each_step_outcome's for that outcome. An execution time beyond the deadline (or kNever)
+  // is stored as D + 1. Throws UsageError for a choice for_each_step_outcome refuses, a step at
+  // the deadline, a motion found on an idle step, or a backtrack (not modelled: SPEC §7).
+  ConcurrentState step(const ConcurrentState& state, int choice, const Observation& observation) const;
+
+  // When some live skeleton is refined in full (the lowest index of them, k): the move that runs
+  // it as soon as it can, the start of k's next action while the robot is idle, else a step in
+  // which the planner idles. Without rewards that is optimal (certain_success); it is the commit
+  // rule the allocators follow once a plan is complete. The default Move (the planner idles)
+  // when there is no such skeleton (complete_plan(state) < 0).
+  Move run_complete_plan(const ConcurrentState& state) const;
+  // The lowest index of a live skeleton refined in full, -1 when there is none.
+  int complete_plan(const ConcurrentState& state) const noexcept;
+
   // Without rewards (SPEC §8): whether some live skeleton is refined in full. Its earliest finish
   // is then at most D, and executing it as soon as possible succeeds: the state is worth 1.
   bool certain_success(const ConcurrentState& state) const noexcept;

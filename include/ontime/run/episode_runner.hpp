@@ -22,7 +22,9 @@
 #include <vector>
 
 #include "ontime/allocators/allocator.hpp"
+#include "ontime/allocators/concurrent_allocator.hpp"
 #include "ontime/allocators/decision_budget.hpp"
+#include "ontime/mdp/concurrent_mdp.hpp"
 #include "ontime/mdp/mdp.hpp"
 #include "ontime/run/session.hpp"
 #include "ontime/run/world.hpp"
@@ -72,6 +74,12 @@ struct LiveRun {
 EpisodeResult run_episode(const Mdp& mdp, Allocator& allocator, World& world, std::uint64_t seed,
                           const DecisionBudget& budget = {}, DecisionTimer* timer = nullptr,
                           const std::optional<LiveRun>& live = std::nullopt);
+
+// One episode acting while planning (SPEC §10) with seed `seed`, seeded as run_episode: the
+// allocator's moves through a ConcurrentSession (concurrent_session.hpp), its steps in `world`.
+// Every move, a start or a step, is a decision (timed when `timer` is given).
+EpisodeResult run_concurrent_episode(const ConcurrentMdp& mdp, ConcurrentAllocator& allocator, World& world,
+                                     std::uint64_t seed, DecisionTimer* timer = nullptr);
 
 // Episodes whose skeletons stream in from the world (World::next_skeleton), as a task planner
 // running alongside finds them. Each episode's session owns its problem (session.hpp): it begins
@@ -187,6 +195,13 @@ MonteCarloResult run_episodes(const Mdp& mdp, const WorldFactory& worlds, const 
 // belong to the episodes' sessions, so `statistics` stays empty.
 MonteCarloResult run_streaming_episodes(const StreamingRun& streaming, const WorldFactory& worlds,
                                         const MonteCarloOptions& options);
+
+// Episodes acting while planning (run_concurrent_episode), seeded and parallel as run_episodes.
+// The decision budget is not used (no concurrent allocator is anytime yet). Throws UsageError
+// for live episodes (not there yet for this mode).
+MonteCarloResult run_concurrent_episodes(const ConcurrentMdp& mdp, const WorldFactory& worlds,
+                                         const ConcurrentAllocatorFactory& allocators,
+                                         const MonteCarloOptions& options);
 
 // The 95% half-width of SPEC §4 for r successes out of n.
 double ci95_half_width(double rate, std::uint64_t episodes) noexcept;

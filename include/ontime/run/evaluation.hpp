@@ -6,6 +6,7 @@
 #include <functional>
 
 #include "ontime/allocators/allocator.hpp"
+#include "ontime/allocators/concurrent_allocator.hpp"
 #include "ontime/mdp/mdp.hpp"
 #include "ontime/run/episode_runner.hpp"
 
@@ -30,5 +31,14 @@ struct ExactEvaluation {
 // thousand states) returns true.
 ExactEvaluation evaluate_exactly(const Mdp& mdp, Allocator& allocator, std::size_t max_states = 10'000'000,
                                  const std::function<bool()>& stop = {});
+
+// Acting while planning (SPEC §10): Monte Carlo in the same hidden sampled worlds
+// (run_concurrent_episodes), and the exact value of a stationary allocator (ConcurrentSolver's
+// policy mode: a finite sum over the states its moves reach). Same errors as above.
+MonteCarloResult run_monte_carlo(const ConcurrentMdp& mdp, const ConcurrentAllocatorFactory& factory,
+                                 const MonteCarloOptions& options);
+// The exact success probability and expected reward of a stationary concurrent allocator, as above.
+ExactEvaluation evaluate_exactly(const ConcurrentMdp& mdp, ConcurrentAllocator& allocator,
+                                 std::size_t max_states = 10'000'000, const std::function<bool()>& stop = {});
 
 }  // namespace ontime

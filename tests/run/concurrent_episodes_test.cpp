@@ -1,0 +1,152 @@
+// Episodes in which the robot acts while planning (SPEC §10): the session's checks and steps, the
+// episode runner's Monte Carlo against the exact values of the same allocators, and seeding.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "ontime/allocators/allocator_registry.hpp"
+#include "ontime/model/instance_io.hpp"
+#include "ontime/run/concurrent_session.hpp"
+#include "ontime/run/evaluation.hpp"
+#include "ontime/run/simulator.hpp"
+#include "ontime/util/error.hpp"
+#include "support/paper.hpp"
+#include "support/random_instances.hpp"
+
+namespace ontime {
+namespace {
+
+Problem two_moves() {
+  // a is found in 1 step and runs 2; b is found after 2 more steps and runs 1; deadline 5.
+  // Plan first: refined at 3, executed by 6, too late. Acting while planning: a runs over steps
+  // 1-3 while b is planned, b over 3-4.
+  return parse_problem(R"({"deadline": 5, "acting": "concurrent",
+    "actions": {"a": {"planning": {"pmf": {"1": 1}}, "execution": {"pmf": {"2": 1}}},
+                "b": {"planning": {"pmf": {"2": 1}}, "execution": {"pmf": {"1": 1}}}},
+    "skeletons": [["a", "b"]]})",
+                       "two-moves");
+}
+
+TEST(ConcurrentSession, TheCallersMovesAndReportsWalkTheModel) {
+  const ConcurrentMdp mdp(two_moves());
+  ConcurrentSession session(mdp);
+  ConcurrentDecision decision = session.decide({-1, 0});
+  EXPECT_EQ(decision.action, 0);
+  EXPECT_EQ(session.report_refined(2), Status::running);
+  decision = session.decide({0, ConcurrentMdp::kWait});  // starts a at 1: no time passes
+  EXPECT_TRUE(decision.is_start());
+  EXPECT_EQ(session.steps_used(), 1);
+  EXPECT_EQ(ConcurrentMdp::robot_left(session.state()), 2);
+  EXPECT_EQ(session.decide({-1, 0}).action, 1);
+  EXPECT_EQ(session.report_not_yet(), Status::running);
+  session.decide({-1, 0});
+  EXPECT_EQ(session.report_refined(1), Status::running);
+  EXPECT_EQ(session.steps_used(), 3);
+  EXPECT_EQ(ConcurrentMdp::robot_left(session.state()), 0);
+  session.decide({1, ConcurrentMdp::kWait});  // b, the last action: done at 4
+  EXPECT_EQ(session.status(), Status::success);
+  EXPECT_EQ(session.solution(), 0);
+  EXPECT_EQ(session.finish(), 4);
+  EXPECT_EQ(session.reward(), 1.0);
+  EXPECT_EQ(session.started(), (std::vector<int>{0, 1}));
+  EXPECT_EQ(session.attempts()[1].effort, 2);
+  EXPECT_TRUE(session.attempts()[1].found);
+}
+
+TEST(ConcurrentSession, MovesAndReportsTheStateDoesNotAllowAreRefused) {
+  const ConcurrentMdp mdp(two_moves());
+  ConcurrentSession session(mdp);
+  EXPECT_THROW(session.choose(), std::logic_error);                     // no allocator
+  EXPECT_THROW(session.report_not_yet(), std::logic_error);             // nothing decided
+  EXPECT_THROW(session.decide({0, ConcurrentMdp::kWait}), UsageError);  // a is not refined
+  EXPECT_THROW(session.decide({-1, 1}), UsageError);                    // no skeleton 1
+  session.decide({-1, 0});
+  EXPECT_THROW(session.decide({-1, 0}), std::logic_error);                // awaiting the report
+  EXPECT_THROW(session.report_refined(-1), UsageError);                   // a negative execution
+  EXPECT_THROW(session.report(Observation::backtracked(0)), UsageError);  // not modelled here
+  EXPECT_EQ(session.report_refined(2), Status::running);                  // the session is unchanged
+  session.decide({-1, ConcurrentMdp::kWait});
+  EXPECT_THROW(session.report_refined(1), UsageError);  // the planner idled
+  const auto allocator = make_concurrent_allocator_factory("dp-rerun", mdp)();
+  ConcurrentSession driven(mdp, *allocator);
+  EXPECT_THROW(driven.decide({-1, 0}), std::logic_error);  // its allocator decides
+}
+
+TEST(ConcurrentSession, ATooSlowPlanFailsWhenTheRobotWouldFinishLate) {
+  // Found with an execution too slow to finish by the deadline: nothing can finish any more.
+  const ConcurrentMdp mdp(two_moves());
+  ConcurrentSession session(mdp);
+  session.decide({-1, 0});
+  EXPECT_EQ(session.report_refined(kNever), Status::failure);
+  EXPECT_EQ(session.reward(), 0.0);
+  EXPECT_EQ(session.solution(), -1);
+  EXPECT_THROW(session.decide({-1, 0}), std::logic_error);
+}
+
+double half_width_of(double value, std::uint64_t episodes) {
+  return std::sqrt(std::max(value * (1 - value), 0.0) / static_cast<double>(episodes));
+}
+
+TEST(ConcurrentEpisodes, TheirMeanRewardIsTheExactValue) {
+  // The runner's hidden worlds against ConcurrentSolver's policy mode, for allocators of each
+  // kind of commit rule (the optimum's, dp-rerun's own, the eager rule), with and without rewards.
+  const auto episodes = static_cast<std::uint64_t>(testing::repetitions_to_check(20'000));
+  for (const Problem& base : {testing::paper_instance("instance2"), testing::navigation_with_deadline(14),
+                              testing::with_random_rewards(testing::paper_instance("instance3"), 5)}) {
+    const Problem problem = base.with_acting(Acting::concurrent);
+    const ConcurrentMdp mdp(problem);
+    for (const std::string name : {"optimal", "dp-rerun", "greedy", "round-robin"}) {
+      const ConcurrentAllocatorFactory factory = make_concurrent_allocator_factory(name, mdp);
+      const auto allocator = factory();
+      const ExactEvaluation exact = evaluate_exactly(mdp, *allocator);
+      MonteCarloOptions options;
+      options.episodes = episodes;
+      options.seed = 11;
+      options.threads = 2;
+      const MonteCarloResult sampled = run_monte_carlo(mdp, factory, options);
+      // Rewards lie in [0, 1], so their variance is at most the mean's v(1 - v).
+      EXPECT_NEAR(sampled.mean_reward, exact.expected_reward,
+                  4 * half_width_of(exact.expected_reward, episodes) + 1e-12)
+          << problem.name() << " " << name;
+      EXPECT_NEAR(sampled.success_rate, exact.success_probability,
+                  4 * half_width_of(exact.success_probability, episodes) + 1e-12)
+          << problem.name() << " " << name;
+    }
+  }
+}
+
+TEST(ConcurrentEpisodes, TheSameSeedGivesTheSameEpisodesOnAnyThreadCount) {
+  const Problem problem = testing::navigation_with_deadline(16).with_acting(Acting::concurrent);
+  const ConcurrentMdp mdp(problem);
+  for (const std::string name : {"dp-rerun", "thompson"}) {
+    const ConcurrentAllocatorFactory factory = make_concurrent_allocator_factory(name, mdp);
+    MonteCarloOptions options;
+    options.episodes = 2'000;
+    options.seed = 3;
+    options.threads = 1;
+    const MonteCarloResult one = run_monte_carlo(mdp, factory, options);
+    options.threads = 2;
+    const MonteCarloResult two = run_monte_carlo(mdp, factory, options);
+    EXPECT_EQ(one.successes, two.successes) << name;
+    EXPECT_EQ(one.mean_reward, two.mean_reward) << name;
+    EXPECT_GT(one.successes, 0U) << name;
+  }
+}
+
+TEST(ConcurrentEpisodes, AThompsonAllocatorIsNotValuedExactly) {
+  const ConcurrentMdp mdp(testing::paper_instance("instance1").with_acting(Acting::concurrent));
+  const auto allocator = make_concurrent_allocator_factory("thompson", mdp)();
+  EXPECT_FALSE(allocator->is_stationary());
+  EXPECT_THROW((void)evaluate_exactly(mdp, *allocator), UsageError);
+  MonteCarloOptions options;
+  options.episodes = 10;
+  options.live = LiveRun{};
+  EXPECT_THROW((void)run_monte_carlo(mdp, make_concurrent_allocator_factory("thompson", mdp), options), UsageError);
+}
+
+}  // namespace
+}  // namespace ontime
