@@ -16,18 +16,65 @@
 
 namespace ontime::cli {
 
+namespace {
+
+struct EvaluateOptions {
+  std::string instance;
+  std::string belief;
+  std::string solver;
+  std::string act;  // empty: the instance's own mode
+  bool exact = false;
+  bool regret = false;
+  bool json = false;
+  bool no_timing = false;
+  AllocatorFlags allocator;
+  MonteCarloFlags monte_carlo;
+};
+
+// Acting while planning (SPEC §10): the allocator's concurrent form in the same hidden worlds.
+void run_concurrent(const EvaluateOptions& options, const Problem& problem) {
+  if (!options.belief.empty()) {
+    throw UsageError(
+        "--belief: acting while planning (concurrent, SPEC §10) is evaluated with the instance's own "
+        "distributions only so far");
+  }
+  if (options.regret) {
+    throw UsageError(
+        "--regret: acting while planning (concurrent, SPEC §10) has no regret estimate yet (--exact "
+        "values a stationary allocator exactly)");
+  }
+  const ParameterValues parameters = options.allocator.values();
+  options.monte_carlo.check_allocator_memory(options.solver, problem, parameters);
+  if (options.exact || allocator_registry().find(options.solver).capabilities.has(Capability::optimal)) {
+    check_exact_work(problem, max_states_of(parameters), options.instance, flag_spelling());
+  }
+  const ConcurrentMdp mdp(problem);
+  const ConcurrentAllocatorFactory factory = make_concurrent_allocator_factory(options.solver, mdp, parameters);
+  MonteCarloOptions monte_carlo = options.monte_carlo.options();
+  monte_carlo.time_decisions = !options.no_timing;
+  ProgressBar bar("evaluate " + options.solver);
+  monte_carlo.progress = [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); };
+  const MonteCarloResult result = run_monte_carlo(mdp, factory, monte_carlo);
+  std::optional<ExactEvaluation> exact;
+  if (options.exact) {
+    const auto allocator = factory();
+    exact = evaluate_exactly(mdp, *allocator, max_states_of(parameters));
+  }
+  const report::Evaluation evaluation{.solver = options.solver,
+                                      .parameters = parameters,
+                                      .instance = options.instance,
+                                      .problem = &problem,
+                                      .seed = options.monte_carlo.seed,
+                                      .result = result,
+                                      .exact = exact,
+                                      .timing = !options.no_timing};
+  fmt::print("{}", options.json ? report::to_json(evaluation) + "\n" : report::to_text(evaluation));
+}
+
+}  // namespace
+
 void add_evaluate_command(CLI::App& app) {
-  struct Options {
-    std::string instance;
-    std::string belief;
-    std::string solver;
-    bool exact = false;
-    bool regret = false;
-    bool json = false;
-    bool no_timing = false;
-    AllocatorFlags allocator;
-    MonteCarloFlags monte_carlo;
-  };
+  using Options = EvaluateOptions;
   auto options = std::make_shared<Options>();
   CLI::App* command = app.add_subcommand("evaluate", "Success rate of one allocator over simulated episodes");
   command->add_option("INSTANCE", options->instance, "Instance file (JSON, SPEC §5)")->required();
@@ -35,6 +82,9 @@ void add_evaluate_command(CLI::App& app) {
   command->add_option("--belief", options->belief,
                       "Instance the allocator plans with (a prediction, a pooled fit): its distributions for "
                       "INSTANCE's actions, matched by id; the episodes and the exact value are drawn from INSTANCE");
+  add_act_option(*command, options->act,
+                 "Concurrent takes the allocators with a commit rule ('ontime allocators' names them), not --belief "
+                 "or --regret yet");
   command->add_flag("--exact", options->exact, "Also compute the exact success probability (no sampling)");
   command->add_flag("--regret", options->regret,
                     "Also estimate the regret V* - V (the optimum less the allocator's success probability) from the "
@@ -48,7 +98,12 @@ void add_evaluate_command(CLI::App& app) {
   options->allocator.add_to(*command);
   command->callback([options] {
     check_solver_names({options->solver});
-    const Problem problem = load_problem(options->instance);
+    Problem problem = load_problem(options->instance);
+    if (!options->act.empty()) problem = problem.with_acting(*parse_acting(options->act));
+    if (problem.acting() == Acting::concurrent) {
+      run_concurrent(*options, problem);
+      return;
+    }
     const Mdp mdp(problem);
     // The allocator's own instance: INSTANCE's skeletons with the belief's distributions.
     std::optional<Problem> planned;

@@ -172,13 +172,7 @@ void add_solve_command(CLI::App& app) {
                    "bounds cannot settle)")
       ->check(CLI::IsMember({"layered", "split", "memoised", "search"}));
   CLI::Option* method_option = command->get_option("--method");
-  command
-      ->add_option("--act", options->act,
-                   "plan-first (the robot executes a skeleton once it is refined in full; SPEC §2) or concurrent (it "
-                   "executes refined actions while the rest is planned, and chooses when to start each; SPEC §10); "
-                   "default: the instance's \"acting\", plan-first when it has none. Concurrent is solved by the "
-                   "memoised solver (the default method then)")
-      ->check(CLI::IsMember({"plan-first", "concurrent"}));
+  add_act_option(*command, options->act, "Concurrent is solved by the memoised solver (the default method then)");
   add_number_option(*command, "--max-states", options->max_states,
                     "Cap on states: layered and search give an interval past it, memoised stops with an error "
                     "(default: none for layered, 10000000 for memoised and search)",

@@ -113,6 +113,16 @@ CLI::Option* add_solver_option(CLI::App& command, std::string& solver) {
       ->required();
 }
 
+CLI::Option* add_act_option(CLI::App& command, std::string& act, const std::string& what) {
+  return command
+      .add_option("--act", act,
+                  "plan-first (the robot executes a skeleton once it is refined in full; SPEC §2) or concurrent (it "
+                  "executes refined actions while the rest is planned, and chooses when to start each; SPEC §10); "
+                  "default: the instance's \"acting\", plan-first when it has none. " +
+                      what)
+      ->check(CLI::IsMember({"plan-first", "concurrent"}));
+}
+
 void check_solver_names(const std::vector<std::string>& names) {
   const std::vector<std::string> known = allocator_registry().names();
   if (names.empty()) throw UsageError("--solvers: give at least one allocator");

@@ -82,6 +82,10 @@ struct MonteCarloFlags {
 // Adds the required `--solver NAME` option, its help listing the allocators.
 CLI::Option* add_solver_option(CLI::App& command, std::string& solver);
 
+// Adds `--act plan-first|concurrent` (SPEC §10); `act` stays empty when it is not given, so that the
+// instance's own "acting" applies. `what` ends the help: how the command takes the mode.
+CLI::Option* add_act_option(CLI::App& command, std::string& act, const std::string& what);
+
 // Checks that every name is a known allocator (the CLI calls them solvers), none empty and
 // none twice; throws UsageError otherwise.
 void check_solver_names(const std::vector<std::string>& names);

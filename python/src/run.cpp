@@ -91,12 +91,18 @@ class PythonWorld final : public World {
   py::object world_;
 };
 
-MonteCarloResult run_with_hooks(const Mdp& mdp, const WorldFactory& worlds, const AllocatorFactory& factory,
-                                MonteCarloOptions options, const std::function<bool()>& stop, Progress& progress) {
+// `options` stopped by `stop` and counting its episodes in `progress`.
+MonteCarloOptions with_hooks(MonteCarloOptions options, const std::function<bool()>& stop, Progress& progress) {
   progress.total = options.episodes;
   options.stop = stop;
   options.progress = [&progress](std::uint64_t done, std::uint64_t) { progress.done = done; };
-  return run_episodes(mdp, worlds, factory, options);
+  return options;
+}
+
+MonteCarloResult run_with_hooks(const Mdp& mdp, const WorldFactory& worlds, const AllocatorFactory& factory,
+                                const MonteCarloOptions& options, const std::function<bool()>& stop,
+                                Progress& progress) {
+  return run_episodes(mdp, worlds, factory, with_hooks(options, stop, progress));
 }
 
 }  // namespace
@@ -170,6 +176,47 @@ py::dict monte_carlo_dict(const std::string& solver, const ParameterValues& valu
                                                         .regret = regret_estimate(result.statistics),
                                                         .timing = true}));
 }
+
+namespace {
+
+// evaluate(act='concurrent'): the allocator's concurrent form (SPEC §10) in the same hidden worlds.
+py::dict evaluate_concurrent(const py::object& source, const Problem& problem, const std::string& solver,
+                             std::uint64_t episodes, std::uint64_t seed, unsigned threads, bool exact, bool regret,
+                             const py::object& belief, const py::object& progress, const ParameterValues& values) {
+  if (!belief.is_none()) {
+    throw UsageError(
+        "belief: acting while planning (concurrent, SPEC §10) is evaluated with the problem's own "
+        "distributions only so far");
+  }
+  if (regret) throw UsageError("regret: acting while planning (concurrent, SPEC §10) has no regret estimate yet");
+  MonteCarloResult result;
+  std::optional<ExactEvaluation> exact_result;
+  run_interruptibly(
+      [&](const std::function<bool()>& stop, Progress& counters) {
+        const ConcurrentMdp mdp(problem);
+        const ConcurrentAllocatorFactory factory = make_concurrent_allocator_factory(solver, mdp, values);
+        MonteCarloOptions options;
+        options.episodes = episodes;
+        options.seed = seed;
+        options.threads = threads;
+        result = run_monte_carlo(mdp, factory, with_hooks(options, stop, counters));
+        if (exact) {
+          const auto allocator = factory();
+          exact_result = evaluate_exactly(mdp, *allocator, max_states_of(values), stop);
+        }
+      },
+      progress);
+  return json_object(report::to_json(report::Evaluation{.solver = solver,
+                                                        .parameters = values,
+                                                        .instance = instance_label(source, problem),
+                                                        .problem = &problem,
+                                                        .seed = seed,
+                                                        .result = result,
+                                                        .exact = exact_result,
+                                                        .timing = true}));
+}
+
+}  // namespace
 
 void bind_run(py::module_& m) {
   py::class_<DecisionView>(m, "Decision", "An allocator's decision: which skeleton, which action to refine now.")
@@ -372,8 +419,14 @@ void bind_run(py::module_& m) {
   m.def(
       "evaluate",
       [](const py::object& problem, const std::string& solver, Episodes episodes, Seed seed, Threads threads,
-         bool exact, bool regret, const py::object& belief, const py::object& progress, const py::kwargs& kwargs) {
+         bool exact, bool regret, const py::object& belief, const py::object& progress,
+         const std::optional<std::string>& act, const py::kwargs& kwargs) {
         check_episodes(episodes);
+        const std::shared_ptr<const Problem> chosen = problem_with_acting(problem, act);
+        if (chosen->acting() == Acting::concurrent) {
+          return evaluate_concurrent(problem, *chosen, solver, episodes, seed, threads, exact, regret, belief, progress,
+                                     parameter_values(kwargs));
+        }
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
         // The allocator's own instance: the problem's skeletons with the belief's distributions.
         std::shared_ptr<MdpHandle> planned = mdp;
@@ -401,7 +454,7 @@ void bind_run(py::module_& m) {
       },
       py::arg("problem"), py::arg("solver"), py::kw_only(), py::arg("episodes") = 10'000, py::arg("seed") = 1,
       py::arg("threads") = 0, py::arg("exact") = false, py::arg("regret") = false, py::arg("belief") = py::none(),
-      py::arg("progress") = py::none(),
+      py::arg("progress") = py::none(), py::arg("act") = py::none(),
       "Success rate of an allocator over simulated episodes (hidden sampled worlds), as `ontime evaluate "
       "--json` reports it: the same fields and, for the same seed, the same counts whatever `threads`. "
       "exact=True adds the exact success probability (stationary allocators); regret=True the estimate of "
@@ -409,6 +462,8 @@ void bind_run(py::module_& m) {
       "ci95, episodes). `belief` (an instance, its "
       "path or a Problem): the allocator plans with its distributions for the problem's actions (matched by "
       "id) while the episodes and the exact value are drawn from `problem` (`ontime evaluate --belief`). "
+      "act='concurrent' (or a problem whose acting is concurrent): the robot acts while planning (SPEC §10), "
+      "the allocator by its commit rule (`ontime evaluate --act`); not yet with belief or regret. "
       "Parameters of the allocator as keyword arguments. The GIL is released; Ctrl-C stops it "
       "(KeyboardInterrupt).");
 

@@ -19,11 +19,8 @@
 #include "ontime/util/memory.hpp"
 
 namespace ontime::python {
-namespace {
 
-// The problem `source` names (a Problem, an Mdp's problem, or an instance path), with the acting
-// mode `act` when given ("plan-first" or "concurrent").
-std::shared_ptr<const Problem> problem_to_solve(const py::object& source, const std::optional<std::string>& act) {
+std::shared_ptr<const Problem> problem_with_acting(const py::object& source, const std::optional<std::string>& act) {
   std::shared_ptr<const Problem> problem;
   if (py::isinstance<MdpHandle>(source)) {
     problem = source.cast<std::shared_ptr<MdpHandle>>()->problem;
@@ -42,8 +39,6 @@ std::shared_ptr<const Problem> problem_to_solve(const py::object& source, const 
   if (!acting) throw UsageError("act must be 'plan-first' or 'concurrent' (got '" + *act + "')");
   return acting == problem->acting() ? problem : std::make_shared<const Problem>(problem->with_acting(*acting));
 }
-
-}  // namespace
 
 void bind_solve(py::module_& m) {
   m.def(
@@ -79,7 +74,7 @@ void bind_solve(py::module_& m) {
             act_given.is_none() ? std::nullopt : std::optional<std::string>(act_given.cast<std::string>());
         // An Mdp is plan-first by construction; anything else is read as a problem with its mode.
         const std::shared_ptr<const Problem> chosen =
-            act || !py::isinstance<MdpHandle>(problem) ? problem_to_solve(problem, act) : nullptr;
+            act || !py::isinstance<MdpHandle>(problem) ? problem_with_acting(problem, act) : nullptr;
         if (chosen && chosen->acting() == Acting::concurrent) {
           if (method_given && *method_given != "memoised") {
             throw UsageError("method '" + *method_given +

@@ -59,10 +59,40 @@ def test_bad_requests_raise_usage_errors(arguments, message):
         ontime.solve(PAPER / "instance1.json", **arguments)
 
 
+def test_evaluate_acts_while_planning_by_the_allocators_commit_rule(cli):
+    instance = PAPER / "instance2.json"
+    result = ontime.evaluate(instance, "round-robin", act="concurrent", episodes=4000, seed=5, exact=True)
+    assert result["acting"] == "concurrent"
+    assert result["commit_rule"].startswith("eager")
+    assert result["exact_success_probability"] == pytest.approx(0.58, abs=1e-12)
+    # The same counts as the command line, and from the problem's own mode.
+    from_cli = cli("evaluate", str(instance), "--act", "concurrent", "--solver", "round-robin", "--episodes", "4000",
+                   "--seed", "5", "--exact", "--json", "--no-timing")
+    assert result["successes"] == from_cli["successes"]
+    marked = ontime.load_problem(instance).with_acting("concurrent")
+    assert ontime.evaluate(marked, "round-robin", episodes=4000, seed=5)["successes"] == result["successes"]
+    # The optimum is certain on instance 1 (0.942 plan-first).
+    first = ontime.evaluate(PAPER / "instance1.json", "optimal", act="concurrent", episodes=500, exact=True)
+    assert first["successes"] == 500
+    assert first["exact_success_probability"] == pytest.approx(1.0, abs=1e-12)
+
+
+@pytest.mark.parametrize("arguments, message", [
+    ({"solver": "mcts"}, "'mcts' does not act while planning"),
+    ({"solver": "dp-rerun", "regret": True}, "regret: acting while planning"),
+    ({"solver": "dp-rerun", "belief": PAPER / "instance1.json"}, "belief: acting while planning"),
+    ({"solver": "thompson", "exact": True}, "exact evaluation needs an allocator whose move"),
+    ({"solver": "dp-rerun", "act": "sometimes"}, "act must be 'plan-first' or 'concurrent'"),
+])
+def test_evaluate_refuses_what_acting_while_planning_does_not_take_yet(arguments, message):
+    arguments = {"act": "concurrent", **arguments}
+    solver = arguments.pop("solver")
+    with pytest.raises(ontime.UsageError, match=message):
+        ontime.evaluate(PAPER / "instance1.json", solver, episodes=10, **arguments)
+
+
 def test_what_does_not_take_the_mode_yet_refuses_it():
     concurrent = ontime.load_problem(PAPER / "instance1.json").with_acting("concurrent")
-    with pytest.raises(ontime.UsageError, match="acts while planning"):
-        ontime.evaluate(concurrent, "dp-rerun", episodes=10)
     with pytest.raises(ontime.UsageError, match="acts while planning"):
         ontime.make_allocator(concurrent, "dp-rerun")
     with pytest.raises(ontime.UsageError, match="acting must be"):

@@ -91,6 +91,11 @@ std::string to_json(const Evaluation& evaluation) {
   out["parameters"] = parameters_object(allocator_registry().find(evaluation.solver), evaluation.parameters);
   out["instance"] = evaluation.instance;
   if (!evaluation.belief.empty()) out["belief"] = evaluation.belief;
+  if (evaluation.problem->acting() == Acting::concurrent) {
+    // Only when acting while planning, so that plan-first outputs stay as they were.
+    out["acting"] = acting_name(Acting::concurrent);
+    out["commit_rule"] = allocator_registry().find(evaluation.solver).commit_rule;
+  }
   out["episodes"] = result.episodes;
   out["seed"] = evaluation.seed;
   out["successes"] = result.successes;
@@ -128,6 +133,10 @@ std::string to_text(const Evaluation& evaluation) {
   out += fmt::format("instance        {} ({}), deadline {}\n", evaluation.instance, evaluation.problem->name(),
                      evaluation.problem->deadline());
   if (!evaluation.belief.empty()) out += fmt::format("planned with    {}\n", evaluation.belief);
+  if (evaluation.problem->acting() == Acting::concurrent) {
+    out += fmt::format("acting          concurrent (SPEC §10); commit rule: {}\n",
+                       allocator_registry().find(evaluation.solver).commit_rule);
+  }
   out += fmt::format("success rate    {:.4f} ± {:.4f}  ({} of {} episodes, seed {})\n", result.success_rate,
                      result.ci95, result.successes, result.episodes, evaluation.seed);
   const bool rewards = evaluation.problem->has_rewards();
@@ -609,6 +618,8 @@ std::string registry_json(const AllocatorRegistry& registry) {
     entry["name"] = kind.name;
     entry["summary"] = kind.summary;
     entry["capabilities"] = kind.capabilities.names();
+    // null: the kind decides plan-first only (SPEC §10).
+    entry["commit_rule"] = kind.acts_while_planning() ? Json(kind.commit_rule) : Json(nullptr);
     entry["parameters"] = Json::array();
     for (const Parameter& parameter : kind.parameters) {
       Json item;
@@ -629,8 +640,8 @@ std::string registry_json(const AllocatorRegistry& registry) {
 std::string registry_markdown(const AllocatorRegistry& registry, const ParameterSpelling& spelling) {
   std::vector<std::vector<std::string>> kinds;
   for (const AllocatorKind& kind : registry.kinds()) {
-    kinds.push_back(
-        {"`" + kind.name + "`", fmt::format("{}", fmt::join(kind.capabilities.names(), ", ")), kind.summary});
+    kinds.push_back({"`" + kind.name + "`", fmt::format("{}", fmt::join(kind.capabilities.names(), ", ")), kind.summary,
+                     kind.acts_while_planning() ? kind.commit_rule : "plan-first only"});
   }
   std::vector<std::vector<std::string>> parameters;
   for (const Parameter& parameter : registry.parameters()) {
@@ -640,8 +651,8 @@ std::string registry_markdown(const AllocatorRegistry& registry, const Parameter
                           parameter.default_value.empty() ? "none" : parameter.default_value, parameter.allowed(),
                           parameter.help});
   }
-  return markdown_table({"allocator", "capabilities", "what it does"}, kinds) + "\n" +
-         markdown_table({"parameter", "of", "type", "default", "allowed", "meaning"}, parameters);
+  return markdown_table({"allocator", "capabilities", "what it does", "acting while planning (SPEC §10)"}, kinds) +
+         "\n" + markdown_table({"parameter", "of", "type", "default", "allowed", "meaning"}, parameters);
 }
 
 namespace {

@@ -5,9 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "apps/cli_test_support.hpp"
@@ -88,6 +90,49 @@ TEST(Cli, EvaluateWithoutTimingPrintsTheSameBytesForAnyThreadCount) {
   ASSERT_EQ(with_timing.exit_code, 0) << with_timing.err;
   EXPECT_EQ(json::parse(with_timing.out)["successes"], out["successes"]);
   EXPECT_TRUE(json::parse(with_timing.out).contains("decision_time_us"));
+}
+
+TEST(Cli, EvaluateActsWhilePlanningByEachAllocatorsCommitRule) {
+  // Instance 1: acting while planning is certain for the optimum (0.942 plan-first) and for
+  // dp-rerun's eager rule; round-robin's eager rule is valued exactly too.
+  const auto optimal = ontime({"evaluate", paper("instance1"), "--act", "concurrent", "--solver", "optimal",
+                               "--episodes", "2000", "--exact", "--json", "--no-timing"});
+  ASSERT_EQ(optimal.exit_code, 0) << optimal.err;
+  const json out = json::parse(optimal.out);
+  EXPECT_EQ(out["acting"], "concurrent");
+  EXPECT_EQ(out["commit_rule"], allocator_registry().find("optimal").commit_rule);
+  EXPECT_EQ(out["successes"], 2000);
+  EXPECT_NEAR(out["exact_success_probability"].get<double>(), 1.0, 1e-12);
+
+  const auto text = ontime({"evaluate", paper("instance2"), "--act", "concurrent", "--solver", "round-robin",
+                            "--episodes", "4000", "--exact"});
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("acting          concurrent (SPEC §10); commit rule: eager"), std::string::npos) << text.out;
+  const auto round_robin = ontime({"evaluate", paper("instance2"), "--act", "concurrent", "--solver", "round-robin",
+                                   "--episodes", "4000", "--exact", "--json"});
+  const json values = json::parse(round_robin.out);
+  const double exact = values["exact_success_probability"].get<double>();
+  EXPECT_NEAR(exact, 0.58, 1e-12);  // the same as plan-first on instance 2 (Table I: 0.58)
+  EXPECT_NEAR(values["success_rate"].get<double>(), exact, 4 * std::sqrt(exact * (1 - exact) / 4000));
+
+  // Plan-first stays as it was: no acting keys.
+  const auto plan_first =
+      ontime({"evaluate", paper("instance1"), "--solver", "optimal", "--episodes", "100", "--json", "--no-timing"});
+  ASSERT_EQ(plan_first.exit_code, 0) << plan_first.err;
+  EXPECT_FALSE(json::parse(plan_first.out).contains("acting"));
+
+  for (const auto& [arguments, message] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{"--solver", "ppo"}, "'ppo' does not act while planning (SPEC §10) yet"},
+           {{"--solver", "dp-rerun", "--regret"}, "--regret: acting while planning"},
+           {{"--solver", "dp-rerun", "--belief", paper("instance1")}, "--belief: acting while planning"},
+           {{"--solver", "thompson", "--exact"}, "exact evaluation needs an allocator whose move depends only on"},
+           {{"--solver", "dp-rerun", "--act", "sometimes"}, "--act"}}) {
+    std::vector<std::string> command{"evaluate", paper("instance1"), "--act", "concurrent", "--episodes", "10"};
+    command.insert(command.end(), arguments.begin(), arguments.end());
+    const auto result = ontime(command);
+    EXPECT_EQ(result.exit_code, 2) << message << ": " << result.err;
+    EXPECT_NE(result.err.find(message), std::string::npos) << result.err;
+  }
 }
 
 TEST(Cli, TablePrintsOneRowPerInstanceAndTheOptimum) {

@@ -76,7 +76,8 @@ TEST(Cli, SolveActsWhilePlanningWhenAsked) {
       {{"solve", instance, "--method", "search"}, "solved by --method memoised only"},
       {{"solve", instance, "--tolerance", "0.1"}, "--tolerance is for the layered solver"},
       {{"solve", instance, "--max-seconds", "5"}, "--max-seconds is for the layered solver"},
-      {{"evaluate", instance, "--solver", "dp-rerun", "--episodes", "10"}, "acts while planning"},
+      {{"evaluate", instance, "--solver", "mcts", "--episodes", "10"}, "'mcts' does not act while planning"},
+      {{"table", instance, "--episodes", "10"}, "acts while planning"},
       {{"solve", paper("instance1"), "--act", "interleaved"}, "--act"},
   };
   for (const auto& [arguments, message] : refused) {
