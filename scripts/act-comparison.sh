@@ -6,6 +6,9 @@
 #   INSTANCES [the paper's Fig. 1 and instances 1-5]      SWEPT [data/instances/navigation.json]
 #   DEADLINES [10,12,14,16]  (the deadlines at which SWEPT is solved, its own deadline replaced)
 #   OUT [docs/images/act-comparison]  (writes OUT.csv and OUT.png)   ONTIME [build/ontime]
+#   ALLOCATORS [dp-rerun,dp,greedy,round-robin,first-found,found-order-round-robin]  ALLOCATOR_DEADLINE [14]
+#   (each allocator's exact value in both modes, `ontime evaluate --exact`, on INSTANCES but Fig. 1
+#   and on SWEPT at ALLOCATOR_DEADLINE, written to OUT-allocators.csv; empty ALLOCATORS: none)
 # Exact figures: they reproduce to the bit on any machine. Navigation at 16 steps takes about 40 s
 # and 0.8 GB; its own deadline (22) is beyond the memoised solver of this mode.
 set -euo pipefail
@@ -14,6 +17,8 @@ paper=data/instances/paper
 INSTANCES=${INSTANCES:-$paper/figure1.json,$paper/instance1.json,$paper/instance2.json,$paper/instance3.json,$paper/instance4.json,$paper/instance5.json}
 SWEPT=${SWEPT:-data/instances/navigation.json}
 DEADLINES=${DEADLINES:-10,12,14,16}
+ALLOCATORS=${ALLOCATORS-dp-rerun,dp,greedy,round-robin,first-found,found-order-round-robin}
+ALLOCATOR_DEADLINE=${ALLOCATOR_DEADLINE:-14}
 OUT=${OUT:-docs/images/act-comparison}
 ONTIME=${ONTIME:-build/ontime}
 if [ ! -x "$ONTIME" ]; then
@@ -64,3 +69,44 @@ os.replace(sys.argv[2] + ".tmp", sys.argv[2])
 PYTHON
 /usr/bin/python3 python/plot_act_comparison.py --data "$OUT.csv" --output "$OUT.png"
 echo "act-comparison: wrote $OUT.csv and $OUT.png" >&2
+[ -n "$ALLOCATORS" ] || exit 0
+
+# Each allocator by its commit rule: the exact value of its policy in both modes (one episode is
+# drawn too, as evaluate always runs some; only the exact values are kept).
+IFS=, read -r -a allocators <<< "$ALLOCATORS"
+valued=()
+for instance in "${instances[@]}"; do
+  [ "$(basename "$instance")" = figure1.json ] || valued+=("$instance")
+done
+if [ -n "$SWEPT" ]; then
+  /usr/bin/python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); d["deadline"] = int(sys.argv[2]); json.dump(d, open(sys.argv[3], "w"))' \
+    "$SWEPT" "$ALLOCATOR_DEADLINE" "$runs/$(basename "$SWEPT" .json)-$ALLOCATOR_DEADLINE.json"
+  valued+=("$runs/$(basename "$SWEPT" .json)-$ALLOCATOR_DEADLINE.json")
+fi
+for instance in "${valued[@]}"; do
+  for allocator in "${allocators[@]}"; do
+    echo "act-comparison: $allocator on $(basename "$instance" .json)" >&2
+    for act in plan-first concurrent; do
+      "$ONTIME" evaluate "$instance" --solver "$allocator" --act "$act" --episodes 1 --exact --json --no-timing \
+        > "$runs/allocator.$(basename "$instance" .json).$allocator.$act.json"
+    done
+  done
+done
+/usr/bin/python3 - "$runs" "$OUT-allocators.csv" <<'PYTHON'
+import glob, json, os, sys
+rows = []
+for path in sorted(glob.glob(os.path.join(sys.argv[1], "allocator.*.concurrent.json"))):
+    _, instance, allocator, _, _ = os.path.basename(path).split(".")
+    with open(path) as file:
+        concurrent = json.load(file)
+    with open(path.replace(".concurrent.json", ".plan-first.json")) as file:
+        plan_first = json.load(file)
+    key = "exact_expected_reward" if "exact_expected_reward" in concurrent else "exact_success_probability"
+    rows.append((instance, allocator, plan_first[key], concurrent[key], concurrent["commit_rule"].split(":")[0].split()[0]))
+with open(sys.argv[2] + ".tmp", "w") as file:
+    file.write("instance,allocator,plan_first,concurrent,commit_rule\n")
+    for row in rows:
+        file.write('{},{},{:.6f},{:.6f},"{}"\n'.format(*row))
+os.replace(sys.argv[2] + ".tmp", sys.argv[2])
+PYTHON
+echo "act-comparison: wrote $OUT-allocators.csv" >&2

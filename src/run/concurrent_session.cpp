@@ -8,14 +8,15 @@
 namespace ontime {
 
 ConcurrentSession::ConcurrentSession(const ConcurrentMdp& mdp, ConcurrentAllocator& allocator, std::uint64_t seed)
-    : ConcurrentSession(mdp) {
-  allocator_ = &allocator;
+    : ConcurrentSession(mdp, &allocator) {
   allocator.begin_episode(seed);
 }
 
-ConcurrentSession::ConcurrentSession(const ConcurrentMdp& mdp)
+ConcurrentSession::ConcurrentSession(const ConcurrentMdp& mdp) : ConcurrentSession(mdp, nullptr) {}
+
+ConcurrentSession::ConcurrentSession(const ConcurrentMdp& mdp, ConcurrentAllocator* allocator)
     : mdp_(&mdp),
-      allocator_(nullptr),
+      allocator_(allocator),
       state_(mdp.start()),
       before_(state_),
       attempts_(static_cast<std::size_t>(mdp.problem().action_count())) {

@@ -89,6 +89,7 @@ class ConcurrentSession {
   std::vector<ActionAttempt> take_attempts() noexcept { return std::move(attempts_); }
 
  private:
+  ConcurrentSession(const ConcurrentMdp& mdp, ConcurrentAllocator* allocator);
   ConcurrentDecision carry_out_move(const ConcurrentMdp::Move& move);
   void end_if_stuck();
 
