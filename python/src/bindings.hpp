@@ -210,6 +210,7 @@ void bind_mdp(py::module_& m);
 void bind_solve(py::module_& m);
 void bind_allocators(py::module_& m);
 void bind_run(py::module_& m);
+void bind_acting(py::module_& m);
 void bind_live(py::module_& m);
 void bind_environment(py::module_& m);
 void bind_learn(py::module_& m);

@@ -256,6 +256,7 @@ PYBIND11_MODULE(_ontime, m) {
   bind_solve(m);
   bind_allocators(m);
   bind_run(m);
+  bind_acting(m);
   bind_live(m);
   bind_environment(m);
   bind_learn(m);

@@ -97,3 +97,87 @@ def test_what_does_not_take_the_mode_yet_refuses_it():
         ontime.make_allocator(concurrent, "dp-rerun")
     with pytest.raises(ontime.UsageError, match="acting must be"):
         concurrent.with_acting(None)
+
+
+TWO_MOVES = {
+    "deadline": 5,
+    "actions": {"a": {"planning": {"pmf": {"1": 1}}, "execution": {"pmf": {"2": 1}}},
+                "b": {"planning": {"pmf": {"2": 1}}, "execution": {"pmf": {"1": 1}}}},
+    "skeletons": [["a", "b"]],
+}
+
+
+def two_moves():
+    """a is found at 1 and runs 2; b is found 2 steps later and runs 1; deadline 5: plan-first fails
+    (refined at 3, executed by 6), acting while planning finishes at 4."""
+    return ontime.Problem.from_json(json.dumps(TWO_MOVES))
+
+
+def test_a_session_of_the_callers_moves_walks_the_model():
+    session = ontime.ConcurrentSession(two_moves())
+    assert session.decide(refine=0) == {"start": None, "skeleton": 0, "action": "a"}
+    session.report_refined(2)
+    assert session.startable == ["a"]
+    assert session.decide(start="a")["start"] == "a"
+    assert (session.steps_used, session.robot_left) == (1, 2)
+    session.decide(refine=0)
+    session.report_not_yet()
+    session.decide(refine=0)
+    assert session.report_refined(1) == ontime.Status.running
+    session.decide(start="b")
+    assert session.status == ontime.Status.success
+    assert (session.solution, session.finish, session.reward) == (0, 4, 1.0)
+    assert session.started == ["a", "b"]
+
+
+def test_a_robot_that_finishes_early_says_so_and_one_never_started_is_refused():
+    session = ontime.ConcurrentSession(two_moves())
+    session.decide(refine=0)
+    session.report_refined(2)
+    with pytest.raises(ontime.UsageError, match="was never started"):
+        session.report_execution_finished("a")
+    session.decide(start=0)
+    session.decide(refine=0)
+    session.report_not_yet()
+    assert session.robot_left == 1
+    session.report_execution_finished("a")
+    assert session.robot_left == 0
+    with pytest.raises(ontime.UsageError, match="was never started"):
+        session.report_execution_finished("b")
+    with pytest.raises(ontime.UsageError, match="no action 'c'"):
+        session.report_execution_finished("c")
+
+
+def test_an_allocators_session_earns_what_its_episodes_do():
+    problem = ontime.load_problem(PAPER / "instance1.json")
+    session = ontime.ConcurrentSession(problem, "dp-rerun", seed=3)
+    moves = 0
+    while session.status == ontime.Status.running:
+        move = session.choose()
+        moves += 1
+        if move["start"] is None:
+            session.report_refined(1) if move["action"] is not None else session.report_not_yet()
+    assert session.status == ontime.Status.success
+    assert moves > 1
+    assert len(session.started) >= 1
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda s: s.decide(start="a", refine=0), "not both"),
+    (lambda s: s.decide(start="a"), "cannot be started now"),
+    (lambda s: s.decide(refine=3), "no skeleton 3"),
+    (lambda s: s.decide(refine="0"), "a skeleton's index"),
+    (lambda s: s.report_not_yet(), "no step awaits its report"),
+    (lambda s: s.report_refined(-1), "execution_steps"),
+    (lambda s: s.choose(), "no allocator"),
+])
+def test_moves_and_reports_out_of_rule_raise_usage_errors(call, message):
+    with pytest.raises(ontime.UsageError, match=message):
+        call(ontime.ConcurrentSession(two_moves()))
+
+
+def test_a_session_refuses_allocators_without_a_commit_rule():
+    with pytest.raises(ontime.UsageError, match="'mcts' does not act while planning"):
+        ontime.ConcurrentSession(two_moves(), "mcts")
+    with pytest.raises(ontime.UsageError, match="need a solver"):
+        ontime.ConcurrentSession(two_moves(), budget=4)

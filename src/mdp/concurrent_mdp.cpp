@@ -242,6 +242,13 @@ ConcurrentState ConcurrentMdp::step(const ConcurrentState& state, int choice, co
   return next;
 }
 
+ConcurrentState ConcurrentMdp::execution_finished(const ConcurrentState& state) const {
+  ConcurrentState next = state;
+  next[1] = 0;
+  canonicalise(next);
+  return next;
+}
+
 int ConcurrentMdp::complete_plan(const ConcurrentState& state) const noexcept {
   for (int k = 0; k < skeleton_count_; ++k) {
     if (is_live(state, k) && refined(state, k) == problem_->skeleton_length(k)) return k;

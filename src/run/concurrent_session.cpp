@@ -1,5 +1,6 @@
 #include "ontime/run/concurrent_session.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
@@ -107,6 +108,20 @@ Status ConcurrentSession::report(const Observation& observation) {
   }
   if (allocator_ != nullptr) allocator_->observe(before_, pending_skeleton_, state_);
   end_if_stuck();
+  return status_;
+}
+
+Status ConcurrentSession::report_execution_finished(int action) {
+  if (status_ != Status::running) throw std::logic_error("the session is over");
+  if (pending_) throw std::logic_error("a step awaits its report: report the execution after it");
+  if (std::find(started_.begin(), started_.end(), action) == started_.end()) {
+    throw UsageError("report_execution_finished: action " + std::to_string(action) +
+                     " was never started: the robot reports only the executions the session started (SPEC §10)");
+  }
+  if (action == started_.back()) {
+    state_ = mdp_->execution_finished(state_);
+    end_if_stuck();
+  }
   return status_;
 }
 

@@ -76,6 +76,35 @@ TEST(ConcurrentSession, MovesAndReportsTheStateDoesNotAllowAreRefused) {
   EXPECT_THROW(driven.decide({-1, 0}), std::logic_error);  // its allocator decides
 }
 
+TEST(ConcurrentSession, ARobotThatFinishesEarlyStartsTheNextActionSooner) {
+  // a is found at 1 and would run to 3; the robot reports it done at 2, while b is still planned.
+  // b is found at 3 either way and then runs 3 -> 4; reported at 2, nothing is left of a.
+  const ConcurrentMdp mdp(two_moves());
+  ConcurrentSession session(mdp);
+  session.decide({-1, 0});
+  session.report_refined(2);
+  EXPECT_THROW(session.report_execution_finished(0), UsageError);  // not started yet
+  session.decide({0, ConcurrentMdp::kWait});
+  session.decide({-1, 0});
+  EXPECT_THROW(session.report_execution_finished(0), std::logic_error);  // a step awaits its report
+  session.report_not_yet();
+  EXPECT_EQ(ConcurrentMdp::robot_left(session.state()), 1);
+  EXPECT_EQ(session.report_execution_finished(0), Status::running);
+  EXPECT_EQ(ConcurrentMdp::robot_left(session.state()), 0);
+  EXPECT_EQ(session.report_execution_finished(0), Status::running);  // told twice: nothing more
+  try {
+    session.report_execution_finished(1);
+    ADD_FAILURE() << "an execution never started was accepted";
+  } catch (const UsageError& error) {
+    EXPECT_NE(std::string(error.what()).find("was never started"), std::string::npos) << error.what();
+  }
+  session.decide({-1, 0});
+  session.report_refined(1);
+  session.decide({1, ConcurrentMdp::kWait});
+  EXPECT_EQ(session.status(), Status::success);
+  EXPECT_EQ(session.finish(), 4);
+}
+
 TEST(ConcurrentSession, ATooSlowPlanFailsWhenTheRobotWouldFinishLate) {
   // Found with an execution too slow to finish by the deadline: nothing can finish any more.
   const ConcurrentMdp mdp(two_moves());

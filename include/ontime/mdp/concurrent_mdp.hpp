@@ -156,6 +156,11 @@ class ConcurrentMdp {
   // the deadline, a motion found on an idle step, or a backtrack (not modelled: SPEC §7).
   ConcurrentState step(const ConcurrentState& state, int choice, const Observation& observation) const;
 
+  // The state with the robot's current execution finished now (r = 0; canonical): what a robot
+  // that finished sooner than its motion's execution time reports. The state itself while it is
+  // idle.
+  ConcurrentState execution_finished(const ConcurrentState& state) const;
+
   // When some live skeleton is refined in full (the lowest index of them, k): the move that runs
   // it as soon as it can, the start of k's next action while the robot is idle, else a step in
   // which the planner idles. Without rewards that is optimal (certain_success); it is the commit

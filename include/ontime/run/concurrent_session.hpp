@@ -64,6 +64,13 @@ class ConcurrentSession {
   Status report_not_yet();
   Status report_refined(Steps execution_steps);
   Status report(const Observation& observation);
+  // The robot reports that its execution of `action` ended (a real robot may finish sooner than the
+  // execution time its motion was found with; on the step clock, an execution ends by itself once
+  // its steps have passed). For the action executing now the robot becomes idle, so that the next
+  // start may come at once; for an action started earlier, whose execution ended when the next one
+  // began, nothing changes. Throws UsageError for an action the robot did not start (naming the
+  // rule), std::logic_error while a step awaits its report or after the end.
+  Status report_execution_finished(int action);
 
   // Where the episode stands: running, then success or failure.
   Status status() const noexcept { return status_; }
