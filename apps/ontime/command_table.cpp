@@ -77,6 +77,7 @@ void add_table_command(CLI::App& app) {
     std::vector<std::string> solvers = default_table_solvers();
     bool exact = false;
     bool json = false;
+    std::vector<std::string> acts;  // empty: each instance's own mode
     AllocatorFlags allocator;
     MonteCarloFlags monte_carlo;
   };
@@ -101,13 +102,24 @@ void add_table_command(CLI::App& app) {
           "Comma-separated allocators, one column each")
       ->default_str(fmt::format("{}", fmt::join(options->solvers, ",")));
   command->add_flag("--exact", options->exact, "Add exact success probabilities and the exact optimum");
+  command
+      ->add_option("--act", options->acts,
+                   "plan-first, concurrent, or both comma-separated (one row per instance and mode, labelled "
+                   "'NAME (concurrent)' when acting while planning; SPEC §10); default: each instance's own "
+                   "\"acting\". Rows acting while planning take the allocators with a commit rule ('ontime "
+                   "allocators'); the default columns are then those")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"plan-first", "concurrent"}));
   command->add_flag("--json", options->json, "Print JSON");
   options->monte_carlo.add_to(*command);
   options->allocator.add_to(*command);
-  command->callback([options] {
+  command->callback([options, command] {
     TableOptions table;
     table.solvers = options->solvers;
     if (table.solvers.empty()) throw UsageError("--solvers: give at least one allocator");
+    // Not given: the library's defaults, which leave out the kinds without a commit rule when a
+    // row acts while planning.
+    if (command->get_option("--solvers")->count() == 0) table.solvers.clear();
     table.exact = options->exact;
     const MonteCarloOptions monte_carlo = options->monte_carlo.options();
     table.episodes = monte_carlo.episodes;
@@ -120,10 +132,26 @@ void add_table_command(CLI::App& app) {
     std::vector<TableInstance> instances;
     for (std::size_t i = 0; i < options->instances.size(); ++i) {
       const std::string& path = options->instances[i];
-      instances.push_back({load_problem(path), path, std::filesystem::path(path).stem().string(),
-                           options->allocator.values(i, options->instances.size())});
+      const Problem problem = load_problem(path);
+      const std::string stem = std::filesystem::path(path).stem().string();
+      const ParameterValues values = options->allocator.values(i, options->instances.size());
+      if (options->acts.empty()) {
+        instances.push_back(
+            {problem, path, stem + (problem.acting() == Acting::concurrent ? " (concurrent)" : ""), values});
+        continue;
+      }
+      for (const std::string& act : options->acts) {
+        const Acting acting = *parse_acting(act);
+        instances.push_back(
+            {problem.with_acting(acting), path, stem + (acting == Acting::concurrent ? " (concurrent)" : ""), values});
+      }
     }
     check_table_request(instances, table, flag_spelling());
+    if (table.solvers.empty())
+      table.solvers =
+          default_table_solvers(std::any_of(instances.begin(), instances.end(), [](const TableInstance& instance) {
+            return instance.problem.acting() == Acting::concurrent;
+          }));
     ProgressBar bar("table");
     TableTimeLeft time_left(table.episodes, table.solvers.size());
     table.progress = [&bar, &time_left](std::uint64_t done, std::uint64_t total) {

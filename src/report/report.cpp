@@ -433,6 +433,8 @@ std::string to_json(const Table& table) {
     Json line;
     line["instance"] = row.source;
     line["name"] = row.name;
+    // Only rows acting while planning (SPEC §10) say so, so that plan-first tables stay as they were.
+    if (row.acting == Acting::concurrent) line["acting"] = acting_name(row.acting);
     Json cells = Json::object();
     for (std::size_t s = 0; s < table.solvers.size(); ++s) {
       const TableCell& cell = row.cells[s];

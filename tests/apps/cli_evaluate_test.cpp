@@ -135,6 +135,41 @@ TEST(Cli, EvaluateActsWhilePlanningByEachAllocatorsCommitRule) {
   }
 }
 
+TEST(Cli, TableSetsPlanFirstBesideActingWhilePlanning) {
+  const auto result = ontime({"table", paper("instance1"), "--act", "plan-first,concurrent", "--solvers",
+                              "dp-rerun,optimal", "--episodes", "500", "--exact", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const json rows = json::parse(result.out)["rows"];
+  ASSERT_EQ(rows.size(), 2U);
+  EXPECT_FALSE(rows[0].contains("acting"));
+  EXPECT_EQ(rows[1]["acting"], "concurrent");
+  EXPECT_NEAR(rows[0]["optimal_success_probability"].get<double>(), 0.942, 1e-12);
+  EXPECT_NEAR(rows[1]["optimal_success_probability"].get<double>(), 1.0, 1e-12);
+  EXPECT_NEAR(rows[0]["solvers"]["dp-rerun"]["exact_success_probability"].get<double>(), 0.94, 1e-12);
+  EXPECT_NEAR(rows[1]["solvers"]["dp-rerun"]["exact_success_probability"].get<double>(), 1.0, 1e-12);
+  EXPECT_EQ(rows[1]["solvers"]["dp-rerun"]["success_rate"], 1.0);
+
+  // The default columns acting while planning are the kinds with a commit rule.
+  const auto defaults = ontime({"table", paper("instance2"), "--act", "concurrent", "--episodes", "50", "--json"});
+  ASSERT_EQ(defaults.exit_code, 0) << defaults.err;
+  const auto columns = json::parse(defaults.out)["solvers"].get<std::vector<std::string>>();
+  EXPECT_EQ(columns, (std::vector<std::string>{"dp", "dp-rerun", "round-robin", "greedy", "thompson", "first-found",
+                                               "found-order-round-robin"}));
+  const auto markdown = ontime({"table", paper("instance2"), "--act", "concurrent", "--episodes", "50"});
+  EXPECT_NE(markdown.out.find("| instance2 (concurrent)  |"), std::string::npos) << markdown.out;
+
+  for (const auto& [arguments, message] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{"--act", "concurrent", "--solvers", "dp-rerun,mcts"}, "allocator 'mcts' does not act while planning"},
+           {{"--act", "concurrent,concurrent"}, "instance given twice"},
+           {{"--act", "plan-first,sometimes"}, "--act"}}) {
+    std::vector<std::string> command{"table", paper("instance1"), "--episodes", "10"};
+    command.insert(command.end(), arguments.begin(), arguments.end());
+    const auto refused = ontime(command);
+    EXPECT_EQ(refused.exit_code, 2) << message << ": " << refused.err;
+    EXPECT_NE(refused.err.find(message), std::string::npos) << refused.err;
+  }
+}
+
 TEST(Cli, TablePrintsOneRowPerInstanceAndTheOptimum) {
   const auto result = ontime(
       {"table", paper("instance2"), paper("instance4"), "--episodes", "500", "--exact", "--solvers", "dp,greedy"});

@@ -77,7 +77,7 @@ TEST(Cli, SolveActsWhilePlanningWhenAsked) {
       {{"solve", instance, "--tolerance", "0.1"}, "--tolerance is for the layered solver"},
       {{"solve", instance, "--max-seconds", "5"}, "--max-seconds is for the layered solver"},
       {{"evaluate", instance, "--solver", "mcts", "--episodes", "10"}, "'mcts' does not act while planning"},
-      {{"table", instance, "--episodes", "10"}, "acts while planning"},
+      {{"table", instance, "--episodes", "10", "--solvers", "mcts"}, "'mcts' does not act while planning"},
       {{"solve", paper("instance1"), "--act", "interleaved"}, "--act"},
   };
   for (const auto& [arguments, message] : refused) {

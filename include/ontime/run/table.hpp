@@ -43,9 +43,10 @@ struct TableCell {
 };
 
 struct TableRow {
-  std::string label;   // the instance's file stem, or the name given
-  std::string source;  // where the instance came from (a file), as given
-  std::string name;    // the instance's own name
+  std::string label;                   // the instance's file stem, or the name given
+  std::string source;                  // where the instance came from (a file), as given
+  std::string name;                    // the instance's own name
+  Acting acting = Acting::plan_first;  // the instance's mode (SPEC §10)
   // The instance has rewards (SPEC §8): the exact parts are expected rewards, and the report
   // shows the mean reward beside the success rate.
   bool rewards = false;
@@ -53,6 +54,10 @@ struct TableRow {
   std::optional<ExactPart> optimum;
 };
 
+// An instance whose acting is concurrent (SPEC §10) is a row acting while planning: its columns are
+// the allocators' concurrent forms (each kind's commit rule), its exact values the solver's policy
+// mode, and its optimum the memoised solver of that model (past the state cap, the interval from
+// the row's best exact value to 1). The same file may then come twice, once in each mode.
 struct TableInstance {
   Problem problem;
   std::string source;          // a file, for messages and the report
@@ -86,8 +91,8 @@ struct Table {
 };
 
 // The default columns: every allocator that needs nothing beyond the instance, the optimum
-// (its own column with exact parts) aside.
-std::vector<std::string> default_table_solvers();
+// (its own column with exact parts) aside; with `acting`, only those with a commit rule.
+std::vector<std::string> default_table_solvers(bool acting = false);
 
 // Checks everything that can be checked before the long work, so that a bad request stops the
 // table at once: UsageError for no column, an empty, unknown or repeated name, an instance given
