@@ -33,6 +33,7 @@ from ._ontime import (  # noqa: F401  (re-exported)
     ConditionalTimeModel,
     Decision,
     Distribution,
+    EndedAttempt,
     Error,
     ExogenousChain,
     InputError,
@@ -73,7 +74,7 @@ from ._arguments import name_wrong_arguments as _name_wrong_arguments
 __version__ = "0.1.0"
 
 __all__ = [
-    "NEVER", "Action", "ActionAttempt", "Allocator", "ChainFit", "ConcurrentSession", "ConditionalTimeModel", "Decision", "Distribution", "Error", "ExogenousChain", "InputError", "LiveSession",
+    "NEVER", "Action", "ActionAttempt", "Allocator", "ChainFit", "ConcurrentSession", "ConditionalTimeModel", "Decision", "Distribution", "EndedAttempt", "Error", "ExogenousChain", "InputError", "LiveSession",
     "ManualClock", "Mdp", "OnlineBelief", "PlanningPosterior", "Problem",
     "ResourceLimitError", "Session", "State", "Status", "UsageError", "World", "allocators", "conditional_model_kinds",
     "evaluate", "fit", "fit_chain", "fit_conditional", "histogram_csv", "load_chain", "load_conditional_model", "load_problem", "make_allocator", "read_planner_log", "reduce_knapsack", "run_episodes", "sample_log", "score", "adapt", "fit_strength",

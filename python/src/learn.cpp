@@ -106,16 +106,26 @@ void bind_conditional(py::module_& m) {
   py::class_<PlanningPosterior>(
       m, "PlanningPosterior",
       "The online update of one action's planning distribution (docs/learning.md): a prior Distribution worth "
-      "`strength` attempts, updated by every attempt found or cut off; mean() is the posterior to plan with.")
-      .def(py::init(
-               [](const Distribution& prior, Number<Steps, "horizon", 1, Distribution::kMaxStep> horizon,
-                  Number<double, "strength", 0.0> strength) { return PlanningPosterior(prior, horizon, strength); }),
-           py::arg("prior"), py::arg("horizon"), py::arg("strength"))
+      "`strength` attempts, updated by every attempt found or cut off; mean() is the posterior to plan with. With "
+      "`backtrack` (the prior's backtrack Distribution, SPEC §7) the planning and backtrack distributions are "
+      "learned together as competing risks: attempts may also backtrack (observe_backtrack), and backtrack_mean() "
+      "is the posterior backtrack distribution, whose mass sums with mean()'s to at most 1.")
+      .def(py::init([](const Distribution& prior, Number<Steps, "horizon", 1, Distribution::kMaxStep> horizon,
+                       Number<double, "strength", 0.0> strength, const std::optional<Distribution>& backtrack) {
+             return backtrack ? PlanningPosterior(prior, *backtrack, horizon, strength)
+                              : PlanningPosterior(prior, horizon, strength);
+           }),
+           py::arg("prior"), py::arg("horizon"), py::arg("strength"), py::kw_only(), py::arg("backtrack") = py::none())
       .def("observe_found", &PlanningPosterior::observe_found, py::arg("steps"), "A motion found after `steps` steps.")
+      .def("observe_backtrack", &PlanningPosterior::observe_backtrack, py::arg("steps"),
+           "An attempt that gave up and backtracked after `steps` steps.")
       .def("observe_cut_off", &PlanningPosterior::observe_cut_off, py::arg("steps"),
-           "An attempt cut off after `steps` steps without a motion.")
+           "An attempt cut off after `steps` steps without a motion or a backtrack.")
       .def("mean", &PlanningPosterior::mean, "The posterior mean Distribution (over 1..horizon, the rest never).")
+      .def("backtrack_mean", &PlanningPosterior::backtrack_mean,
+           "The posterior mean backtrack Distribution (over 1..horizon, the rest never).")
       .def("predictive_found", &PlanningPosterior::predictive_found, py::arg("steps"))
+      .def("predictive_backtrack", &PlanningPosterior::predictive_backtrack, py::arg("steps"))
       .def("predictive_cut_off", &PlanningPosterior::predictive_cut_off, py::arg("steps"))
       .def_property_readonly("observations", &PlanningPosterior::observations)
       .def_property_readonly("strength", &PlanningPosterior::strength)
@@ -136,11 +146,15 @@ void bind_conditional(py::module_& m) {
            py::arg("prior"), py::arg("strength"))
       .def(
           "observe",
-          [](OnlineBelief& belief, const std::string& action_id, Number<Steps, "effort", 0> effort, bool found) {
-            belief.observe(action_id, ActionAttempt{effort, found});
+          [](OnlineBelief& belief, const std::string& action_id, Number<Steps, "effort", 0> effort, bool found,
+             bool backtracked) {
+            if (found && backtracked) throw UsageError("an attempt ends with a motion or by backtracking, not both");
+            belief.observe(action_id, backtracked ? ActionAttempt{0, false, {EndedAttempt{effort, false, true}}}
+                                                  : ActionAttempt{effort, found});
           },
-          py::arg("action_id"), py::arg("effort"), py::arg("found"),
-          "One attempt on an action (by id or base id): found after `effort` steps, or cut off after them.")
+          py::arg("action_id"), py::arg("effort"), py::arg("found"), py::kw_only(), py::arg("backtracked") = false,
+          "One attempt on an action (by id or base id): found after `effort` steps, backtracked after them "
+          "(backtracked=True), or cut off after them.")
       .def(
           "observe",
           [](OnlineBelief& belief, const py::object& problem, const std::vector<ActionAttempt>& attempts) {
@@ -157,6 +171,8 @@ void bind_conditional(py::module_& m) {
           py::arg("structure"),
           "`structure`'s skeletons with the believed distributions, each action by its id or base id.")
       .def("planning", &OnlineBelief::planning, py::arg("action_id"), "The planning Distribution believed now.")
+      .def("backtrack", &OnlineBelief::backtrack, py::arg("action_id"),
+           "The backtrack Distribution believed now (the prior's for an action that does not backtrack).")
       .def_property_readonly("prior", &OnlineBelief::prior)
       .def_property_readonly("strength", &OnlineBelief::strength)
       .def_property_readonly("observations", &OnlineBelief::observations);

@@ -1,6 +1,7 @@
 // Bindings of the run layer: sessions a caller's planner drives, worlds written in Python, and the
 // long computations on the library's one episode runner (episodes, evaluation, Table I, studies).
 
+#include <pybind11/operators.h>
 #include <pybind11/stl.h>
 
 #include <cmath>
@@ -235,18 +236,41 @@ void bind_run(py::module_& m) {
                (d.action >= 0 ? " '" + d.problem->action(d.action).id + "'" : std::string()) + ")";
       });
 
-  py::class_<ActionAttempt>(m, "ActionAttempt",
-                            "What a session saw of one action: the steps of effort its refinement got and whether "
-                            "it found a motion (an OnlineBelief learns from it).")
-      .def(py::init([](Number<Steps, "effort", 0> effort, bool found) {
-             return ActionAttempt{effort, found};
+  py::class_<EndedAttempt>(m, "EndedAttempt",
+                           "An attempt of an action that a backtrack ended before the episode did (SPEC §7): after "
+                           "`effort` steps, with a motion the backtrack discarded (found), by giving up itself "
+                           "(backtracked), or with neither (cut off).")
+      .def(py::init([](Number<Steps, "effort", 0> effort, bool found, bool backtracked) {
+             if (found && backtracked) throw UsageError("an attempt ends with a motion or by backtracking, not both");
+             return EndedAttempt{effort, found, backtracked};
            }),
-           py::arg("effort"), py::arg("found"))
+           py::arg("effort"), py::arg("found") = false, py::arg("backtracked") = false)
+      .def_readonly("effort", &EndedAttempt::effort)
+      .def_readonly("found", &EndedAttempt::found)
+      .def_readonly("backtracked", &EndedAttempt::backtracked)
+      .def(py::self == py::self)  // NOLINT(misc-redundant-expression)
+      .def("__repr__", [](const EndedAttempt& a) {
+        return "ontime.EndedAttempt(effort=" + std::to_string(a.effort) + ", found=" + (a.found ? "True" : "False") +
+               ", backtracked=" + (a.backtracked ? "True" : "False") + ")";
+      });
+
+  py::class_<ActionAttempt>(m, "ActionAttempt",
+                            "What a session saw of one action: the steps of effort its current refinement got and "
+                            "whether it found a motion, and `ended`, the attempts a backtrack ended before it "
+                            "(ontime.EndedAttempt; empty without backtracking). An OnlineBelief learns from it.")
+      .def(py::init([](Number<Steps, "effort", 0> effort, bool found, std::vector<EndedAttempt> ended) {
+             return ActionAttempt{effort, found, std::move(ended)};
+           }),
+           py::arg("effort"), py::arg("found"), py::arg("ended") = std::vector<EndedAttempt>{})
       .def_readonly("effort", &ActionAttempt::effort)
       .def_readonly("found", &ActionAttempt::found)
+      .def_readonly("ended", &ActionAttempt::ended)
+      .def(py::self == py::self)  // NOLINT(misc-redundant-expression)
       .def("__repr__", [](const ActionAttempt& a) {
-        return "ontime.ActionAttempt(effort=" + std::to_string(a.effort) + ", found=" + (a.found ? "True" : "False") +
-               ")";
+        std::string text =
+            "ontime.ActionAttempt(effort=" + std::to_string(a.effort) + ", found=" + (a.found ? "True" : "False");
+        if (!a.ended.empty()) text += ", ended=[" + std::to_string(a.ended.size()) + " attempts]";
+        return text + ")";
       });
 
   py::class_<SessionHandle>(

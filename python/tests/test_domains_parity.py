@@ -68,6 +68,25 @@ def test_tamp_that_learns_across_episodes_matches_the_cli(cli):
         assert got["episode_results"][first] == plain["episode_results"][first]
 
 
+def test_tamp_that_learns_in_a_kitchen_that_backtracks_matches_the_cli(cli):
+    # The kitchen whose refinements give up and blame the grasp (docs/spec.md section 7), its fitted
+    # library (planning and backtracking of move+place(B1,S) take all its mass) a prior of strength
+    # 10: the believed libraries used to be refused ("planning and backtrack probabilities sum above
+    # 1"); now the sequences run and give the command line's numbers.
+    expected = cli("tamp", "--domain", "manipulation", "--world", KITCHEN_GRASPS, "--library", KITCHEN_GRASPS_MODEL,
+                   "--deadline", 280, "--solver", "dp-rerun", "--episodes", 3, "--sequences", 2, "--adapt-strength", 10,
+                   "--threads", 2, "--clock", "model", "--json")
+    kitchen = ontime.domains.load("manipulation", KITCHEN_GRASPS)
+    got = ontime.domains.tamp(kitchen, KITCHEN_GRASPS_MODEL, "dp-rerun", 280, episodes=3, sequences=2,
+                              adapt_strength=10, threads=1, clock="model")
+    assert without(got, "seconds") == without(expected, "seconds")
+    assert got["backtracks"] > 0 and got["episodes"] == 6
+    assert sum(e["successes"] for e in got["adaptation"]["by_episode"]) == got["successes"]
+    plain = ontime.domains.tamp(kitchen, KITCHEN_GRASPS_MODEL, "dp-rerun", 280, episodes=6, threads=1, clock="model")
+    for first in (0, 3):
+        assert got["episode_results"][first] == plain["episode_results"][first]
+
+
 def test_tamp_refuses_what_the_cli_refuses():
     building = ontime.domains.load("navigation", BUILDING)
     with pytest.raises(ontime.UsageError, match="^deadline 2: 0 steps of 3 s"):

@@ -186,6 +186,7 @@ Status Session::report_live(int choice, int action, const Observation& observati
     ActionAttempt& attempt = attempts_[static_cast<std::size_t>(action)];
     attempt.effort = std::min<Steps>(attempt.effort + effort, Distribution::kMaxStep);
     attempt.found = observation.refined;
+    if (observation.is_backtrack()) end_attempts_below(observation.culprit, action);
   }
   if (action >= 0 && !observation.refined && !observation.is_backtrack() && effort > 1) {
     for (const int member : mdp_->problem().members(action)) {

@@ -169,6 +169,7 @@ Status Session::report(const Observation& observation, double execution_seconds)
     ActionAttempt& attempt = attempts_[static_cast<std::size_t>(action)];
     ++attempt.effort;
     attempt.found = observation.refined;
+    if (observation.is_backtrack()) end_attempts_below(observation.culprit, action);
   }
   // Only live and owning sessions keep what each action revealed; a plain session (an episode of
   // a Monte Carlo run) does no work for it.
@@ -203,6 +204,20 @@ Status Session::report(const Observation& observation, double execution_seconds)
     return status_;
   }
   return report_live(choice, action, observation, execution_seconds);
+}
+
+void Session::end_attempts_below(int culprit, int backtracking) {
+  const Problem& problem = mdp_->problem();
+  for (int a = 0; a < problem.action_count(); ++a) {
+    ActionAttempt& attempt = attempts_[static_cast<std::size_t>(a)];
+    if (attempt.effort <= 0) continue;
+    bool below = a == culprit;
+    for (int up = problem.parent(a); up >= 0 && !below; up = problem.parent(up)) below = up == culprit;
+    if (!below) continue;
+    attempt.ended.push_back(EndedAttempt{attempt.effort, attempt.found, a == backtracking});
+    attempt.effort = 0;
+    attempt.found = false;
+  }
 }
 
 Status Session::carry_out_timed(World& world) {

@@ -14,6 +14,7 @@
 #include "apps/cli_test_support.hpp"
 #include "ontime/allocators/dp_rerun.hpp"
 #include "ontime/learn/online_adaptation.hpp"
+#include "ontime/mdp/mdp.hpp"
 #include "ontime/model/instance_io.hpp"
 #include "ontime/run/evaluation.hpp"
 #include "support/paper.hpp"
@@ -138,6 +139,37 @@ TEST(Cli, AdaptRunsEpisodesWithTheUpdatedPriorAsTheLibraryDoes) {
       ontime({"adapt", paper("instance4"), "--belief", paper("instance1"), "--solver", "dp-rerun", "--episodes", "2"});
   EXPECT_EQ(other.exit_code, 2);
   EXPECT_NE(other.err.find("instance1.json: the deadlines differ"), std::string::npos) << other.err;
+}
+
+// Every shipped example with backtracking (SPEC §7), its own prior: `adapt` learns planning and
+// backtracking together (the believed instances used to be refused: "planning and backtrack
+// probabilities sum above 1"), with the library's numbers; the first episode plans with the prior
+// itself, dp-rerun's own value. The first, with the command's defaults (10 episodes of 100
+// sequences), as it was refused.
+TEST(Cli, AdaptTakesEveryShippedExampleWithBacktracking) {
+  for (const char* path : {"data/instances/kitchen-grasps.json", "data/instances/chains/cup-through-the-door.json",
+                           "data/instances/backtracking/grasp-and-place.json"}) {
+    SCOPED_TRACE(path);
+    const std::string instance = testing::source_path(path).string();
+    const bool defaults = std::string(path) == "data/instances/kitchen-grasps.json";
+    std::vector<std::string> command = {"adapt", instance, "--belief", instance, "--solver", "dp-rerun", "--json"};
+    if (!defaults) command.insert(command.end(), {"--episodes", "4", "--sequences", "20"});
+    const auto result = ontime(command);
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+    const json out = json::parse(result.out);
+    const Problem truth = load_problem(instance);
+    AdaptationOptions options;
+    if (!defaults) {
+      options.episodes = 4;
+      options.sequences = 20;
+    }
+    const AdaptationResult expected = run_adaptation(truth, truth, options);
+    EXPECT_EQ(out["successes"].get<std::vector<std::uint64_t>>(), expected.successes);
+    EXPECT_EQ(out["exact_success_probability"].get<std::vector<double>>(), expected.exact);
+    const Mdp mdp(truth);
+    DpRerunAllocator allocator(mdp);
+    EXPECT_NEAR(expected.exact.front(), evaluate_exactly(mdp, allocator).success_probability, 1e-12);
+  }
 }
 
 TEST(Cli, FitStrengthScoresEachStrengthOnUnseenLogs) {

@@ -13,10 +13,13 @@
 
 #include "ontime/allocators/allocator_registry.hpp"
 #include "ontime/domains/library_messages.hpp"
+#include "ontime/domains/manipulation.hpp"
+#include "ontime/domains/manipulation_world.hpp"
 #include "ontime/domains/navigation.hpp"
 #include "ontime/domains/planner_world.hpp"
 #include "ontime/domains/registry.hpp"
 #include "ontime/domains/task_planner.hpp"
+#include "ontime/learn/online_belief.hpp"
 #include "ontime/model/instance_io.hpp"
 #include "ontime/run/episode_runner.hpp"
 #include "ontime/util/error.hpp"
@@ -296,6 +299,56 @@ TEST(RunTamp, SequencesThatLearnAcrossEpisodesStartFromTheLibraryAndReproduce) {
   options.adaptation = TampAdaptation{.strength = 1.0, .sequences = 2};
   options.picture_episode = 0;
   EXPECT_THROW(run_tamp(f.domain, f.library, options), UsageError);
+}
+
+// The kitchen whose cubby takes one pair of grasps (a refinement there gives up and blames the grasp,
+// SPEC §7), with data/instances/kitchen-grasps.json as the library and a prior of strength 10:
+// every sequence learns planning and backtracking together, and every episode plans with a valid
+// believed library. The sessions record each attempt as the planner made it: every backtrack the
+// world counted ends one attempt as backtracked, and every refinement it started is one attempt,
+// ended or current; each sequence's first episode is the run without learning.
+TEST(RunTamp, SequencesInAKitchenThatBacktracksLearnPlanningAndBacktrackingTogether) {
+  const ManipulationDomain domain(load_manipulation_world(testing::source_path("data/domains/kitchen-grasps.json")));
+  const Problem library = load_problem(testing::source_path("data/instances/kitchen-grasps.json"));
+  TampOptions options = modelled_tamp(6, 1);
+  options.deadline = 280;  // 40 steps of 7 s
+  options.effort = EffortSettings{EffortUnit::collision_checks, domain.world().collection.checks_per_second};
+  options.max_skeletons = 16;
+  options.world_name = "kitchen-grasps.json";
+  const TampResult plain = run_tamp(domain, library, options);
+  options.episodes = 3;
+  options.adaptation = TampAdaptation{.strength = 10.0, .sequences = 2};
+  const TampResult learning = run_tamp(domain, library, options);
+  ASSERT_EQ(learning.episodes.size(), 6U);
+  ASSERT_EQ(learning.successes_by_episode.size(), 3U);
+  EXPECT_EQ(learning.successes_by_episode[0] + learning.successes_by_episode[1] + learning.successes_by_episode[2],
+            learning.summary.successes);
+  for (const std::size_t first : {std::size_t{0}, std::size_t{3}}) {
+    EXPECT_EQ(learning.episodes[first].status, plain.episodes[first].status) << first;
+    EXPECT_EQ(learning.episodes[first].live.elapsed, plain.episodes[first].live.elapsed) << first;
+  }
+  std::size_t backtracked = 0, attempts = 0;
+  for (const EpisodeResult& episode : learning.episodes) {
+    for (const ActionAttempt& attempt : episode.attempts) {
+      attempts += attempt.ended.size() + (attempt.effort > 0 ? 1 : 0);
+      for (const EndedAttempt& ended : attempt.ended) backtracked += ended.backtracked ? 1 : 0;
+    }
+  }
+  EXPECT_GT(backtracked, 0U);
+  EXPECT_EQ(static_cast<double>(backtracked), learning.summary.world_statistics.find("backtracks").value_or(-1));
+  EXPECT_EQ(static_cast<double>(attempts), learning.summary.world_statistics.find("refinements_started").value_or(-1));
+  // The belief of the first sequence after its episodes: a valid library (the constructor checks
+  // that planning and backtracking sum to at most 1), whose backtracking action learned both.
+  OnlineBelief belief(library, 10.0);
+  for (std::size_t e = 0; e < 3; ++e) {
+    ASSERT_NE(learning.episodes[e].problem, nullptr);
+    belief.observe(*learning.episodes[e].problem, learning.episodes[e].attempts);
+  }
+  const Problem believed = belief.believed();
+  const int place = library.find_action("move+place(B1,S)");
+  EXPECT_NE(believed.action(place).backtrack, library.action(place).backtrack);
+  EXPECT_LE(2.0 - believed.action(place).planning.never() - believed.action(place).backtrack.never(),
+            1.0 + Distribution::kSumTolerance);
 }
 
 }  // namespace

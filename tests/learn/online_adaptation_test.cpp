@@ -7,6 +7,7 @@
 
 #include "ontime/allocators/dp_rerun.hpp"
 #include "ontime/mdp/mdp.hpp"
+#include "ontime/model/instance_io.hpp"
 #include "ontime/run/evaluation.hpp"
 #include "ontime/solve/optimal_solver.hpp"
 #include "ontime/util/error.hpp"
@@ -107,6 +108,37 @@ TEST(OnlineAdaptation, StrengthScoresAreThePrequentialLogScore) {
   const std::vector<double> bad = {0};
   EXPECT_THROW(score_prior_strengths(*model, validation, bad), UsageError);
   EXPECT_THROW(score_prior_strengths(*model, validation, {}), UsageError);
+}
+
+// Every shipped example with backtracking (SPEC §7), the truth as its own prior: each episode's
+// belief learns planning and backtracking together and stays a valid instance, episode 0 is
+// dp-rerun's own value, no episode's plan beats the optimum, and the numbers do not depend on the
+// thread count.
+TEST(OnlineAdaptation, TakesEveryShippedExampleWithBacktracking) {
+  for (const char* path : {"data/instances/backtracking/grasp-and-place.json", "data/instances/kitchen-grasps.json",
+                           "data/instances/chains/cup-through-the-door.json"}) {
+    SCOPED_TRACE(path);
+    const Problem truth = load_problem(testing::source_path(path));
+    ASSERT_TRUE(truth.has_backtracking());
+    AdaptationOptions options;
+    options.strength = 2;
+    options.episodes = 4;
+    options.sequences = 16;
+    options.threads = 1;
+    const AdaptationResult one = run_adaptation(truth, truth, options);
+    options.threads = 2;
+    const AdaptationResult two = run_adaptation(truth, truth, options);
+    EXPECT_EQ(one.successes, two.successes);
+    EXPECT_EQ(one.exact, two.exact);
+    ASSERT_EQ(one.exact.size(), 4u);
+    const Mdp mdp(truth);
+    DpRerunAllocator allocator(mdp);
+    EXPECT_NEAR(one.exact.front(), evaluate_exactly(mdp, allocator).success_probability, 1e-12);
+    OptimalSolver solver(mdp);
+    const double optimum = solver.solve(mdp.start());
+    for (const double value : one.exact) EXPECT_LE(value, optimum + 1e-12);
+    for (const std::uint64_t successes : one.successes) EXPECT_LE(successes, options.sequences);
+  }
 }
 
 }  // namespace

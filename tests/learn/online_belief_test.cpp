@@ -2,11 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
 #include <vector>
 
 #include "ontime/mdp/mdp.hpp"
+#include "ontime/model/instance_io.hpp"
 #include "ontime/run/session.hpp"
 #include "ontime/util/error.hpp"
+#include "support/paper.hpp"
 
 namespace ontime {
 namespace {
@@ -112,6 +115,96 @@ TEST(OnlineBelief, BadInputIsRefusedBeforeAnythingIsObserved) {
   const std::vector<ActionAttempt> both{{1, true}, {1, true}};
   EXPECT_THROW(belief.observe(other, both), UsageError);
   EXPECT_EQ(belief.observations(), 0u);
+}
+
+// The total mass of a distribution within its steps (1 - never).
+double mass(const Distribution& d) { return 1.0 - d.never(); }
+
+// data/instances/kitchen-grasps.json's move+place(B1,S) is found at step 5 with 0.001 and
+// backtracks at 1 and 2 with 0.978 and 0.021: planning and backtracking take all its mass. Five
+// attempts found at 5 used to raise its planning mass alone, past 1 with the backtrack kept, and the
+// believed instance was refused ("planning and backtrack probabilities sum above 1"). Learned
+// together, with strength 10 (a = 10 p, b = 10 q, c = 10 S, plus the attempts): step 1 has
+// b = 9.78 and c = 0.22 + 5 of a total of 15, step 2 b = 0.21 and c = 0.01 + 5, steps 3 and 4
+// c only, step 5 a = 0.01 + 5 and nothing else. So q(1) = 9.78 / 15, q(2) = 0.21 / 15 and
+// p(5) = 5.01 / 15: they sum to 1.
+TEST(OnlineBelief, ABacktrackingActionFoundMoreOftenThanItsPriorSaysStaysAValidInstance) {
+  const Problem prior = load_problem(testing::source_path("data/instances/kitchen-grasps.json"));
+  const std::string id = "move+place(B1,S)";
+  OnlineBelief belief(prior, 10.0);
+  for (int i = 0; i < 5; ++i) belief.observe(id, ActionAttempt{5, true});
+  const Problem believed = belief.believed();
+  const Action& action = believed.action(believed.find_action(id));
+  EXPECT_NEAR(action.planning.pmf(5), 5.01 / 15, 1e-12);
+  EXPECT_NEAR(mass(action.planning), 5.01 / 15, 1e-12);
+  EXPECT_NEAR(action.backtrack.pmf(1), 9.78 / 15, 1e-12);
+  EXPECT_NEAR(action.backtrack.pmf(2), 0.21 / 15, 1e-12);
+  EXPECT_NEAR(mass(action.backtrack), 9.99 / 15, 1e-12);
+  ASSERT_EQ(action.culprits.size(), 1u);  // the prior's
+  EXPECT_EQ(action.culprits[0].id, "move+pick(B1)");
+  EXPECT_EQ(action.culprits[0].probability, 1.0);
+  EXPECT_EQ(belief.planning(id), action.planning);
+  EXPECT_EQ(belief.backtrack(id), action.backtrack);
+  // The other actions keep their prior bit for bit.
+  for (int a = 0; a < prior.action_count(); ++a) {
+    if (prior.action(a).id == id) continue;
+    EXPECT_EQ(believed.action(a).planning, prior.action(a).planning);
+    EXPECT_EQ(believed.action(a).backtrack, prior.action(a).backtrack);
+  }
+}
+
+// What a session saw in grasp-and-place (tests/run/session_test.cpp: pick(A) found after 1 step,
+// then discarded, then found after 2; place(A,R1) backtracked after 2; place(A,R2) cut off after
+// 1), learned attempt by attempt: place(A,R1), which backtracks, learns both distributions as
+// PlanningPosterior does with its prior over the deadline; pick(A) and place(A,R2), which do not
+// backtrack, learn their planning time.
+TEST(OnlineBelief, LearnsTheAttemptsABacktrackEndedAsCompetingRisks) {
+  const Problem problem = load_problem(testing::source_path("data/instances/backtracking/grasp-and-place.json"));
+  const Mdp mdp(problem);
+  Session session(mdp);
+  for (const auto& [skeleton, observation] : std::vector<std::pair<int, Observation>>{{0, Observation::found(1)},
+                                                                                      {1, Observation::not_yet()},
+                                                                                      {0, Observation::not_yet()},
+                                                                                      {0, Observation::backtracked(0)},
+                                                                                      {0, Observation::not_yet()},
+                                                                                      {0, Observation::found(1)}}) {
+    session.decide(skeleton);
+    session.report(observation);
+  }
+  OnlineBelief belief(problem, 3.0);
+  belief.observe(problem, session.attempts());
+  EXPECT_EQ(belief.observations(), 4u);
+
+  const auto prior_of = [&](const char* id) { return problem.action(problem.find_action(id)); };
+  PlanningPosterior place(prior_of("place(A,R1)").planning, prior_of("place(A,R1)").backtrack, 12, 3.0);
+  place.observe_backtrack(2);
+  PlanningPosterior pick(prior_of("pick(A)").planning, 12, 3.0);
+  pick.observe_found(1);
+  pick.observe_found(2);
+  PlanningPosterior other(prior_of("place(A,R2)").planning, 12, 3.0);
+  other.observe_cut_off(1);
+  const Problem believed = belief.believed();
+  EXPECT_EQ(believed.action(1).planning, place.mean());
+  EXPECT_EQ(believed.action(1).backtrack, place.backtrack_mean());
+  EXPECT_EQ(believed.action(0).planning, pick.mean());
+  EXPECT_EQ(believed.action(2).planning, other.mean());
+  EXPECT_EQ(believed.action(3).planning, problem.action(3).planning);
+  // By hand: place(A,R1) has p(1) = 0.3, p(2) = 0.2, q(2) = 0.4, strength 3. The backtrack at 2
+  // adds 1 to c_1 (3 x 0.7 + 1 = 3.1) and to b_2 (1.2 + 1 = 2.2): the hazards of step 1 are
+  // 0.9 / 4 and 0, of step 2 0.6 / 3.1 and 2.2 / 3.1 (c_2 = 3 x 0.1 = 0.3). So p(1) = 0.225,
+  // p(2) = 0.775 x 0.6 / 3.1 = 0.15, q(2) = 0.775 x 2.2 / 3.1 = 0.55, never 0.075.
+  EXPECT_NEAR(believed.action(1).planning.pmf(1), 0.225, 1e-12);
+  EXPECT_NEAR(believed.action(1).planning.pmf(2), 0.15, 1e-12);
+  EXPECT_NEAR(believed.action(1).backtrack.pmf(2), 0.55, 1e-12);
+  EXPECT_NEAR(believed.action(1).backtrack.never(), 0.45, 1e-12);
+
+  // An action whose prior does not backtrack has no culprit to blame: a backtrack of it counts as
+  // an attempt cut off there.
+  OnlineBelief cut(problem, 3.0), backtracked(problem, 3.0);
+  cut.observe("pick(A)", ActionAttempt{2, false});
+  backtracked.observe("pick(A)", ActionAttempt{0, false, {EndedAttempt{2, false, true}}});
+  EXPECT_EQ(backtracked.believed().action(0).planning, cut.believed().action(0).planning);
+  EXPECT_EQ(backtracked.believed().action(0).backtrack, Distribution{});
 }
 
 }  // namespace

@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "ontime/allocators/optimal.hpp"
+#include "ontime/model/instance_io.hpp"
+#include "ontime/run/clock.hpp"
 #include "ontime/run/episode_runner.hpp"
 #include "ontime/run/simulator.hpp"
 #include "ontime/util/error.hpp"
@@ -250,6 +252,48 @@ TEST(Session, ACallerDecidedSessionCanOwnItsProblem) {
   EXPECT_EQ(session.decide(1).action, 1);
   EXPECT_EQ(session.report_refined(0), Status::success);
   EXPECT_EQ(session.solution(), 1);
+}
+
+// Backtracking (SPEC §7) in data/instances/backtracking/grasp-and-place.json: pick(A) (index 0) is
+// found at its first step; place(A,R2) (2, of skeleton 1) gets one step; place(A,R1) (1, of
+// skeleton 0) gets one step, then backtracks at its second, blaming pick(A). That ends three
+// attempts: pick(A)'s (found after 1 step; its motion is discarded), place(A,R1)'s (backtracked
+// after 2) and place(A,R2)'s (cut off after 1: it is below pick(A)); pick(B)'s (3) is not below the
+// culprit and goes on. pick(A) is then found anew after 2 steps.
+std::vector<ActionAttempt> grasp_and_place_attempts(Session& session, ManualClock* clock) {
+  const auto step = [&](int skeleton, const Observation& observation) {
+    session.decide(skeleton);
+    if (clock != nullptr) clock->advance(session.problem().step_seconds());
+    session.report(observation);
+  };
+  step(0, Observation::found(1));
+  step(1, Observation::not_yet());
+  step(0, Observation::not_yet());
+  step(2, Observation::not_yet());
+  step(0, Observation::backtracked(0));
+  step(0, Observation::not_yet());
+  step(0, Observation::found(1));
+  return session.attempts();
+}
+
+TEST(Session, ABacktrackEndsTheAttemptsOfTheCulpritAndOfEveryActionBelowIt) {
+  const Problem problem = load_problem(testing::source_path("data/instances/backtracking/grasp-and-place.json"));
+  ASSERT_EQ(problem.find_action("place(A,R1)"), 1);
+  ASSERT_EQ(problem.find_action("pick(B)"), 3);
+  const Mdp mdp(problem);
+  Session session(mdp);
+  const std::vector<ActionAttempt> expected{
+      ActionAttempt{2, true, {EndedAttempt{1, true, false}}},    // pick(A): found again after 2 steps
+      ActionAttempt{0, false, {EndedAttempt{2, false, true}}},   // place(A,R1): backtracked after 2
+      ActionAttempt{0, false, {EndedAttempt{1, false, false}}},  // place(A,R2): cut off after 1
+      ActionAttempt{1, false},                                   // pick(B): going on
+      ActionAttempt{0, false}};                                  // place(B,R1): never picked
+  EXPECT_EQ(grasp_and_place_attempts(session, nullptr), expected);
+  EXPECT_EQ(session.state().time, 7);
+  // A live session whose clock moves one slice per call sees the same attempts.
+  ManualClock clock;
+  Session live(problem, {}, 0, &clock);
+  EXPECT_EQ(grasp_and_place_attempts(live, &clock), expected);
 }
 
 }  // namespace

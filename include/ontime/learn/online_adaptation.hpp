@@ -1,9 +1,11 @@
 #pragma once
 // Repeated episodes in one world with the online update of online_update.hpp (docs/learning.md,
 // "Online update"): a robot that starts from a prediction (the prior) and, after every episode,
-// updates each action's planning-time distribution with the attempts it made there (found after t
-// steps, or still unrefined after c when the episode ended), so that the next episode's
-// allocator plans with the posterior mean. Execution times stay the prior's.
+// updates each action's planning-time distribution (and, for an action that backtracks, its
+// backtrack distribution with it: OnlineBelief) with the attempts it made there (found after t
+// steps, backtracked after t, or still unrefined after c when the episode or a backtrack ended
+// it), so that the next episode's allocator plans with the posterior mean. Execution times stay
+// the prior's.
 //
 // run_adaptation computes, for each episode index e = 0..E-1 over R independent sequences of E
 // episodes in the true instance: the successes, and (when asked) the mean over the sequences of the

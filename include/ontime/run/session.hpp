@@ -41,13 +41,15 @@
 // and no time elsewhere, a live session makes exactly the MDP's transitions.
 //
 // Cost: a step of a session that is not live allocates nothing (the state before a transition
-// is kept in a reused buffer, and only when an allocator observes it or the clock needs it). The
+// is kept in a reused buffer, and only when an allocator observes it or the clock needs it), but
+// for a backtrack, which records the attempts it ends (ActionAttempt::ended). The
 // live overhead per step is a few clock reads and one timeline entry (reserved up front).
 
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ontime/allocators/allocator.hpp"
@@ -91,15 +93,37 @@ struct Decision {
   int action = -1;    // the action to refine now, or -1: the step is spent idle
 };
 
-// What a session saw of one action: the steps of effort its refinement got (a live session
-// counts each planner call as the slices it charged to the action, as PT_k does, at least one)
-// and whether that refinement found a motion. An action never picked has effort 0. Within an
-// episode an action is refined once, so this is one attempt: found after `effort` steps, or cut
-// off after `effort` steps without a motion when the session ended (online_belief.hpp learns from
-// it).
-struct ActionAttempt {
+// An attempt of an action that ended before its episode did (backtracking, SPEC §7): after
+// `effort` steps, with a motion that a backtrack later discarded (found: a backtrack blamed the
+// action or one before it), by giving up and blaming an earlier action itself (backtracked), or
+// with neither when a backtrack discarded it (cut off after `effort` steps).
+struct EndedAttempt {
   Steps effort = 0;
   bool found = false;
+  bool backtracked = false;
+  friend bool operator==(const EndedAttempt&, const EndedAttempt&) = default;
+};
+
+// What a session saw of one action: its current attempt, the steps of effort its refinement got
+// (a live session counts each planner call as the slices it charged to the action, as PT_k does,
+// at least one) and whether that refinement found a motion, and the attempts a backtrack ended
+// before it. An action never picked has effort 0. Without backtracking an action is refined once
+// in an episode, so this is one attempt: found after `effort` steps, or cut off after `effort`
+// steps without a motion when the session ended. With backtracking (SPEC §7) an attempt also ends
+// when it backtracks, or when a backtrack blames the action or one before it on its path: it then
+// joins `ended` (in the order they ended) and a new attempt starts with effort 0
+// (online_belief.hpp learns from them all).
+struct ActionAttempt {
+  ActionAttempt() = default;
+  // The current attempt, `effort_steps` steps long, found or not, after the attempts `earlier`. (A
+  // constructor rather than an aggregate, so that attempts without backtracking name just these two.)
+  ActionAttempt(Steps effort_steps, bool found_motion, std::vector<EndedAttempt> earlier = {})
+      : effort(effort_steps), found(found_motion), ended(std::move(earlier)) {}
+
+  Steps effort = 0;
+  bool found = false;
+  std::vector<EndedAttempt> ended;  // empty without backtracking
+  friend bool operator==(const ActionAttempt&, const ActionAttempt&) = default;
 };
 
 class Session {
@@ -284,6 +308,9 @@ class Session {
   Steps execution_steps(double execution_seconds) const;
   Steps steps_at(double seconds) const noexcept;
   void end_if_out_of_time();
+  // A backtrack of the action `backtracking` blaming `culprit` (SPEC §7): the attempts of the
+  // culprit and of every action below it end (attempts_[a].ended), and theirs start anew.
+  void end_attempts_below(int culprit, int backtracking);
   // No skeleton can succeed and none is expected to come.
   bool out_of_skeletons() const;
   // Replaces the skeletons (add_skeleton, retire_skeleton) and carries the state over.
