@@ -34,6 +34,7 @@ void add_run_command(CLI::App& app) {
     std::string world;
     std::string instance;
     std::string belief;
+    std::string act;  // empty: the instance's own mode
     std::string solver;
     std::string effort = "checks";
     std::uint64_t episodes = 200;
@@ -75,6 +76,9 @@ void add_run_command(CLI::App& app) {
       "--independent-starts", options->independent_starts,
       "Start every action after the first from a fresh pose in its room, not where the previous refinement ended");
   command->add_flag("--exact", options->exact, "Also the exact success the allocator expects from the instance");
+  add_act_option(*command, options->act,
+                 "Concurrent: the robot executes each motion it starts while the planner refines the next from where "
+                 "that motion ends, on the model's steps (not yet --live, --effort wall or --belief)");
   command->add_flag("--live", options->live,
                     "Live episodes on the clock (always with --effort wall): the allocator's thinking and the "
                     "planner's overruns are charged; with --effort checks planner calls count their nominal seconds");
@@ -113,7 +117,8 @@ void add_run_command(CLI::App& app) {
       check_outputs(outputs, {world, instance});
     }
     const domains::LoadedDomain loaded = domains::load_domain(options->domain, world);
-    const Problem problem = load_problem(instance);
+    Problem problem = load_problem(instance);
+    if (!options->act.empty()) problem = problem.with_acting(*parse_acting(options->act));
     std::optional<Problem> belief;
     if (!options->belief.empty()) {
       belief.emplace(load_problem(options->belief));

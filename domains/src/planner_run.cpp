@@ -23,7 +23,44 @@ void check_planner_run_request(const Problem& problem, const std::string& source
   }
 }
 
+namespace {
+
+// Acting while planning (SPEC §10): the robot starts each refined motion while the planner refines
+// the next from where that motion ends (the planner world's starts, unless independent), on the
+// model's step clock.
+PlannerRun run_concurrent_planner_episodes(const Domain& domain, const Problem& problem,
+                                           const PlannerRunOptions& options) {
+  if (is_live(options)) {
+    throw UsageError(
+        "live episodes (--live, --effort wall) acting while planning (SPEC §10) are not there yet: run "
+        "them on the model's steps (--effort checks)");
+  }
+  if (options.belief != nullptr) {
+    throw UsageError(
+        "--belief: acting while planning (SPEC §10) decides with the instance's own distributions only "
+        "so far");
+  }
+  const ConcurrentMdp mdp(problem);
+  const ConcurrentAllocatorFactory factory = make_concurrent_allocator_factory(options.solver, mdp, options.parameters);
+  PlannerWorldOptions planner;
+  planner.effort = options.effort;
+  planner.independent_starts = options.independent_starts;
+  PlannerRun run;
+  run.summary = run_concurrent_episodes(mdp, planner_worlds(domain, problem, planner), factory,
+                                        detail::monte_carlo_options(options));
+  run.refinements_started = run.summary.world_statistics.find("refinements_started").value_or(0.0) /
+                            static_cast<double>(run.summary.episodes);
+  if (options.exact) {
+    const auto allocator = factory();
+    run.exact = evaluate_exactly(mdp, *allocator, max_states_of(options.parameters), options.stop);
+  }
+  return run;
+}
+
+}  // namespace
+
 PlannerRun run_planner_episodes(const Domain& domain, const Problem& problem, const PlannerRunOptions& options) {
+  if (problem.acting() == Acting::concurrent) return run_concurrent_planner_episodes(domain, problem, options);
   const Mdp mdp(problem);
   const std::optional<Problem> planned = options.belief == nullptr
                                              ? std::nullopt

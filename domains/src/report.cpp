@@ -306,6 +306,11 @@ std::string to_json(const Run& run) {
   out["instance"] = run.instance;
   out["solver"] = options.solver;
   out["parameters"] = parameters_object(options.solver, options.parameters);
+  if (run.problem->acting() == Acting::concurrent) {
+    // Only when acting while planning (SPEC §10), so that plan-first reports stay as they were.
+    out["acting"] = acting_name(Acting::concurrent);
+    out["commit_rule"] = allocator_registry().find(options.solver).commit_rule;
+  }
   out["episodes"] = summary.episodes;
   out["seed"] = options.seed;
   out["successes"] = summary.successes;
@@ -337,6 +342,10 @@ std::string to_text(const Run& run) {
   std::string out =
       fmt::format("solver               {} on the {} domain (model {}{})\n", options.solver, run.domain, run.instance,
                   options.belief == nullptr ? "" : ", deciding with the distributions of " + options.belief_source);
+  if (run.problem->acting() == Acting::concurrent) {
+    out += fmt::format("acting               concurrent (SPEC §10); commit rule: {}\n",
+                       allocator_registry().find(options.solver).commit_rule);
+  }
   out += fmt::format("real planner         {:.4f} ± {:.4f}  ({} of {} episodes, seed {}, {:.1f} s){}\n",
                      summary.success_rate, summary.ci95, summary.successes, summary.episodes, options.seed,
                      summary.seconds, live ? ", live" : "");

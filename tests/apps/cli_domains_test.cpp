@@ -11,9 +11,14 @@
 #include <fstream>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "apps/cli_test_support.hpp"
+#include "ontime/allocators/allocator_registry.hpp"
+#include "ontime/mdp/concurrent_mdp.hpp"
+#include "ontime/model/instance_io.hpp"
+#include "ontime/run/evaluation.hpp"
 #include "support/mini_world.hpp"
 
 namespace ontime {
@@ -436,6 +441,49 @@ TEST(Cli, AWorldWhoseGoalCannotBeReachedIsRefused) {
   }
   EXPECT_FALSE(std::filesystem::exists(dir / "log.jsonl"));
   EXPECT_FALSE(std::filesystem::exists(dir / "map.png"));
+}
+
+}  // namespace
+}  // namespace ontime
+
+namespace ontime {
+namespace {
+
+using namespace cli_test;
+
+TEST(Cli, RunActsWhilePlanningWithTheRealPlanner) {
+  // Navigation at its own deadline: the robot drives each refined move while OMPL refines the next
+  // from where that move ends. The model's exact value of dp-rerun's eager rule is the library's.
+  const auto run = ontime({"run", "--domain", "navigation", "--solver", "dp-rerun", "--episodes", "40", "--act",
+                           "concurrent", "--exact", "--json"});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const json out = json::parse(run.out);
+  EXPECT_EQ(out["acting"], "concurrent");
+  EXPECT_EQ(out["commit_rule"], allocator_registry().find("dp-rerun").commit_rule);
+  const Problem navigation =
+      load_problem(testing::source_path("data/instances/navigation.json").string()).with_acting(Acting::concurrent);
+  const ConcurrentMdp mdp(navigation);
+  const auto allocator = make_concurrent_allocator_factory("dp-rerun", mdp)();
+  const double exact = evaluate_exactly(mdp, *allocator).success_probability;
+  EXPECT_EQ(out["model_exact_success_probability"].get<double>(), exact);
+  // Acting while planning is worth more than planning first, in the model.
+  const auto plan_first =
+      ontime({"run", "--domain", "navigation", "--solver", "dp-rerun", "--episodes", "1", "--exact", "--json"});
+  ASSERT_EQ(plan_first.exit_code, 0) << plan_first.err;
+  EXPECT_GT(exact, json::parse(plan_first.out)["model_exact_success_probability"].get<double>() + 0.2);
+  EXPECT_GE(out["successes"].get<int>(), 1);
+
+  for (const auto& [arguments, message] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{"--solver", "dp-rerun", "--live"}, "live episodes (--live, --effort wall) acting while planning"},
+           {{"--solver", "dp-rerun", "--belief", testing::source_path("data/instances/navigation.json").string()},
+            "--belief: acting"},
+           {{"--solver", "mcts"}, "'mcts' does not act while planning"}}) {
+    std::vector<std::string> command{"run", "--domain", "navigation", "--episodes", "2", "--act", "concurrent"};
+    command.insert(command.end(), arguments.begin(), arguments.end());
+    const auto refused = ontime(command);
+    EXPECT_EQ(refused.exit_code, 2) << message << ": " << refused.err;
+    EXPECT_NE(refused.err.find(message), std::string::npos) << refused.err;
+  }
 }
 
 }  // namespace

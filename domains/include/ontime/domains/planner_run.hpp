@@ -68,7 +68,9 @@ struct PlannerRun {
 void check_planner_run_request(const Problem& problem, const std::string& source, const PlannerRunOptions& options,
                                const ParameterSpelling& spelling = nullptr);
 
-// The episodes (and the exact value). The instance's action ids must be actions of the domain.
+// The episodes (and the exact value). The instance's action ids must be actions of the domain. An
+// instance acting while planning (SPEC §10) runs the allocator by its commit rule on the model's
+// steps (UsageError for live episodes or a belief, not there yet in that mode).
 PlannerRun run_planner_episodes(const Domain& domain, const Problem& problem, const PlannerRunOptions& options);
 
 }  // namespace ontime::domains
