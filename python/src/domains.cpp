@@ -196,15 +196,16 @@ void bind_domains(py::module_& m) {
       [](const Required<DomainHandle, "domain">& domain, const py::object& problem, const std::string& solver,
          Episodes episodes, Seed seed, Threads threads, const std::string& effort, ChecksPerSecond checks_per_second,
          bool independent_starts, bool exact, bool live, DecisionShare decision_share, const py::object& belief,
-         const py::object& progress, const py::kwargs& kwargs) {
-        const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
-        const std::string instance = instance_label(problem, *mdp->problem);
+         const py::object& progress, const std::optional<std::string>& act, const py::kwargs& kwargs) {
+        // Read as a problem: one acting while planning (SPEC §10) makes no plan-first Mdp.
+        const std::shared_ptr<const Problem> chosen = problem_with_acting(problem, act);
+        const std::string instance = instance_label(problem, *chosen);
         std::shared_ptr<MdpHandle> believed;
         domains::PlannerRunOptions options;
         if (!belief.is_none()) {
           believed = to_mdp(belief, "belief");
           try {
-            (void)with_distributions_of(*mdp->problem, *believed->problem);
+            (void)with_distributions_of(*chosen, *believed->problem);
           } catch (const UsageError& error) {
             throw UsageError(std::string("belief: ") + error.what());
           }
@@ -221,19 +222,19 @@ void bind_domains(py::module_& m) {
         options.exact = exact;
         options.live = live;
         options.decision_share = decision_share;
-        domains::check_planner_run_request(*mdp->problem, instance, options, python_spelling());
+        domains::check_planner_run_request(*chosen, instance, options, python_spelling());
         domains::PlannerRun result;
         run_interruptibly(
             [&](const std::function<bool()>& stop, Progress& counters) {
               const Hooks hooks = hooks_of(stop, counters);
               options.progress = hooks.progress;
               options.stop = hooks.stop;
-              result = domains::run_planner_episodes(*domain->loaded.domain, *mdp->problem, options);
+              result = domains::run_planner_episodes(*domain->loaded.domain, *chosen, options);
             },
             progress);
         return json_object(domains::report::to_json(domains::report::Run{.domain = domain->name,
                                                                          .instance = instance,
-                                                                         .problem = mdp->problem.get(),
+                                                                         .problem = chosen.get(),
                                                                          .options = &options,
                                                                          .result = &result}));
       },
@@ -241,11 +242,14 @@ void bind_domains(py::module_& m) {
       py::arg("seed") = 1, py::arg("threads") = 0, py::arg("effort") = "checks", py::arg("checks_per_second") = 0.0,
       py::arg("independent_starts") = false, py::arg("exact") = false, py::arg("live") = false,
       py::arg("decision_share") = 0.5, py::arg("belief") = py::none(), py::arg("progress") = py::none(),
+      py::arg("act") = py::none(),
       "`ontime run`: episodes in which the allocator `solver` (parameters as keyword arguments), with `problem` "
       "as its model, drives the domain's real motion planner; live=True (always with effort 'wall') charges "
       "its thinking and the planner's overruns on the clock; `belief` (a Problem or instance file): the "
       "allocator decides with its distributions, `problem`'s skeletons and culprits kept (`ontime run "
-      "--belief`). Returns the fields of `ontime run --json` (live: every episode with its timeline).");
+      "--belief`); act='concurrent' (or a problem acting while planning): the robot executes each motion it "
+      "starts while the planner refines the next (`ontime run --act`). Returns the fields of `ontime run --json` "
+      "(live: every episode with its timeline).");
 
   m.def(
       "tamp",

@@ -171,6 +171,22 @@ def test_run_matches_the_cli(cli):
     assert len(live["episode_results"]) == 2 and all(episode["timeline"] for episode in live["episode_results"])
 
 
+def test_run_acting_while_planning_matches_the_cli(cli):
+    expected = cli("run", "--domain", "navigation", "--world", NAVIGATION, "--instance", NAVIGATION_MODEL, "--solver",
+                   "dp-rerun", "--episodes", 6, "--threads", 2, "--seed", 3, "--exact", "--act", "concurrent",
+                   "--json")
+    nav = ontime.domains.load("navigation", NAVIGATION)
+    got = ontime.domains.run(nav, NAVIGATION_MODEL, "dp-rerun", episodes=6, threads=1, seed=3, exact=True,
+                             act="concurrent")
+    assert without(got, "seconds") == without(expected, "seconds")
+    assert got["acting"] == "concurrent"
+    # The model's value of acting while planning is above planning first.
+    plan_first = ontime.domains.run(nav, NAVIGATION_MODEL, "dp-rerun", episodes=1, exact=True)
+    assert got["model_exact_success_probability"] > plan_first["model_exact_success_probability"] + 0.2
+    with pytest.raises(ontime.UsageError, match="live episodes"):
+        ontime.domains.run(nav, NAVIGATION_MODEL, "dp-rerun", episodes=1, live=True, act="concurrent")
+
+
 def test_run_with_a_belief_in_a_world_that_backtracks_matches_the_cli(cli, tmp_path):
     # The same log read without its backtracks: the allocator's belief; the world's places give up.
     with open(KITCHEN_GRASPS_MODEL, encoding="utf-8") as text:
