@@ -211,6 +211,51 @@ void BM_ConcurrentDpRerunDecision(benchmark::State& bench) {
 }
 BENCHMARK(BM_ConcurrentDpRerunDecision)->DenseRange(1, 5);
 
+// The moves of the registry's allocators acting while planning (SPEC §10), each by its commit rule,
+// in the states of 500 of their own episodes in hidden sampled worlds (ConcurrentSession), cycled
+// through: argument 0 the kind (below), argument 1 the instance.
+const std::vector<std::string> kConcurrentKinds = {"dp-rerun", "optimal", "greedy", "round-robin", "thompson"};
+void BM_ConcurrentAllocatorMove(benchmark::State& bench) {
+  const std::string& kind = kConcurrentKinds[static_cast<std::size_t>(bench.range(0))];
+  const ontime::Problem problem = paper(static_cast<int>(bench.range(1))).with_acting(ontime::Acting::concurrent);
+  const ontime::ConcurrentMdp mdp(problem);
+  const auto allocator = ontime::make_concurrent_allocator_factory(kind, mdp)();
+  ontime::HiddenWorld world(problem, 0);
+  std::vector<ontime::ConcurrentState> states;
+  for (std::uint64_t episode = 0; episode < 500; ++episode) {
+    world.begin_episode(episode);
+    ontime::ConcurrentSession session(mdp, *allocator, episode);
+    while (session.status() == ontime::Status::running) {
+      states.push_back(session.state());
+      if (!session.choose().is_start() && session.status() == ontime::Status::running) session.carry_out(world);
+    }
+  }
+  allocator->begin_episode(1);
+  std::size_t next = 0;
+  for (auto _ : bench) {
+    benchmark::DoNotOptimize(allocator->choose(states[next]));
+    next = next + 1 == states.size() ? 0 : next + 1;
+  }
+  bench.counters["states"] = static_cast<double>(states.size());
+  bench.SetLabel(kind + " " + problem.name());
+}
+BENCHMARK(BM_ConcurrentAllocatorMove)->ArgsProduct({{0, 1, 2, 3, 4}, {1, 2}});
+
+// Whole episodes acting while planning in hidden sampled worlds: dp-rerun's moves, the world's
+// answers and the session's steps (run_concurrent_episode), per episode.
+void BM_ConcurrentEpisode(benchmark::State& bench) {
+  const ontime::Problem problem = paper(static_cast<int>(bench.range(0))).with_acting(ontime::Acting::concurrent);
+  const ontime::ConcurrentMdp mdp(problem);
+  const auto allocator = ontime::make_concurrent_allocator_factory("dp-rerun", mdp)();
+  ontime::HiddenWorld world(problem, 0);
+  std::uint64_t seed = 0;
+  for (auto _ : bench) {
+    benchmark::DoNotOptimize(ontime::run_concurrent_episode(mdp, *allocator, world, ++seed).status);
+  }
+  bench.SetLabel(problem.name());
+}
+BENCHMARK(BM_ConcurrentEpisode)->DenseRange(1, 5);
+
 // The exact optimum of acting while planning (SPEC §10) by the memoised solver of its MDP.
 void BM_ConcurrentSolve(benchmark::State& bench) {
   const ontime::Problem problem = paper(static_cast<int>(bench.range(0)));

@@ -3,6 +3,7 @@
 
 #include "ontime/allocators/allocator.hpp"
 #include "ontime/allocators/allocator_registry.hpp"
+#include "ontime/allocators/concurrent_allocator.hpp"
 #include "ontime/allocators/dp.hpp"
 #include "ontime/allocators/dp_rerun.hpp"
 #include "ontime/allocators/first_found.hpp"
@@ -30,6 +31,7 @@
 #include "ontime/model/problem.hpp"
 #include "ontime/model/skeleton_file.hpp"
 #include "ontime/run/clock.hpp"
+#include "ontime/run/concurrent_session.hpp"
 #include "ontime/run/episode_runner.hpp"
 #include "ontime/run/evaluation.hpp"
 #include "ontime/run/experiments.hpp"
