@@ -107,6 +107,31 @@ TEST(Cli, DeepNestingIsRefusedInEveryFileKindAtItsPlace) {
 
 // A boosted model whose planning booster has a cycle of children (prediction would loop forever)
 // or a child beyond its nodes (read out of bounds): refused before XGBoost reads it.
+// Item 5 of round 4: features out of range are refused naming the log, the record and the feature,
+// for both kinds, before any fit (the hazard kind's optimiser and XGBoost never see them); a motion
+// found in no time takes its first step, as `fit` counts it, and the model written reads back.
+TEST(Cli, AConditionalFitRefusesHugeFeaturesAtTheirRecordAndTakesInstantMotions) {
+  const auto dir = scratch("conditional-features");
+  const std::string log = (dir / "huge.jsonl").string();
+  for (const std::string huge : {"1e308", "-1e308", "3.5e38", "1e16"}) {
+    write_probe(log, replaced_once(kProbeLog, "\"features\": [0]}\n{", "\"features\": [" + huge + "]}\n{"));
+    for (const std::string kind : {"pooled", "hazard", "boosted"}) {
+      expect_refused_probe({"fit", log, "--conditional", kind, "--step", "1", "-o", (dir / "m.json").string()}, log,
+                           "record 1: features[0]", "a feature must be within [-1e15, 1e15]");
+      EXPECT_FALSE(std::filesystem::exists(dir / "m.json")) << kind << " " << huge;
+    }
+  }
+  const std::string instant = (dir / "instant.jsonl").string();
+  write_probe(instant, replaced_once(kProbeLog, "\"planning_seconds\": 1,", "\"planning_seconds\": 0,"));
+  for (const std::string kind : {"pooled", "hazard", "boosted"}) {
+    const std::string model = (dir / (kind + ".json")).string();
+    const auto fitted = ontime({"fit", instant, "--conditional", kind, "--step", "1", "--json", "-o", model});
+    ASSERT_EQ(fitted.exit_code, 0) << kind << ": " << fitted.err;
+    const auto read_back = ontime({"fit-strength", instant, "--model", model, "--strengths", "1"});
+    EXPECT_EQ(read_back.exit_code, 0) << kind << ": " << read_back.err;
+  }
+}
+
 TEST(Cli, ABoostedModelWithABrokenTreeIsRefused) {
   const auto dir = scratch("broken-booster");
   const std::string train = (dir / "train.jsonl").string();
