@@ -157,7 +157,8 @@ std::shared_ptr<MdpHandle> to_mdp(const py::object& source, const char* paramete
 // The problem `source` names (a Problem, an Mdp's problem, or an instance path), with the acting
 // mode `act` when given ("plan-first" or "concurrent"; SPEC §10): read as a problem, not an Mdp,
 // since an instance whose "acting" is concurrent makes no Mdp.
-std::shared_ptr<const Problem> problem_with_acting(const py::object& source, const std::optional<std::string>& act);
+std::shared_ptr<const Problem> problem_with_acting(const py::object& source, const std::optional<std::string>& act,
+                                                   const char* parameter = "problem");
 // The text of a path argument (str or os.PathLike); UsageError naming `parameter` for anything else.
 std::string path_argument(const py::handle& value, const char* parameter);
 // The instance's file name when `source` is a path, else the problem's name (the `instance` field

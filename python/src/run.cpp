@@ -577,14 +577,15 @@ void bind_run(py::module_& m) {
               row_parameters[key] = value;
             }
           }
-          const std::shared_ptr<MdpHandle> mdp = to_mdp(source, "instances");
-          const std::string label = instance_label(source, *mdp->problem);
+          // Read as a problem: one acting while planning (SPEC §10) makes a row of that mode.
+          const std::shared_ptr<const Problem> problem = problem_with_acting(source, std::nullopt, "instances");
+          const std::string label = instance_label(source, *problem);
           const bool is_file = py::isinstance<py::str>(source) || py::hasattr(source, "__fspath__");
-          rows.push_back(
-              {*mdp->problem, label,
-               is_file ? py::str(py::module_::import("pathlib").attr("Path")(source).attr("stem")).cast<std::string>()
-                       : label,
-               parameter_values(row_parameters)});
+          const std::string row_label =
+              (is_file ? py::str(py::module_::import("pathlib").attr("Path")(source).attr("stem")).cast<std::string>()
+                       : label) +
+              (problem->acting() == Acting::concurrent ? " (concurrent)" : "");
+          rows.push_back({*problem, label, row_label, parameter_values(row_parameters)});
         }
         const ParameterSpelling spelling = python_spelling();
         check_table_request(rows, options, spelling);
@@ -608,8 +609,10 @@ void bind_run(py::module_& m) {
       "Table I's layout, as `ontime table` computes it: one row per instance (a file or a Problem), one column "
       "per allocator (default: every one that needs nothing beyond the instance), sampled success ± 95% and, "
       "with exact=True, exact values and the exact optimum (or its certified interval). Parameters as keyword "
-      "arguments; a list gives one value per instance (policy=[...]). format='json' returns the dict of "
-      "`ontime table --json`, 'markdown' the table it prints. The GIL is released; Ctrl-C stops it.");
+      "arguments; a list gives one value per instance (policy=[...]). A problem acting while planning "
+      "(Problem.with_acting('concurrent'); SPEC §10) is a row of that mode, labelled 'NAME (concurrent)', as "
+      "`ontime table --act`. format='json' returns the dict of `ontime table --json`, 'markdown' the table it "
+      "prints. The GIL is released; Ctrl-C stops it.");
 
   m.def(
       "study",

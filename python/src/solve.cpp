@@ -20,7 +20,8 @@
 
 namespace ontime::python {
 
-std::shared_ptr<const Problem> problem_with_acting(const py::object& source, const std::optional<std::string>& act) {
+std::shared_ptr<const Problem> problem_with_acting(const py::object& source, const std::optional<std::string>& act,
+                                                   const char* parameter) {
   std::shared_ptr<const Problem> problem;
   if (py::isinstance<MdpHandle>(source)) {
     problem = source.cast<std::shared_ptr<MdpHandle>>()->problem;
@@ -32,7 +33,7 @@ std::shared_ptr<const Problem> problem_with_acting(const py::object& source, con
     const py::gil_scoped_release release;
     problem = std::make_shared<const Problem>(load_problem(path));
   } else {
-    problem = to_mdp(source)->problem;  // raises the error that names what `problem` may be
+    problem = to_mdp(source, parameter)->problem;  // raises the error that names what `parameter` may be
   }
   if (!act) return problem;
   const std::optional<Acting> acting = parse_acting(*act);

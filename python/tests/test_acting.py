@@ -91,6 +91,28 @@ def test_evaluate_refuses_what_acting_while_planning_does_not_take_yet(arguments
         ontime.evaluate(PAPER / "instance1.json", solver, episodes=10, **arguments)
 
 
+def test_a_table_sets_both_modes_side_by_side_as_the_command_line(cli):
+    instance = PAPER / "instance1.json"
+    problem = ontime.load_problem(instance)
+    got = ontime.table([problem, problem.with_acting("concurrent")], solvers=["dp-rerun", "greedy"], episodes=300,
+                       exact=True)
+    expected = cli("table", str(instance), "--act", "plan-first,concurrent", "--solvers", "dp-rerun,greedy",
+                   "--episodes", "300", "--exact", "--json")
+    assert [row.get("acting") for row in got["rows"]] == [None, "concurrent"]
+    assert [row["optimal_success_probability"] for row in got["rows"]] == \
+        [row["optimal_success_probability"] for row in expected["rows"]]
+    assert got["rows"][1]["optimal_success_probability"] == pytest.approx(1.0, abs=1e-12)
+    for name in ("dp-rerun", "greedy"):
+        assert [row["solvers"][name]["successes"] if "successes" in row["solvers"][name] else
+                row["solvers"][name]["success_rate"] for row in got["rows"]] == \
+            [row["solvers"][name]["successes"] if "successes" in row["solvers"][name] else
+             row["solvers"][name]["success_rate"] for row in expected["rows"]]
+    markdown = ontime.table([problem.with_acting("concurrent")], solvers=["dp-rerun"], episodes=50, format="markdown")
+    assert "paper-instance-1 (concurrent)" in markdown
+    with pytest.raises(ontime.UsageError, match="'mcts' does not act while planning"):
+        ontime.table([problem.with_acting("concurrent")], solvers=["mcts"], episodes=10)
+
+
 def test_what_does_not_take_the_mode_yet_refuses_it():
     concurrent = ontime.load_problem(PAPER / "instance1.json").with_acting("concurrent")
     with pytest.raises(ontime.UsageError, match="acts while planning"):
