@@ -5,12 +5,12 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <cstring>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <stdexcept>
 
 #include "ontime/domains/collection.hpp"
+#include "ontime/util/atomic_file.hpp"
 #include "ontime/util/error.hpp"
 #include "ontime/util/json_input.hpp"
 
@@ -56,8 +56,7 @@ void write_all(int descriptor, const std::string& text, const std::filesystem::p
   while (written < text.size()) {
     const ssize_t n = ::write(descriptor, text.data() + written, text.size() - written);
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0)
-      throw std::runtime_error(path.string() + ": cannot write the checkpoint (" + std::strerror(errno) + ")");
+    if (n <= 0) throw_file_error(path, "cannot write the checkpoint", n < 0 ? errno : EIO);
     written += static_cast<std::size_t>(n);
   }
 }
@@ -173,9 +172,9 @@ CollectionJournal::CollectionJournal(std::filesystem::path path, const Domain& d
   own_ = own;
   const std::string source = own_.string();
   descriptor_ = ::open(own_.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
-  if (descriptor_ < 0) throw std::runtime_error(source + ": cannot open the checkpoint (" + std::strerror(errno) + ")");
+  if (descriptor_ < 0) throw_file_error(own_, "cannot open the checkpoint", errno);
   if (::ftruncate(descriptor_, static_cast<off_t>(keep)) != 0 || ::lseek(descriptor_, 0, SEEK_END) < 0) {
-    throw std::runtime_error(source + ": cannot prepare the checkpoint (" + std::strerror(errno) + ")");
+    throw_file_error(own_, "cannot prepare the checkpoint", errno);
   }
   if (keep == 0) write_all(descriptor_, expected.dump() + "\n", own_);
 }

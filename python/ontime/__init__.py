@@ -294,23 +294,28 @@ def fit_chain(logs_or_sequences: Union[PathLike, Sequence[PathLike], Sequence[Se
         logs, sequences = [os.fspath(logs_or_sequences)], []
     else:
         items = list(_iterable(logs_or_sequences, "logs_or_sequences", "a path, a list of paths or of sequences"))
-        if items and all(isinstance(item, (str, os.PathLike)) for item in items):
+        if not items:
+            raise UsageError("parameter 'logs_or_sequences': give at least one log or sequence")
+        if all(isinstance(item, (str, os.PathLike)) for item in items):
             logs, sequences = [os.fspath(item) for item in items], []
         else:
             what = "a list of paths or of sequences of states"
-            logs, sequences = [], [[_state_name(state) for state in _iterable(sequence, "logs_or_sequences", what)]
-                                   for sequence in items]
-    listed = [_state_name(state) for state in _iterable(states, "states", "a list of states")] \
+            logs, sequences = [], [[_state_name(state, "logs_or_sequences")
+                                    for state in _iterable(sequence, "logs_or_sequences", what)] for sequence in items]
+    listed = [_state_name(state, "states") for state in _iterable(states, "states", "a list of states")] \
         if states is not None else []
+    if len(set(listed)) != len(listed):
+        twice = next(state for number, state in enumerate(listed) if state in listed[:number])
+        raise UsageError(f"parameter 'states': state '{twice}' is listed twice")
     return _ontime._fit_chain(logs, sequences, kind, name, prior, listed, capacity)
 
 
-def _state_name(state: Union[int, str]) -> str:
+def _state_name(state: Union[int, str], parameter: str) -> str:
     """A state's name: a str as it is, a whole number >= 0 (int, numpy integer) as its digits."""
     if isinstance(state, str):
         return state
     if isinstance(state, bool) or not hasattr(state, "__index__") or operator.index(state) < 0:
-        raise UsageError(f"a state is a name (str) or a whole number >= 0 (got {state!r})")
+        raise UsageError(f"parameter '{parameter}': a state is a name (str) or a whole number >= 0 (got {state!r})")
     return str(operator.index(state))
 
 

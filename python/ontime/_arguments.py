@@ -3,11 +3,17 @@
 pybind11 answers a call whose arguments match no signature with a TypeError that lists the
 signatures ("incompatible function arguments"). Every function and method of the extension is
 wrapped here so that such a call raises UsageError naming the first parameter at fault and what it
-must be, as the command line and the numeric parameters (parameter 'NAME': RULE (got WHAT)) do. The
-check runs only after pybind11 has refused the call: a valid call costs one Python frame.
+must be, as the command line and the numeric parameters (parameter 'NAME': RULE (got WHAT)) do;
+with overloads, the one whose parameters the arguments match by number and name is meant. The
+functions and classes written in Python are wrapped too, so that an argument too many, an unknown
+keyword or a missing argument is a UsageError naming it rather than Python's TypeError. A class of
+the extension that callers do not make (ontime.Action, ontime.State, ...) raises UsageError when
+called. The check runs only after the call has raised TypeError: a valid call costs one Python
+frame.
 """
 
 import functools
+import inspect
 import numbers
 import os
 import re
@@ -153,7 +159,8 @@ def _describe(annotation: str) -> str:
         return f"a list whose items are each {_describe(arguments[0])}"
     if head == "Dict" and len(arguments) == 2:
         return f"a dict from {_describe(arguments[0])} to {_describe(arguments[1])}"
-    return "a " + head.rsplit(".", 1)[-1]
+    name = head.rsplit(".", 1)[-1]
+    return ("an " if name[:1].lower() in "aeiou" else "a ") + name
 
 
 def _shown(value: Any) -> str:
@@ -166,39 +173,35 @@ def _shown(value: Any) -> str:
     return "a " + type(value).__name__
 
 
-def _named_error(error: TypeError, args: tuple, kwargs: dict) -> Optional[Exception]:
-    """The UsageError naming the parameter pybind11 refused, or None to keep its TypeError."""
+def _arity_error(parameters: List[_Parameter], args: tuple, kwargs: dict, any_keyword: bool,
+                 any_positional: bool = False) -> Tuple[Optional[Exception], dict]:
+    """UsageError for arguments that match no parameter or leave one without a value (else None),
+    and the arguments by parameter name."""
     from . import UsageError
-    lines = str(error).splitlines()
-    if not lines or not _INCOMPATIBLE.match(lines[0]):
-        return None
-    signatures = [match.group("parameters") for match in map(_SIGNATURE.match, lines[1:]) if match]
-    if len(signatures) != 1:
-        return None  # overloads: which one was meant cannot be told
-    parameters = _parameters(signatures[0])
-    if parameters is None:
-        return None
     positional = [parameter for parameter in parameters if not parameter.keyword_only]
-    if len(args) > len(positional):
-        return UsageError(f"takes at most {len(positional)} positional arguments ({len(args)} given)")
+    if len(args) > len(positional) and not any_positional:
+        return UsageError(f"takes at most {len(positional)} positional arguments ({len(args)} given)"), {}
     given = {parameter.name: value for parameter, value in zip(positional, args)}
     known = {parameter.name for parameter in parameters}
     for name, value in kwargs.items():
         if name in given:
-            return UsageError(f"parameter '{name}' given twice")
+            return UsageError(f"parameter '{name}' given twice"), given
+        if name not in known and not any_keyword:
+            return UsageError(f"unknown parameter '{name}'"), given
         given[name] = value
     for parameter in parameters:
-        if parameter.name not in given:
-            if not parameter.has_default:
-                return UsageError(f"parameter '{parameter.name}' is missing")
-            continue
-        value = given[parameter.name]
-        if _fits(value, parameter.annotation) is False:
+        if parameter.name not in given and not parameter.has_default:
+            return UsageError(f"parameter '{parameter.name}' is missing"), given
+    return None, given
+
+
+def _type_error(parameters: List[_Parameter], given: dict) -> Optional[Exception]:
+    """UsageError for the first argument whose type the parameter does not take (else None)."""
+    from . import UsageError
+    for parameter in parameters:
+        if parameter.name in given and _fits(given[parameter.name], parameter.annotation) is False:
             return UsageError(f"parameter '{parameter.name}': must be {_describe(parameter.annotation)} "
-                              f"(got {_shown(value)})")
-    for name in given:
-        if name not in known and "**kwargs" not in signatures[0]:
-            return UsageError(f"unknown parameter '{name}'")
+                              f"(got {_shown(given[parameter.name])})")
     # Every type fits: a whole number beyond what the C++ parameter holds.
     for parameter in parameters:
         value = given.get(parameter.name)
@@ -209,33 +212,104 @@ def _named_error(error: TypeError, args: tuple, kwargs: dict) -> Optional[Except
     return None
 
 
+def _named_error(error: TypeError, args: tuple, kwargs: dict) -> Optional[Exception]:
+    """The UsageError naming the parameter pybind11 refused, or None to keep its TypeError."""
+    lines = str(error).splitlines()
+    if not lines or not _INCOMPATIBLE.match(lines[0]):
+        return None
+    signatures = [match.group("parameters") for match in map(_SIGNATURE.match, lines[1:]) if match]
+    # With overloads, the first whose parameters the arguments match (by number and by name) is
+    # the one meant; when none does, what the first one misses is named.
+    first_arity_error = None
+    for signature in signatures:
+        parameters = _parameters(signature)
+        if parameters is None:
+            return None
+        arity_error, given = _arity_error(parameters, args, kwargs, "**kwargs" in signature)
+        if arity_error is None:
+            return _type_error(parameters, given)
+        first_arity_error = first_arity_error or arity_error
+    return first_arity_error
+
+
+def _python_error(function: Callable, method: bool, args: tuple, kwargs: dict) -> Optional[Exception]:
+    """For a function written in Python: the UsageError for arguments that match none of its
+    parameters or leave one without a value, or None when they match (the TypeError came from
+    within)."""
+    try:
+        signature = inspect.signature(function)
+    except (TypeError, ValueError):
+        return None
+    listed = list(signature.parameters.values())[1 if method else 0:]  # a method's object left out
+    variadic = (inspect.Parameter.VAR_POSITIONAL, inspect.Parameter.VAR_KEYWORD)
+    parameters = [_Parameter(p.name, "", p.default is not inspect.Parameter.empty,
+                             p.kind == inspect.Parameter.KEYWORD_ONLY) for p in listed if p.kind not in variadic]
+    any_keyword = any(p.kind == inspect.Parameter.VAR_KEYWORD for p in listed)
+    any_positional = any(p.kind == inspect.Parameter.VAR_POSITIONAL for p in listed)
+    return _arity_error(parameters, args, kwargs, any_keyword, any_positional)[0]
+
+
 def _wrapped(function: Callable, method: bool) -> Callable:
+    python = inspect.isfunction(function)
+
     @functools.wraps(function)
     def call(*args, **kwargs):
         try:
             return function(*args, **kwargs)
         except TypeError as error:
             # A method's first argument is its object: the parameters are the arguments after it.
-            named = _named_error(error, args[1:] if method else args, kwargs)
+            arguments = args[1:] if method else args
+            named = _python_error(function, method, arguments, kwargs) if python else \
+                _named_error(error, arguments, kwargs)
             if named is None:
                 raise
             raise named from None
+    call.__ontime_wrapped__ = True
     return call
 
 
+def _not_made_by_callers(cls: type) -> Callable:
+    def refuse(self, *args, **kwargs):
+        from . import UsageError
+        raise UsageError(f"ontime.{cls.__name__} objects are not made by calling the class: OnTime's functions "
+                         f"and methods return them")
+    refuse.__ontime_wrapped__ = True
+    return refuse
+
+
+def _wrap_class(cls: type) -> None:
+    """Wraps the constructor and the public methods of a class of the extension or of the package."""
+    extension = type(cls).__name__ == "pybind11_type"
+    for attribute, member in list(vars(cls).items()):
+        if attribute.startswith("__") and attribute != "__init__":
+            continue
+        if getattr(member, "__ontime_wrapped__", False) or \
+                getattr(getattr(member, "__func__", None), "__ontime_wrapped__", False):
+            continue
+        kind = type(member).__name__
+        if attribute == "__init__" and extension and kind == "wrapper_descriptor":
+            # A class of the extension without a constructor: pybind11 raises TypeError.
+            setattr(cls, attribute, _not_made_by_callers(cls))
+        elif kind == "instancemethod" or inspect.isfunction(member):
+            setattr(cls, attribute, _wrapped(member, method=True))
+        elif isinstance(member, staticmethod) and (type(member.__func__).__name__ == "builtin_function_or_method" or
+                                                   inspect.isfunction(member.__func__)):
+            setattr(cls, attribute, staticmethod(_wrapped(member.__func__, method=False)))
+
+
 def name_wrong_arguments(module: Any) -> None:
-    """Wraps the extension's functions and the methods and constructors of its classes in `module`."""
+    """Wraps the extension's functions and the methods and constructors of its classes in `module`,
+    and the functions and classes written in Python in `module` itself. Wrapping twice wraps once."""
     for name, value in list(vars(module).items()):
         kind = type(value).__name__
-        if not str(getattr(value, "__module__", "")).startswith("ontime"):
-            continue  # not the extension's
+        origin = str(getattr(value, "__module__", ""))
+        if not origin.startswith("ontime") or getattr(value, "__ontime_wrapped__", False):
+            continue  # not the extension's nor the package's, or wrapped already
         if kind == "builtin_function_or_method":
             setattr(module, name, _wrapped(value, method=False))
-        elif kind == "pybind11_type":
-            for attribute, member in list(vars(value).items()):
-                if type(member).__name__ == "instancemethod" and (not attribute.startswith("__") or
-                                                                  attribute == "__init__"):
-                    setattr(value, attribute, _wrapped(member, method=True))
-                elif isinstance(member, staticmethod) and \
-                        type(member.__func__).__name__ == "builtin_function_or_method":
-                    setattr(value, attribute, staticmethod(_wrapped(member.__func__, method=False)))
+        elif inspect.isfunction(value) and origin == module.__name__ and not name.startswith("_"):
+            setattr(module, name, _wrapped(value, method=False))
+        elif kind == "pybind11_type" and not issubclass(value, BaseException):
+            _wrap_class(value)
+        elif isinstance(value, type) and origin == module.__name__ and not issubclass(value, BaseException):
+            _wrap_class(value)

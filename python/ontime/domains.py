@@ -59,6 +59,9 @@ if available:
                 raise UsageError(f"{option} is not an option of the {domain} generator (its options: "
                                  f"{', '.join(known)})")
         return generate(output, **options)
+
+    # And generate_world's own arguments (an argument too many, a keyword missing).
+    _name_wrong_arguments(sys.modules[__name__])
 else:
     __all__ = ["available"]
 

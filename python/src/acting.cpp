@@ -39,24 +39,16 @@ struct ConcurrentSessionHandle {
   std::unique_ptr<ConcurrentSession> session;
 };
 
-// An action named by its id (a str) or its index (an int), for a message naming `parameter`.
+// An action named by its id (a str, as Problem.actions and the moves name it), for a message naming
+// `parameter`.
 int action_index(const Problem& problem, const py::object& action, const char* parameter) {
-  if (py::isinstance<py::str>(action)) {
-    const std::string id = action.cast<std::string>();
-    const int index = problem.find_action(id);
-    if (index < 0) throw UsageError(std::string(parameter) + ": no action '" + id + "'");
-    return index;
+  if (!py::isinstance<py::str>(action)) {
+    throw UsageError(std::string(parameter) + ": an action's id (str) (got " + std::string(py::repr(action)) + ")");
   }
-  if (py::isinstance<py::int_>(action) && !py::isinstance<py::bool_>(action)) {
-    const long long index = action.cast<long long>();
-    if (index < 0 || index >= problem.action_count()) {
-      throw UsageError(std::string(parameter) + ": no action " + std::to_string(index) + " (the problem has " +
-                       std::to_string(problem.action_count()) + ")");
-    }
-    return static_cast<int>(index);
-  }
-  throw UsageError(std::string(parameter) + ": an action's id (str) or index (int) (got " +
-                   std::string(py::repr(action)) + ")");
+  const std::string id = action.cast<std::string>();
+  const int index = problem.find_action(id);
+  if (index < 0) throw UsageError(std::string(parameter) + ": no action '" + id + "'");
+  return index;
 }
 
 py::dict decision_dict(const Problem& problem, const ConcurrentDecision& decision) {
@@ -110,17 +102,18 @@ void bind_acting(py::module_& m) {
               if (!py::isinstance<py::int_>(refine) || py::isinstance<py::bool_>(refine)) {
                 throw UsageError("refine: a skeleton's index (int) (got " + std::string(py::repr(refine)) + ")");
               }
-              const long long k = refine.cast<long long>();
-              if (k < 0 || k >= h.problem->skeleton_count()) {
-                throw UsageError("refine: no skeleton " + std::to_string(k) + " (the problem has " +
+              // Compared in Python's integers, so that any int is refused without overflowing.
+              if (refine.attr("__lt__")(0).cast<bool>() ||
+                  refine.attr("__ge__")(h.problem->skeleton_count()).cast<bool>()) {
+                throw UsageError("refine: no skeleton " + std::string(py::str(refine)) + " (the problem has " +
                                  std::to_string(h.problem->skeleton_count()) + ")");
               }
-              move.refine = static_cast<int>(k);
+              move.refine = refine.cast<int>();
             }
             return decision_dict(*h.problem, session_call([&] { return h.session->decide(move); }));
           },
           py::kw_only(), py::arg("start") = py::none(), py::arg("refine") = py::none(),
-          "The caller's move (a session without a solver): start=ACTION (id or index) starts it, refine=K spends "
+          "The caller's move (a session without a solver): start=ACTION (its id) starts it, refine=K spends "
           "the step on skeleton K's next action, neither: the planner idles for a step. Checked as the "
           "allocator's moves are (UsageError naming the rule).")
       .def(
@@ -143,7 +136,7 @@ void bind_acting(py::module_& m) {
             return session_call([&] { return h.session->report_execution_finished(index); });
           },
           py::arg("action"),
-          "The robot finished executing `action` (id or index), possibly sooner than its execution time: it is "
+          "The robot finished executing `action` (its id), possibly sooner than its execution time: it is "
           "idle now. UsageError for an action the session never started. Returns the status.")
       .def_property_readonly("status", [](const ConcurrentSessionHandle& h) { return h.session->status(); })
       .def_property_readonly(

@@ -49,6 +49,7 @@ void bind_allocators(py::module_& m) {
           "choose",
           [](AllocatorHandle& h, const StateView& state, std::optional<Iterations> iterations,
              std::optional<Seconds> seconds) {
+            check_state_of(*h.mdp->problem, state);
             const DecisionBudget budget = budget_of(iterations, seconds);
             const py::gil_scoped_release release;
             return h.allocator->choose(state.state, budget);

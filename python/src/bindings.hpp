@@ -71,7 +71,10 @@ std::string number_rule(T min, T max) {
   const char* kind = std::is_integral_v<T>     ? "must be a whole number"
                      : std::isinf(double(max)) ? "must be a number"
                                                : "must be a finite number";
-  const bool low = min != std::numeric_limits<T>::lowest(), high = max != std::numeric_limits<T>::max();
+  const bool low = min != std::numeric_limits<T>::lowest();
+  // A whole number of 32 bits or fewer shows its top, which a Python int passes easily.
+  const bool high = max != std::numeric_limits<T>::max() || (std::is_integral_v<T> && sizeof(T) < 8);
+  if (!low && !high && !std::is_integral_v<T>) return kind;
   if (low && !high) return std::string(kind) + " >= " + text(min);
   if (!low && high && !std::is_integral_v<T>) return std::string(kind) + " <= " + text(max);
   return std::string(kind) + " from " + text(min) + " to " + text(max);
@@ -114,11 +117,17 @@ using ChainStates = std::optional<std::map<std::string, std::string>>;
 Observation with_reported_chains(const Mdp& mdp, Observation observation, const ChainStates& reported);
 std::map<std::string, std::string> chain_states(const Mdp& mdp, std::uint16_t joint);
 
-// A State with the number of skeletons it is about, so that Python sees K entries, not 16.
+// A State with the number of skeletons it is about, so that Python sees K entries, not 16, and
+// the problem of the MDP it is a state of.
 struct StateView {
   State state;
   int skeletons = 0;
+  std::shared_ptr<const Problem> problem;
 };
+
+// UsageError naming `parameter` unless `state` is a state of an MDP of `problem` (or of a problem
+// with the same deadline, actions and skeletons): the MDP's tables are indexed by its values.
+void check_state_of(const Problem& problem, const StateView& state, const char* parameter = "state");
 
 // Session calls out of turn raise std::logic_error in C++: a usage error for a Python caller.
 template <class Call>
@@ -159,7 +168,8 @@ std::shared_ptr<MdpHandle> to_mdp(const py::object& source, const char* paramete
 // since an instance whose "acting" is concurrent makes no Mdp.
 std::shared_ptr<const Problem> problem_with_acting(const py::object& source, const std::optional<std::string>& act,
                                                    const char* parameter = "problem");
-// The text of a path argument (str or os.PathLike); UsageError naming `parameter` for anything else.
+// The text of a path argument (str or os.PathLike); UsageError naming `parameter` for anything else
+// and for empty text.
 std::string path_argument(const py::handle& value, const char* parameter);
 // The instance's file name when `source` is a path, else the problem's name (the `instance` field
 // of the results, as the command line reports it).
@@ -192,11 +202,15 @@ py::dict monte_carlo_dict(const std::string& solver, const ParameterValues& valu
 std::shared_ptr<AllocatorHandle> make_allocator_handle(std::shared_ptr<MdpHandle> mdp, const std::string& name,
                                                        const ParameterValues& values);
 
+// UsageError naming `parameter` unless `callback` is None or callable.
+void check_callable(const py::object& callback, const char* parameter);
+
 // Runs `work(stop)` on a thread of its own with the GIL released while this thread waits, checking
 // for signals every 50 ms. On Ctrl-C (or any signal handler that raises) `stop()` starts returning
 // true; `work` is expected to end soon after (by throwing ontime::Cancelled), and the Python
 // exception (KeyboardInterrupt) is raised here once it has. `progress`, when given, is called on
-// this thread, GIL held, with what `work` reported through the counters it is handed.
+// this thread, GIL held, with what `work` reported through the counters it is handed; a
+// `progress` that is neither None nor callable is a UsageError naming it, before `work` starts.
 struct Progress {
   std::atomic<std::uint64_t> done{0};
   std::atomic<std::uint64_t> total{0};

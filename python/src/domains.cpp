@@ -128,6 +128,7 @@ void bind_domains(py::module_& m) {
       [](const Required<DomainHandle, "domain">& domain, Number<std::uint64_t, "trials", 1> trials, Seed seed,
          Threads threads, const std::string& effort, ChecksPerSecond checks_per_second, StepSeconds step_seconds,
          BudgetSteps budget_steps, bool every_action, bool features, const py::object& progress) {
+        check_callable(progress, "progress");
         const domains::CollectAndFitOptions request = collect_request(
             trials, seed, threads, effort, checks_per_second, step_seconds, budget_steps, every_action, features);
         domains::CollectionOptions options = domains::collection_options(domain->loaded.defaults, request);
@@ -143,7 +144,7 @@ void bind_domains(py::module_& m) {
       },
       py::arg("domain"), py::kw_only(), py::arg("trials") = 1000, py::arg("seed") = 1, py::arg("threads") = 0,
       py::arg("effort") = "checks", py::arg("checks_per_second") = 0.0, py::arg("step_seconds") = 0.0,
-      py::arg("budget_steps") = 0, py::arg("every_action") = false, py::arg("features") = false,
+      py::arg("budget_steps") = 0, py::arg("every_action").noconvert() = false, py::arg("features").noconvert() = false,
       py::arg("progress") = py::none(),
       "Refines every action of the domain's skeleton tree (every_action=True: every action the domain can "
       "refine, each on its own; features=True: every record carries the world and the action's feature vector) "
@@ -160,6 +161,7 @@ void bind_domains(py::module_& m) {
          Number<Steps, "deadline", 0, Problem::kMaxDeadline> deadline, BudgetSteps budget_steps,
          Number<double, "laplace", 0.0> laplace, bool every_action, bool features, const std::string& log_format,
          const py::object& checkpoint, bool resume, const py::object& progress) {
+        check_callable(progress, "progress");
         domains::CollectAndFitOptions options = collect_request(trials, seed, threads, effort, checks_per_second,
                                                                 step_seconds, budget_steps, every_action, features);
         options.deadline = deadline;
@@ -183,8 +185,9 @@ void bind_domains(py::module_& m) {
       py::arg("domain"), py::arg("log"), py::arg("instance"), py::kw_only(), py::arg("trials") = 1000,
       py::arg("seed") = 1, py::arg("threads") = 0, py::arg("effort") = "checks", py::arg("checks_per_second") = 0.0,
       py::arg("step_seconds") = 0.0, py::arg("deadline") = 0, py::arg("budget_steps") = 0, py::arg("laplace") = 0.0,
-      py::arg("every_action") = false, py::arg("features") = false, py::arg("log_format") = "jsonl",
-      py::arg("checkpoint") = py::none(), py::arg("resume") = false, py::arg("progress") = py::none(),
+      py::arg("every_action").noconvert() = false, py::arg("features").noconvert() = false,
+      py::arg("log_format") = "jsonl", py::arg("checkpoint") = py::none(), py::arg("resume").noconvert() = false,
+      py::arg("progress") = py::none(),
       "`ontime collect`: collects as collect() does, writes the planner log to `log` (log_format 'jsonl' or "
       "'ompl-benchmark'), fits the instance (deadline steps; 0: the world file's) and writes it to `instance`; "
       "returns the fields of `ontime collect --json`. Finished trials go to `checkpoint` (default: the log's "
@@ -197,6 +200,7 @@ void bind_domains(py::module_& m) {
          Episodes episodes, Seed seed, Threads threads, const std::string& effort, ChecksPerSecond checks_per_second,
          bool independent_starts, bool exact, bool live, DecisionShare decision_share, const py::object& belief,
          const py::object& progress, const std::optional<std::string>& act, const py::kwargs& kwargs) {
+        check_callable(progress, "progress");
         // Read as a problem: one acting while planning (SPEC §10) makes no plan-first Mdp.
         const std::shared_ptr<const Problem> chosen = problem_with_acting(problem, act);
         const std::string instance = instance_label(problem, *chosen);
@@ -240,9 +244,9 @@ void bind_domains(py::module_& m) {
       },
       py::arg("domain"), py::arg("problem"), py::arg("solver"), py::kw_only(), py::arg("episodes") = 200,
       py::arg("seed") = 1, py::arg("threads") = 0, py::arg("effort") = "checks", py::arg("checks_per_second") = 0.0,
-      py::arg("independent_starts") = false, py::arg("exact") = false, py::arg("live") = false,
-      py::arg("decision_share") = 0.5, py::arg("belief") = py::none(), py::arg("progress") = py::none(),
-      py::arg("act") = py::none(),
+      py::arg("independent_starts").noconvert() = false, py::arg("exact").noconvert() = false,
+      py::arg("live").noconvert() = false, py::arg("decision_share") = 0.5, py::arg("belief") = py::none(),
+      py::arg("progress") = py::none(), py::arg("act") = py::none(),
       "`ontime run`: episodes in which the allocator `solver` (parameters as keyword arguments), with `problem` "
       "as its model, drives the domain's real motion planner; live=True (always with effort 'wall') charges "
       "its thinking and the planner's overruns on the clock; `belief` (a Problem or instance file): the "
@@ -263,6 +267,7 @@ void bind_domains(py::module_& m) {
          std::optional<Number<std::uint64_t, "picture_episode">> picture_episode,
          std::optional<Number<double, "adapt_strength", 1e-9, 1e9>> adapt_strength,
          Number<std::uint64_t, "sequences", 1> sequences, const py::object& progress, const py::kwargs& kwargs) {
+        check_callable(progress, "progress");
         if (clock != "real" && clock != "model") {
           throw UsageError("clock must be 'real' or 'model' (got '" + clock + "')");
         }
@@ -377,8 +382,8 @@ void bind_domains(py::module_& m) {
         return std::make_shared<Problem>(
             domains::predict_instance(*domain->loaded.domain, domain->loaded.defaults, *model, options));
       },
-      py::arg("domain"), py::arg("model"), py::kw_only(), py::arg("deadline") = 0, py::arg("library") = false,
-      py::arg("name") = "", py::arg("threads") = 0,
+      py::arg("domain"), py::arg("model"), py::kw_only(), py::arg("deadline") = 0,
+      py::arg("library").noconvert() = false, py::arg("name") = "", py::arg("threads") = 0,
       "`ontime predict`: the instance of the domain's world with every action's distributions predicted by the "
       "conditional time model (the world's skeletons, or every action on its own with library=True or a world "
       "without skeletons); deadline 0: the world file's. The actions' features are computed on `threads` threads "
@@ -400,6 +405,20 @@ void bind_domains(py::module_& m) {
          Number<int, "max_boxes", 0, domains::kMaxBuildingBoxes> max_boxes,
          Number<int, "skeletons", 0, domains::kMaxBuildingSkeletons> skeletons, Seed seed,
          const std::optional<std::string>& name) {
+        // Ranges given backwards are named here: the generator names them as the command line spells them.
+        const auto ordered = [](double low, double high, const char* low_name, const char* high_name) {
+          if (low > high) {
+            throw UsageError("parameter '" + std::string(low_name) + "': must not exceed " + high_name + " (" +
+                             std::string(py::str(py::float_(high))) + ") (got " +
+                             std::string(py::str(py::float_(low))) + ")");
+          }
+        };
+        ordered(narrow_min, narrow_max, "narrow_min", "narrow_max");
+        ordered(wide_min, wide_max, "wide_min", "wide_max");
+        ordered(min_boxes, max_boxes, "min_boxes", "max_boxes");
+        if (empty_rooms + cluttered_rooms > 1) {
+          throw UsageError("parameters 'empty_rooms' and 'cluttered_rooms': must sum to at most 1");
+        }
         domains::BuildingOptions options;
         options.rows = rows;
         options.cols = cols;

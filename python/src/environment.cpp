@@ -47,13 +47,14 @@ class EnvironmentCore {
     return observation();
   }
 
-  py::tuple step(long long action) {
+  py::tuple step(Number<std::int64_t, "action"> action) {
     if (status() != Status::running) throw UsageError("the episode is over: call reset() before step()");
-    if (action < 0 || action >= skeleton_count()) {
-      throw UsageError("action " + std::to_string(action) + " is not a skeleton index in [0, " +
+    const std::int64_t k = action;
+    if (k < 0 || k >= skeleton_count()) {
+      throw UsageError("parameter 'action': " + std::to_string(k) + " is not a skeleton index in [0, " +
                        std::to_string(skeleton_count()) + ")");
     }
-    session_->decide(static_cast<int>(action));
+    session_->decide(static_cast<int>(k));
     const Status status = session_->carry_out(world_);
     const double reward = session_->reward();
     return py::make_tuple(observation(), reward, status != Status::running, false);
@@ -69,7 +70,7 @@ class EnvironmentCore {
     return mask;
   }
 
-  StateView state() const { return {current_state(), skeleton_count()}; }
+  StateView state() const { return {current_state(), skeleton_count(), mdp_->problem}; }
   // No episode yet: step() needs a reset() first.
   Status status() const { return session_ ? session_->status() : Status::failure; }
   std::shared_ptr<MdpHandle> mdp() const { return mdp_; }

@@ -116,17 +116,42 @@ void bind_conditional(py::module_& m) {
                               : PlanningPosterior(prior, horizon, strength);
            }),
            py::arg("prior"), py::arg("horizon"), py::arg("strength"), py::kw_only(), py::arg("backtrack") = py::none())
-      .def("observe_found", &PlanningPosterior::observe_found, py::arg("steps"), "A motion found after `steps` steps.")
-      .def("observe_backtrack", &PlanningPosterior::observe_backtrack, py::arg("steps"),
-           "An attempt that gave up and backtracked after `steps` steps.")
-      .def("observe_cut_off", &PlanningPosterior::observe_cut_off, py::arg("steps"),
-           "An attempt cut off after `steps` steps without a motion or a backtrack.")
+      .def(
+          "observe_found",
+          [](PlanningPosterior& posterior, Number<Steps, "steps", 1> steps) { posterior.observe_found(steps); },
+          py::arg("steps"), "A motion found after `steps` steps.")
+      .def(
+          "observe_backtrack",
+          [](PlanningPosterior& posterior, Number<Steps, "steps", 1> steps) { posterior.observe_backtrack(steps); },
+          py::arg("steps"), "An attempt that gave up and backtracked after `steps` steps.")
+      .def(
+          "observe_cut_off",
+          [](PlanningPosterior& posterior, Number<Steps, "steps", 0> steps) { posterior.observe_cut_off(steps); },
+          py::arg("steps"), "An attempt cut off after `steps` steps without a motion or a backtrack.")
       .def("mean", &PlanningPosterior::mean, "The posterior mean Distribution (over 1..horizon, the rest never).")
       .def("backtrack_mean", &PlanningPosterior::backtrack_mean,
            "The posterior mean backtrack Distribution (over 1..horizon, the rest never).")
-      .def("predictive_found", &PlanningPosterior::predictive_found, py::arg("steps"))
-      .def("predictive_backtrack", &PlanningPosterior::predictive_backtrack, py::arg("steps"))
-      .def("predictive_cut_off", &PlanningPosterior::predictive_cut_off, py::arg("steps"))
+      .def(
+          "predictive_found",
+          [](const PlanningPosterior& posterior, Number<Steps, "steps"> steps) {
+            return posterior.predictive_found(steps);
+          },
+          py::arg("steps"),
+          "The posterior predictive probability that the next attempt finds a motion at step `steps` (P(T = steps)).")
+      .def(
+          "predictive_backtrack",
+          [](const PlanningPosterior& posterior, Number<Steps, "steps"> steps) {
+            return posterior.predictive_backtrack(steps);
+          },
+          py::arg("steps"),
+          "The posterior predictive probability that the next attempt backtracks at step `steps`.")
+      .def(
+          "predictive_cut_off",
+          [](const PlanningPosterior& posterior, Number<Steps, "steps"> steps) {
+            return posterior.predictive_cut_off(steps);
+          },
+          py::arg("steps"),
+          "The posterior predictive probability that the next attempt is cut off after `steps` steps (P(T > steps)).")
       .def_property_readonly("observations", &PlanningPosterior::observations)
       .def_property_readonly("strength", &PlanningPosterior::strength)
       .def_property_readonly("horizon", &PlanningPosterior::horizon);
@@ -152,13 +177,20 @@ void bind_conditional(py::module_& m) {
             belief.observe(action_id, backtracked ? ActionAttempt{0, false, {EndedAttempt{effort, false, true}}}
                                                   : ActionAttempt{effort, found});
           },
-          py::arg("action_id"), py::arg("effort"), py::arg("found"), py::kw_only(), py::arg("backtracked") = false,
+          py::arg("action_id"), py::arg("effort"), py::arg("found").noconvert(), py::kw_only(),
+          py::arg("backtracked").noconvert() = false,
           "One attempt on an action (by id or base id): found after `effort` steps, backtracked after them "
           "(backtracked=True), or cut off after them.")
       .def(
           "observe",
           [](OnlineBelief& belief, const py::object& problem, const std::vector<ActionAttempt>& attempts) {
-            belief.observe(*to_mdp(problem)->problem, attempts);
+            const std::shared_ptr<MdpHandle> episode = to_mdp(problem);
+            if (attempts.size() != static_cast<std::size_t>(episode->problem->action_count())) {
+              throw UsageError("parameter 'attempts': one per action of the problem: " +
+                               std::to_string(episode->problem->action_count()) + ", not " +
+                               std::to_string(attempts.size()));
+            }
+            belief.observe(*episode->problem, attempts);
           },
           py::arg("problem"), py::arg("attempts"),
           "Every attempt of one episode: a session's problem and its attempts, by action index.")
@@ -186,7 +218,14 @@ void bind_conditional(py::module_& m) {
       "fit_strength",
       [](const Required<ConditionalTimeModel, "model">& model, const std::vector<py::object>& logs,
          const std::vector<double>& strengths) {
-        if (logs.empty()) throw UsageError("logs: give at least one planner log");
+        if (logs.empty()) throw UsageError("parameter 'logs': give at least one planner log");
+        if (strengths.empty()) throw UsageError("parameter 'strengths': give at least one strength");
+        for (const double strength : strengths) {
+          if (!(std::isfinite(strength) && strength > 0)) {
+            throw UsageError("parameter 'strengths': every strength must be a finite number > 0 (got " +
+                             std::string(py::str(py::float_(strength))) + ")");
+          }
+        }
         std::vector<std::filesystem::path> paths;
         for (const py::object& log : logs) {
           paths.emplace_back(path_argument(log, "logs"));
@@ -300,9 +339,9 @@ void bind_learn(py::module_& m) {
   m.def(
       "score",
       [](const py::object& problem, const std::vector<py::object>& logs, Number<Steps, "horizon", 0> horizon,
-         double floor, bool skip_unknown) {
+         Number<double, "floor", 0.0, 1.0> floor, bool skip_unknown) {
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
-        if (logs.empty()) throw UsageError("logs: give at least one planner log");
+        if (logs.empty()) throw UsageError("parameter 'logs': give at least one planner log");
         std::vector<std::string> paths;
         for (const py::object& log : logs) paths.emplace_back(path_argument(log, "logs"));
         report::ScoreReport report{.instance = instance_label(problem, *mdp->problem),
@@ -324,7 +363,7 @@ void bind_learn(py::module_& m) {
         return json_object(report::attempt_scores_json(report));
       },
       py::arg("problem"), py::arg("logs"), py::kw_only(), py::arg("horizon") = 0, py::arg("floor") = 1e-6,
-      py::arg("skip_unknown") = false,
+      py::arg("skip_unknown").noconvert() = false,
       "`ontime score`: how well the problem's distributions explain the attempts of planner logs (paths): the "
       "censoring-aware planning log score, the integrated Brier score and the execution log score, as the "
       "command's --json fields (docs/learning.md).");
@@ -352,6 +391,7 @@ void bind_learn(py::module_& m) {
       "train_ppo",
       [](const py::object& problem, const py::object& out, Episodes episodes, Seed seed, const py::object& progress) {
         check_episodes(episodes);
+        check_callable(progress, "progress");
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
         const std::string path = path_argument(out, "out");
         std::optional<PpoTraining> training;

@@ -154,8 +154,15 @@ void bind_live(py::module_& m) {
           py::arg("seconds"), "Time the clock did not see but the deadline must.")
       .def(
           "add_skeleton",
-          [](LiveSessionHandle& h, const std::vector<std::string>& ids, std::vector<Action> new_actions, double reward,
-             double reward_per_step) {
+          [](LiveSessionHandle& h, const std::vector<std::string>& ids, std::vector<Action> new_actions,
+             Number<double, "reward", 0.0, 1.0> reward, Number<double, "reward_per_step", 0.0> reward_per_step) {
+            if (ids.empty()) throw UsageError("parameter 'action_ids': give at least one action id");
+            const double deadline = h.session.problem().deadline();
+            if (reward - reward_per_step * deadline < 0) {
+              throw UsageError(
+                  "parameter 'reward_per_step': the reward falls below 0 before the deadline (reward - "
+                  "reward_per_step * deadline < 0)");
+            }
             const int added = session_call([&] {
               return h.session.add_skeleton(ids, std::move(new_actions), SkeletonReward{reward, reward_per_step});
             });
@@ -206,7 +213,7 @@ void bind_live(py::module_& m) {
           "steps of the robot's clock (1.0 without rewards), else 0.0.")
       .def_property_readonly("state",
                              [](const LiveSessionHandle& h) {
-                               return StateView{h.session.state(), h.session.problem().skeleton_count()};
+                               return StateView{h.session.state(), h.session.problem().skeleton_count(), h.current};
                              })
       .def_property_readonly(
           "problem", [](const LiveSessionHandle& h) { return std::const_pointer_cast<Problem>(h.current); },

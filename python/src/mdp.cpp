@@ -6,8 +6,12 @@
 #include <pybind11/operators.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
+#include <string>
+
 #include "bindings.hpp"
 #include "ontime/mdp/state.hpp"
+#include "ontime/util/error.hpp"
 
 namespace ontime::python {
 
@@ -20,13 +24,40 @@ py::list first(const Array& values, int count) {
   return out;
 }
 
+// UsageError unless `k` is a skeleton of `mdp`.
+void check_skeleton(const Mdp& mdp, int k) {
+  if (k >= mdp.skeleton_count()) {
+    throw UsageError("parameter 'skeleton': must be a whole number from 0 to " +
+                     std::to_string(mdp.skeleton_count() - 1) + " (got " + std::to_string(k) + ")");
+  }
+}
+
 }  // namespace
 
+void check_state_of(const Problem& problem, const StateView& view, const char* parameter) {
+  const Problem* origin = view.problem.get();
+  bool same = origin == &problem;
+  if (!same && origin != nullptr) {
+    same = origin->deadline() == problem.deadline() && origin->action_count() == problem.action_count() &&
+           origin->skeleton_count() == problem.skeleton_count() && origin->chains().size() == problem.chains().size() &&
+           origin->has_backtracking() == problem.has_backtracking();
+    for (int k = 0; same && k < problem.skeleton_count(); ++k) {
+      same = std::ranges::equal(origin->skeleton(k), problem.skeleton(k));
+    }
+  }
+  if (!same) {
+    throw UsageError("parameter '" + std::string(parameter) +
+                     "': a state of the MDP of another problem (its deadline, actions or skeletons differ)");
+  }
+}
+
 void bind_mdp(py::module_& m) {
-  py::enum_<Status>(m, "Status", "Where an episode or session stands.")
-      .value("running", Status::running)
-      .value("success", Status::success)
-      .value("failure", Status::failure);
+  py::enum_<Status> status(m, "Status", "Where an episode or session stands.");
+  status.value("running", Status::running).value("success", Status::success).value("failure", Status::failure);
+  // Made from its value only when it is one: pybind11's own constructor takes any int.
+  py::delattr(status, "__init__");
+  status.def(py::init([](Number<int, "value", 0, 2> value) { return static_cast<Status>(value.value); }),
+             py::arg("value"));
 
   py::class_<StateView>(m, "State",
                         "An MDP state (SPEC §2): CT, and per skeleton l_k (actions refined), PT_k (steps on its "
@@ -40,7 +71,9 @@ void bind_mdp(py::module_& m) {
       .def_property_readonly(
           "execution", [](const StateView& s) { return first(s.state.execution, s.skeletons); },
           "ET_k for each skeleton.")
-      .def("__eq__", [](const StateView& a, const StateView& b) { return a.state == b.state; })
+      .def(
+          "__eq__", [](const StateView& a, const StateView& b) { return a.state == b.state; },
+          py::is_operator())  // another object: NotImplemented, so False
       .def("__hash__",
            [](const StateView& s) {
              return py::hash(py::make_tuple(s.state.time, first(s.state.refined, s.skeletons),
@@ -66,18 +99,21 @@ void bind_mdp(py::module_& m) {
       .def(
           "start",
           [](const MdpHandle& h) {
-            return StateView{h.mdp.start(), h.mdp.skeleton_count()};
+            return StateView{h.mdp.start(), h.mdp.skeleton_count(), h.problem};
           },
           "The start state.")
       .def(
           "next_action",
           [](const MdpHandle& h, const StateView& s, Number<int, "skeleton", 0> k) {
+            check_state_of(*h.problem, s);
+            check_skeleton(h.mdp, k);
             return h.mdp.next_action(s.state, k);
           },
           py::arg("state"), py::arg("skeleton"), "The action skeleton k refines next, or -1 when it is fully refined.")
       .def(
           "useful_choices",
           [](const MdpHandle& h, const StateView& s) {
+            check_state_of(*h.problem, s);
             std::vector<int> out;
             for (const int choice : h.mdp.useful_choices(s.state)) out.push_back(choice);
             return out;
@@ -86,6 +122,8 @@ void bind_mdp(py::module_& m) {
       .def(
           "can_succeed",
           [](const MdpHandle& h, const StateView& s, Number<int, "skeleton", 0> k) {
+            check_state_of(*h.problem, s);
+            check_skeleton(h.mdp, k);
             return h.mdp.can_succeed(s.state, k);
           },
           py::arg("state"), py::arg("skeleton"), "Whether skeleton k can still meet the deadline from this state.");

@@ -18,9 +18,18 @@ namespace ontime::python {
 
 namespace {
 
-std::vector<double> to_vector(const py::array_t<double, py::array::c_style | py::array::forcecast>& values) {
-  if (values.ndim() != 1) throw UsageError("a distribution is a one-dimensional array of probabilities");
-  return {values.data(), values.data() + values.size()};
+// A distribution made by `make` from the probabilities of a one-dimensional array; UsageError
+// naming `parameter` for another array or a bad table.
+template <class Make>
+Distribution distribution_of(const py::array_t<double, py::array::c_style | py::array::forcecast>& values,
+                             const char* parameter, Make make) {
+  const std::string name = "parameter '" + std::string(parameter) + "': ";
+  if (values.ndim() != 1) throw UsageError(name + "must be a one-dimensional array of probabilities");
+  try {
+    return make(std::vector<double>(values.data(), values.data() + values.size()));
+  } catch (const UsageError& error) {
+    throw UsageError(name + error.what());
+  }
 }
 
 py::object step_or_none(Steps step) { return step == kNever ? py::none() : py::object(py::int_(step)); }
@@ -52,13 +61,15 @@ void bind_model(py::module_& m) {
       .def_static(
           "from_pmf",
           [](const py::array_t<double, py::array::c_style | py::array::forcecast>& masses) {
-            return Distribution::from_pmf(to_vector(masses));
+            return distribution_of(masses, "masses",
+                                   [](std::vector<double> p) { return Distribution::from_pmf(std::move(p)); });
           },
           py::arg("masses"), "From probabilities: masses[t] = P(T = t). Raises UsageError for a bad table.")
       .def_static(
           "from_cdf",
           [](const py::array_t<double, py::array::c_style | py::array::forcecast>& cumulative) {
-            return Distribution::from_cdf(to_vector(cumulative));
+            return distribution_of(cumulative, "cumulative",
+                                   [](const std::vector<double>& c) { return Distribution::from_cdf(c); });
           },
           py::arg("cumulative"), "From cumulative probabilities: cumulative[t] = P(T <= t).")
       .def_property_readonly(
@@ -74,8 +85,9 @@ void bind_model(py::module_& m) {
       .def(
           "survival", [](const Distribution& d, Number<Steps, "t"> t) { return d.survival(t); }, py::arg("t"),
           "P(T > t), \"never\" included.")
-      .def("hazard", &Distribution::hazard, py::arg("spent"),
-           "P(T = spent + 1 | T > spent): the chance that one more step finishes.")
+      .def(
+          "hazard", [](const Distribution& d, Number<Steps, "spent", 0> spent) { return d.hazard(spent); },
+          py::arg("spent"), "P(T = spent + 1 | T > spent): the chance that one more step finishes.")
       .def("mean_finite", &Distribution::mean_finite, "E[T | T finite] (inf when nothing is finite).")
       .def_property_readonly(
           "min_step", [](const Distribution& d) { return step_or_none(d.min_step()); },

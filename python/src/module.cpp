@@ -48,7 +48,9 @@ std::string path_argument(const py::handle& value, const char* parameter) {
   if (!py::isinstance<py::str>(text)) {
     throw UsageError("parameter '" + std::string(parameter) + "': must be a path of text, not bytes");
   }
-  return text.cast<std::string>();
+  std::string path = text.cast<std::string>();
+  if (path.empty()) throw UsageError("parameter '" + std::string(parameter) + "': must be a path, not empty text");
+  return path;
 }
 
 void refuse_number(const char* name, const std::string& rule, py::handle got) {
@@ -141,8 +143,16 @@ std::shared_ptr<AllocatorHandle> make_allocator_handle(std::shared_ptr<MdpHandle
   return handle;
 }
 
+void check_callable(const py::object& callback, const char* parameter) {
+  if (!callback.is_none() && PyCallable_Check(callback.ptr()) == 0) {
+    throw UsageError("parameter '" + std::string(parameter) + "': must be callable or None (got a " +
+                     std::string(py::str(py::type::of(callback).attr("__name__"))) + ")");
+  }
+}
+
 void run_interruptibly(const std::function<void(const std::function<bool()>& stop, Progress& progress)>& work,
                        const py::object& progress_callback) {
+  check_callable(progress_callback, "progress");
   std::atomic<bool> stop_requested{false};
   const std::function<bool()> stop = [&stop_requested] { return stop_requested.load(std::memory_order_relaxed); };
   Progress progress;

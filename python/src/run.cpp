@@ -40,7 +40,7 @@ struct SessionHandle {
 // A World implemented in Python (a subclass of ontime.World), called with the GIL held.
 class PythonWorld final : public World {
  public:
-  explicit PythonWorld(py::object world) : world_(std::move(world)) {}
+  PythonWorld(py::object world, int action_count) : world_(std::move(world)), action_count_(action_count) {}
   ~PythonWorld() override {
     const py::gil_scoped_acquire acquire;
     world_ = py::object();
@@ -61,7 +61,16 @@ class PythonWorld final : public World {
       const auto pair = result.cast<py::tuple>();
       if (py::len(pair) == 2 && py::isinstance<py::str>(pair[0]) && pair[0].cast<std::string>() == "backtrack") {
         // ("backtrack", culprit action index): the attempt gave up blaming that action (SPEC §7).
-        return Observation::backtracked(pair[1].cast<int>());
+        const py::object culprit = pair[1];
+        if (PyBool_Check(culprit.ptr()) || !py::hasattr(culprit, "__index__")) {
+          throw UsageError("World.step: a backtrack is (\"backtrack\", the index of the action blamed), not " +
+                           std::string(py::repr(result)));
+        }
+        const auto index = py::int_(culprit).cast<long long>();
+        if (index < 0 || index >= static_cast<long long>(action_count_)) {
+          throw UsageError("World.step: a backtrack blames action " + std::to_string(index) + ", not an action index");
+        }
+        return Observation::backtracked(static_cast<int>(index));
       }
     }
     if (py::isinstance<py::bool_>(result)) {
@@ -84,12 +93,22 @@ class PythonWorld final : public World {
   void collect_statistics(Statistics& statistics) const override {
     const py::gil_scoped_acquire acquire;
     if (!py::hasattr(world_, "statistics")) return;
-    const py::dict counters = world_.attr("statistics")();
-    for (const auto& [name, value] : counters) statistics.add(std::string(py::str(name)), value.cast<double>());
+    const py::object counters = world_.attr("statistics")();
+    if (!py::isinstance<py::dict>(counters)) {
+      throw UsageError("World.statistics must return a dict of counters (name -> number)");
+    }
+    for (const auto& [name, value] : py::reinterpret_borrow<py::dict>(counters)) {
+      if (PyBool_Check(value.ptr()) || (!py::isinstance<py::int_>(value) && !py::isinstance<py::float_>(value) &&
+                                        !py::hasattr(value, "__float__"))) {
+        throw UsageError("World.statistics: counter '" + std::string(py::str(name)) + "' is not a number");
+      }
+      statistics.add(std::string(py::str(name)), py::float_(py::reinterpret_borrow<py::object>(value)).cast<double>());
+    }
   }
 
  private:
   py::object world_;
+  int action_count_;
 };
 
 // `options` stopped by `stop` and counting its episodes in `progress`.
@@ -241,10 +260,12 @@ void bind_run(py::module_& m) {
                            "`effort` steps, with a motion the backtrack discarded (found), by giving up itself "
                            "(backtracked), or with neither (cut off).")
       .def(py::init([](Number<Steps, "effort", 0> effort, bool found, bool backtracked) {
-             if (found && backtracked) throw UsageError("an attempt ends with a motion or by backtracking, not both");
+             if (found && backtracked) {
+               throw UsageError("found and backtracked: an attempt ends with a motion or by backtracking, not both");
+             }
              return EndedAttempt{effort, found, backtracked};
            }),
-           py::arg("effort"), py::arg("found") = false, py::arg("backtracked") = false)
+           py::arg("effort"), py::arg("found").noconvert() = false, py::arg("backtracked").noconvert() = false)
       .def_readonly("effort", &EndedAttempt::effort)
       .def_readonly("found", &EndedAttempt::found)
       .def_readonly("backtracked", &EndedAttempt::backtracked)
@@ -261,7 +282,7 @@ void bind_run(py::module_& m) {
       .def(py::init([](Number<Steps, "effort", 0> effort, bool found, std::vector<EndedAttempt> ended) {
              return ActionAttempt{effort, found, std::move(ended)};
            }),
-           py::arg("effort"), py::arg("found"), py::arg("ended") = std::vector<EndedAttempt>{})
+           py::arg("effort"), py::arg("found").noconvert(), py::arg("ended") = std::vector<EndedAttempt>{})
       .def_readonly("effort", &ActionAttempt::effort)
       .def_readonly("found", &ActionAttempt::found)
       .def_readonly("ended", &ActionAttempt::ended)
@@ -293,22 +314,15 @@ void bind_run(py::module_& m) {
            py::arg("seconds") = py::none())
       .def(
           "choose",
-          [](SessionHandle& h) {
-            const int skeleton = session_call([&] { return h.session.choose(h.budget).skeleton; });
-            return DecisionView{skeleton, h.session.mdp().next_action(h.session.state(), skeleton),
-                                h.allocator->mdp->problem};
-          },
-          "Asks the allocator for the next step (within the session's budget).")
-      .def(
-          "choose",
           [](SessionHandle& h, std::optional<Iterations> iterations, std::optional<Seconds> seconds) {
-            const DecisionBudget budget = budget_of(iterations, seconds);
+            const DecisionBudget budget = iterations || seconds ? budget_of(iterations, seconds) : h.budget;
             const int skeleton = session_call([&] { return h.session.choose(budget).skeleton; });
             return DecisionView{skeleton, h.session.mdp().next_action(h.session.state(), skeleton),
                                 h.allocator->mdp->problem};
           },
           py::kw_only(), py::arg("iterations") = py::none(), py::arg("seconds") = py::none(),
-          "The same within this budget (iterations and/or seconds of search) for this decision only.")
+          "Asks the allocator for the next step, within the session's budget, or within `iterations` and/or "
+          "`seconds` of search for this decision only.")
       .def(
           "report_not_yet",
           [](SessionHandle& h, const ChainStates& chains) {
@@ -320,8 +334,7 @@ void bind_run(py::module_& m) {
           "after the step ({chain: state}). Returns the status.")
       .def(
           "report_refined",
-          [](SessionHandle& h, long long execution_steps, const ChainStates& chains) {
-            if (execution_steps < 0) throw UsageError("execution time must be >= 0 steps");
+          [](SessionHandle& h, Number<std::int64_t, "execution_steps", 0> execution_steps, const ChainStates& chains) {
             const Steps steps = execution_steps >= kNever ? kNever : static_cast<Steps>(execution_steps);
             const Observation observation = with_reported_chains(h.session.mdp(), Observation::found(steps), chains);
             return session_call([&] { return h.session.report(observation); });
@@ -344,10 +357,11 @@ void bind_run(py::module_& m) {
           "The step just decided gave up (SPEC §7) blaming the earlier action `culprit` (its id): its motion and "
           "everything refined after it are discarded. Returns the status.")
       .def_property_readonly("status", [](const SessionHandle& h) { return h.session.status(); })
-      .def_property_readonly("state",
-                             [](const SessionHandle& h) {
-                               return StateView{h.session.state(), h.session.mdp().skeleton_count()};
-                             })
+      .def_property_readonly(
+          "state",
+          [](const SessionHandle& h) {
+            return StateView{h.session.state(), h.session.mdp().skeleton_count(), h.allocator->mdp->problem};
+          })
       .def_property_readonly(
           "solution",
           [](const SessionHandle& h) -> py::object {
@@ -379,6 +393,7 @@ void bind_run(py::module_& m) {
          Threads threads, std::optional<Iterations> iterations, std::optional<Seconds> seconds,
          const py::object& progress, const py::kwargs& kwargs) {
         check_episodes(episodes);
+        check_callable(progress, "progress");
         const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
         std::string solver;
         ParameterValues values;
@@ -390,29 +405,40 @@ void bind_run(py::module_& m) {
           if (kwargs.size() > 0) throw UsageError("give parameters to make_allocator, not with an Allocator");
           solver = handle.name;
           values = handle.values;
-        } else {
+        } else if (py::isinstance<py::str>(allocator)) {
           solver = allocator.cast<std::string>();
           values = parameter_values(kwargs);
+        } else {
+          throw UsageError("parameter 'allocator': must be an ontime.Allocator or the name of an allocator (got " +
+                           (allocator.is_none()
+                                ? std::string("None")
+                                : "a " + std::string(py::str(py::type::of(allocator).attr("__name__")))) +
+                           ")");
         }
-        const bool instance = py::hasattr(world, "step");
+        // A World object, or a callable (a World's class among them) that makes one per thread.
+        const bool instance = !py::isinstance<py::type>(world) && py::hasattr(world, "step");
         if (instance && threads != 1) {
           throw UsageError(
               "one World object runs on one thread: give a factory (e.g. the World's class) for threads != 1");
         }
-        if (!instance && !PyCallable_Check(world.ptr())) {
-          throw py::type_error("world must be an ontime.World or a callable that makes one");
+        if (!instance && PyCallable_Check(world.ptr()) == 0) {
+          throw UsageError("parameter 'world': must be an ontime.World or a callable that makes one (got " +
+                           (world.is_none() ? std::string("None")
+                                            : "a " + std::string(py::str(py::type::of(world).attr("__name__")))) +
+                           ")");
         }
         const AllocatorFactory factory = [&] {
           const py::gil_scoped_release release;
           return make_allocator_factory(solver, mdp->mdp, values);
         }();
-        const WorldFactory worlds = [world, instance]() -> std::unique_ptr<World> {
+        const int action_count = mdp->problem->action_count();
+        const WorldFactory worlds = [world, instance, action_count]() -> std::unique_ptr<World> {
           const py::gil_scoped_acquire acquire;
           py::object made = instance ? world : world();
           if (!py::hasattr(made, "step") || !py::hasattr(made, "begin_episode")) {
             throw UsageError("the world factory must return an ontime.World (begin_episode and step)");
           }
-          return std::make_unique<PythonWorld>(std::move(made));
+          return std::make_unique<PythonWorld>(std::move(made), action_count);
         };
         MonteCarloOptions options;
         options.episodes = episodes;
@@ -446,6 +472,7 @@ void bind_run(py::module_& m) {
          bool exact, bool regret, const py::object& belief, const py::object& progress,
          const std::optional<std::string>& act, const py::kwargs& kwargs) {
         check_episodes(episodes);
+        check_callable(progress, "progress");
         const std::shared_ptr<const Problem> chosen = problem_with_acting(problem, act);
         if (chosen->acting() == Acting::concurrent) {
           return evaluate_concurrent(problem, *chosen, solver, episodes, seed, threads, exact, regret, belief, progress,
@@ -477,8 +504,8 @@ void bind_run(py::module_& m) {
         return out;
       },
       py::arg("problem"), py::arg("solver"), py::kw_only(), py::arg("episodes") = 10'000, py::arg("seed") = 1,
-      py::arg("threads") = 0, py::arg("exact") = false, py::arg("regret") = false, py::arg("belief") = py::none(),
-      py::arg("progress") = py::none(), py::arg("act") = py::none(),
+      py::arg("threads") = 0, py::arg("exact").noconvert() = false, py::arg("regret").noconvert() = false,
+      py::arg("belief") = py::none(), py::arg("progress") = py::none(), py::arg("act") = py::none(),
       "Success rate of an allocator over simulated episodes (hidden sampled worlds), as `ontime evaluate "
       "--json` reports it: the same fields and, for the same seed, the same counts whatever `threads`. "
       "exact=True adds the exact success probability (stationary allocators); regret=True the estimate of "
@@ -534,7 +561,7 @@ void bind_run(py::module_& m) {
       py::arg("problem"), py::arg("belief"), py::arg("solver") = "dp-rerun", py::kw_only(),
       py::arg("strength") = AdaptationOptions{}.strength, py::arg("episodes") = AdaptationOptions{}.episodes,
       py::arg("sequences") = AdaptationOptions{}.sequences, py::arg("seed") = 1, py::arg("threads") = 0,
-      py::arg("exact") = true,
+      py::arg("exact").noconvert() = true,
       "`ontime adapt`: `sequences` independent runs of `episodes` episodes in `problem` (the truth), the "
       "allocator planning with `belief` (the prior) updated after every episode by the attempts made in it; "
       "per episode the successes and the exact success probability of its plan in the truth, as the "
@@ -546,12 +573,17 @@ void bind_run(py::module_& m) {
          Episodes episodes, Seed seed, Threads threads, const std::string& format, const py::object& progress,
          const py::kwargs& kwargs) {
         check_episodes(episodes);
+        check_callable(progress, "progress");
+        if (py::isinstance<py::str>(instances)) {
+          throw UsageError("parameter 'instances': must be a list of instances (files or Problems), not a str");
+        }
         if (format != "json" && format != "markdown") {
           throw UsageError("format must be 'json' or 'markdown' (got '" + format + "')");
         }
+        if (py::len(instances) == 0) throw UsageError("parameter 'instances': give at least one instance");
         TableOptions options;
         if (solvers) {
-          if (solvers->empty()) throw UsageError("solvers: give at least one allocator");
+          if (solvers->empty()) throw UsageError("parameter 'solvers': give at least one allocator");
           options.solvers = *solvers;
         }
         options.exact = exact;
@@ -603,7 +635,7 @@ void bind_run(py::module_& m) {
         if (format == "markdown") return py::object(py::str(report::to_markdown(table, spelling)));
         return json_object(report::to_json(table));
       },
-      py::arg("instances"), py::kw_only(), py::arg("solvers") = py::none(), py::arg("exact") = false,
+      py::arg("instances"), py::kw_only(), py::arg("solvers") = py::none(), py::arg("exact").noconvert() = false,
       py::arg("episodes") = 10'000, py::arg("seed") = 1, py::arg("threads") = 0, py::arg("format") = "json",
       py::arg("progress") = py::none(),
       "Table I's layout, as `ontime table` computes it: one row per instance (a file or a Problem), one column "
@@ -620,6 +652,11 @@ void bind_run(py::module_& m) {
          const std::optional<std::string>& searcher, const std::optional<std::string>& reference,
          const std::optional<std::vector<double>>& log10_multipliers, const py::object& progress,
          const py::kwargs& kwargs) {
+        check_callable(progress, "progress");
+        if (py::isinstance<py::str>(instances)) {
+          throw UsageError("parameter 'instances': must be a list of instances (files or Problems), not a str");
+        }
+        if (py::len(instances) == 0) throw UsageError("parameter 'instances': give at least one instance");
         const StudyKind kind = study_kind(kind_name);
         StudySettings settings;
         settings.episodes = episodes;
@@ -631,12 +668,19 @@ void bind_run(py::module_& m) {
         std::vector<double> multipliers{0, 0.5, 1, 1.5, 2, 2.5, 3, 3.5, 4, 4.5, 5};
         if (log10_multipliers) {
           if (kind != StudyKind::anytime) throw UsageError("log10_multipliers is for the anytime study");
+          for (const double exponent : *log10_multipliers) {
+            if (!(exponent >= -3 && exponent <= 9)) {
+              throw UsageError("parameter 'log10_multipliers': every value must lie within [-3, 9] (got " +
+                               std::string(py::str(py::float_(exponent))) + ")");
+            }
+          }
           multipliers = *log10_multipliers;
         }
         if (kind != StudyKind::anytime) multipliers.clear();
         std::vector<StudyInstance> rows;
-        for (const py::handle source : instances) {
-          const auto object = py::reinterpret_borrow<py::object>(source);
+        // Each item held while it is used: a numpy array's items are new objects.
+        for (std::size_t i = 0; i < static_cast<std::size_t>(py::len(instances)); ++i) {
+          const py::object object = instances[i];
           const std::shared_ptr<MdpHandle> mdp = to_mdp(object, "instances");
           const std::string label = instance_label(object, *mdp->problem);
           const bool is_file = py::isinstance<py::str>(object) || py::hasattr(object, "__fspath__");

@@ -46,9 +46,25 @@ void bind_solve(py::module_& m) {
       "reduce_knapsack",
       [](const py::object& knapsack, const std::optional<std::string>& name) {
         const bool is_file = py::isinstance<py::str>(knapsack) || py::hasattr(knapsack, "__fspath__");
+        if (!is_file && !py::isinstance(knapsack, py::module_::import("collections.abc").attr("Mapping"))) {
+          throw UsageError("parameter 'knapsack': must be a path or a dict {'capacity': W, 'items': [...]} (got " +
+                           (knapsack.is_none() ? std::string("None")
+                                               : "a " + std::string(py::str(py::type::of(knapsack).attr("__name__")))) +
+                           ")");
+        }
         const std::string source = is_file ? path_argument(knapsack, "knapsack") : "<knapsack>";
-        const std::string text =
-            is_file ? std::string() : std::string(py::str(py::module_::import("json").attr("dumps")(knapsack)));
+        std::string text;
+        if (!is_file) {
+          try {
+            text = py::str(py::module_::import("json").attr("dumps")(knapsack));
+          } catch (py::error_already_set& error) {
+            if (!error.matches(PyExc_TypeError) && !error.matches(PyExc_ValueError) &&
+                !error.matches(PyExc_RecursionError)) {
+              throw;
+            }
+            throw InputError(source, "top level", std::string("cannot be written as JSON: ") + error.what());
+          }
+        }
         const py::gil_scoped_release release;
         const Knapsack parsed = is_file ? load_knapsack(source) : parse_knapsack(text, source);
         const std::string problem_name =

@@ -158,7 +158,7 @@ def test_a_robot_that_finishes_early_says_so_and_one_never_started_is_refused():
     session.report_refined(2)
     with pytest.raises(ontime.UsageError, match="was never started"):
         session.report_execution_finished("a")
-    session.decide(start=0)
+    session.decide(start="a")
     session.decide(refine=0)
     session.report_not_yet()
     assert session.robot_left == 1

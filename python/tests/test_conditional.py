@@ -179,3 +179,32 @@ def test_the_kitchen_family_fits_and_predicts(tmp_path, cli):
     assert len(problem.skeletons) == len(unseen.skeletons)
     with pytest.raises(ontime.UsageError, match="is not move\\+pick"):
         ontime.domains.features(unseen, "move+pick(nothing)")
+
+
+def test_a_model_file_whose_numbers_are_not_finite_or_overflow_is_an_input_error(corpus, tmp_path):
+    # A number that is not finite is refused where the reader meets it; finite numbers can still
+    # overflow where they meet features (a scale of 1e-320 makes door_width's standard score
+    # infinite, a coefficient of 0 makes it NaN), and the prediction names the file and its
+    # parameters (it used to raise "a probability is not a number (NaN)", naming neither).
+    folder, logs, unseen = corpus
+    data = json.loads(ontime.fit_conditional(logs, step=3.0, kind="hazard", domain="navigation").to_json())
+    data["parameters"]["hazard"][0] = 12345.5
+    marked = json.dumps(data, indent=2)
+    for number in ("1e999", "-1e999", "NaN", "Infinity"):
+        path = tmp_path / f"{number}.json"
+        path.write_text(marked.replace("12345.5", number))
+        with pytest.raises(ontime.InputError) as error:
+            ontime.load_conditional_model(path)
+        assert error.value.source == str(path) and error.value.place.startswith("line "), str(error.value)
+    data["parameters"]["hazard"] = [0.0] * len(data["parameters"]["hazard"])
+    data["parameters"]["scale"][0] = 1e-320
+    path = tmp_path / "overflow.json"
+    path.write_text(json.dumps(data))
+    overflowing = ontime.load_conditional_model(path)
+    far = np.array(data["parameters"]["mean"]) + 1.0
+    for predict in (lambda: overflowing.predict(far), lambda: overflowing.predict(np.array([far, far])),
+                    lambda: ontime.domains.predict(ontime.domains.load("navigation", unseen), overflowing)):
+        with pytest.raises(ontime.InputError) as error:
+            predict()
+        assert (error.value.source, error.value.place) == (str(path), "parameters")
+        assert error.value.rule.startswith("the model's numbers overflow for some features: ")

@@ -152,7 +152,23 @@ void ConditionalTimeModel::check_features(std::span<const double> features) cons
 
 PredictedTimes ConditionalTimeModel::predict(std::span<const double> features) const {
   check_features(features);
-  return predict_checked(features);
+  try {
+    return predict_checked(features);
+  } catch (const UsageError&) {
+    throw_for_parameters();
+  }
+}
+
+void ConditionalTimeModel::throw_for_parameters() const {
+  // The features were checked: what fails now is the model's numbers (finite, each within the
+  // file's rules, but overflowing together), which a file brings.
+  try {
+    throw;
+  } catch (const UsageError& error) {
+    if (source_.empty()) throw;
+    throw InputError(source_, "parameters",
+                     std::string("the model's numbers overflow for some features: ") + error.what());
+  }
 }
 
 std::vector<PredictedTimes> ConditionalTimeModel::predict_rows(std::span<const double> rows, std::size_t count) const {
@@ -168,7 +184,12 @@ std::vector<PredictedTimes> ConditionalTimeModel::predict_rows(std::span<const d
       throw UsageError("row " + std::to_string(r + 1) + ": " + error.what());
     }
   }
-  return count == 0 ? std::vector<PredictedTimes>{} : predict_rows_checked(rows, count);
+  if (count == 0) return {};
+  try {
+    return predict_rows_checked(rows, count);
+  } catch (const UsageError&) {
+    throw_for_parameters();
+  }
 }
 
 std::vector<PredictedTimes> ConditionalTimeModel::predict_rows_checked(std::span<const double> rows,
@@ -334,9 +355,18 @@ std::unique_ptr<ConditionalTimeModel> parse_conditional_model(std::string_view t
   if (!json.contains("parameters") || !json["parameters"].is_object()) fail("parameters", "must be an object");
   const detail::ParameterReader reader(json["parameters"], name);
   const std::string kind = json.contains("kind") && json["kind"].is_string() ? json["kind"].get<std::string>() : "";
-  if (kind == PooledTimeModel::kind_name()) return detail::read_pooled_model(reader, std::move(header));
-  if (kind == HazardTimeModel::kind_name()) return detail::read_hazard_model(reader, std::move(header));
-  if (kind == BoostedTimeModel::kind_name()) return detail::read_boosted_model(reader, std::move(header));
+  std::unique_ptr<ConditionalTimeModel> model;
+  if (kind == PooledTimeModel::kind_name()) {
+    model = detail::read_pooled_model(reader, std::move(header));
+  } else if (kind == HazardTimeModel::kind_name()) {
+    model = detail::read_hazard_model(reader, std::move(header));
+  } else if (kind == BoostedTimeModel::kind_name()) {
+    model = detail::read_boosted_model(reader, std::move(header));
+  }
+  if (model) {
+    model->set_source(name);
+    return model;
+  }
   std::string known;
   for (const ConditionalModelKind& k : conditional_model_kinds()) known += (known.empty() ? "" : ", ") + k.name;
   throw InputError(name, "kind", "unknown kind '" + kind + "' (known: " + known + ")");

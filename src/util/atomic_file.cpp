@@ -19,11 +19,9 @@
 #include "util/signal_handoff.hpp"
 
 namespace ontime {
-namespace {
-
 // The error type for a failed system call: the caller's to fix (a path, a permission, a full
 // disk) or a failure of the system itself.
-[[noreturn]] void fail(const std::filesystem::path& path, const char* what, int error) {
+void throw_file_error(const std::filesystem::path& path, const char* what, int error) {
   const std::string message = path.string() + ": " + what + ": " + std::strerror(error);
   switch (error) {
     case EACCES:
@@ -43,6 +41,12 @@ namespace {
     default:
       throw std::runtime_error(message);
   }
+}
+
+namespace {
+
+[[noreturn]] void fail(const std::filesystem::path& path, const char* what, int error) {
+  throw_file_error(path, what, error);
 }
 
 // Writes all of `content` to `descriptor`; returns 0 or the errno of the failed write.

@@ -11,6 +11,9 @@
 #include <stdexcept>
 #include <string>
 
+#include "ontime/util/atomic_file.hpp"
+#include "ontime/util/error.hpp"
+
 namespace ontime {
 namespace {
 
@@ -25,7 +28,7 @@ std::size_t staged_count = 0;  // the last entry is the directory
 struct sigaction previous_actions[std::size(kTerminationSignals)];
 
 void check_length(const std::filesystem::path& path) {
-  if (path.string().size() >= kMaxPath) throw std::runtime_error(path.string() + ": path too long for an output file");
+  if (path.string().size() >= kMaxPath) throw UsageError(path.string() + ": path too long for an output file");
 }
 
 void copy_path(char* slot, const std::filesystem::path& path) {
@@ -37,25 +40,23 @@ void copy_path(char* slot, const std::filesystem::path& path) {
 // until the commit: no temporary of its own, so the directory holds only members).
 void write_whole_file(const std::filesystem::path& path, std::string_view content) {
   const int descriptor = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (descriptor < 0) throw std::runtime_error(path.string() + ": cannot create: " + std::strerror(errno));
+  if (descriptor < 0) throw_file_error(path, "cannot create", errno);
   const char* data = content.data();
   std::size_t left = content.size();
   while (left > 0) {
     const ssize_t written = ::write(descriptor, data, left);
     if (written < 0 && errno == EINTR) continue;
     if (written < 0) {
-      const std::string reason = std::strerror(errno);
+      const int error = errno;
       ::close(descriptor);
-      throw std::runtime_error(path.string() + ": cannot write: " + reason);
+      throw_file_error(path, "cannot write", error);
     }
     data += written;
     left -= static_cast<std::size_t>(written);
   }
   const bool flushed = ::fsync(descriptor) == 0;
   const int flush_error = errno;
-  if (::close(descriptor) != 0 || !flushed) {
-    throw std::runtime_error(path.string() + ": cannot flush: " + std::strerror(flushed ? errno : flush_error));
-  }
+  if (::close(descriptor) != 0 || !flushed) throw_file_error(path, "cannot flush", flushed ? errno : flush_error);
 }
 
 extern "C" void remove_staging_and_end(int signal_number) {
@@ -100,9 +101,9 @@ OutputSet::OutputSet(const std::filesystem::path& directory) : directory_(direct
   sigset_t previous_mask;
   ::pthread_sigmask(SIG_BLOCK, &blocked, &previous_mask);
   if (::mkdtemp(pattern.data()) == nullptr) {
-    const std::string reason = std::strerror(errno);
+    const int error = errno;
     ::pthread_sigmask(SIG_SETMASK, &previous_mask, nullptr);
-    throw std::runtime_error(directory_.string() + ": cannot create a staging directory: " + reason);
+    throw_file_error(directory_, "cannot create a staging directory", error);
   }
   staging_ = pattern;
   publish(members_, staging_);
@@ -160,9 +161,9 @@ void OutputSet::commit() {
   sigset_t previous;
   ::pthread_sigmask(SIG_BLOCK, &blocked, &previous);
   const auto fail = [&](const std::filesystem::path& path, const char* what) {
-    const std::string reason = std::strerror(errno);
+    const int error = errno;
     ::pthread_sigmask(SIG_SETMASK, &previous, nullptr);
-    throw std::runtime_error(path.string() + ": " + what + ": " + reason);
+    throw_file_error(path, what, error);
   };
   for (const std::filesystem::path& member : members_) {
     if (std::rename((staging_ / member.filename()).c_str(), member.c_str()) != 0) fail(member, "cannot replace");

@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -132,6 +134,51 @@ TEST(Cli, PredictRefusesAModelOfOtherFeaturesAndWritesNothing) {
                 .exit_code,
             2);
   EXPECT_FALSE(std::filesystem::exists(c.dir / "plain.json"));
+}
+
+// A model file with a number that is not finite, or whose finite numbers overflow where they meet
+// the world's features, is refused with exit 2 and one line naming the file and the place (`line
+// L, column C`; `parameters`), and nothing is written.
+TEST(Cli, PredictRefusesAModelWhoseNumbersAreNotFiniteOrOverflow) {
+  const auto dir = scratch("predict-overflow");
+  const std::string trained = (dir / "w1.json").string(), unseen = (dir / "w4.json").string();
+  ASSERT_EQ(
+      ontime({"generate-world", "--rows", "2", "--cols", "3", "--narrow-doors", "0.5", "--seed", "1", "-o", trained})
+          .exit_code,
+      0);
+  ASSERT_EQ(ontime({"generate-world", "--rows", "2", "--cols", "3", "--seed", "4", "-o", unseen}).exit_code, 0);
+  const std::string log = (dir / "w1.jsonl").string();
+  const auto collected =
+      ontime({"collect", "--domain", "navigation", "--world", trained, "--every-action", "--features", "--trials", "6",
+              "--threads", "2", "--log", log, "-o", (dir / "w1.instance.json").string()});
+  ASSERT_EQ(collected.exit_code, 0) << collected.err;
+  const std::string model = (dir / "hazard.json").string();
+  ASSERT_EQ(
+      ontime({"fit", log, "--conditional", "hazard", "--domain", "navigation", "--step", "3", "-o", model}).exit_code,
+      0);
+  json file = json::parse(read_file(model));
+  const std::string instance = (dir / "predicted.json").string();
+  const auto refused = [&](const std::string& text, const std::string& name, const std::string& place) {
+    const std::string bad = (dir / name).string();
+    std::ofstream(bad, std::ios::binary) << text;
+    const auto result =
+        ontime({"predict", "--domain", "navigation", "--world", unseen, "--model", bad, "-o", instance});
+    EXPECT_EQ(result.exit_code, 2) << name << ": " << result.err;
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+    EXPECT_NE(result.err.find(bad + ": " + place), std::string::npos) << result.err;
+    EXPECT_FALSE(std::filesystem::exists(instance)) << name;
+  };
+  file["parameters"]["hazard"][0] = 12345.5;
+  const std::string marked = file.dump(2);
+  for (const std::string number : {"1e999", "NaN"}) {
+    std::string text = marked;
+    text.replace(text.find("12345.5"), 7, number);
+    refused(text, number + ".json", "line ");
+  }
+  for (std::size_t i = 0; i < file["parameters"]["hazard"].size(); ++i) {
+    file["parameters"]["hazard"][i] = i % 2 == 0 ? 1e308 : -1e308;
+  }
+  refused(file.dump(2), "overflow.json", "parameters: the model's numbers overflow for some features");
 }
 
 // The kitchen family end to end: small generated scenes (one target, one or two neighbours), a

@@ -293,6 +293,51 @@ TEST(ConditionalTimeModel, RefusesBadFeaturesAndBadFiles) {
   EXPECT_EQ(whole->to_json(), text);
 }
 
+// A model file's numbers: one that is not a finite number (1e999, NaN, Infinity) is refused where
+// the reader meets it; finite numbers that overflow together (a scale of 1e-308 makes a feature's
+// standard score infinite, and a coefficient of 0 makes it NaN) are refused when a prediction meets
+// them, naming the file and its parameters, not with a table that is not a distribution and no
+// file. A fitted model's prediction is as it was.
+TEST(ConditionalTimeModel, AFileWhoseNumbersAreNotFiniteOrOverflowIsRefusedNamingTheFile) {
+  HazardTruth truth{{-1.0, -1.0}, 0.7, -1.0, 0.8, 0.5, -0.2, 0.4, 2};
+  const auto model = fit_conditional_model(conditional_data(sample_hazard(truth, 100, 3), 1.0, "log"), options());
+  nlohmann::ordered_json file = nlohmann::ordered_json::parse(model->to_json());
+  file["parameters"]["hazard"][0] = 12345.5;
+  const std::string marked = file.dump(2);
+  for (const std::string number : {"1e999", "-1e999", "NaN", "Infinity"}) {
+    std::string bad = marked;
+    bad.replace(bad.find("12345.5"), 7, number);
+    try {
+      parse_conditional_model(bad, "m.json");
+      ADD_FAILURE() << number << " accepted";
+    } catch (const InputError& error) {
+      EXPECT_EQ(error.source(), "m.json") << number;
+      EXPECT_EQ(error.place().rfind("line ", 0), 0U) << number << ": " << error.what();
+    }
+  }
+  file["parameters"]["hazard"] = {0.0, 0.0};
+  file["parameters"]["scale"][0] = 1e-308;
+  const auto overflowing = parse_conditional_model(file.dump(2), "m.json");
+  const std::vector<double> far{1e6, 1e6};
+  for (const bool rows : {false, true}) {
+    try {
+      if (rows) {
+        (void)overflowing->predict_rows(far, 1);
+      } else {
+        (void)overflowing->predict(far);
+      }
+      ADD_FAILURE() << "a prediction of probabilities that are not numbers";
+    } catch (const InputError& error) {
+      EXPECT_EQ(error.source(), "m.json");
+      EXPECT_EQ(error.place(), "parameters");
+      EXPECT_NE(error.rule().find("the model's numbers overflow for some features"), std::string::npos) << error.what();
+    }
+  }
+  EXPECT_EQ(overflowing->source(), "m.json");
+  EXPECT_EQ(model->source(), "");
+  EXPECT_NO_THROW((void)model->predict(far));
+}
+
 TEST(ConditionalTimeModel, PredictsALibraryCutAtTheDeadline) {
   HazardTruth truth{{-1.0, -1.0, -1.0, -1.0, -1.0, -1.0}, 0.7, -1.0, 0.8, 0.5, -0.2, 0.4, 6};
   const ConditionalData data = conditional_data(sample_hazard(truth, 300, 9), 1.0, "log");

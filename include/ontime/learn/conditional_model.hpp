@@ -138,15 +138,22 @@ class ConditionalTimeModel {
   // The worlds those attempts came from.
   std::size_t training_worlds() const noexcept { return training_worlds_; }
 
-  // Throws UsageError for a vector of the wrong length or with a number that is not finite.
+  // Throws UsageError for a vector of the wrong length or with a number that is not finite, and,
+  // for a model read from a file, InputError naming the file and `parameters` when its numbers
+  // give tables that are not distributions for these features (finite numbers that overflow).
   PredictedTimes predict(std::span<const double> features) const;
   // The check of predict alone: UsageError for a vector predict refuses.
   void check_features(std::span<const double> features) const;
   // predict of each of `count` feature vectors laid out row after row in `rows` (row-major), the
   // same distributions as one call each, at a lower cost per row for a kind whose every call has
   // a fixed cost (boosted). UsageError for rows of the wrong total length or a number that is not
-  // finite (naming the row).
+  // finite (naming the row); InputError as predict.
   std::vector<PredictedTimes> predict_rows(std::span<const double> rows, std::size_t count) const;
+
+  // The model file it was read from (parse_conditional_model's `source`), or empty when fitted.
+  const std::string& source() const noexcept { return source_; }
+  // Records the file it was read from.
+  void set_source(std::string source) { source_ = std::move(source); }
 
   // The model file (JSON, one object): format, version, kind, feature names, step, horizon,
   // training summary and the kind's parameters.
@@ -162,10 +169,14 @@ class ConditionalTimeModel {
   virtual std::string parameters_json() const = 0;
 
  private:
+  // Within a catch of a prediction's UsageError: InputError naming the model file, or the error again.
+  [[noreturn]] void throw_for_parameters() const;
+
   std::vector<std::string> feature_names_;
   double step_seconds_;
   Steps horizon_;
   std::size_t training_rows_, training_worlds_;
+  std::string source_;
 };
 
 // Fits the kind `options.kind` (UsageError for an unknown kind, bad options, no rows, or

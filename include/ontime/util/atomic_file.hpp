@@ -42,6 +42,12 @@ class AtomicFileWriter {
   int slot_ = -1;  // in the table of temporary files removed on a signal (remove_temporaries_on_signal)
 };
 
+// Throws the error of a file that could not be written for the system's reason `error` (an errno)
+// while doing `what` ("cannot create", ...), with the message "PATH: WHAT: REASON": UsageError for
+// the caller's to fix (a missing or unwritable folder, a directory in the way, a name too long),
+// ResourceLimitError for a full disk or quota, std::runtime_error for any other failure.
+[[noreturn]] void throw_file_error(const std::filesystem::path& path, const char* what, int error);
+
 // With `enable`, a termination signal (SIGINT, SIGTERM, SIGHUP, SIGQUIT) removes the temporary
 // file of every AtomicFileWriter (and write_file_atomically) alive, then takes its course (the
 // handler there before, else the end of the process). The command line enables it; a Python

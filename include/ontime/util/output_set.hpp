@@ -22,8 +22,9 @@ namespace ontime {
 
 class OutputSet {
  public:
-  // Every target lies in `directory` (which must exist). Throws std::runtime_error (naming the
-  // directory and the system's reason) when the staging directory cannot be made.
+  // Every target lies in `directory` (which must exist). Throws as write_file_atomically does
+  // (atomic_file.hpp: UsageError for a missing or unwritable directory or a path too long, naming
+  // it and the system's reason) when the staging directory cannot be made.
   explicit OutputSet(const std::filesystem::path& directory);
   ~OutputSet();
   OutputSet(const OutputSet&) = delete;
@@ -37,7 +38,8 @@ class OutputSet {
   // `target` does not belong to this output: removed at commit if it exists.
   void remove_on_commit(const std::filesystem::path& target);
   // Renames every staged member over its target and removes the others. Throws
-  // std::runtime_error (naming the file) when a member is missing or a rename fails.
+  // std::runtime_error (naming the file) when a member is missing, and as write_file_atomically
+  // does when a rename fails.
   void commit();
 
  private:

@@ -69,7 +69,8 @@ class CollectionJournal {
   // The trials read when the journal was opened.
   const std::vector<JournalTrial>& finished() const noexcept { return finished_; }
 
-  // Appends a finished trial (thread-safe). Throws std::runtime_error when the write fails.
+  // Appends a finished trial (thread-safe). Throws as write_file_atomically does (util/atomic_file.hpp)
+  // when the write fails.
   void record(const JournalTrial& trial);
 
   // Closes and deletes the files, once the collection's outputs are written (with ranks: every
