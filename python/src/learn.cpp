@@ -143,8 +143,7 @@ void bind_conditional(py::module_& m) {
           [](const PlanningPosterior& posterior, Number<Steps, "steps"> steps) {
             return posterior.predictive_backtrack(steps);
           },
-          py::arg("steps"),
-          "The posterior predictive probability that the next attempt backtracks at step `steps`.")
+          py::arg("steps"), "The posterior predictive probability that the next attempt backtracks at step `steps`.")
       .def(
           "predictive_cut_off",
           [](const PlanningPosterior& posterior, Number<Steps, "steps"> steps) {
