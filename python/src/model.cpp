@@ -280,7 +280,11 @@ void bind_model(py::module_& m) {
               index = chain.state_index(*from);
               if (index < 0) throw UsageError("chain '" + chain.name + "' has no state '" + *from + "'");
             }
-            const std::vector<double> distribution = chain_distribution(chain, index, steps);
+            // Released and stopped by Ctrl-C: a distribution far ahead takes as many steps.
+            std::vector<double> distribution;
+            run_interruptibly([&](const std::function<bool()>& stop,
+                                  Progress&) { distribution = chain_distribution(chain, index, steps, stop); },
+                              py::none());
             return py::array_t<double>(static_cast<py::ssize_t>(distribution.size()), distribution.data());
           },
           py::arg("steps"), py::arg("from_state") = py::none(),

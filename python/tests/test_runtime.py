@@ -73,6 +73,7 @@ def run_and_interrupt(code, after_seconds):
     "ontime.evaluate(problem, 'dp-rerun', episodes=10**10, threads=2)",
     "ontime.evaluate(problem, 'mcts', episodes=10**9, iterations=100000)",
     "ontime.run_episodes(problem, lambda: Slow(), 'dp', episodes=10**9, threads=2)",
+    "ontime.fit_chain([[0, 1, 1, 0]], kind='birth-death', capacity=2).chain.distribution(2**62)",
 ])
 def test_ctrl_c_stops_a_long_call_with_keyboard_interrupt(call):
     code = f"""

@@ -177,7 +177,8 @@ void save_chain(const ExogenousChain& chain, const std::filesystem::path& path) 
   write_file_atomically(path, chain_to_json(chain));
 }
 
-std::vector<double> chain_distribution(const ExogenousChain& chain, int from, std::int64_t steps) {
+std::vector<double> chain_distribution(const ExogenousChain& chain, int from, std::int64_t steps,
+                                       const std::function<bool()>& stop) {
   require_valid(chain);
   const std::size_t n = chain.states.size();
   if (from < 0 || static_cast<std::size_t>(from) >= n) {
@@ -190,6 +191,8 @@ std::vector<double> chain_distribution(const ExogenousChain& chain, int from, st
   std::vector<double> next(n);
   now[static_cast<std::size_t>(from)] = 1.0;
   for (std::int64_t t = 0; t < steps; ++t) {
+    if (t % 4096 == 0 && stop && stop())
+      throw Cancelled("the chain's distribution was stopped at step " + std::to_string(t));
     advance_chain_distribution(chain, now, next);
     now.swap(next);
   }

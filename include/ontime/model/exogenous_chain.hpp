@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -61,8 +62,10 @@ void save_chain(const ExogenousChain& chain, const std::filesystem::path& path);
 
 // The distribution of the chain's state `steps` steps after it is in state `from`: a vector over
 // chain.states. Summed in a fixed order (row by row, state by state), so that it is the same on
-// every machine. O(steps * n^2). Throws UsageError for an invalid chain or `from`, or steps < 0.
-std::vector<double> chain_distribution(const ExogenousChain& chain, int from, std::int64_t steps);
+// every machine. O(steps * n^2). Throws UsageError for an invalid chain or `from`, or steps < 0;
+// Cancelled once `stop` (checked every 4096 steps) returns true, so that a caller can stop a long one.
+std::vector<double> chain_distribution(const ExogenousChain& chain, int from, std::int64_t steps,
+                                       const std::function<bool()>& stop = {});
 
 // One step of a distribution over the chain's states: next[j] = sum_i now[i] * transitions[i][j], in
 // that fixed order (rows of states with no mass skipped). Both spans have one entry per state (not
