@@ -29,6 +29,10 @@ runs=$(mktemp -d)
 trap 'rm -rf "$runs"' EXIT
 IFS=, read -r -a instances <<< "$INSTANCES"
 IFS=, read -r -a deadlines <<< "$DEADLINES"
+with_deadline() {  # INSTANCE FILE, DEADLINE, COPY: a copy of the instance with its deadline replaced
+  /usr/bin/python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); d["deadline"] = int(sys.argv[2]); json.dump(d, open(sys.argv[3], "w"))' \
+    "$1" "$2" "$3"
+}
 solve_both() {  # INSTANCE FILE, LABEL
   echo "act-comparison: $2" >&2
   "$ONTIME" solve "$1" --method memoised --act plan-first --json > "$runs/$2.plan-first.json"
@@ -40,8 +44,7 @@ done
 if [ -n "$SWEPT" ]; then
   for deadline in "${deadlines[@]}"; do
     # The swept instance with its deadline replaced (a temporary copy; the original is untouched).
-    /usr/bin/python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); d["deadline"] = int(sys.argv[2]); json.dump(d, open(sys.argv[3], "w"))' \
-      "$SWEPT" "$deadline" "$runs/swept-$deadline.json"
+    with_deadline "$SWEPT" "$deadline" "$runs/swept-$deadline.json"
     solve_both "$runs/swept-$deadline.json" "$(basename "$SWEPT" .json)@$deadline"
   done
 fi
@@ -79,8 +82,7 @@ for instance in "${instances[@]}"; do
   [ "$(basename "$instance")" = figure1.json ] || valued+=("$instance")
 done
 if [ -n "$SWEPT" ]; then
-  /usr/bin/python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); d["deadline"] = int(sys.argv[2]); json.dump(d, open(sys.argv[3], "w"))' \
-    "$SWEPT" "$ALLOCATOR_DEADLINE" "$runs/$(basename "$SWEPT" .json)-$ALLOCATOR_DEADLINE.json"
+  with_deadline "$SWEPT" "$ALLOCATOR_DEADLINE" "$runs/$(basename "$SWEPT" .json)-$ALLOCATOR_DEADLINE.json"
   valued+=("$runs/$(basename "$SWEPT" .json)-$ALLOCATOR_DEADLINE.json")
 fi
 for instance in "${valued[@]}"; do
