@@ -105,6 +105,11 @@ void EagerCommitAllocator::observe(const ConcurrentState& before, int choice, co
 }
 
 ConcurrentAllocatorFactory eager_commit_factory(const ConcurrentMdp& mdp, AllocatorFactory plan_first) {
+  if (mdp.is_timed()) {
+    throw UsageError(mdp.problem().name() +
+                     ": the eager commit rule reads a plan-first view without the chains' state or expiry (SPEC "
+                     "§9): with acting while planning (SPEC §10) only the optimal allocator takes chains so far");
+  }
   return
       [&mdp, plan_first = std::move(plan_first)] { return std::make_unique<EagerCommitAllocator>(mdp, plan_first()); };
 }

@@ -5,26 +5,15 @@
 #include <string>
 
 namespace ontime {
-namespace {
-
-const Problem& refuse_unmodelled(const Problem& problem) {
-  const std::string rule = " with acting \"concurrent\" (SPEC §10) is not modelled yet: solve " + problem.name() +
-                           " plan-first (--act plan-first)";
-  if (problem.is_timed())
-    throw UsageError(problem.name() + ": exogenous chains or actions that expire (SPEC §9)" + rule);
-  return problem;
-}
-
-}  // namespace
-
 ConcurrentMdp::ConcurrentMdp(const Problem& problem)
-    : problem_(std::make_unique<const Problem>(refuse_unmodelled(problem).with_acting(Acting::plan_first))),
+    : problem_(std::make_unique<const Problem>(problem.with_acting(Acting::plan_first))),
       mdp_(*problem_),
       deadline_(problem.deadline()),
       skeleton_count_(problem.skeleton_count()),
       action_count_(problem.action_count()),
       backtracking_(problem.has_backtracking()),
-      culprit_(static_cast<std::size_t>(problem.action_count()), 0) {
+      culprit_(static_cast<std::size_t>(problem.action_count()), 0),
+      timed_(problem.is_timed()) {
   for (int a = 0; a < action_count_; ++a) {
     for (const Problem::CulpritIndex& culprit : problem_->culprits(a)) {
       if (culprit.probability > 0) culprit_[static_cast<std::size_t>(culprit.action)] = 1;
@@ -41,11 +30,18 @@ ConcurrentMdp::ConcurrentMdp(const Problem& problem)
       next_finish_[row + static_cast<std::size_t>(pt)] = next_positive == kNever ? kNever : next_positive - pt;
       if (pt >= 1 && problem_->action(a).planning.pmf(pt) > 0) next_positive = pt;
     }
-    for (const Mdp::ExecutionOutcome& outcome : mdp_.execution_outcomes(a)) {
-      if (outcome.steps <= deadline_ && outcome.probability > 0) {
-        fastest_execution_[static_cast<std::size_t>(a)] =
-            std::min(fastest_execution_[static_cast<std::size_t>(a)], outcome.steps);
+    Steps& fastest = fastest_execution_[static_cast<std::size_t>(a)];
+    if (problem_->execution_chain(a) >= 0) {
+      // Drawn when it starts, from the chain's state then: the fastest over every state.
+      for (const Distribution& drawn : problem_->action(a).execution_by_state) {
+        for (Steps x = 0; x <= deadline_ && x < fastest; ++x) {
+          if (drawn.pmf(x) > 0) fastest = x;
+        }
       }
+      continue;
+    }
+    for (const Mdp::ExecutionOutcome& outcome : mdp_.execution_outcomes(a)) {
+      if (outcome.steps <= deadline_ && outcome.probability > 0) fastest = std::min(fastest, outcome.steps);
     }
   }
 }
@@ -56,6 +52,7 @@ ConcurrentState ConcurrentMdp::start() const {
   ConcurrentState state(
       kHeader + 2 * static_cast<std::size_t>(skeleton_count_) + static_cast<std::size_t>(action_count_), 0);
   for (int a = 0; a < action_count_; ++a) execution_word(state, a) = kUnknown;
+  state[3] = mdp_.start().chains;
   canonicalise(state);
   return state;
 }
@@ -75,7 +72,8 @@ int ConcurrentMdp::executed_depth(const ConcurrentState& state) const noexcept {
 
 std::int64_t ConcurrentMdp::robot_free(const ConcurrentState& state, int k) const noexcept {
   std::int64_t free = std::int64_t{time(state)} + robot_left(state);
-  for (int j = executed_depth(state); j < refined(state, k); ++j) free += execution(state, problem_->action_at(k, j));
+  for (int j = executed_depth(state); j < refined(state, k); ++j)
+    free += known_execution(state, problem_->action_at(k, j));
   return free;
 }
 
@@ -108,12 +106,13 @@ std::int64_t ConcurrentMdp::earliest_finish(const ConcurrentState& state, int k)
     discardable = discardable || (backtracking_ && culprit_[static_cast<std::size_t>(action)] != 0);
     if (j < refined_count) {
       // Refined: it can start as soon as the robot is free (found again, no sooner than now).
+      if (!before_expiry(action, robot_free)) return Mdp::kUnreachableNeed;
       if (!discardable) {
-        robot_free += execution(state, action);
+        robot_free += known_execution(state, action);
       } else if (fastest == kNever) {
         return Mdp::kUnreachableNeed;
       } else {
-        robot_free += std::min<std::int64_t>(execution(state, action), fastest);
+        robot_free += std::min<std::int64_t>(known_execution(state, action), fastest);
       }
       continue;
     }
@@ -122,7 +121,9 @@ std::int64_t ConcurrentMdp::earliest_finish(const ConcurrentState& state, int k)
     if (backtracking_ && j == refined_count) planning = std::min(planning, planning_from(action, 0));
     if (planning == kNever || fastest == kNever) return Mdp::kUnreachableNeed;
     planned += planning;
-    robot_free = std::max(robot_free, planned) + fastest;
+    robot_free = std::max(robot_free, planned);
+    if (!before_expiry(action, robot_free)) return Mdp::kUnreachableNeed;
+    robot_free += fastest;
   }
   return robot_free;
 }
@@ -161,6 +162,7 @@ std::vector<int> ConcurrentMdp::startable(const ConcurrentState& state) const {
   for (int k = 0; k < skeleton_count_; ++k) {
     if (!is_live(state, k) || refined(state, k) <= depth) continue;
     const int child = problem_->action_at(k, depth);
+    if (timed_ && !may_start_now(state, child)) continue;
     if (std::find(children.begin(), children.end(), child) == children.end()) children.push_back(child);
   }
   std::sort(children.begin(), children.end());
@@ -168,7 +170,7 @@ std::vector<int> ConcurrentMdp::startable(const ConcurrentState& state) const {
 }
 
 int ConcurrentMdp::forced_start(const ConcurrentState& state) const noexcept {
-  if (backtracking_ || robot_left(state) > 0) return -1;
+  if (backtracking_ || timed_ || robot_left(state) > 0) return -1;
   const int depth = executed_depth(state);
   int child = -1;
   for (int k = 0; k < skeleton_count_; ++k) {
@@ -181,7 +183,14 @@ int ConcurrentMdp::forced_start(const ConcurrentState& state) const noexcept {
   return child;
 }
 
-ConcurrentMdp::StartOutcome ConcurrentMdp::start_action(const ConcurrentState& state, int action) const {
+bool ConcurrentMdp::may_start_now(const ConcurrentState& state, int action) const noexcept {
+  const Action& model = problem_->action(action);
+  if (model.start_by != kNever && time(state) > model.start_by) return false;
+  const int blocking = problem_->blocking_chain(action);
+  return blocking < 0 || !problem_->blocks(action, mdp_.chain_state(chains(state), blocking));
+}
+
+ConcurrentMdp::StartOutcome ConcurrentMdp::start_action(const ConcurrentState& state, int action, Steps drawn) const {
   const std::vector<int> children = startable(state);
   if (!std::binary_search(children.begin(), children.end(), action)) {
     throw UsageError("action " + std::to_string(action) +
@@ -189,7 +198,14 @@ ConcurrentMdp::StartOutcome ConcurrentMdp::start_action(const ConcurrentState& s
                      "on a skeleton that can still finish, and only while it is idle");
   }
   StartOutcome outcome;
-  const std::uint16_t steps = execution(state, action);
+  std::uint16_t steps = execution(state, action);
+  if (steps == kDrawnAtStart) {
+    if (drawn < 0) {
+      throw UsageError("action " + problem_->action(action).id +
+                       ": its execution depends on a chain's state when it starts (SPEC §9); give the time drawn");
+    }
+    steps = static_cast<std::uint16_t>(std::min<Steps>(drawn, deadline_ + 1));
+  }
   const std::int64_t finish = std::int64_t{time(state)} + steps;
   const int position = problem_->position(action);
   for (const int k : problem_->members(action)) {
@@ -232,6 +248,14 @@ ConcurrentState ConcurrentMdp::step(const ConcurrentState& state, int choice, co
   ConcurrentState next = state;
   ++next[0];
   if (next[1] > 0) --next[1];
+  if (mdp_.has_chains()) {
+    // The chains move whatever the step does (SPEC §9).
+    if (observation.chains >= mdp_.joint_chain_states()) {
+      throw UsageError("the chains' joint state " + std::to_string(observation.chains) + " is not one of the " +
+                       std::to_string(mdp_.joint_chain_states()) + " states of this problem's chains");
+    }
+    next[3] = observation.chains;
+  }
   if (choice == kWait) {
     if (observation.refined || observation.is_backtrack()) {
       throw UsageError("a motion cannot be found, nor an attempt give up, in a step in which the planner idles");
@@ -257,7 +281,10 @@ ConcurrentState ConcurrentMdp::step(const ConcurrentState& state, int choice, co
   }
   if (observation.refined) {
     const Steps saturated = std::min<Steps>(observation.execution, deadline_ + 1);
-    execution_word(next, action) = static_cast<std::uint16_t>(saturated);
+    // An execution that depends on a chain is drawn when it starts (SPEC §9): what the world
+    // reported for it is not used.
+    execution_word(next, action) =
+        problem_->execution_chain(action) >= 0 ? kDrawnAtStart : static_cast<std::uint16_t>(saturated);
   }
   // The live skeletons whose next action is `action` share the step (SPEC §1).
   for (const int m : problem_->members(action)) {
@@ -301,7 +328,7 @@ ConcurrentMdp::Move ConcurrentMdp::run_complete_plan(const ConcurrentState& stat
 }
 
 bool ConcurrentMdp::certain_success(const ConcurrentState& state) const noexcept {
-  return !problem_->has_rewards() && complete_plan(state) >= 0;
+  return !problem_->has_rewards() && !timed_ && complete_plan(state) >= 0;
 }
 
 void ConcurrentMdp::give_up(ConcurrentState& next, const ConcurrentState& state, int action, int culprit) const {

@@ -21,6 +21,12 @@ ConcurrentSession::ConcurrentSession(const ConcurrentMdp& mdp, ConcurrentAllocat
       state_(mdp.start()),
       before_(state_),
       attempts_(static_cast<std::size_t>(mdp.problem().action_count())) {
+  if (mdp.is_timed()) {
+    throw UsageError(mdp.problem().name() +
+                     ": episodes with exogenous chains or expiry (SPEC §9) acting while planning (SPEC §10) are not "
+                     "there yet: the session would simulate the chains and draw executions when they start; solve "
+                     "the instance exactly instead (ontime solve --act concurrent)");
+  }
   end_if_stuck();
 }
 

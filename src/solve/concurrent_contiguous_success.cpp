@@ -13,6 +13,11 @@ ConcurrentContiguousSuccess::ConcurrentContiguousSuccess(const ConcurrentMdp& md
 }
 
 void ConcurrentContiguousSuccess::check_supported(const ConcurrentMdp& mdp) {
+  if (mdp.is_timed()) {
+    throw UsageError(mdp.problem().name() +
+                     ": dp and dp-rerun acting while planning (SPEC §10) do not value exogenous chains or expiry "
+                     "(SPEC §9) yet (the optimal allocator takes them)");
+  }
   if (mdp.has_backtracking()) {
     throw UsageError(mdp.problem().name() +
                      ": dp and dp-rerun acting while planning (SPEC §10) do not value backtracking (SPEC §7) yet: "

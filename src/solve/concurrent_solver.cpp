@@ -41,7 +41,7 @@ void ConcurrentSolver::set_stop(std::function<bool()> stop) { impl_->stop = std:
 std::size_t ConcurrentSolver::states() const noexcept { return impl_->memo.size(); }
 
 double ConcurrentSolver::max_bytes(const Problem& problem, std::size_t max_states) {
-  const double words = 3.0 + 2.0 * problem.skeleton_count() + problem.action_count();
+  const double words = 4.0 + 2.0 * problem.skeleton_count() + problem.action_count();
   // A state's words on the heap: rounded up to the allocator's 16 bytes, plus its 16-byte header.
   const double heap = std::ceil(words * 2.0 / 16.0) * 16.0 + 16.0;
   const double slot = sizeof(ConcurrentState) + sizeof(Impl::Entry) + 1.0;
@@ -108,12 +108,19 @@ double ConcurrentSolver::solve(const ConcurrentState& root) {
       if (complete) consider(q, Move{-1, refine});
     };
     const auto start_value = [&](int action) {
-      const ConcurrentMdp::StartOutcome outcome = mdp.start_action(state, action);
-      if (outcome.ends) {
-        consider(outcome.reward, Move{action, ConcurrentMdp::kWait});
-      } else if (const std::optional<double> value = known(outcome.next)) {
-        consider(*value, Move{action, ConcurrentMdp::kWait});
-      }
+      // One outcome, or one per execution time drawn from a chain when the action starts.
+      double q = 0.0;
+      bool complete = true;
+      mdp.for_each_start_outcome(state, action, [&](double probability, const ConcurrentMdp::StartOutcome& outcome) {
+        if (outcome.ends) {
+          q += probability * outcome.reward;
+        } else if (const std::optional<double> value = known(outcome.next)) {
+          q += probability * *value;
+        } else {
+          complete = false;
+        }
+      });
+      if (complete) consider(q, Move{action, ConcurrentMdp::kWait});
     };
     if (!optimum) {
       const Move move = impl_->policy(state);

@@ -223,9 +223,63 @@ TEST(Concurrent, ThePaperInstancesAgreeWithTheIndependentFigures) {
   }
 }
 
+TEST(Concurrent, WithChainsAndExpiryTheOptimumIsTheReferenceRecursions) {
+  // SPEC §9 read with §10: the chains move with every step, an execution that depends on one is
+  // drawn when it starts, an action that expires starts only in time and unblocked; half with
+  // rewards, a third with backtracking. Plan-first is still one policy of the model.
+  const int count = testing::repetitions_to_check(200);
+  int better = 0;
+  for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
+    Problem problem = testing::with_random_chains(testing::random_instance(seed + 5000, 4, 3, 10), seed, seed % 2 == 0);
+    // Every third with backtracking too (SPEC §7).
+    if (seed % 3 == 0) problem = testing::with_backtracking(problem, seed);
+    ASSERT_TRUE(problem.is_timed());
+    const double optimum = concurrent_optimum(problem);
+    EXPECT_NEAR(optimum, testing::ConcurrentReference(problem).optimum(), 1e-12) << "seed " << seed;
+    const double plan_first = plan_first_optimum(problem);
+    EXPECT_GE(optimum, plan_first - 1e-12) << "seed " << seed;
+    better += optimum > plan_first + 1e-9 ? 1 : 0;
+  }
+  std::printf("with chains, acting while planning worth more on %d of %d\n", better, count);
+  EXPECT_GT(better, count / 10);
+}
+
+TEST(Concurrent, WithChainsTheRobotWaitsForTheDoor) {
+  // go is found in 1 step and runs 1; through is found 1 step later and runs 1, but cannot start
+  // while the door is locked; locked at 0, it opens with probability 1/2 each step and stays
+  // open. Plan-first executes the plan as soon as it is refined (step 2): through starts at 3,
+  // open with probability 1 - 1/8. Acting while planning the robot waits at the door: through
+  // starts at the first open step up to 5 (finishing by 6), 1 - 1/32.
+  const Problem problem = parse_problem(R"({"deadline": 6,
+    "chains": {"door": {"states": ["open", "locked"], "start": "locked", "transitions": [[1, 0], [0.5, 0.5]]}},
+    "actions": {"go": {"planning": {"pmf": {"1": 1}}, "execution": {"pmf": {"1": 1}}},
+                "through": {"planning": {"pmf": {"1": 1}}, "execution": {"pmf": {"1": 1}},
+                            "expires": {"chain": "door", "states": ["locked"]}}},
+    "skeletons": [["go", "through"]]})",
+                                        "door");
+  EXPECT_NEAR(plan_first_optimum(problem), 0.875, 1e-15);
+  EXPECT_NEAR(concurrent_optimum(problem), 1.0 - 1.0 / 32, 1e-15);
+  EXPECT_NEAR(testing::ConcurrentReference(problem).optimum(), 1.0 - 1.0 / 32, 1e-15);
+  // At step 2 with the door locked, through is refined and the robot idle: it cannot start.
+  const ConcurrentMdp mdp(problem);
+  ConcurrentState state = mdp.start();
+  state = mdp.step(state, 0, Observation::found(1).with_chains(1));
+  state = mdp.start_action(state, 0).next;
+  state = mdp.step(state, 0, Observation::found(1).with_chains(1));
+  EXPECT_EQ(ConcurrentMdp::robot_left(state), 0);
+  EXPECT_TRUE(mdp.startable(state).empty());
+  EXPECT_EQ(mdp.forced_start(state), -1);
+  EXPECT_FALSE(mdp.certain_success(state));
+  // The door opens at 3: through may start and ends the episode at 4.
+  state = mdp.step(state, ConcurrentMdp::kWait, Observation::not_yet().with_chains(0));
+  ASSERT_EQ(mdp.startable(state), std::vector<int>{1});
+  const ConcurrentMdp::StartOutcome through = mdp.start_action(state, 1);
+  EXPECT_TRUE(through.ends);
+  EXPECT_EQ(through.reward, 1.0);
+}
+
 TEST(Concurrent, WhatTheModelDoesNotTakeYetIsRefused) {
   const Problem base = testing::paper_instance("instance1");
-  EXPECT_THROW(ConcurrentMdp(testing::with_random_chains(base, 3, false)), UsageError);
   // The plan-first MDP refuses a concurrent problem rather than read it as plan-first.
   try {
     const Mdp mdp(base.with_acting(Acting::concurrent));

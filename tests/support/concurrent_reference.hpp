@@ -9,10 +9,15 @@
 // Backtracking (SPEC §7 read with §10): an attempt that gives up un-refines the action it blames
 // and every action below it, their effort too, but for what is executed; blaming an executed one
 // also blocks the action that gave up for good.
+// Exogenous chains and expiry (SPEC §9 read with §10): every step moves each chain by its own row
+// (they are independent), a start moves nothing; an execution that depends on a chain is drawn
+// from its row for the chain's state when the action starts; an action that expires starts only up
+// to its step `after` and in no blocking state of its chain.
 //
 // plan_first() values the plan-first policies of the same MDP (SPEC §2 and §8 read as a policy
 // of §10: the robot never moves until a skeleton is refined in full, then runs the first one that
-// fits from that step): its optimum must be OptimalSolver's. Exponential; small instances only.
+// fits from that step): its optimum must be OptimalSolver's; not with chains or expiry.
+// Exponential; small instances only.
 
 #include <algorithm>
 #include <map>
@@ -33,15 +38,17 @@ class ConcurrentReference {
 
  private:
   static constexpr long kUnrefined = -1;
-  static constexpr long kExecuted = -2;  // executed or executing: its time is in robot_left
-  static constexpr long kBlocked = -3;   // gave up blaming an executed action: never refined again
+  static constexpr long kExecuted = -2;      // executed or executing: its time is in robot_left
+  static constexpr long kBlocked = -3;       // gave up blaming an executed action: never refined again
+  static constexpr long kDrawnAtStart = -4;  // refined; its execution is drawn from a chain at its start
 
   struct Node {
     int time = 0;
     long robot_left = 0;
     std::vector<int> executed;    // the executed path, in order
     std::vector<int> spent;       // per action: steps on its current attempt
-    std::vector<long> execution;  // per action: kUnrefined, kExecuted or its execution time
+    std::vector<long> execution;  // per action: kUnrefined, kExecuted, kBlocked, kDrawnAtStart or its time
+    std::vector<int> chains;      // per chain: its state
     auto operator<=>(const Node&) const = default;
   };
 
@@ -49,7 +56,9 @@ class ConcurrentReference {
     plan_first_ = plan_first;
     memo_.clear();
     const auto actions = static_cast<std::size_t>(problem_.action_count());
-    return value(Node{0, 0, {}, std::vector<int>(actions, 0), std::vector<long>(actions, kUnrefined)});
+    std::vector<int> chains;
+    for (const ExogenousChain& chain : problem_.chains()) chains.push_back(chain.start);
+    return value(Node{0, 0, {}, std::vector<int>(actions, 0), std::vector<long>(actions, kUnrefined), chains});
   }
 
   bool through_executed(const Node& node, int k) const {
@@ -89,8 +98,7 @@ class ConcurrentReference {
         if (!through_executed(node, k) || problem_.skeleton_length(k) <= static_cast<int>(depth)) continue;
         const int child = problem_.action_at(k, static_cast<int>(depth));
         const long x = node.execution[static_cast<std::size_t>(child)];
-        if (x < 0) continue;
-        double start_value = 0.0;
+        if ((x < 0 && x != kDrawnAtStart) || !may_start(node, child)) continue;
         int ending = -1;
         for (int m = 0; m < skeletons; ++m) {
           if (through_executed(node, m) && problem_.skeleton_length(m) == static_cast<int>(depth) + 1 &&
@@ -98,14 +106,30 @@ class ConcurrentReference {
             ending = m;
           }
         }
-        if (ending >= 0) {
-          start_value = reward(ending, node.time + x);
-        } else {
+        const auto start_with = [&](long steps) {
+          if (ending >= 0) return reward(ending, node.time + steps);
           Node next = node;
           next.executed.push_back(child);
-          next.robot_left = x;
+          next.robot_left = steps;
           forget_unusable(next);
-          start_value = value(next);
+          return value(next);
+        };
+        double start_value = 0.0;
+        if (x != kDrawnAtStart) {
+          start_value = start_with(x);
+        } else {
+          // Drawn now, from the row of the chain's state.
+          const int chain = problem_.execution_chain(child);
+          const Distribution& drawn =
+              problem_.action(child)
+                  .execution_by_state[static_cast<std::size_t>(node.chains[static_cast<std::size_t>(chain)])];
+          double in_time = 0.0;
+          for (Steps steps = 0; steps <= problem_.deadline(); ++steps) {
+            if (drawn.pmf(steps) <= 0) continue;
+            in_time += drawn.pmf(steps);
+            start_value += drawn.pmf(steps) * start_with(steps);
+          }
+          if (1.0 - in_time > 1e-15) start_value += (1.0 - in_time) * start_with(problem_.deadline() + 1L);
         }
         best = std::max(best, start_value);
       }
@@ -116,7 +140,7 @@ class ConcurrentReference {
       Node idle = node;
       ++idle.time;
       idle.robot_left = std::max(0L, node.robot_left - 1);
-      best = std::max(best, value(idle));
+      best = std::max(best, after_step(idle));
       std::vector<int> tried;
       for (int k = 0; k < skeletons; ++k) {
         if (!through_executed(node, k)) continue;
@@ -157,13 +181,18 @@ class ConcurrentReference {
     if (hazard + back < 1.0) {
       Node missed = after;
       ++missed.spent[slot];
-      q += (1.0 - hazard - back) * value(missed);
+      q += (1.0 - hazard - back) * after_step(missed);
     }
     for (const Problem::CulpritIndex& culprit : problem_.culprits(action)) {
       if (back <= 0.0 || culprit.probability <= 0.0) continue;
-      q += back * culprit.probability * value(given_up(after, action, culprit.action));
+      q += back * culprit.probability * after_step(given_up(after, action, culprit.action));
     }
-    if (hazard > 0.0) {
+    if (hazard > 0.0 && problem_.execution_chain(action) >= 0) {
+      Node found = after;
+      found.execution[slot] = kDrawnAtStart;
+      found.spent[slot] = 0;
+      q += hazard * after_step(found);
+    } else if (hazard > 0.0) {
       const Distribution& execution = problem_.action(action).execution;
       double in_time = 0.0;
       for (Steps x = 0; x <= problem_.deadline(); ++x) {
@@ -173,17 +202,45 @@ class ConcurrentReference {
         Node found = after;
         found.execution[slot] = x;
         found.spent[slot] = 0;
-        q += hazard * mass * value(found);
+        q += hazard * mass * after_step(found);
       }
       if (1.0 - in_time > 1e-15) {
         // Too slow or never: no skeleton through it can finish; valued all the same.
         Node found = after;
         found.execution[slot] = problem_.deadline() + 1L;
         found.spent[slot] = 0;
-        q += hazard * (1.0 - in_time) * value(found);
+        q += hazard * (1.0 - in_time) * after_step(found);
       }
     }
     return q;
+  }
+
+  // The value of `node`, reached by a step: each chain moves by its row, independently.
+  double after_step(const Node& node) {
+    double total = 0.0;
+    Node moved = node;
+    const auto move = [&](const auto& self, std::size_t c, double probability) -> void {
+      if (c == problem_.chains().size()) {
+        total += probability * value(moved);
+        return;
+      }
+      const std::vector<double>& row = problem_.chains()[c].transitions[static_cast<std::size_t>(node.chains[c])];
+      for (std::size_t to = 0; to < row.size(); ++to) {
+        if (row[to] <= 0) continue;
+        moved.chains[c] = static_cast<int>(to);
+        self(self, c + 1, probability * row[to]);
+      }
+    };
+    move(move, 0, 1.0);
+    return total;
+  }
+
+  // SPEC §9's expiry: `action` may start now (not past its step `after`, not blocked).
+  bool may_start(const Node& node, int action) const {
+    const Action& model = problem_.action(action);
+    if (model.start_by != kNever && node.time > model.start_by) return false;
+    const int chain = problem_.blocking_chain(action);
+    return chain < 0 || !problem_.blocks(action, node.chains[static_cast<std::size_t>(chain)]);
   }
 
   // The attempt on `action` gave up blaming `culprit` (SPEC §7, §10).

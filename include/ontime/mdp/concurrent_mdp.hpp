@@ -12,9 +12,9 @@
 //
 // A state is a short array of 16-bit words (ConcurrentState), in this order:
 //   CT; r (0: the robot is idle); E (0: nothing executed, else 1 + the index of E's last action);
-//   per skeleton l_k (kDropped once it is not through E or cannot finish by D) and PT_k; per
-//   action its execution time x_a (D + 1 for too slow or never) while it is refined, below E and
-//   on a live skeleton, kUnknown otherwise.
+//   the chains' joint state (SPEC §9; 0 without chains); per skeleton l_k (kDropped once it is not through E or cannot
+//   finish by D) and PT_k; per action its execution time x_a (D + 1 for too slow or never) while it is refined, below E
+//   and on a live skeleton, kUnknown otherwise.
 // States are canonical: what cannot change the value (dropped skeletons, executions no live
 // skeleton will run) holds fixed values, so that states with equal futures are equal. A skeleton
 // is live when it is through E and its earliest finish (below) is at most D; once dropped it
@@ -33,8 +33,15 @@
 // blocked, the skeletons through it dropped. With backtracking a skeleton that cannot finish by D stays in the state
 // (a backtrack may discard a slow motion and make it able again, and refining it may cause such a
 // backtrack), so "live" then means through E only, and the failure test reads the earliest
-// finish. Exogenous chains or expiry (SPEC §9) are not modelled here yet: the constructor refuses
-// them (UsageError naming the rule).
+// finish.
+//
+// Exogenous chains and expiry (SPEC §9, §10 "With chains"): every step moves the chains by one
+// step of their joint transition, whatever the move; a start takes no time and moves nothing. An
+// action whose execution depends on a chain has it drawn when it starts, from the chain's state
+// then (its word holds kDrawnAtStart while it is refined and not started); an action that expires
+// can be started only up to its step `after` and while its chain is in no blocking state. The
+// robot may wait whenever it is idle, also with a plan refined in full: with chains or expiry the
+// solvers use neither the forced start nor the certain success.
 //
 // Cost: a move copies and canonicalises one state, O(K * A_max + A) word operations; the tables
 // (hazards, execution outcomes: the plan-first Mdp's, so that both models read the same numbers
@@ -62,6 +69,9 @@ class ConcurrentMdp {
   static constexpr int kWait = -1;
   // CT, PT and the saturated D + 1 fit a word and stay apart from kUnknown.
   static_assert(Problem::kMaxDeadline + 1 < kUnknown);
+  // x_a of a refined action whose execution is drawn from a chain's state when it starts.
+  static constexpr std::uint16_t kDrawnAtStart = 0xFFFE;
+  static_assert(Problem::kMaxDeadline + 1 < kDrawnAtStart);
 
   // One move: a start of `start` (an action index), or a step refining skeleton `refine`'s next
   // action (kWait: the planner idles).
@@ -73,8 +83,7 @@ class ConcurrentMdp {
     friend bool operator==(const Move&, const Move&) = default;
   };
 
-  // Any acting mode is read as concurrent (the model of this class). Throws UsageError when the
-  // problem has chains or actions that expire (SPEC §9).
+  // Any acting mode is read as concurrent (the model of this class).
   explicit ConcurrentMdp(const Problem& problem);
   ~ConcurrentMdp();
   ConcurrentMdp(const ConcurrentMdp&) = delete;
@@ -88,6 +97,8 @@ class ConcurrentMdp {
   int skeleton_count() const noexcept { return skeleton_count_; }
   // Whether some attempt may give up and blame a culprit (SPEC §7).
   bool has_backtracking() const noexcept { return backtracking_; }
+  // Whether some execution depends on a chain or some action expires (SPEC §9).
+  bool is_timed() const noexcept { return timed_; }
 
   // The start: CT 0, the robot idle, nothing executed or refined (canonical).
   ConcurrentState start() const;
@@ -98,6 +109,8 @@ class ConcurrentMdp {
   static Steps robot_left(const ConcurrentState& state) noexcept { return state[1]; }
   // The last action of E, -1 while nothing has been started.
   static int executed(const ConcurrentState& state) noexcept { return static_cast<int>(state[2]) - 1; }
+  // The chains' joint state (Mdp::joint_chain_state; 0 without chains).
+  static std::uint16_t chains(const ConcurrentState& state) noexcept { return state[3]; }
   // Whether skeleton k is through E and (without backtracking) can still finish by D.
   static bool is_live(const ConcurrentState& state, int k) noexcept { return refined_word(state, k) != kDropped; }
   // l_k of a live skeleton: its actions refined.
@@ -106,7 +119,7 @@ class ConcurrentMdp {
   Steps spent(const ConcurrentState& state, int k) const noexcept {
     return state[kHeader + static_cast<std::size_t>(skeleton_count_ + k)];
   }
-  // x_a, or kUnknown.
+  // x_a, kDrawnAtStart or kUnknown.
   std::uint16_t execution(const ConcurrentState& state, int action) const noexcept {
     return state[kHeader + 2 * static_cast<std::size_t>(skeleton_count_) + static_cast<std::size_t>(action)];
   }
@@ -115,7 +128,7 @@ class ConcurrentMdp {
   // Position of E's last action + 1: how many actions of a skeleton through E have been started.
   int executed_depth(const ConcurrentState& state) const noexcept;
   // When the robot is free if it runs live skeleton k's refined actions after E back to back from
-  // now: CT + r + their execution times.
+  // now: CT + r + their execution times (an execution drawn when it starts: its fastest).
   std::int64_t robot_free(const ConcurrentState& state, int k) const noexcept;
   // The plan-first Mdp of the same problem: its hazards and execution outcomes are this model's.
   const Mdp& plan_first_mdp() const noexcept { return mdp_; }
@@ -132,13 +145,14 @@ class ConcurrentMdp {
   // when k cannot finish at all.
   std::int64_t earliest_finish(const ConcurrentState& state, int k) const noexcept;
 
-  // The children of E the robot may start now (refined, on a live skeleton), ascending; empty
-  // while it executes.
+  // The children of E the robot may start now (refined, on a live skeleton, and with expiry not
+  // past their step `after` nor blocked by their chain's state), ascending; empty while it
+  // executes.
   std::vector<int> startable(const ConcurrentState& state) const;
   // The start that is as good as every other move (docs/theory.md, "Acting while planning"): the
   // robot is idle and every live skeleton goes through one child c of E, which is refined; -1
   // otherwise, and always with backtracking (an executed motion can no longer be blamed and
-  // refined again, so committing may cost).
+  // refined again, so committing may cost) or with chains or expiry (waiting may pay).
   int forced_start(const ConcurrentState& state) const noexcept;
 
   // What starting `action` (a startable child of E) leads to: the end of the episode, when it is
@@ -149,8 +163,14 @@ class ConcurrentMdp {
     double reward = 0;
     ConcurrentState next;
   };
-  // Starts `action` in `state`: the end of the episode or the next state, as above.
-  StartOutcome start_action(const ConcurrentState& state, int action) const;
+  // Starts `action` in `state`: the end of the episode or the next state, as above. An execution
+  // drawn from a chain when it starts takes `drawn` steps (the world's draw; kNever or past D:
+  // too slow), which is required for it (UsageError otherwise) and ignored for any other.
+  StartOutcome start_action(const ConcurrentState& state, int action, Steps drawn = -1) const;
+  // Calls visit(probability, outcome) for every outcome of starting `action`: one, or with an
+  // execution drawn from a chain when it starts, one per execution time of the chain's state now.
+  template <class Visitor>
+  void for_each_start_outcome(const ConcurrentState& state, int action, Visitor&& visit) const;
 
   // The step choices worth considering: one per group of live skeletons sharing their next action
   // (named by the lowest index), ascending; empty when no live skeleton has an action left to
@@ -188,13 +208,13 @@ class ConcurrentMdp {
   // ends by D; -1 when there is none.
   int complete_plan(const ConcurrentState& state) const noexcept;
 
-  // Without rewards (SPEC §8): whether some live skeleton is refined in full and ends by D when
-  // executed as soon as possible (complete_plan). The planner idling meanwhile, nothing is
-  // attempted, nothing given up: the state is worth 1.
+  // Without rewards (SPEC §8), chains or expiry (SPEC §9): whether some live skeleton is refined
+  // in full and ends by D when executed as soon as possible (complete_plan). The planner idling
+  // meanwhile, nothing is attempted, nothing given up: the state is worth 1.
   bool certain_success(const ConcurrentState& state) const noexcept;
 
  private:
-  static constexpr std::size_t kHeader = 3;
+  static constexpr std::size_t kHeader = 4;
 
   static std::uint16_t refined_word(const ConcurrentState& state, int k) noexcept {
     return state[kHeader + static_cast<std::size_t>(k)];
@@ -229,7 +249,61 @@ class ConcurrentMdp {
   std::vector<Steps> fastest_execution_;  // per action; kNever when none is finite
   bool backtracking_ = false;
   std::vector<std::uint8_t> culprit_;  // per action: 1 when some action may blame it
+  bool timed_ = false;
+  // Moves the chains one step from `state`'s joint state into `next` (already canonical) and calls
+  // visit(probability * step probability, next) per step; without chains, once.
+  template <class Visitor>
+  void for_each_chain_step(ConcurrentState& next, double probability, Visitor&& visit) const;
+  // Whether `action` may start at the state's CT in its chains' state (SPEC §9 expiry).
+  bool may_start_now(const ConcurrentState& state, int action) const noexcept;
+  // x_a of a refined action, its fastest (D + 1 for none) while it is drawn when it starts.
+  std::int64_t known_execution(const ConcurrentState& state, int action) const noexcept {
+    const std::uint16_t word = execution(state, action);
+    if (word != kDrawnAtStart) return word;
+    const Steps fastest = fastest_execution_[static_cast<std::size_t>(action)];
+    return fastest == kNever ? std::int64_t{deadline_} + 1 : fastest;
+  }
+  // Whether `action` may still start at step `start` (its step `after`, SPEC §9).
+  bool before_expiry(int action, std::int64_t start) const noexcept {
+    const Steps last = problem_->action(action).start_by;
+    return last == kNever || start <= last;
+  }
 };
+
+template <class Visitor>
+void ConcurrentMdp::for_each_chain_step(ConcurrentState& next, double probability, Visitor&& visit) const {
+  if (!mdp_.has_chains()) {
+    visit(probability, static_cast<const ConcurrentState&>(next));
+    return;
+  }
+  for (const Mdp::ChainStep& step : mdp_.chain_steps(next[3])) {
+    if (step.probability <= 0) continue;
+    ConcurrentState moved = next;
+    moved[3] = step.next;
+    visit(probability * step.probability, static_cast<const ConcurrentState&>(moved));
+  }
+}
+
+template <class Visitor>
+void ConcurrentMdp::for_each_start_outcome(const ConcurrentState& state, int action, Visitor&& visit) const {
+  const int chain = problem_->execution_chain(action);
+  if (chain < 0) {
+    visit(1.0, static_cast<const StartOutcome&>(start_action(state, action)));
+    return;
+  }
+  const Distribution& drawn =
+      problem_->action(action).execution_by_state[static_cast<std::size_t>(mdp_.chain_state(chains(state), chain))];
+  double in_time = 0.0;
+  for (Steps x = 0; x <= deadline_; ++x) {
+    const double mass = drawn.pmf(x);
+    if (mass <= 0) continue;
+    in_time += mass;
+    visit(mass, static_cast<const StartOutcome&>(start_action(state, action, x)));
+  }
+  // Too slow or never: one outcome, as in SPEC §2.
+  if (1.0 - in_time > 1e-15)
+    visit(1.0 - in_time, static_cast<const StartOutcome&>(start_action(state, action, kNever)));
+}
 
 template <class Visitor>
 void ConcurrentMdp::for_each_step_outcome(const ConcurrentState& state, int choice, Visitor&& visit) const {
@@ -238,7 +312,7 @@ void ConcurrentMdp::for_each_step_outcome(const ConcurrentState& state, int choi
   if (next[1] > 0) --next[1];
   if (choice == kWait) {
     canonicalise(next);
-    visit(1.0, static_cast<const ConcurrentState&>(next));
+    for_each_chain_step(next, 1.0, visit);
     return;
   }
   if (choice < 0 || choice >= skeleton_count_ || !is_live(state, choice) ||
@@ -264,18 +338,25 @@ void ConcurrentMdp::for_each_step_outcome(const ConcurrentState& state, int choi
     ConcurrentState missed = next;
     for_group([&](int m) { ++spent_word(missed, m); });
     canonicalise(missed);
-    visit(missed_probability, static_cast<const ConcurrentState&>(missed));
+    for_each_chain_step(missed, missed_probability, visit);
   }
   if (found > 0.0) {
-    for (const Mdp::ExecutionOutcome& outcome : mdp_.execution_outcomes(action)) {
+    const auto refine = [&](std::uint16_t execution, double probability) {
       ConcurrentState refined_state = next;
-      execution_word(refined_state, action) = static_cast<std::uint16_t>(outcome.steps);
+      execution_word(refined_state, action) = execution;
       for_group([&](int m) {
         ++refined_word(refined_state, m);
         spent_word(refined_state, m) = 0;
       });
       canonicalise(refined_state);
-      visit(found * outcome.probability, static_cast<const ConcurrentState&>(refined_state));
+      for_each_chain_step(refined_state, probability, visit);
+    };
+    if (problem_->execution_chain(action) >= 0) {
+      refine(kDrawnAtStart, found);  // drawn when it starts (SPEC §9)
+    } else {
+      for (const Mdp::ExecutionOutcome& outcome : mdp_.execution_outcomes(action)) {
+        refine(static_cast<std::uint16_t>(outcome.steps), found * outcome.probability);
+      }
     }
   }
   if (back > 0.0) {
@@ -284,7 +365,7 @@ void ConcurrentMdp::for_each_step_outcome(const ConcurrentState& state, int choi
       ConcurrentState gave_up = next;
       give_up(gave_up, state, action, culprit.action);
       canonicalise(gave_up);
-      visit(back * culprit.probability, static_cast<const ConcurrentState&>(gave_up));
+      for_each_chain_step(gave_up, back * culprit.probability, visit);
     }
   }
 }

@@ -31,11 +31,12 @@ namespace ontime {
 class ConcurrentContiguousSuccess {
  public:
   // The values of `mdp`'s skeletons with Eq. (1)'s `aggregation`; memoised as they are asked for.
-  // Throws UsageError (check_supported) when the problem has backtracking.
+  // Throws UsageError (check_supported) when the problem has backtracking, chains or expiry.
   ConcurrentContiguousSuccess(const ConcurrentMdp& mdp, Aggregation aggregation);
 
-  // Eq. (1) here has no give-up term: UsageError naming the rule when `mdp` has backtracking
-  // (SPEC §7), before any allocator built on these values is made.
+  // Eq. (1) here has no give-up term nor chains: UsageError naming the rule when `mdp` has
+  // backtracking (SPEC §7) or chains or expiry (SPEC §9), before any allocator built on these
+  // values is made.
   static void check_supported(const ConcurrentMdp& mdp);
 
   // PS(k, l, spent, time, backlog); 0 when the backlog alone passes the deadline.

@@ -14,7 +14,9 @@
 // through one refined child of what the robot executed (ConcurrentMdp::forced_start), and,
 // without rewards, any move once a live skeleton is refined in full and fits
 // (ConcurrentMdp::certain_success: worth 1). With backtracking (SPEC §7) every move is considered
-// but at a certain success. Plan-first is one
+// but at a certain success; with chains or expiry (SPEC §9) there is no forced start nor certain
+// success (waiting for a chain may pay), and a start whose execution a chain's state draws is a
+// chance move over that draw. Plan-first is one
 // policy of this MDP, so V* is at least the plan-first optimum (OptimalSolver) of the same problem.
 // Ties (values within kTieTolerance) go to the first move in this order: the steps, ascending by
 // skeleton, then the planner idling, then the starts, ascending by action; so the robot starts an action
@@ -22,7 +24,7 @@
 //
 // Cost: time and memory linear in the reachable states, which grow with the skeletons, the
 // deadline and the execution times the robot may still run (one word each, per refined action);
-// each state costs its words (3 + 2K + A, two bytes each) and a hash-table slot. The solver stops
+// each state costs its words (4 + 2K + A, two bytes each) and a hash-table slot. The solver stops
 // with ResourceLimitError past `max_states` states, never by running out of memory, and walks the
 // states with an explicit stack (no recursion), so any deadline is safe.
 
