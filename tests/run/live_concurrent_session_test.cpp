@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -92,7 +93,7 @@ TEST(LiveConcurrentSession, APlannerOverrunCostsTheStepsItTookAndCountsAsEffort)
   EXPECT_EQ(session.report_refined_seconds(3.0), Status::running);  // a: 3 s, 2 steps
   EXPECT_EQ(session.steps_used(), 1);
   EXPECT_TRUE(session.decide({0, ConcurrentMdp::kWait}).is_start());  // a runs from 2 s to 5 s
-  EXPECT_EQ(ConcurrentMdp::robot_left(session.state()), 2);          // ceil(5 / 2) - 1
+  EXPECT_EQ(ConcurrentMdp::robot_left(session.state()), 2);           // ceil(5 / 2) - 1
   EXPECT_EQ(session.decide({-1, 0}).action, 1);
   clock.advance(5);  // 2.5 slices
   EXPECT_EQ(session.report_not_yet(), Status::running);
@@ -219,7 +220,7 @@ TEST(LiveConcurrentSession, AnExecutionThatEndsLaterHoldsTheRobotAndCanCostTheDe
     ManualClock clock;
     ConcurrentSession session = started_and_refined_by_four_seconds(mdp, clock);
     EXPECT_EQ(session.report_execution_left(0, 3.0), Status::running);  // ends at 7 s
-    EXPECT_EQ(ConcurrentMdp::robot_left(session.state()), 2);          // ceil(7 / 2) - 2
+    EXPECT_EQ(ConcurrentMdp::robot_left(session.state()), 2);           // ceil(7 / 2) - 2
     EXPECT_THROW(session.decide({1, ConcurrentMdp::kWait}), UsageError);
     session.decide({-1, ConcurrentMdp::kWait});
     clock.advance(2);
@@ -278,6 +279,54 @@ TEST(LiveConcurrentSession, ALastMotionStartsOnlyWhileItsStepsFitTheDeadline) {
     EXPECT_EQ(session.status(), Status::success);
     EXPECT_DOUBLE_EQ(session.finish_seconds(), 15.0);
   }
+}
+
+// An owning session takes a skeleton as it arrives: the state carried over equals the state the
+// same moves give on the final skeletons from the start; a skeleton not through what the robot
+// executed arrives dropped, and retire_dropped removes it.
+TEST(LiveConcurrentSession, ArrivingSkeletonsCarryTheStateOverAsIfTheyHadBeenThereFromTheStart) {
+  const auto action = [](std::string id, std::vector<double> planning) {
+    return Action{std::move(id), Distribution::from_pmf(std::move(planning)), Distribution::from_pmf({0.0, 0.0, 1.0})};
+  };
+  const std::vector<Action> actions{action("a", {0.0, 0.5, 0.5}), action("b", {0.0, 0.2, 0.8}),
+                                    action("c", {0.0, 0.6, 0.4}), action("d", {0.0, 1.0})};
+  const Problem first("arrivals", 10, 1.0, {actions[0], actions[1]}, {{0, 1}});
+  const Problem full("arrivals", 10, 1.0, {actions[0], actions[1], actions[2]}, {{0, 1}, {0, 2}});
+  const ConcurrentMdp full_mdp(full);
+  for (const bool live : {false, true}) {
+    SCOPED_TRACE(live ? "live" : "steps");
+    ManualClock clock;
+    ManualClock full_clock;
+    ConcurrentSession growing(first, ConcurrentSession::AllocatorMaker{}, 1, live ? &clock : nullptr);
+    ConcurrentSession from_start = live ? ConcurrentSession(full_mdp, full_clock) : ConcurrentSession(full_mdp);
+    // a missed, then found (2 steps to execute), b missed: on both.
+    for (ConcurrentSession* session : {&growing, &from_start}) {
+      ManualClock& its_clock = session == &growing ? clock : full_clock;
+      session->decide({-1, 0});
+      its_clock.advance(1);
+      session->report_not_yet();
+      session->decide({-1, 0});
+      its_clock.advance(1);
+      session->report_refined(2);
+      session->decide({-1, 0});
+      its_clock.advance(1);
+      session->report_not_yet();
+    }
+    EXPECT_EQ(growing.add_skeleton({"a", "c"}, {actions[2]}), 1);
+    EXPECT_EQ(growing.state(), from_start.state());
+    EXPECT_EQ(growing.problem().action_count(), 3);
+    // The robot starts a; d does not go through it, so it arrives dropped and then retires.
+    growing.decide({0, ConcurrentMdp::kWait});
+    EXPECT_EQ(growing.add_skeleton({"d"}, {actions[3]}), 2);
+    EXPECT_FALSE(ConcurrentMdp::is_live(growing.state(), 2));
+    EXPECT_TRUE(ConcurrentMdp::is_live(growing.state(), 1));
+    EXPECT_EQ(growing.retire_dropped(), 1);
+    EXPECT_EQ(growing.problem().skeleton_count(), 2);
+    EXPECT_EQ(growing.started(), std::vector<int>{0});
+    EXPECT_EQ(ConcurrentMdp::robot_left(growing.state()), 2);
+  }
+  ConcurrentSession not_owning(full_mdp);
+  EXPECT_THROW(not_owning.add_skeleton({"a"}), std::logic_error);
 }
 
 }  // namespace
