@@ -45,7 +45,7 @@ Steps LiveLedger::whole_steps(double seconds, const char* what) const {
   check_seconds(seconds, what);
   const double slices = std::ceil(seconds / step_seconds_ - kSliceTolerance);
   return std::isinf(seconds) || slices >= static_cast<double>(kNever) ? kNever
-                                                                       : static_cast<Steps>(std::max(0.0, slices));
+                                                                      : static_cast<Steps>(std::max(0.0, slices));
 }
 
 Steps LiveLedger::effort_of(double planning) const noexcept {
