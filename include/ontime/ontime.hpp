@@ -35,7 +35,6 @@
 #include "ontime/run/episode_runner.hpp"
 #include "ontime/run/evaluation.hpp"
 #include "ontime/run/experiments.hpp"
-#include "ontime/run/live_ledger.hpp"
 #include "ontime/run/session.hpp"
 #include "ontime/run/simulator.hpp"
 #include "ontime/run/world.hpp"
