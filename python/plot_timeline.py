@@ -2,12 +2,15 @@
 
 Reads the CSV that `ontime run --effort wall --timeline` writes (one row per step: skeleton,
 action, start, outside_seconds, decision_seconds, planning_seconds, overrun_seconds,
-observe_seconds, refined, execution_seconds) and draws, for each step, the allocator's thinking
+observe_seconds, refined, execution_seconds, and optionally lane, execution_start,
+execution_end) and draws, for each step, the allocator's thinking
 (grey: its choice before the call, taking in the outcome after), the planner's slice
 (the skeleton's colour) with its overrun beyond the slice hatched in red, a star where a motion
-was found, and the execution of the plan that succeeded (dark, thin) after the last step. Dotted lines
-mark the step boundaries of the model, a solid line the deadline. Exit statuses: see
-ontime_plotting.
+was found, and the execution of the plan that succeeded (dark, thin) after the last step. Rows of
+lane "execution" (the robot's motions, from start to end) are drawn in a lane of their own, the
+robot's, below the skeletons, on the same time axis; rows of lane "start" (the robot starting a
+motion while the planner works, SPEC §10) draw their decision there. Dotted lines mark the step
+boundaries of the model, a solid line the deadline. Exit statuses: see ontime_plotting.
 """
 
 import argparse
@@ -46,6 +49,12 @@ def read_steps(path):
             if step[column] < 0:
                 raise bad_input(path, f"row {row_number}: {column} must be >= 0")
         step["refined"] = number(path, row_number, "refined", row["refined"], int) == 1
+        step["lane"] = row.get("lane") or "planning"
+        if step["lane"] not in ("planning", "start", "execution"):
+            raise bad_input(path, f"row {row_number}: lane must be planning, start or execution")
+        if step["lane"] != "planning":
+            for column in ("execution_start", "execution_end"):
+                step[column] = number(path, row_number, column, row.get(column) or "")
         steps.append(step)
     return steps
 
@@ -62,13 +71,41 @@ def main():
     parser.add_argument("--execution", type=float, default=0.0, help="its execution seconds")
     arguments = parser.parse_args()
     steps = read_steps(arguments.data)
+    executions = [step for step in steps if step["lane"] == "execution"]
+    acting = any(step["lane"] == "start" for step in steps)  # the robot acted while planning
     lanes = min(arguments.skeletons, MAX_LANES)
+    robot = lanes if executions else None  # the robot's lane, below the skeletons'
     colours = plt.get_cmap("tab10")
 
-    figure, axes = plt.subplots(figsize=(9.0, 1.2 + 0.42 * lanes))
+    figure, axes = plt.subplots(figsize=(9.0, 1.2 + 0.42 * (lanes + (1 if executions else 0))))
     end = 0.0
     reported = 0.0  # the last planner call's end
+    for execution in executions:
+        axes.broken_barh(
+            [(execution["execution_start"], execution["execution_end"] - execution["execution_start"])],
+            (robot - 0.3, 0.6),
+            color=EXECUTION_COLOUR,
+            edgecolor="white",
+        )
+        axes.annotate(
+            label(execution["action"], 24),
+            (execution["execution_start"], robot + 0.42),
+            fontsize=6,
+            ha="left",
+            va="top",
+            rotation=20,
+        )
     for step in steps:
+        if step["lane"] == "execution":
+            continue
+        if step["lane"] == "start" or step["skeleton"] < 0:
+            # A start (or a step in which the planner idled): only the decision, in the robot's lane.
+            if robot is not None:
+                thinking_start = step["start"] + step["outside_seconds"]
+                axes.broken_barh(
+                    [(thinking_start, step["decision_seconds"])], (robot - 0.4, 0.8), color=THINKING_COLOUR
+                )
+            continue
         lane = min(step["skeleton"], lanes - 1)
         thinking_start = step["start"] + step["outside_seconds"]
         planning_start = thinking_start + step["decision_seconds"]
@@ -94,7 +131,7 @@ def main():
             )
         end = max(end, finish + step["observe_seconds"])
         reported = max(reported, finish)
-    if arguments.solution >= 0:
+    if arguments.solution >= 0 and not acting:
         lane = min(arguments.solution, lanes - 1)
         axes.broken_barh([(reported, arguments.execution)], (lane - 0.12, 0.24), color=EXECUTION_COLOUR)
     boundary = arguments.step
@@ -103,9 +140,10 @@ def main():
         boundary += arguments.step
     axes.axvline(arguments.deadline, color="black", linewidth=1.2)
     axes.set_xlim(0, arguments.deadline * 1.02)
-    axes.set_ylim(-1.0, lanes - 0.3)
-    axes.set_yticks(range(lanes))
-    axes.set_yticklabels([f"skeleton {k}" for k in range(lanes)], fontsize=7)
+    shown = lanes + (1 if executions else 0)
+    axes.set_ylim(-1.0, shown - 0.3)
+    axes.set_yticks(range(shown))
+    axes.set_yticklabels([f"skeleton {k}" for k in range(lanes)] + (["robot"] if executions else []), fontsize=7)
     axes.invert_yaxis()
     axes.set_xlabel("seconds since the episode began (deadline: solid line; model steps: dotted)")
     axes.legend(

@@ -54,6 +54,7 @@ void add_tamp_command(CLI::App& app) {
     bool json = false;
     double adapt_strength = 0;
     std::uint64_t sequences = 1;
+    std::string act;  // empty: the library's own mode
     AllocatorFlags allocator;
   };
   auto options = std::make_shared<Options>();
@@ -106,6 +107,10 @@ void add_tamp_command(CLI::App& app) {
                     1e-9, 1e9);
   add_number_option(*command, "--sequences", options->sequences,
                     "With --adapt-strength: independent sequences of --episodes episodes each", std::uint64_t{1});
+  add_act_option(*command, options->act,
+                 "Concurrent: the robot executes each motion it starts while the task planner and the planner work on; "
+                 "after each start the task planner streams only paths from where the robot is committed to go (not "
+                 "with --adapt-strength)");
   command->add_flag("--json", options->json, "Print JSON (with every episode and its timeline)");
   options->allocator.add_to(*command);
   command->callback([options, command] {
@@ -154,6 +159,7 @@ void add_tamp_command(CLI::App& app) {
     tamp.arrival_period = options->period;
     tamp.max_skeletons = options->max_skeletons;
     tamp.decision_share = options->decision_share;
+    tamp.acting = options->act.empty() ? library.acting() : *parse_acting(options->act);
     if (options->clock == "model") tamp.thinking = options->thinking;
     tamp.keep_episodes = options->json;
     if (!options->picture.empty()) tamp.picture_episode = options->picture_episode;

@@ -25,16 +25,19 @@ void check_planner_run_request(const Problem& problem, const std::string& source
 
 namespace {
 
+// Live episodes: each one's result kept in run.episodes (with its timeline), for the report.
+void keep_live_episodes(const PlannerRunOptions& options, MonteCarloOptions& episodes, PlannerRun& run) {
+  episodes.live = LiveRun{LiveOptions{.decision_share = options.decision_share}, true};
+  run.episodes.resize(options.episodes);
+  // Each episode writes its own slot: no two threads touch one.
+  episodes.on_episode = [&run](std::uint64_t episode, const EpisodeResult& result) { run.episodes[episode] = result; };
+}
+
 // Acting while planning (SPEC §10): the robot starts each refined motion while the planner refines
 // the next from where that motion ends (the planner world's starts, unless independent), on the
-// model's step clock.
+// model's step clock, or live on the robot's clock (live ConcurrentSessions).
 PlannerRun run_concurrent_planner_episodes(const Domain& domain, const Problem& problem,
                                            const PlannerRunOptions& options) {
-  if (is_live(options)) {
-    throw UsageError(
-        "live episodes (--live, --effort wall) acting while planning (SPEC §10) are not there yet: run "
-        "them on the model's steps (--effort checks)");
-  }
   if (options.belief != nullptr) {
     throw UsageError(
         "--belief: acting while planning (SPEC §10) decides with the instance's own distributions only "
@@ -45,9 +48,10 @@ PlannerRun run_concurrent_planner_episodes(const Domain& domain, const Problem& 
   PlannerWorldOptions planner;
   planner.effort = options.effort;
   planner.independent_starts = options.independent_starts;
+  MonteCarloOptions episodes = detail::monte_carlo_options(options);
   PlannerRun run;
-  run.summary = run_concurrent_episodes(mdp, planner_worlds(domain, problem, planner), factory,
-                                        detail::monte_carlo_options(options));
+  if (is_live(options)) keep_live_episodes(options, episodes, run);
+  run.summary = run_concurrent_episodes(mdp, planner_worlds(domain, problem, planner), factory, episodes);
   run.refinements_started = run.summary.world_statistics.find("refinements_started").value_or(0.0) /
                             static_cast<double>(run.summary.episodes);
   if (options.exact) {
@@ -72,14 +76,7 @@ PlannerRun run_planner_episodes(const Domain& domain, const Problem& problem, co
   planner.independent_starts = options.independent_starts;
   MonteCarloOptions episodes = detail::monte_carlo_options(options);
   PlannerRun run;
-  if (is_live(options)) {
-    episodes.live = LiveRun{LiveOptions{.decision_share = options.decision_share}, true};
-    run.episodes.resize(options.episodes);
-    // Each episode writes its own slot: no two threads touch one.
-    episodes.on_episode = [&run](std::uint64_t episode, const EpisodeResult& result) {
-      run.episodes[episode] = result;
-    };
-  }
+  if (is_live(options)) keep_live_episodes(options, episodes, run);
   run.summary = run_episodes(mdp, planner_worlds(domain, problem, planner), factory, episodes);
   run.refinements_started = run.summary.world_statistics.find("refinements_started").value_or(0.0) /
                             static_cast<double>(run.summary.episodes);

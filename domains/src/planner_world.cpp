@@ -44,12 +44,24 @@ void PlannerWorld::begin_episode(std::uint64_t seed) {
     node_ids_.clear();
     refinements_.clear();
     attempts_.clear();
+    committed_.clear();
   }
+}
+
+void PlannerWorld::commit(const std::vector<int>& executed) {
+  committed_.clear();
+  for (const int action : executed) committed_.push_back(actions_.at(static_cast<std::size_t>(action)).action);
 }
 
 std::optional<FoundSkeleton> PlannerWorld::next_skeleton() {
   if (!task_planner_) return std::nullopt;
   std::optional<std::vector<std::string>> moves = task_planner_->next();
+  // After a commit, only skeletons through what the robot executed: the paths in order of length
+  // that begin with it are that prefix followed by the shortest paths from where it ends.
+  while (moves &&
+         (moves->size() < committed_.size() || !std::equal(committed_.begin(), committed_.end(), moves->begin()))) {
+    moves = task_planner_->next();
+  }
   if (!moves) return std::nullopt;
   FoundSkeleton found;
   found.charged_seconds = streaming_.seconds_per_skeleton;

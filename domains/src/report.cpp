@@ -67,8 +67,15 @@ Json live_episode(const EpisodeResult& result) {
                         {"steps_charged", step.steps_charged},
                         {"refined", step.refined},
                         {"execution_seconds", step.refined ? Json(step.execution_seconds) : Json(nullptr)}});
+    // A start of the robot acting while planning (SPEC §10): the action it began.
+    if (step.started >= 0) timeline.back()["started"] = step.started;
   }
   episode["timeline"] = std::move(timeline);
+  Json executions = Json::array();
+  for (const LiveExecution& execution : result.executions) {
+    executions.push_back({{"action", execution.action}, {"start", execution.start}, {"end", execution.end}});
+  }
+  episode["executions"] = std::move(executions);
   return episode;
 }
 
@@ -115,15 +122,32 @@ const char* status_name(Status status) noexcept {
 }
 
 std::string timeline_csv(const Problem& problem, const EpisodeResult& result) {
+  // The first ten columns are those of plan-first timelines before the execution lane; the lane and
+  // the execution's start and end come after them, so that readers of the ten keep working.
   std::string csv =
       "skeleton,action,start,outside_seconds,decision_seconds,planning_seconds,overrun_seconds,observe_seconds,"
-      "refined,execution_seconds\n";
+      "refined,execution_seconds,lane,execution_start,execution_end\n";
+  const auto execution_of = [&result](int action) -> const LiveExecution* {
+    for (const LiveExecution& execution : result.executions) {
+      if (execution.action == action) return &execution;
+    }
+    return nullptr;
+  };
   for (const LiveStep& step : result.timeline) {
-    const std::string action = step.action >= 0 ? problem.action(step.action).id : "";
-    csv += fmt::format("{},{},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{},{:.9f}\n", step.skeleton,
+    const int named = step.started >= 0 ? step.started : step.action;
+    const std::string action = named >= 0 ? problem.action(named).id : "";
+    csv += fmt::format("{},{},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{:.9f},{},{:.9f}", step.skeleton,
                        ontime::report::csv_field(action), step.start, step.outside_seconds, step.decision_seconds,
                        step.planning_seconds, step.overrun_seconds, step.observe_seconds, step.refined ? 1 : 0,
                        step.refined ? step.execution_seconds : 0.0);
+    const LiveExecution* started = step.started >= 0 ? execution_of(step.started) : nullptr;
+    csv += started != nullptr ? fmt::format(",start,{:.9f},{:.9f}\n", started->start, started->end) : ",planning,,\n";
+  }
+  // The robot's lane: each execution from its start to its end.
+  for (const LiveExecution& execution : result.executions) {
+    csv += fmt::format("-1,{},{:.9f},0,0,0,0,0,0,{:.9f},execution,{:.9f},{:.9f}\n",
+                       ontime::report::csv_field(problem.action(execution.action).id), execution.start,
+                       execution.end - execution.start, execution.start, execution.end);
   }
   return csv;
 }
@@ -205,6 +229,11 @@ std::string to_json(const Tamp& tamp) {
   out["library"] = tamp.library;
   out["solver"] = options.solver;
   out["parameters"] = parameters_object(options.solver, options.parameters);
+  if (options.acting == Acting::concurrent) {
+    // Only when acting while planning (SPEC §10), so that plan-first reports stay as they were.
+    out["acting"] = acting_name(Acting::concurrent);
+    out["commit_rule"] = allocator_registry().find(options.solver).commit_rule;
+  }
   out["deadline_seconds"] = deadline_seconds(result);
   out["deadline_steps"] = result.deadline_steps;
   out["step_seconds"] = result.step_seconds;
@@ -254,6 +283,10 @@ std::string to_text(const Tamp& tamp) {
   const MonteCarloResult& summary = result.summary;
   std::string out = fmt::format("solver               {} on {} ({} s deadline = {} steps of {} s)\n", options.solver,
                                 tamp.world, deadline_seconds(result), result.deadline_steps, result.step_seconds);
+  if (options.acting == Acting::concurrent) {
+    out += fmt::format("acting               concurrent (SPEC §10); commit rule: {}\n",
+                       allocator_registry().find(options.solver).commit_rule);
+  }
   out += fmt::format("success              {:.4f} ± {:.4f}  ({} of {} episodes, seed {}, {:.1f} s)\n",
                      summary.success_rate, summary.ci95, summary.successes, summary.episodes, options.seed,
                      summary.seconds);
@@ -326,8 +359,11 @@ std::string to_json(const Run& run) {
   out["live"] = live;
   if (live) {
     out["decision_share"] = options.decision_share;
-    out["step_clock_successes"] = summary.model_successes;
-    out["step_clock_undecided"] = summary.model_undecided;
+    if (run.problem->acting() != Acting::concurrent) {
+      // A live concurrent session has no step clock beside it: its starts depend on the seconds.
+      out["step_clock_successes"] = summary.model_successes;
+      out["step_clock_undecided"] = summary.model_undecided;
+    }
     add_charges(out, summary.live_mean, "mean_");
     out["episode_results"] = live_episodes(result.episodes, false);
   }
@@ -349,12 +385,14 @@ std::string to_text(const Run& run) {
   out += fmt::format("real planner         {:.4f} ± {:.4f}  ({} of {} episodes, seed {}, {:.1f} s){}\n",
                      summary.success_rate, summary.ci95, summary.successes, summary.episodes, options.seed,
                      summary.seconds, live ? ", live" : "");
-  if (live) {
+  if (live && run.problem->acting() != Acting::concurrent) {
     out += fmt::format(
         "same calls, steps    {:.4f}  ({} of {} by the model's step clock; {} undecided when the live episode "
         "ended)\n",
         static_cast<double>(summary.model_successes) / static_cast<double>(summary.episodes), summary.model_successes,
         summary.episodes, summary.model_undecided);
+  }
+  if (live) {
     out += fmt::format(
         "charged per episode  thinking {:.3f} s, planning {:.3f} s (overruns {:.3f} s): {:.3f} s of {:.1f} s\n",
         summary.live_mean.decision, summary.live_mean.planning, summary.live_mean.overrun, summary.live_mean.elapsed,

@@ -1,6 +1,7 @@
 #include "ontime/domains/tamp.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <cmath>
 
@@ -12,6 +13,14 @@
 #include "ontime/util/random.hpp"
 
 namespace ontime::domains {
+
+namespace {
+
+// Acting while planning: how far the task planner's stream goes (the session still holds at most
+// max_skeletons skeletons at once).
+constexpr int kConcurrentTaskPaths = 1000;
+
+}  // namespace
 
 Steps tamp_deadline_steps(const Problem& library, double deadline) {
   return static_cast<Steps>(std::floor(deadline / library.step_seconds() + 1e-9));
@@ -26,6 +35,20 @@ void check_tamp_request(const Domain& domain, const Problem& library, const Tamp
   if (options.picture_episode && *options.picture_episode >= options.episodes) {
     throw UsageError(fmt::format("{} {}: the run has episodes 0 to {}", spell_parameter(spelling, "picture-episode"),
                                  *options.picture_episode, options.episodes - 1));
+  }
+  if (options.acting == Acting::concurrent) {
+    if (options.adaptation) {
+      throw UsageError(
+          fmt::format("{} with {} concurrent: learning across episodes acting while planning (SPEC §10) "
+                      "is not there yet",
+                      spell_parameter(spelling, "adapt-strength"), spell_parameter(spelling, "act")));
+    }
+    if (!allocator_registry().find(options.solver).acts_while_planning()) {
+      throw UsageError(
+          fmt::format("allocator '{}' does not act while planning (SPEC §10) yet: it has no commit rule; "
+                      "{} do",
+                      options.solver, fmt::join(allocator_registry().acting_names(), ", ")));
+    }
   }
   if (options.adaptation) {
     if (options.picture_episode) {
@@ -80,6 +103,15 @@ TampResult run_tamp(const Domain& domain, const Problem& library, const TampOpti
   StreamingWorldOptions stream;
   stream.library = &library;
   stream.task_planners = domain.task_planners(options.max_skeletons);
+  if (options.acting == Acting::concurrent) {
+    streaming.make_concurrent_allocator = [solver = options.solver,
+                                           parameters = options.parameters](const ConcurrentMdp& mdp) {
+      return make_concurrent_allocator_factory(solver, mdp, parameters)();
+    };
+    // After a commit the task planner reads on for the paths through what the robot executed, so
+    // its stream goes on past the first max_skeletons paths (the session holds at most that many).
+    stream.task_planners = domain.task_planners(kConcurrentTaskPaths);
+  }
   stream.seconds_per_skeleton = options.task_seconds;
   PlannerWorldOptions planner;
   planner.effort = options.effort;

@@ -253,7 +253,7 @@ void bind_domains(py::module_& m) {
       "allocator decides with its distributions, `problem`'s skeletons and culprits kept (`ontime run "
       "--belief`); act='concurrent' (or a problem acting while planning): the robot executes each motion it "
       "starts while the planner refines the next (`ontime run --act`). Returns the fields of `ontime run --json` "
-      "(live: every episode with its timeline).");
+      "(live: every episode with its timeline and, acting while planning, the robot's executions).");
 
   m.def(
       "tamp",
@@ -266,7 +266,8 @@ void bind_domains(py::module_& m) {
          std::optional<Number<double, "iteration_seconds", 1e-12, 1e6>> iteration_seconds,
          std::optional<Number<std::uint64_t, "picture_episode">> picture_episode,
          std::optional<Number<double, "adapt_strength", 1e-9, 1e9>> adapt_strength,
-         Number<std::uint64_t, "sequences", 1> sequences, const py::object& progress, const py::kwargs& kwargs) {
+         Number<std::uint64_t, "sequences", 1> sequences, const py::object& progress,
+         const std::optional<std::string>& act, const py::kwargs& kwargs) {
         check_callable(progress, "progress");
         if (clock != "real" && clock != "model") {
           throw UsageError("clock must be 'real' or 'model' (got '" + clock + "')");
@@ -274,8 +275,10 @@ void bind_domains(py::module_& m) {
         if (clock == "real" && (decision_seconds || iteration_seconds)) {
           throw UsageError("decision_seconds and iteration_seconds need clock='model'");
         }
-        const std::shared_ptr<MdpHandle> mdp = to_mdp(library, "library");
+        // Read as a problem: a library acting while planning (SPEC §10) makes no plan-first Mdp.
+        const std::shared_ptr<const Problem> chosen = problem_with_acting(library, act, "library");
         domains::TampOptions options;
+        options.acting = chosen->acting();
         options.solver = solver;
         options.parameters = parameter_values(kwargs);
         options.deadline = deadline;
@@ -301,14 +304,14 @@ void bind_domains(py::module_& m) {
           throw UsageError("sequences needs adapt_strength");
         }
         options.world_name = std::filesystem::path(domain->world_file).filename().string();
-        options.library_source = instance_label(library, *mdp->problem);
+        options.library_source = instance_label(library, *chosen);
         domains::TampResult result;
         run_interruptibly(
             [&](const std::function<bool()>& stop, Progress& counters) {
               const Hooks hooks = hooks_of(stop, counters);
               options.progress = hooks.progress;
               options.stop = hooks.stop;
-              result = domains::run_tamp(*domain->loaded.domain, *mdp->problem, options, python_spelling());
+              result = domains::run_tamp(*domain->loaded.domain, *chosen, options, python_spelling());
             },
             progress);
         py::dict out = json_object(domains::report::to_json(domains::report::Tamp{.domain = domain->name,
@@ -325,6 +328,7 @@ void bind_domains(py::module_& m) {
       py::arg("decision_share") = 0.5, py::arg("clock") = "real", py::arg("decision_seconds") = py::none(),
       py::arg("iteration_seconds") = py::none(), py::arg("picture_episode") = py::none(),
       py::arg("adapt_strength") = py::none(), py::arg("sequences") = 1, py::arg("progress") = py::none(),
+      py::arg("act") = py::none(),
       "`ontime tamp`: the whole TAMP loop on the clock. The domain's task planner streams skeletons (at most "
       "max_skeletons, each charged task_seconds of search, one every arrival_period steps), the allocator "
       "`solver` (parameters as keyword arguments) decides which action the real motion planner refines next, "
@@ -334,7 +338,9 @@ void bind_domains(py::module_& m) {
       "picture_episode, also 'picture': that episode's drawing (what plot_tamp.py draws) and timeline CSV. "
       "adapt_strength: `sequences` sequences of `episodes` episodes that learn as they go (`--adapt-strength`): "
       "each episode plans with the library updated by the attempts of its sequence's episodes before, the "
-      "library a prior worth adapt_strength attempts; 'adaptation' gives the success rate by episode.");
+      "library a prior worth adapt_strength attempts; 'adaptation' gives the success rate by episode. "
+      "act='concurrent' (default: the library's acting): the robot acts while planning (`--act`, SPEC §10), the "
+      "task planner streaming only paths through what it executed after each start.");
 
   m.def(
       "map_data",

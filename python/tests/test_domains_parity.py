@@ -183,8 +183,19 @@ def test_run_acting_while_planning_matches_the_cli(cli):
     # The model's value of acting while planning is above planning first.
     plan_first = ontime.domains.run(nav, NAVIGATION_MODEL, "dp-rerun", episodes=1, exact=True)
     assert got["model_exact_success_probability"] > plan_first["model_exact_success_probability"] + 0.2
-    with pytest.raises(ontime.UsageError, match="live episodes"):
-        ontime.domains.run(nav, NAVIGATION_MODEL, "dp-rerun", episodes=1, live=True, act="concurrent")
+    # Live, on the robot's clock: the fields of the CLI's, every episode with its timeline and the
+    # robot's executions, one per start of the timeline, one at a time.
+    live_expected = cli("run", "--domain", "navigation", "--world", NAVIGATION, "--instance", NAVIGATION_MODEL,
+                        "--solver", "dp-rerun", "--episodes", 2, "--threads", 1, "--live", "--act", "concurrent",
+                        "--json")
+    live = ontime.domains.run(nav, NAVIGATION_MODEL, "dp-rerun", episodes=2, threads=1, live=True, act="concurrent")
+    assert list(live) == list(live_expected)
+    assert "step_clock_successes" not in live
+    for episode in live["episode_results"]:
+        started = [step["started"] for step in episode["timeline"] if "started" in step]
+        assert started == [execution["action"] for execution in episode["executions"]]
+        ends = [0.0] + [execution["end"] for execution in episode["executions"]]
+        assert all(execution["start"] >= end for execution, end in zip(episode["executions"], ends))
 
 
 def test_run_with_a_belief_in_a_world_that_backtracks_matches_the_cli(cli, tmp_path):

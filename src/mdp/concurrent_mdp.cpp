@@ -242,12 +242,34 @@ ChoiceList ConcurrentMdp::refine_choices(const ConcurrentState& state) const {
 }
 
 ConcurrentState ConcurrentMdp::step(const ConcurrentState& state, int choice, const Observation& observation) const {
+  return step(state, choice, observation,
+              ClockReading{.time = time(state) + 1, .robot_left = std::max<Steps>(0, robot_left(state) - 1)});
+}
+
+namespace {
+
+std::uint16_t clock_word(Steps value, Steps deadline) {
+  return static_cast<std::uint16_t>(std::clamp<Steps>(value, 0, deadline + 1));
+}
+
+}  // namespace
+
+ConcurrentState ConcurrentMdp::on_clock(const ConcurrentState& state, const ClockReading& clock) const {
+  ConcurrentState next = state;
+  next[0] = clock_word(std::max(time(state), clock.time), deadline_);
+  next[1] = clock_word(clock.robot_left, deadline_);
+  canonicalise(next);
+  return next;
+}
+
+ConcurrentState ConcurrentMdp::step(const ConcurrentState& state, int choice, const Observation& observation,
+                                    const ClockReading& clock) const {
   if (time(state) >= deadline_) {
     throw UsageError("no step is left at the deadline (step " + std::to_string(deadline_) + ")");
   }
   ConcurrentState next = state;
-  ++next[0];
-  if (next[1] > 0) --next[1];
+  next[0] = clock_word(std::max(time(state), clock.time), deadline_);
+  next[1] = clock_word(clock.robot_left, deadline_);
   if (mdp_.has_chains()) {
     // The chains move whatever the step does (SPEC §9).
     if (observation.chains >= mdp_.joint_chain_states()) {
@@ -296,11 +318,37 @@ ConcurrentState ConcurrentMdp::step(const ConcurrentState& state, int choice, co
       ++refined_word(next, m);
       spent_word(next, m) = 0;
     } else {
-      ++spent_word(next, m);
+      spent_word(next, m) = clock_word(spent(state, m) + 1 + clock.extra_effort, deadline_);
     }
   }
   canonicalise(next);
   return next;
+}
+
+ConcurrentState ConcurrentMdp::state_of(Steps time, Steps robot_left, int executed, std::span<const Steps> execution,
+                                        std::span<const Steps> effort) const {
+  ConcurrentState state = start();
+  state[0] = clock_word(time, deadline_);
+  state[1] = clock_word(robot_left, deadline_);
+  state[2] = static_cast<std::uint16_t>(executed + 1);
+  for (int a = 0; a < action_count_; ++a) {
+    const Steps known = execution[static_cast<std::size_t>(a)];
+    execution_word(state, a) = known < 0 ? kUnknown : clock_word(known, deadline_);
+  }
+  for (int k = 0; k < skeleton_count_; ++k) {
+    int refined = 0;
+    while (refined < problem_->skeleton_length(k) &&
+           execution[static_cast<std::size_t>(problem_->action_at(k, refined))] >= 0) {
+      ++refined;
+    }
+    refined_word(state, k) = static_cast<std::uint16_t>(refined);
+    spent_word(state, k) =
+        refined < problem_->skeleton_length(k)
+            ? clock_word(effort[static_cast<std::size_t>(problem_->action_at(k, refined))], deadline_)
+            : std::uint16_t{0};
+  }
+  canonicalise(state);
+  return state;
 }
 
 ConcurrentState ConcurrentMdp::execution_finished(const ConcurrentState& state) const {

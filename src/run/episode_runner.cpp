@@ -109,9 +109,12 @@ struct Arrivals {
   World* world = nullptr;
   bool open = true;          // the planner may find more
   int steps_since_last = 0;  // steps decided since the last skeleton arrived
+  int found = 0;             // skeletons found so far (acting while planning retires some)
 };
 
-void take_next_skeleton(Session& session, Arrivals& arrivals) {
+// The next skeleton into a session that owns its problem (Session or ConcurrentSession).
+template <class AnySession>
+void take_next_skeleton(AnySession& session, Arrivals& arrivals) {
   std::optional<FoundSkeleton> found;
   if (session.problem().skeleton_count() < arrivals.streaming->max_skeletons) found = arrivals.world->next_skeleton();
   if (!found) {
@@ -122,6 +125,7 @@ void take_next_skeleton(Session& session, Arrivals& arrivals) {
   if (session.is_live()) session.charge_outside(found->charged_seconds);
   session.add_skeleton(found->action_ids, std::move(found->new_actions));
   arrivals.steps_since_last = 0;
+  ++arrivals.found;
 }
 
 // The one loop of the runner's episodes: the allocator decides, the session carries the step
@@ -159,16 +163,25 @@ EpisodeResult drive(Session& session, World& world, const DecisionBudget& budget
   if (live) {
     result.live = session.totals();
     result.model_status = session.model_status();
-    if (live->keep_timeline) result.timeline = session.timeline();
+    if (live->keep_timeline) {
+      result.timeline = session.timeline();
+      result.executions = session.executions();
+    }
   }
   return result;
 }
 
 // The loop of concurrent episodes (SPEC §10): the allocator's moves through the session, a start
 // carried out at once, a step in the world, until the session ends.
-EpisodeResult drive_concurrent(ConcurrentSession& session, World& world, DecisionTimer* timer) {
+EpisodeResult drive_concurrent(ConcurrentSession& session, World& world, DecisionTimer* timer,
+                               const std::optional<LiveRun>& live, Arrivals* arrivals = nullptr) {
   EpisodeResult result;
   while (session.status() == Status::running) {
+    if (arrivals != nullptr && arrivals->open &&
+        (arrivals->steps_since_last >= arrivals->streaming->period || !session.can_succeed())) {
+      take_next_skeleton(session, *arrivals);
+      continue;
+    }
     ConcurrentDecision decision;
     if (timer != nullptr) {
       const auto start = std::chrono::steady_clock::now();
@@ -179,7 +192,16 @@ EpisodeResult drive_concurrent(ConcurrentSession& session, World& world, Decisio
       decision = session.choose();
     }
     ++result.decisions;
-    if (!decision.is_start() && session.status() == Status::running) session.carry_out(world);
+    if (decision.is_start() && arrivals != nullptr && session.status() == Status::running) {
+      // The robot committed: the skeletons not through what it executed leave, and the task
+      // planner streams only skeletons through it from now on.
+      session.retire_dropped();
+      world.commit(session.started());
+    }
+    if (!decision.is_start() && session.status() == Status::running) {
+      session.carry_out(world);
+      if (arrivals != nullptr) ++arrivals->steps_since_last;
+    }
   }
   result.status = session.status();
   result.solution = session.solution();
@@ -187,6 +209,13 @@ EpisodeResult drive_concurrent(ConcurrentSession& session, World& world, Decisio
   result.steps_used = session.steps_used();
   result.skeletons = session.mdp().skeleton_count();
   result.attempts = session.take_attempts();
+  if (live) {
+    result.live = session.totals();
+    if (live->keep_timeline) {
+      result.timeline = session.timeline();
+      result.executions = session.executions();
+    }
+  }
   return result;
 }
 
@@ -205,18 +234,22 @@ EpisodeResult run_episode(const Mdp& mdp, Allocator& allocator, World& world, st
   return drive(session, world, budget, timer, live, nullptr);
 }
 
-EpisodeResult run_streaming_episode(const StreamingRun& streaming, World& world, std::uint64_t seed,
-                                    const DecisionBudget& budget, DecisionTimer* timer,
-                                    const std::optional<LiveRun>& live) {
+namespace {
+
+// A streaming episode's first skeleton, the problem it makes, and its search time on the clock.
+struct FirstSkeleton {
+  Problem problem;
+  double charged_seconds = 0;
+};
+
+std::optional<FirstSkeleton> first_skeleton(const StreamingRun& streaming, World& world, const Clock& clock) {
   if (streaming.max_skeletons < 1 || streaming.period < 1) {
     throw UsageError("streaming episodes need at least 1 skeleton and a period of at least 1 step");
   }
-  world.begin_episode(seed);
-  const Clock& clock = clock_of(world);
   const double search_began = clock.now();
   std::optional<FoundSkeleton> first = world.next_skeleton();
   const double first_search = clock.now() - search_began;
-  if (!first) return EpisodeResult{};  // no skeleton at all: a failure without a decision
+  if (!first) return std::nullopt;
   std::vector<int> path;
   for (const std::string& id : first->action_ids) {
     int index = -1;
@@ -226,25 +259,53 @@ EpisodeResult run_streaming_episode(const StreamingRun& streaming, World& world,
     if (index < 0) throw UsageError("the first skeleton found names action '" + id + "' without bringing it");
     path.push_back(index);
   }
-  Problem problem(streaming.name, streaming.deadline, streaming.step_seconds, std::move(first->new_actions),
-                  {std::move(path)});
-  Session session(std::move(problem), streaming.make_allocator, stream_seed(seed, 1), live ? &clock : nullptr,
-                  live ? live->options : LiveOptions{});
-  Arrivals arrivals{&streaming, &world, streaming.max_skeletons > 1, 0};
-  session.expect_more_skeletons(arrivals.open);
-  if (live) session.charge_outside(first->charged_seconds + first_search);
-  EpisodeResult result = drive(session, world, budget, timer, live, &arrivals);
-  if (streaming.keep_problem || (live && live->keep_timeline)) {
-    result.problem = std::make_shared<const Problem>(session.problem());
+  return FirstSkeleton{Problem(streaming.name, streaming.deadline, streaming.step_seconds,
+                               std::move(first->new_actions), {std::move(path)}),
+                       first->charged_seconds + first_search};
+}
+
+}  // namespace
+
+EpisodeResult run_streaming_episode(const StreamingRun& streaming, World& world, std::uint64_t seed,
+                                    const DecisionBudget& budget, DecisionTimer* timer,
+                                    const std::optional<LiveRun>& live) {
+  world.begin_episode(seed);
+  const Clock& clock = clock_of(world);
+  std::optional<FirstSkeleton> first = first_skeleton(streaming, world, clock);
+  if (!first) return EpisodeResult{};  // no skeleton at all: a failure without a decision
+  Arrivals arrivals{&streaming, &world, streaming.max_skeletons > 1, 0, 1};
+  const bool keep_problem = streaming.keep_problem || (live && live->keep_timeline);
+  EpisodeResult result;
+  std::shared_ptr<const Problem> problem;
+  if (streaming.make_concurrent_allocator) {
+    ConcurrentSession session(first->problem.with_acting(Acting::concurrent), streaming.make_concurrent_allocator,
+                              stream_seed(seed, 1), live ? &clock : nullptr, live ? live->options : LiveOptions{});
+    session.expect_more_skeletons(arrivals.open);
+    if (live) session.charge_outside(first->charged_seconds);
+    result = drive_concurrent(session, world, timer, live, &arrivals);
+    result.skeletons = arrivals.found;
+    if (keep_problem) problem = std::make_shared<const Problem>(session.problem());
+  } else {
+    Session session(std::move(first->problem), streaming.make_allocator, stream_seed(seed, 1), live ? &clock : nullptr,
+                    live ? live->options : LiveOptions{});
+    session.expect_more_skeletons(arrivals.open);
+    if (live) session.charge_outside(first->charged_seconds);
+    result = drive(session, world, budget, timer, live, &arrivals);
+    if (keep_problem) problem = std::make_shared<const Problem>(session.problem());
   }
+  result.problem = std::move(problem);
   return result;
 }
 
 EpisodeResult run_concurrent_episode(const ConcurrentMdp& mdp, ConcurrentAllocator& allocator, World& world,
-                                     std::uint64_t seed, DecisionTimer* timer) {
+                                     std::uint64_t seed, DecisionTimer* timer, const std::optional<LiveRun>& live) {
   world.begin_episode(seed);
-  ConcurrentSession session(mdp, allocator, stream_seed(seed, 1));
-  return drive_concurrent(session, world, timer);
+  if (!live) {
+    ConcurrentSession session(mdp, allocator, stream_seed(seed, 1));
+    return drive_concurrent(session, world, timer, live);
+  }
+  ConcurrentSession session(mdp, allocator, stream_seed(seed, 1), clock_of(world), live->options);
+  return drive_concurrent(session, world, timer, live);
 }
 
 std::size_t LatencyHistogram::bucket_of(std::uint64_t nanoseconds) noexcept {
@@ -357,6 +418,7 @@ void pack_episode(BytePacker& packer, std::uint64_t episode, const EpisodeResult
   packer.put(result.model_status);
   packer.put_vector(result.timeline);
   packer.put(result.skeletons);
+  packer.put_vector(result.executions);
 }
 
 EpisodeResult unpack_episode(ByteUnpacker& unpacker, std::uint64_t& episode) {
@@ -371,6 +433,7 @@ EpisodeResult unpack_episode(ByteUnpacker& unpacker, std::uint64_t& episode) {
   result.model_status = unpacker.get<Status>();
   result.timeline = unpacker.get_vector<LiveStep>();
   result.skeletons = unpacker.get<int>();
+  result.executions = unpacker.get_vector<LiveExecution>();
   return result;
 }
 
@@ -544,12 +607,9 @@ MonteCarloResult run_streaming_episodes(const StreamingRun& streaming, const Wor
 MonteCarloResult run_concurrent_episodes(const ConcurrentMdp& mdp, const WorldFactory& worlds,
                                          const ConcurrentAllocatorFactory& allocators,
                                          const MonteCarloOptions& options) {
-  if (options.live) {
-    throw UsageError("live episodes acting while planning (SPEC §10) are not there yet: run them on the step clock");
-  }
   return run_many(worlds, &allocators, options, [&](ThreadRun& run, std::uint64_t seed) {
     return run_concurrent_episode(mdp, *run.concurrent_allocator, *run.world, seed,
-                                  options.time_decisions ? &run.timer : nullptr);
+                                  options.time_decisions ? &run.timer : nullptr, options.live);
   });
 }
 

@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -57,14 +58,10 @@ Session::Session(Problem problem, AllocatorMaker make_allocator, std::uint64_t s
       owned_mdp_(std::make_unique<Mdp>(*owned_problem_)),
       make_allocator_(std::move(make_allocator)),
       seed_(seed) {
-  if (make_allocator_) {
-    owned_allocator_ = make_allocator_(*owned_mdp_);
-    if (!owned_allocator_) throw UsageError("the allocator maker returned no allocator");
-  }
+  owned_allocator_ = made_allocator(make_allocator_, *owned_mdp_);
   mdp_ = owned_mdp_.get();
   allocator_ = owned_allocator_.get();
-  state_ = mdp_->start();
-  before_ = state_;
+  before_ = state_ = mdp_->start();
   attempts_.assign(static_cast<std::size_t>(owned_problem_->action_count()), ActionAttempt{});
   action_execution_steps_.assign(static_cast<std::size_t>(owned_problem_->action_count()), -1);
   action_execution_seconds_.assign(static_cast<std::size_t>(owned_problem_->action_count()), -1.0);
@@ -82,12 +79,12 @@ void Session::expect_more_skeletons(bool expected) {
     throw std::logic_error("expect_more_skeletons needs a session that owns its problem (made from a Problem)");
   }
   more_expected_ = expected;
-  if (clock_ != nullptr && model_status_ == Status::running && !expected && !mdp_->any_can_succeed(model_state_)) {
+  if (live_.is_live() && model_status_ == Status::running && !expected && !mdp_->any_can_succeed(model_state_)) {
     model_status_ = Status::failure;
   }
   if (status_ == Status::running && pending_ < 0 && out_of_skeletons()) {
     status_ = Status::failure;
-    if (clock_ != nullptr) ended_at_ = elapsed_seconds();
+    live_.end();
   }
 }
 
@@ -108,7 +105,7 @@ Decision Session::choose(const DecisionBudget& budget) {
   if (allocator_ == nullptr) {
     throw std::logic_error("choose() needs a session with an allocator; in this one the caller decides (decide())");
   }
-  if (clock_ == nullptr) {
+  if (!live_.is_live()) {
     const int choice = allocator_->choose(state_, budget);
     if (choice < 0 || choice >= mdp_->skeleton_count()) {
       throw UsageError("allocator '" + std::string(allocator_->name()) + "' chose skeleton " + std::to_string(choice) +
@@ -131,7 +128,7 @@ Decision Session::decide(int skeleton) {
     throw UsageError("skeleton " + std::to_string(skeleton) + " is outside [0, " +
                      std::to_string(mdp_->skeleton_count()) + ")");
   }
-  if (clock_ == nullptr) {
+  if (!live_.is_live()) {
     pending_ = skeleton;
     pending_action_ = mdp_->next_action(state_, skeleton);
     return Decision{skeleton, pending_action_};
@@ -148,12 +145,12 @@ Status Session::report_not_yet() { return report(Observation::not_yet()); }
 Status Session::report_refined(Steps execution_steps) { return report(Observation::found(execution_steps)); }
 
 Status Session::report(const Observation& observation) {
-  if (clock_ == nullptr || !observation.refined) {
+  if (!live_.is_live() || !observation.refined) {
     return report(observation, std::numeric_limits<double>::quiet_NaN());
   }
   if (observation.execution < 0) return report(observation, -1.0);  // rejected below with the steps
-  const double seconds =
-      observation.execution == kNever ? std::numeric_limits<double>::infinity() : observation.execution * step_seconds_;
+  const double seconds = observation.execution == kNever ? std::numeric_limits<double>::infinity()
+                                                         : observation.execution * live_.step_seconds();
   return report(observation, seconds);
 }
 
@@ -161,10 +158,10 @@ Status Session::report(const Observation& observation, double execution_seconds)
   if (pending_ < 0) throw std::logic_error("report without a decision: call choose() or decide() first");
   const int choice = pending_;
   const int action = pending_action_;
-  if (allocator_ != nullptr || clock_ != nullptr) before_ = state_;
+  if (allocator_ != nullptr || live_.is_live()) before_ = state_;
   const Status model_status = mdp_->apply(state_, choice, observation);
   pending_ = -1;
-  if (action >= 0 && clock_ == nullptr) {
+  if (action >= 0 && !live_.is_live()) {
     // One step of effort (a live session counts the slices its report charges: report_live).
     ActionAttempt& attempt = attempts_[static_cast<std::size_t>(action)];
     ++attempt.effort;
@@ -192,7 +189,7 @@ Status Session::report(const Observation& observation, double execution_seconds)
                                       : observation.execution == kNever ? std::numeric_limits<double>::infinity()
                                                                         : observation.execution * step_seconds();
   }
-  if (clock_ == nullptr) {
+  if (!live_.is_live()) {
     status_ = model_status;
     // Skeletons still to come keep a session going that its present ones cannot save.
     if (status_ == Status::failure && more_expected_ && state_.time < mdp_->deadline()) status_ = Status::running;
@@ -226,7 +223,7 @@ Status Session::carry_out_timed(World& world) {
     exogenous_ = SplitMix64(stream_seed(seed_, 0x65786f67));
     exogenous_seeded_ = true;
   }
-  if (clock_ != nullptr && !simulated_chains_) {
+  if (live_.is_live() && !simulated_chains_) {
     // A live session in a world: the chains follow the clock (report_live, end_if_out_of_time),
     // one step of their path per step of CT, however many steps a report charges.
     simulated_chains_ = true;
@@ -267,7 +264,7 @@ double Session::reward() const {
   if (status_ != Status::success || solution_ < 0) return 0.0;
   if (mdp_->is_timed()) return timed_reward_;
   const SkeletonReward& reward = problem().reward(solution_);
-  if (clock_ != nullptr) return std::max(0.0, reward.at(finish_seconds_ / step_seconds()));  // (within a slice)
+  if (live_.is_live()) return std::max(0.0, reward.at(finish_seconds_ / step_seconds()));  // (within a slice)
   return reward.at(static_cast<double>(state_.time + state_.execution[static_cast<std::size_t>(solution_)]));
 }
 
@@ -320,22 +317,13 @@ State Session::carried_over(const State& old, const Problem& next) const {
   return out;
 }
 
-void Session::change_skeletons(std::vector<Action> actions, std::vector<std::vector<int>> skeletons,
-                               std::vector<SkeletonReward> rewards) {
-  const Problem& current = mdp_->problem();
+void Session::change_skeletons(Problem next) {
   // Everything that can fail comes first, so that a failure leaves the session as it was.
-  auto problem =
-      std::make_unique<Problem>(current.name(), current.deadline(), current.step_seconds(), std::move(actions),
-                                std::move(skeletons), current.description(), std::move(rewards),
-                                std::vector<ExogenousChain>(current.chains().begin(), current.chains().end()));
+  auto problem = std::make_unique<Problem>(std::move(next));
   auto mdp = std::make_unique<Mdp>(*problem);
-  std::unique_ptr<Allocator> allocator;
-  if (make_allocator_) {
-    allocator = make_allocator_(*mdp);
-    if (!allocator) throw UsageError("the allocator maker returned no allocator");
-  }
+  std::unique_ptr<Allocator> allocator = made_allocator(make_allocator_, *mdp);
   State state = carried_over(state_, *problem);
-  State model = clock_ != nullptr ? carried_over(model_state_, *problem) : State{};
+  State model = live_.is_live() ? carried_over(model_state_, *problem) : State{};
 
   owned_problem_ = std::move(problem);
   owned_mdp_ = std::move(mdp);
@@ -349,7 +337,7 @@ void Session::change_skeletons(std::vector<Action> actions, std::vector<std::vec
   action_execution_seconds_.resize(static_cast<std::size_t>(owned_problem_->action_count()), -1.0);
   ++changes_;
   if (allocator_ != nullptr) allocator_->begin_episode(stream_seed(seed_, changes_));
-  if (clock_ != nullptr) {
+  if (live_.is_live()) {
     model_state_ = std::move(model);
     if (model_status_ == Status::running && !more_expected_ && !mdp_->any_can_succeed(model_state_)) {
       model_status_ = Status::failure;
@@ -357,7 +345,7 @@ void Session::change_skeletons(std::vector<Action> actions, std::vector<std::vec
   }
   if (out_of_skeletons()) {
     status_ = Status::failure;
-    if (clock_ != nullptr) ended_at_ = elapsed_seconds();
+    live_.end();
   }
 }
 
@@ -373,10 +361,8 @@ void check_changeable(bool owns_problem, int pending, Status status, const char*
 
 }  // namespace
 
-int Session::add_skeleton(const std::vector<std::string>& action_ids, std::vector<Action> new_actions,
-                          SkeletonReward reward) {
-  check_changeable(owned_problem_ != nullptr, pending_, status_, "add_skeleton");
-  const Problem& current = mdp_->problem();
+Problem with_added_skeleton(const Problem& current, const std::vector<std::string>& action_ids,
+                            std::vector<Action> new_actions, SkeletonReward reward) {
   std::vector<Action> actions(current.actions().begin(), current.actions().end());
   const auto known = static_cast<int>(actions.size());
   for (Action& action : new_actions) actions.push_back(std::move(action));
@@ -395,31 +381,15 @@ int Session::add_skeleton(const std::vector<std::string>& action_ids, std::vecto
   skeletons.push_back(std::move(path));
   std::vector<SkeletonReward> rewards(current.rewards().begin(), current.rewards().end());
   rewards.push_back(reward);
-  const int added = current.skeleton_count();
-  change_skeletons(std::move(actions), std::move(skeletons), std::move(rewards));
-  return added;
+  return with_skeletons(current, std::move(actions), std::move(skeletons), std::move(rewards));
 }
 
-void Session::revise_distributions(const Problem& beliefs) {
-  check_changeable(owned_problem_ != nullptr, pending_, status_, "revise_distributions");
-  const Problem& current = mdp_->problem();
-  const Problem revised = with_distributions_of(current, beliefs);
-  change_skeletons(std::vector<Action>(revised.actions().begin(), revised.actions().end()), current.skeleton_lists(),
-                   std::vector<SkeletonReward>(current.rewards().begin(), current.rewards().end()));
-}
-
-void Session::retire_skeleton(int k) {
-  check_changeable(owned_problem_ != nullptr, pending_, status_, "retire_skeleton");
-  const Problem& current = mdp_->problem();
+std::optional<Problem> without_skeleton(const Problem& current, int k) {
   if (k < 0 || k >= current.skeleton_count()) {
     throw UsageError("retire_skeleton: skeleton " + std::to_string(k) + " out of range [0, " +
                      std::to_string(current.skeleton_count()) + ")");
   }
-  if (current.skeleton_count() == 1) {
-    status_ = Status::failure;  // nothing left to refine
-    if (clock_ != nullptr) ended_at_ = elapsed_seconds();
-    return;
-  }
+  if (current.skeleton_count() == 1) return std::nullopt;
   std::vector<std::vector<int>> skeletons;
   std::vector<SkeletonReward> rewards;
   for (int other = 0; other < current.skeleton_count(); ++other) {
@@ -427,8 +397,39 @@ void Session::retire_skeleton(int k) {
     skeletons.emplace_back(current.skeleton(other).begin(), current.skeleton(other).end());
     rewards.push_back(current.reward(other));
   }
-  change_skeletons(std::vector<Action>(current.actions().begin(), current.actions().end()), std::move(skeletons),
-                   std::move(rewards));
+  return with_skeletons(current, std::vector<Action>(current.actions().begin(), current.actions().end()),
+                        std::move(skeletons), std::move(rewards));
+}
+
+Problem with_skeletons(const Problem& current, std::vector<Action> actions, std::vector<std::vector<int>> skeletons,
+                       std::vector<SkeletonReward> rewards) {
+  return Problem(current.name(), current.deadline(), current.step_seconds(), std::move(actions), std::move(skeletons),
+                 current.description(), std::move(rewards),
+                 std::vector<ExogenousChain>(current.chains().begin(), current.chains().end()));
+}
+
+int Session::add_skeleton(const std::vector<std::string>& action_ids, std::vector<Action> new_actions,
+                          SkeletonReward reward) {
+  check_changeable(owned_problem_ != nullptr, pending_, status_, "add_skeleton");
+  const int added = mdp_->problem().skeleton_count();
+  change_skeletons(with_added_skeleton(mdp_->problem(), action_ids, std::move(new_actions), reward));
+  return added;
+}
+
+void Session::revise_distributions(const Problem& beliefs) {
+  check_changeable(owned_problem_ != nullptr, pending_, status_, "revise_distributions");
+  change_skeletons(with_distributions_of(mdp_->problem(), beliefs));
+}
+
+void Session::retire_skeleton(int k) {
+  check_changeable(owned_problem_ != nullptr, pending_, status_, "retire_skeleton");
+  std::optional<Problem> next = without_skeleton(mdp_->problem(), k);  // checks k
+  if (!next) {
+    status_ = Status::failure;  // nothing left to refine
+    live_.end();
+    return;
+  }
+  change_skeletons(std::move(*next));
 }
 
 }  // namespace ontime

@@ -473,8 +473,34 @@ TEST(Cli, RunActsWhilePlanningWithTheRealPlanner) {
   EXPECT_GT(exact, json::parse(plan_first.out)["model_exact_success_probability"].get<double>() + 0.2);
   EXPECT_GE(out["successes"].get<int>(), 1);
 
+  // Live, on the robot's clock (planner calls count their nominal seconds): each episode's motions
+  // with a start of the timeline for each, in order, the last one ending by the 66 s deadline on success.
+  const auto live = ontime({"run", "--domain", "navigation", "--solver", "dp-rerun", "--episodes", "3", "--threads",
+                            "1", "--act", "concurrent", "--live", "--json"});
+  ASSERT_EQ(live.exit_code, 0) << live.err;
+  const json lived = json::parse(live.out);
+  EXPECT_TRUE(lived["live"].get<bool>());
+  EXPECT_FALSE(lived.contains("step_clock_successes"));  // no step clock beside a concurrent session
+  ASSERT_EQ(lived["episode_results"].size(), 3U);
+  for (const json& episode : lived["episode_results"]) {
+    std::vector<int> started;
+    for (const json& step : episode["timeline"]) {
+      if (step.contains("started")) started.push_back(step["started"].get<int>());
+    }
+    ASSERT_EQ(started.size(), episode["executions"].size());
+    double free = 0;
+    for (std::size_t i = 0; i < started.size(); ++i) {
+      const json& execution = episode["executions"][i];
+      EXPECT_EQ(execution["action"].get<int>(), started[i]);
+      EXPECT_GE(execution["start"].get<double>(), free);  // one motion at a time
+      free = execution["end"].get<double>();
+    }
+    if (episode["status"] == "success") {
+      EXPECT_LE(free, 66.0 + 1e-9);
+    }
+  }
+
   for (const auto& [arguments, message] : std::vector<std::pair<std::vector<std::string>, std::string>>{
-           {{"--solver", "dp-rerun", "--live"}, "live episodes (--live, --effort wall) acting while planning"},
            {{"--solver", "dp-rerun", "--belief", testing::source_path("data/instances/navigation.json").string()},
             "--belief: acting"},
            {{"--solver", "mcts"}, "'mcts' does not act while planning"}}) {

@@ -248,7 +248,10 @@ TEST(Cli, RunLiveReportsEveryEpisodesChargesAndTimeline) {
   }
   EXPECT_EQ(out["successes"].get<std::uint64_t>(), successes);
   EXPECT_LE(out["step_clock_successes"].get<std::uint64_t>() + out["step_clock_undecided"].get<std::uint64_t>(), 3u);
-  EXPECT_EQ(line_count(dir / "timeline.csv"), out["episode_results"][2]["timeline"].size() + 1);
+  // A row per step, then the robot's lane: plan-first, the plan executed after a success.
+  const json& drawn = out["episode_results"][2];
+  EXPECT_EQ(drawn["executions"].empty(), drawn["status"] != "success");
+  EXPECT_EQ(line_count(dir / "timeline.csv"), drawn["timeline"].size() + 1 + drawn["executions"].size());
   EXPECT_FALSE(std::filesystem::exists(dir / "timeline.png"));
 
   const auto not_live = ontime({"run", "--domain", "navigation", "--solver", "dp", "--decision-share", "0.3"});

@@ -7,7 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <optional>
 #include <set>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -18,9 +20,12 @@
 #include "ontime/domains/navigation.hpp"
 #include "ontime/domains/planner_world.hpp"
 #include "ontime/domains/registry.hpp"
+#include "ontime/domains/report.hpp"
 #include "ontime/domains/task_planner.hpp"
 #include "ontime/learn/online_belief.hpp"
 #include "ontime/model/instance_io.hpp"
+#include "ontime/run/clock.hpp"
+#include "ontime/run/concurrent_session.hpp"
 #include "ontime/run/episode_runner.hpp"
 #include "ontime/util/error.hpp"
 #include "support/paper.hpp"
@@ -349,6 +354,123 @@ TEST(RunTamp, SequencesInAKitchenThatBacktracksLearnPlanningAndBacktrackingToget
   EXPECT_NE(believed.action(place).backtrack, library.action(place).backtrack);
   EXPECT_LE(2.0 - believed.action(place).planning.never() - believed.action(place).backtrack.never(),
             1.0 + Distribution::kSumTolerance);
+}
+
+// After a commit the streaming world passes over the room paths that do not begin with what the
+// robot executed: every skeleton it streams then begins with that prefix.
+TEST(StreamingPlannerWorld, AfterACommitEverySkeletonBeginsWithWhatTheRobotExecuted) {
+  const Fixture& f = fixture();
+  StreamingWorldOptions streaming;
+  streaming.library = &f.library;
+  streaming.task_planners = room_path_planners(f.domain.world());
+  PlannerWorld world(f.domain, streaming, f.options);
+  world.begin_episode(1);
+  const std::optional<FoundSkeleton> first = world.next_skeleton();
+  ASSERT_TRUE(first.has_value());
+  ASSERT_GE(first->action_ids.size(), 2U);
+  world.commit({0});  // the first skeleton's first move
+  int streamed = 0;
+  std::set<std::vector<std::string>> seen;
+  while (std::optional<FoundSkeleton> next = world.next_skeleton()) {
+    ASSERT_FALSE(next->action_ids.empty());
+    EXPECT_EQ(next->action_ids.front(), first->action_ids.front());
+    EXPECT_TRUE(seen.insert(next->action_ids).second);
+    ++streamed;
+  }
+  // Every simple room path through that first move but the first skeleton itself.
+  std::size_t through = 0;
+  const NavigationWorld& map = f.domain.world();
+  const std::string first_move = world.actions().front().action;
+  for (const auto& rooms : map.room_paths(map.start_room, map.goal_room)) {
+    through += moves_of(rooms).front() == first_move ? 1 : 0;
+  }
+  EXPECT_EQ(static_cast<std::size_t>(streamed) + 1, through);
+}
+
+// Acting while planning in the loop (SPEC §10) on the modelled clock: the same episodes for any
+// thread count; the robot starts a first motion while the planner still refines (a start before a
+// later planner step), and an episode's skeletons at its end all begin with what the robot executed.
+TEST(RunTamp, ActingWhilePlanningCommitsWhilePlanningAndStreamsThroughWhatTheRobotExecuted) {
+  const Fixture& f = fixture();
+  TampOptions options = modelled_tamp(6, 3);
+  options.acting = Acting::concurrent;
+  const TampResult one = run_tamp(f.domain, f.library, options);
+  options.threads = 2;
+  const TampResult two = run_tamp(f.domain, f.library, options);
+  EXPECT_EQ(one.summary.successes, two.summary.successes);
+  EXPECT_GT(one.summary.successes, 0U);
+  ASSERT_EQ(one.episodes.size(), 6U);
+  bool committed_while_planning = false;
+  for (std::size_t e = 0; e < one.episodes.size(); ++e) {
+    const EpisodeResult& episode = one.episodes[e];
+    EXPECT_EQ(episode.status, two.episodes[e].status) << e;
+    EXPECT_EQ(episode.live.elapsed, two.episodes[e].live.elapsed) << e;
+    EXPECT_EQ(episode.executions, two.episodes[e].executions) << e;
+    const auto first_start = std::find_if(episode.timeline.begin(), episode.timeline.end(),
+                                          [](const LiveStep& step) { return step.started >= 0; });
+    committed_while_planning |=
+        first_start != episode.timeline.end() &&
+        std::any_of(first_start, episode.timeline.end(), [](const LiveStep& step) { return step.action >= 0; });
+    ASSERT_NE(episode.problem, nullptr);
+    for (int k = 0; k < episode.problem->skeleton_count(); ++k) {
+      const std::span<const int> path = episode.problem->skeleton(k);
+      ASSERT_GE(path.size(), episode.executions.size()) << e;
+      for (std::size_t i = 0; i < episode.executions.size(); ++i) {
+        EXPECT_EQ(path[i], episode.executions[i].action) << "episode " << e << " skeleton " << k;
+      }
+    }
+    if (episode.status == Status::success) {
+      EXPECT_EQ(static_cast<int>(episode.executions.size()), episode.problem->skeleton_length(episode.solution));
+      EXPECT_LE(episode.executions.back().end, options.deadline + 1e-9);
+    }
+  }
+  EXPECT_TRUE(committed_while_planning);
+  options.solver = "mcts";
+  EXPECT_THROW(run_tamp(f.domain, f.library, options), UsageError);
+}
+
+// The timeline CSV of a concurrent episode on a manual clock (two actions, slices of 2 s): a row
+// per planner step and per start, then the robot's lane, one row per execution from start to end.
+TEST(TimelineCsv, ActingWhilePlanningAddsTheRobotsLaneAfterThePlannersColumns) {
+  const Problem problem = parse_problem(R"({"deadline": 8, "step_seconds": 2, "acting": "concurrent",
+    "actions": {"a": {"planning": {"pmf": {"1": 1}}, "execution": {"pmf": {"2": 1}}},
+                "b": {"planning": {"pmf": {"1": 1}}, "execution": {"pmf": {"1": 1}}}},
+    "skeletons": [["a", "b"]]})",
+                                        "two-moves");
+  const ConcurrentMdp mdp(problem);
+  ManualClock clock;
+  ConcurrentSession session(mdp, clock);
+  session.decide({-1, 0});
+  clock.advance(2);
+  session.report_refined_seconds(3.0);
+  session.decide({0, ConcurrentMdp::kWait});  // a from 2 s
+  session.decide({-1, 0});
+  clock.advance(2);
+  session.report_refined_seconds(1.0);
+  session.report_execution_finished(0);       // at 4 s, a second sooner than its motion said
+  session.decide({1, ConcurrentMdp::kWait});  // b from 4 s to 5 s
+  ASSERT_EQ(session.status(), Status::success);
+  EpisodeResult result;
+  result.status = session.status();
+  result.solution = session.solution();
+  result.timeline = session.timeline();
+  result.executions = session.executions();
+  const std::string zero = "0.000000000";
+  const auto seconds = [](int whole) { return std::to_string(whole) + ".000000000"; };
+  const std::string expected =
+      std::string(
+          "skeleton,action,start,outside_seconds,decision_seconds,planning_seconds,overrun_seconds,observe_seconds,"
+          "refined,execution_seconds,lane,execution_start,execution_end\n") +
+      // skeleton, action (quoted), start, outside, decision, planning, overrun, observe, refined, execution
+      "0,\"a\"," + zero + "," + zero + "," + zero + "," + seconds(2) + "," + zero + "," + zero + ",1," + seconds(3) +
+      ",planning,,\n" + "-1,\"a\"," + seconds(2) + "," + zero + "," + zero + "," + zero + "," + zero + "," + zero +
+      ",0," + zero + ",start," + seconds(2) + "," + seconds(4) + "\n" + "0,\"b\"," + seconds(2) + "," + zero + "," +
+      zero + "," + seconds(2) + "," + zero + "," + zero + ",1," + seconds(1) + ",planning,,\n" + "-1,\"b\"," +
+      seconds(4) + "," + zero + "," + zero + "," + zero + "," + zero + "," + zero + ",0," + zero + ",start," +
+      seconds(4) + "," + seconds(5) + "\n" + "-1,\"a\"," + seconds(2) + ",0,0,0,0,0,0," + seconds(2) + ",execution," +
+      seconds(2) + "," + seconds(4) + "\n" + "-1,\"b\"," + seconds(4) + ",0,0,0,0,0,0," + seconds(1) + ",execution," +
+      seconds(4) + "," + seconds(5) + "\n";
+  EXPECT_EQ(report::timeline_csv(problem, result), expected);
 }
 
 }  // namespace

@@ -199,10 +199,6 @@ TEST(ConcurrentEpisodes, AThompsonAllocatorIsNotValuedExactly) {
   const auto allocator = make_concurrent_allocator_factory("thompson", mdp)();
   EXPECT_FALSE(allocator->is_stationary());
   EXPECT_THROW((void)evaluate_exactly(mdp, *allocator), UsageError);
-  MonteCarloOptions options;
-  options.episodes = 10;
-  options.live = LiveRun{};
-  EXPECT_THROW((void)run_monte_carlo(mdp, make_concurrent_allocator_factory("thompson", mdp), options), UsageError);
 }
 
 }  // namespace

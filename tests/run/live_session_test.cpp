@@ -21,6 +21,7 @@
 #include "ontime/util/random.hpp"
 #include "support/chain_reference.hpp"
 #include "support/paper.hpp"
+#include "support/sliced_world.hpp"
 
 namespace ontime {
 namespace {
@@ -188,24 +189,7 @@ TEST(LiveSession, AnAnytimeAllocatorGetsItsShareOfASlice) {
   EXPECT_THROW(Session(fast_mdp, *searcher, 1, clock, LiveOptions{.decision_share = 0.0}), UsageError);
 }
 
-// A hidden world on a manual clock that one step of effort advances by exactly one slice (or by
-// `slices` of them).
-class SlicedWorld final : public World {
- public:
-  explicit SlicedWorld(const Problem& problem, double slices = 1)
-      : world_(problem, 0), slice_(slices * problem.step_seconds()) {}
-  void begin_episode(std::uint64_t seed) override { world_.begin_episode(seed); }
-  Observation step(int action, Steps spent) override {
-    clock_.advance(slice_);
-    return world_.step(action, spent);
-  }
-  const Clock* clock() const noexcept override { return &clock_; }
-
- private:
-  HiddenWorld world_;
-  double slice_;
-  ManualClock clock_;
-};
+using testing::SlicedWorld;
 
 // The same episodes twice: in hidden worlds on the step clock (2 threads), then live in worlds
 // whose every report takes exactly one slice (1 thread).

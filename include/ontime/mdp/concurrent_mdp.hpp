@@ -49,6 +49,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "ontime/mdp/mdp.hpp"
@@ -192,6 +193,33 @@ class ConcurrentMdp {
   // the deadline, a motion found or a backtrack on an idle step, or a culprit the action cannot
   // blame.
   ConcurrentState step(const ConcurrentState& state, int choice, const Observation& observation) const;
+
+  // What the robot's clock says after a step or before a move (a live session,
+  // run/concurrent_session.hpp): CT (at least the state's), the steps the robot's current
+  // execution still needs (0: idle), and the slices of effort an unsuccessful call counted beyond
+  // the model's one.
+  struct ClockReading {
+    Steps time = 0;
+    Steps robot_left = 0;
+    Steps extra_effort = 0;
+  };
+  // step() with CT, r and the effort read off the clock instead of one step each: the planner's
+  // PT grows by 1 + extra_effort on a miss. step(state, choice, observation) is this with CT + 1,
+  // r - 1 and no extra effort. Throws what step() throws.
+  ConcurrentState step(const ConcurrentState& state, int choice, const Observation& observation,
+                       const ClockReading& clock) const;
+  // The state brought up to the clock between steps: CT raised to clock.time, r set to
+  // clock.robot_left (canonical; extra_effort is not used).
+  ConcurrentState on_clock(const ConcurrentState& state, const ClockReading& clock) const;
+
+  // The state of what is known, for a session whose skeletons change (run/concurrent_session.hpp):
+  // CT `time`, the robot's `robot_left`, the executed prefix ending with action `executed` (-1:
+  // none), and per action its execution time in steps once refined (-1: not refined) and the steps
+  // of effort spent on it (its PT while unrefined). A skeleton has refined its leading actions
+  // whose execution is known; canonical (the skeletons not through the prefix, or unable to finish,
+  // dropped). Both spans have an entry per action.
+  ConcurrentState state_of(Steps time, Steps robot_left, int executed, std::span<const Steps> execution,
+                           std::span<const Steps> effort) const;
 
   // The state with the robot's current execution finished now (r = 0; canonical): what a robot
   // that finished sooner than its motion's execution time reports. The state itself while it is

@@ -26,6 +26,7 @@
 #include "ontime/allocators/decision_budget.hpp"
 #include "ontime/mdp/concurrent_mdp.hpp"
 #include "ontime/mdp/mdp.hpp"
+#include "ontime/run/concurrent_session.hpp"
 #include "ontime/run/session.hpp"
 #include "ontime/run/world.hpp"
 #include "ontime/util/ranks.hpp"
@@ -52,6 +53,9 @@ struct EpisodeResult {
   LiveTotals live;
   Status model_status = Status::running;
   std::vector<LiveStep> timeline;
+  // Live episodes whose timeline is kept: the robot's executions (acting while planning, each
+  // motion it started; plan-first, the plan executed after success).
+  std::vector<LiveExecution> executions;
   // Streaming episodes: the skeletons found, and (when the timeline is kept, or
   // StreamingRun::keep_problem) the episode's final problem, whose action and skeleton indices the
   // timeline and `attempts` use.
@@ -79,7 +83,8 @@ EpisodeResult run_episode(const Mdp& mdp, Allocator& allocator, World& world, st
 // allocator's moves through a ConcurrentSession (concurrent_session.hpp), its steps in `world`.
 // Every move, a start or a step, is a decision (timed when `timer` is given).
 EpisodeResult run_concurrent_episode(const ConcurrentMdp& mdp, ConcurrentAllocator& allocator, World& world,
-                                     std::uint64_t seed, DecisionTimer* timer = nullptr);
+                                     std::uint64_t seed, DecisionTimer* timer = nullptr,
+                                     const std::optional<LiveRun>& live = std::nullopt);
 
 // Episodes whose skeletons stream in from the world (World::next_skeleton), as a task planner
 // running alongside finds them. Each episode's session owns its problem (session.hpp): it begins
@@ -93,6 +98,11 @@ struct StreamingRun {
   Steps deadline = 1;
   double step_seconds = 1;
   Session::AllocatorMaker make_allocator;
+  // Set: the robot acts while planning (SPEC §10), each episode an owning ConcurrentSession with this
+  // maker's allocators. After every start the skeletons not through what the robot executed
+  // retire, and the world is told the executed prefix (World::commit), so that its task planner
+  // streams only skeletons through it.
+  ConcurrentSession::AllocatorMaker make_concurrent_allocator;
   int period = 1;
   int max_skeletons = kMaxExactSkeletons;
   bool keep_problem = false;  // every episode's final problem in its result (the ids of its attempts)
@@ -197,8 +207,8 @@ MonteCarloResult run_streaming_episodes(const StreamingRun& streaming, const Wor
                                         const MonteCarloOptions& options);
 
 // Episodes acting while planning (run_concurrent_episode), seeded and parallel as run_episodes.
-// The decision budget is not used (no concurrent allocator is anytime yet). Throws UsageError
-// for live episodes (not there yet for this mode).
+// The decision budget is not used (no concurrent allocator is anytime yet). Live episodes
+// (MonteCarloOptions::live) are live ConcurrentSessions on each world's clock.
 MonteCarloResult run_concurrent_episodes(const ConcurrentMdp& mdp, const WorldFactory& worlds,
                                          const ConcurrentAllocatorFactory& allocators,
                                          const MonteCarloOptions& options);

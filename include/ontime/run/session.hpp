@@ -48,6 +48,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -56,37 +57,11 @@
 #include "ontime/allocators/decision_budget.hpp"
 #include "ontime/mdp/mdp.hpp"
 #include "ontime/run/clock.hpp"
+#include "ontime/run/live_ledger.hpp"
 #include "ontime/run/world.hpp"
+#include "ontime/util/error.hpp"
 
 namespace ontime {
-
-struct LiveOptions {
-  // Share of a slice an anytime allocator may think per decision when the caller passes no
-  // budget of its own; in (0, 1e6].
-  double decision_share = 0.5;
-};
-
-// One step of a live session, in seconds since the session began.
-struct LiveStep {
-  int skeleton = -1;
-  int action = -1;               // -1: an idle step
-  double start = 0;              // when the decision began
-  double outside_seconds = 0;    // caller's time since the previous report (or the start)
-  double decision_seconds = 0;   // the allocator's thinking
-  double planning_seconds = 0;   // the planner's call: its slice and any overrun
-  double overrun_seconds = 0;    // beyond the slice
-  double observe_seconds = 0;    // the allocator taking in the outcome (a search moving its tree)
-  Steps steps_charged = 0;       // CT after the report minus CT before the decision
-  bool refined = false;          // the call found a motion
-  double execution_seconds = 0;  // of that motion, when refined
-};
-
-// What a live session charged, in seconds (decision: the allocator's choices and what it did with
-// their outcomes).
-struct LiveTotals {
-  double decision = 0, planning = 0, overrun = 0, outside = 0;
-  double elapsed = 0;  // at the end of the session (or now, while it runs)
-};
 
 struct Decision {
   int skeleton = -1;  // the allocator's (or the caller's) choice
@@ -267,7 +242,7 @@ class Session {
   std::vector<ActionAttempt> take_attempts() noexcept { return std::move(attempts_); }
 
   // Whether the session runs on a Clock's seconds (made with one) rather than on steps.
-  bool is_live() const noexcept { return clock_ != nullptr; }
+  bool is_live() const noexcept { return live_.is_live(); }
   // Whether an allocator decides (choose()) rather than the caller (decide()).
   bool has_allocator() const noexcept { return allocator_ != nullptr; }
   // Live sessions: D * step_seconds, the seconds gone (frozen when the session ended), the
@@ -276,7 +251,9 @@ class Session {
   double deadline_seconds() const noexcept;
   double elapsed_seconds() const;
   // One entry per step; its skeleton index is the one at the time of the step.
-  const std::vector<LiveStep>& timeline() const noexcept { return timeline_; }
+  const std::vector<LiveStep>& timeline() const noexcept { return live_.timeline(); }
+  // After a live success, the plan's execution: its actions back to back from the success on.
+  const std::vector<LiveExecution>& executions() const noexcept { return live_.executions(); }
   LiveTotals totals() const;
   // Live sessions: the same planner calls judged by the model's step clock (one step per call,
   // steps of execution, nothing charged for thinking or overruns): success or failure once that
@@ -299,23 +276,19 @@ class Session {
   Decision choose_live(const DecisionBudget& budget);
   Decision decide_live(int skeleton);
   Decision record_live_decision(int choice, double begin, Steps steps_before);
+  // A live success: the plan's actions executed back to back from `elapsed` seconds on.
+  void record_plan_execution(int skeleton, double elapsed);
   Status report_live(int choice, int action, const Observation& observation, double execution_seconds);
-  // The search iterations the allocator has run so far (its "iterations" counter; 0 if none).
-  std::uint64_t search_iterations() const;
   Status report(const Observation& observation, double execution_seconds);
-  // The whole slices an execution of `execution_seconds` takes (kNever for infinity); UsageError
-  // for a negative or NaN time.
-  Steps execution_steps(double execution_seconds) const;
-  Steps steps_at(double seconds) const noexcept;
   void end_if_out_of_time();
   // A backtrack of the action `backtracking` blaming `culprit` (SPEC §7): the attempts of the
   // culprit and of every action below it end (attempts_[a].ended), and theirs start anew.
   void end_attempts_below(int culprit, int backtracking);
   // No skeleton can succeed and none is expected to come.
   bool out_of_skeletons() const;
-  // Replaces the skeletons (add_skeleton, retire_skeleton) and carries the state over.
-  void change_skeletons(std::vector<Action> actions, std::vector<std::vector<int>> skeletons,
-                        std::vector<SkeletonReward> rewards);
+  // Replaces the problem (add_skeleton, retire_skeleton, revise_distributions: the same actions, in
+  // the same order, and maybe more) and carries the state over.
+  void change_skeletons(Problem next);
   State carried_over(const State& old, const Problem& next) const;
 
   const Mdp* mdp_;
@@ -354,20 +327,33 @@ class Session {
   bool more_expected_ = false;  // expect_more_skeletons()
 
   // Live sessions only.
-  const Clock* clock_ = nullptr;
-  LiveOptions live_;
-  double step_seconds_ = 1;
-  double started_ = 0;
-  double charged_outside_ = 0;  // charge_outside() so far
-  double last_report_ = 0;      // clock time of the last report (or the start)
-  double decided_at_ = 0;       // clock time the pending decision was made
-  double ended_at_ = -1;        // elapsed seconds when the session ended
+  LiveLedger live_;
   double finish_seconds_ = -1;  // live success: when the plan's execution ends, elapsed seconds
   State model_state_;           // the step clock's state
   Status model_status_ = Status::running;
-  std::vector<LiveStep> timeline_;
-  LiveTotals totals_;
 };
+
+// Sessions whose skeletons change (Session, ConcurrentSession): the allocator `make_allocator` makes
+// for `mdp`, null without a maker. Throws UsageError when the maker returns none.
+template <class Maker, class AnyMdp>
+auto made_allocator(const Maker& make_allocator, const AnyMdp& mdp) -> decltype(make_allocator(mdp)) {
+  if (!make_allocator) return nullptr;
+  auto allocator = make_allocator(mdp);
+  if (!allocator) throw UsageError("the allocator maker returned no allocator");
+  return allocator;
+}
+
+// Sessions whose skeletons change (Session, ConcurrentSession): `current` with one more skeleton,
+// `action_ids` in order, the actions it does not know among `new_actions` (appended in their
+// order), worth `reward`. Throws UsageError for an action in neither, or a broken rule of the problem.
+Problem with_added_skeleton(const Problem& current, const std::vector<std::string>& action_ids,
+                            std::vector<Action> new_actions, SkeletonReward reward = {});
+// `current` without skeleton k (its actions stay); nullopt when k is the last skeleton (a problem
+// has one at least). Throws UsageError for k out of range.
+std::optional<Problem> without_skeleton(const Problem& current, int k);
+// `current`'s name, deadline, step, description and chains with these actions, skeletons and rewards.
+Problem with_skeletons(const Problem& current, std::vector<Action> actions, std::vector<std::vector<int>> skeletons,
+                       std::vector<SkeletonReward> rewards);
 
 // Inline, so that the runner's loop pays for no more than the calls it would make itself.
 inline Status Session::carry_out(World& world) {

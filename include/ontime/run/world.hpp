@@ -60,6 +60,11 @@ class World {
   // the next action indices of the episode's problem, in the order of new_actions. The default:
   // a world of fixed skeletons, which has none to add.
   virtual std::optional<FoundSkeleton> next_skeleton() { return std::nullopt; }
+  // Acting while planning (SPEC §10): the robot committed to the executed prefix `executed` (action
+  // indices of the episode's problem, in order). A world with a task planner streams only skeletons
+  // through it from now on (the executed prefix followed by a path from where it ends). The
+  // default: nothing to do.
+  virtual void commit(const std::vector<int>& executed) { (void)executed; }
 };
 
 using WorldFactory = std::function<std::unique_ptr<World>()>;

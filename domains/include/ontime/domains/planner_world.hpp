@@ -109,6 +109,9 @@ class PlannerWorld final : public World {
   // (nullptr) in the wall-clock unit, where planner calls take the time they take.
   const Clock* clock() const noexcept override;
   std::optional<FoundSkeleton> next_skeleton() override;
+  // Streaming worlds acting while planning: from now on the task planner's skeletons that do not
+  // begin with the domain actions of `executed` are passed over.
+  void commit(const std::vector<int>& executed) override;
   // Streaming worlds: the library the distributions of the skeletons found from now on come from
   // (e.g. an online belief's, between two episodes); it must outlive its use and have the
   // library's step. Throws std::invalid_argument for a world that does not stream or another step.
@@ -127,7 +130,8 @@ class PlannerWorld final : public World {
   // Streaming worlds only.
   StreamingWorldOptions streaming_;
   std::unique_ptr<TaskPlanner> task_planner_;
-  std::vector<std::string> node_ids_;  // by action index: the id in the episode's problem
+  std::vector<std::string> node_ids_;   // by action index: the id in the episode's problem
+  std::vector<std::string> committed_;  // the domain actions the robot committed to (commit)
   std::uint64_t seed_ = 0;
   std::vector<std::unique_ptr<Refinement>> refinements_;  // by action, in this episode
   std::vector<std::uint64_t> attempts_;                   // by action: attempts before the current one

@@ -27,7 +27,10 @@ namespace ontime::domains::report {
 const char* status_name(Status status) noexcept;
 
 // One row per step of a live episode (skeleton, action id, start, the seconds charged, refined,
-// execution seconds): what the timeline picture draws.
+// execution seconds; then its lane, "planning", or "start" for a start of the robot acting while
+// planning with the execution's start and end), then one row per execution of the robot (lane
+// "execution", skeleton -1, action id, start, execution seconds, start and end): what the timeline
+// picture draws.
 std::string timeline_csv(const Problem& problem, const EpisodeResult& result);
 // The execution seconds of the plan a successful live episode executed (0 otherwise).
 double executed_plan_seconds(const Problem& problem, const EpisodeResult& result);

@@ -47,6 +47,11 @@ struct TampOptions {
   std::uint64_t episodes = 100;  // with `adaptation`: per sequence
   std::uint64_t seed = 1;        // episode e uses stream e of it (episode e of sequence r: r * episodes + e)
   std::optional<TampAdaptation> adaptation;
+  // Concurrent: the robot acts while planning (SPEC §10): each episode a live ConcurrentSession that
+  // owns its skeletons, the allocator by its commit rule. After each start the skeletons not through
+  // what the robot executed retire and the task planner streams only paths through it (the executed
+  // prefix followed by a path from the room where it ends). Not with `adaptation`.
+  Acting acting = Acting::plan_first;
   unsigned threads = 0;         // 0: one per hardware thread
   double task_seconds = 0.5;    // search seconds charged for each skeleton found
   int arrival_period = 2;       // steps between two skeletons (sooner when none found can still succeed)
