@@ -155,6 +155,22 @@ int ConcurrentMdp::forced_start(const ConcurrentState& state) const noexcept {
   return child;
 }
 
+std::vector<ConcurrentMdp::Move> ConcurrentMdp::useful_moves(const ConcurrentState& state) const {
+  std::vector<Move> moves;
+  if (!any_live(state)) return moves;
+  if (const int forced = forced_start(state); forced >= 0) {
+    moves.push_back({forced, kWait});
+    return moves;
+  }
+  if (time(state) < deadline_) {
+    const ChoiceList choices = refine_choices(state);
+    if (choices.empty()) moves.push_back({-1, kWait});
+    for (const int choice : choices) moves.push_back({-1, choice});
+  }
+  for (const int action : startable(state)) moves.push_back({action, kWait});
+  return moves;
+}
+
 ConcurrentMdp::StartOutcome ConcurrentMdp::start_action(const ConcurrentState& state, int action) const {
   const std::vector<int> children = startable(state);
   if (!std::binary_search(children.begin(), children.end(), action)) {

@@ -477,7 +477,7 @@ TEST(Cli, RunActsWhilePlanningWithTheRealPlanner) {
            {{"--solver", "dp-rerun", "--live"}, "live episodes (--live, --effort wall) acting while planning"},
            {{"--solver", "dp-rerun", "--belief", testing::source_path("data/instances/navigation.json").string()},
             "--belief: acting"},
-           {{"--solver", "mcts"}, "'mcts' does not act while planning"}}) {
+           {{"--solver", "ppo"}, "'ppo' does not act while planning"}}) {
     std::vector<std::string> command{"run", "--domain", "navigation", "--episodes", "2", "--act", "concurrent"};
     command.insert(command.end(), arguments.begin(), arguments.end());
     const auto refused = ontime(command);

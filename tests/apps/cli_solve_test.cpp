@@ -76,8 +76,8 @@ TEST(Cli, SolveActsWhilePlanningWhenAsked) {
       {{"solve", instance, "--method", "search"}, "solved by --method memoised only"},
       {{"solve", instance, "--tolerance", "0.1"}, "--tolerance is for the layered solver"},
       {{"solve", instance, "--max-seconds", "5"}, "--max-seconds is for the layered solver"},
-      {{"evaluate", instance, "--solver", "mcts", "--episodes", "10"}, "'mcts' does not act while planning"},
-      {{"table", instance, "--episodes", "10", "--solvers", "mcts"}, "'mcts' does not act while planning"},
+      {{"evaluate", instance, "--solver", "ppo", "--episodes", "10"}, "'ppo' does not act while planning"},
+      {{"table", instance, "--episodes", "10", "--solvers", "ppo"}, "'ppo' does not act while planning"},
       {{"solve", paper("instance1"), "--act", "interleaved"}, "--act"},
   };
   for (const auto& [arguments, message] : refused) {
