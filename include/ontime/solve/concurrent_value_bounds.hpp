@@ -15,13 +15,18 @@
 //   planning and execution time a fixed latent draw, any policy that ends the episode through k
 //   has refined and started each of k's actions no sooner than the devoted policy, so it succeeds
 //   only where the devoted policy does, and earns at most its reward (SPEC §8's rewards do not
-//   rise with the finish); the union of these events over k bounds V*.
+//   rise with the finish); the union of these events over k bounds V*. Without rewards, also
+//   1 - prod over groups g of (1 - min(1, sum over k in g of P_k)), the skeletons grouped by their
+//   next unrefined action: groups share no unrefined action, so their events are independent.
 // docs/theory.md, "Acting while planning", has the proofs. A state where no skeleton can finish
 // is worth 0; without rewards one with a live skeleton refined in full is worth 1 (both exact).
 //
-// Cost: per state O(K^2) to find the eligible skeletons plus K queries of
+// Cost: per state O(K^2) to find the eligible skeletons and group them, plus K queries of
 // ConcurrentContiguousSuccess (each a sum over at most D - CT planning steps of memoised values);
 // memory: that memo. Not thread-safe (the memo): one object per thread.
+
+#include <utility>
+#include <vector>
 
 #include "ontime/mdp/concurrent_mdp.hpp"
 #include "ontime/solve/concurrent_contiguous_success.hpp"
@@ -51,6 +56,7 @@ class ConcurrentValueBounds {
 
   const ConcurrentMdp* mdp_;
   ConcurrentContiguousSuccess devoted_;
+  std::vector<std::pair<int, double>> groups_;  // scratch: next unrefined action, summed devoted values
 };
 
 }  // namespace ontime
