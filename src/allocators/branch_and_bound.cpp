@@ -224,6 +224,10 @@ AllocatorKind branch_and_bound_kind() {
           "the search's: starts an action when starting has the best certified lower end (the "
           "optimum's where the search closes)",
       .make_concurrent = [](const ConcurrentMdp& mdp, const ParameterReader& parameters) -> ConcurrentAllocatorFactory {
+        if (parameters.given("trials")) {
+          throw UsageError(
+              "parameter 'trials': acting while planning (SPEC §10) the search is all trials; it takes no share");
+        }
         BranchAndBoundOptions options;
         options.budget = detail::default_budget(parameters);
         options.max_states = parameters.integer("max-states");

@@ -14,6 +14,7 @@
 #include "ontime/mdp/concurrent_mdp.hpp"
 #include "ontime/run/evaluation.hpp"
 #include "ontime/solve/concurrent_solver.hpp"
+#include "ontime/util/error.hpp"
 #include "ontime/util/random.hpp"
 #include "support/paper.hpp"
 #include "support/random_instances.hpp"
@@ -73,6 +74,19 @@ TEST(ConcurrentSearchAllocators, MctsAndBranchAndBoundPlayAllowedMovesOnly) {
     }
   }
   EXPECT_GT(moves, 4 * count);
+}
+
+TEST(ConcurrentSearchAllocators, OptionsWithoutAMeaningInThisModeAreRefused) {
+  const ConcurrentMdp mdp(testing::paper_instance("instance1").with_acting(Acting::concurrent));
+  try {
+    (void)make_concurrent_allocator_factory("branch-and-bound", mdp, {{"trials", "0.3"}});
+    ADD_FAILURE() << "trials was accepted";
+  } catch (const UsageError& error) {
+    EXPECT_NE(std::string(error.what()).find("parameter 'trials'"), std::string::npos) << error.what();
+  }
+  EXPECT_THROW((void)make_concurrent_allocator_factory("mcts", mdp, {{"leaf", "upper"}}), UsageError);  // needs bellman
+  EXPECT_NO_THROW((void)make_concurrent_allocator_factory("mcts", mdp, {{"rollout", "dp-rerun"}}));
+  EXPECT_THROW((void)make_concurrent_allocator_factory("mcts", mdp, {{"rollout", "thompson"}}), UsageError);
 }
 
 TEST(ConcurrentSearchAllocators, BranchAndBoundWithoutALimitMakesOptimalMoves) {
