@@ -48,6 +48,23 @@ def test_the_same_figures_as_the_command_line(cli):
     assert from_python["first_choice"] == from_cli["first_choice"]
 
 
+def test_backtracking_acting_while_planning_as_the_command_line(cli):
+    """SPEC §7 with §10: the kitchen whose placements may blame their grasps gains by acting while
+    planning; dp-rerun, whose Eq. (1) has no give-up term, is refused; chains are refused."""
+    kitchen = PAPER.parent / "kitchen-grasps.json"
+    from_cli = cli("solve", str(kitchen), "--act", "concurrent", "--json", "--no-timing")
+    concurrent = ontime.solve(kitchen, act="concurrent")
+    assert concurrent["optimal_success_probability"] == from_cli["optimal_success_probability"]
+    assert concurrent["optimal_success_probability"] > \
+        ontime.solve(kitchen, method="memoised")["optimal_success_probability"] + 0.01
+    exact = ontime.evaluate(kitchen, "optimal", act="concurrent", episodes=200, exact=True)
+    assert exact["exact_success_probability"] == concurrent["optimal_success_probability"]
+    with pytest.raises(ontime.UsageError, match=r"do not value backtracking \(SPEC §7\)"):
+        ontime.evaluate(kitchen, "dp-rerun", act="concurrent", episodes=10)
+    with pytest.raises(ontime.UsageError, match=r"SPEC §9"):
+        ontime.solve(PAPER.parent / "chains" / "cup-through-the-door.json", act="concurrent")
+
+
 @pytest.mark.parametrize("arguments, message", [
     ({"act": "interleaved"}, "act must be 'plan-first' or 'concurrent'"),
     ({"act": 1}, "act must be 'plan-first' or 'concurrent'"),

@@ -24,6 +24,21 @@ void plan_first_view(const ConcurrentMdp& mdp, const ConcurrentState& state, Sta
     const std::int64_t robot_needs = mdp.robot_free(state, k) - ConcurrentMdp::time(state);
     view.execution[slot] = static_cast<std::uint16_t>(std::min(robot_needs, too_late));
   }
+  if (!mdp.has_backtracking()) return;
+  // SPEC §7's restore value B_c of a culprit refined after E: the robot's backlog before it, so
+  // that a backtrack the plan-first allocator foresees restores what acting would.
+  for (int slot = 0; slot < problem.culprit_slot_count(); ++slot) view.restore[static_cast<std::size_t>(slot)] = 0;
+  for (int k = 0; k < mdp.skeleton_count(); ++k) {
+    if (!ConcurrentMdp::is_live(state, k)) continue;
+    std::int64_t backlog = ConcurrentMdp::robot_left(state);
+    for (int j = mdp.executed_depth(state); j < ConcurrentMdp::refined(state, k); ++j) {
+      const int action = problem.action_at(k, j);
+      if (const int culprit_slot = problem.culprit_slot(action); culprit_slot >= 0) {
+        view.restore[static_cast<std::size_t>(culprit_slot)] = static_cast<std::uint16_t>(std::min(backlog, too_late));
+      }
+      backlog += mdp.execution(state, action);
+    }
+  }
 }
 
 EagerCommitAllocator::EagerCommitAllocator(const ConcurrentMdp& mdp, std::unique_ptr<Allocator> plan_first)

@@ -114,6 +114,7 @@ AllocatorKind dp_rerun_kind() {
           "back to back while the rest is planned)",
       .make_concurrent = [](const ConcurrentMdp& mdp, const ParameterReader& parameters) -> ConcurrentAllocatorFactory {
         const Aggregation aggregation = parse_aggregation(parameters.text("aggregation"));
+        ConcurrentContiguousSuccess::check_supported(mdp);
         return
             [model = &mdp, aggregation] { return std::make_unique<ConcurrentDpRerunAllocator>(*model, aggregation); };
       }};

@@ -10,7 +10,6 @@ namespace {
 const Problem& refuse_unmodelled(const Problem& problem) {
   const std::string rule = " with acting \"concurrent\" (SPEC §10) is not modelled yet: solve " + problem.name() +
                            " plan-first (--act plan-first)";
-  if (problem.has_backtracking()) throw UsageError(problem.name() + ": backtracking (SPEC §7)" + rule);
   if (problem.is_timed())
     throw UsageError(problem.name() + ": exogenous chains or actions that expire (SPEC §9)" + rule);
   return problem;
@@ -23,7 +22,14 @@ ConcurrentMdp::ConcurrentMdp(const Problem& problem)
       mdp_(*problem_),
       deadline_(problem.deadline()),
       skeleton_count_(problem.skeleton_count()),
-      action_count_(problem.action_count()) {
+      action_count_(problem.action_count()),
+      backtracking_(problem.has_backtracking()),
+      culprit_(static_cast<std::size_t>(problem.action_count()), 0) {
+  for (int a = 0; a < action_count_; ++a) {
+    for (const Problem::CulpritIndex& culprit : problem_->culprits(a)) {
+      if (culprit.probability > 0) culprit_[static_cast<std::size_t>(culprit.action)] = 1;
+    }
+  }
   const auto deadline = static_cast<std::size_t>(deadline_);
   next_finish_.assign(static_cast<std::size_t>(action_count_) * (deadline + 1), kNever);
   fastest_execution_.assign(static_cast<std::size_t>(action_count_), kNever);
@@ -56,7 +62,8 @@ ConcurrentState ConcurrentMdp::start() const {
 
 bool ConcurrentMdp::any_live(const ConcurrentState& state) const noexcept {
   for (int k = 0; k < skeleton_count_; ++k) {
-    if (is_live(state, k)) return true;
+    // Without backtracking a kept skeleton can finish (canonicalise drops the others).
+    if (is_live(state, k) && (!backtracking_ || can_finish(state, k))) return true;
   }
   return false;
 }
@@ -85,17 +92,34 @@ std::int64_t ConcurrentMdp::earliest_finish(const ConcurrentState& state, int k)
   const int refined_count = refined(state, k);
   std::int64_t robot_free = std::int64_t{time(state)} + robot_left(state);
   std::int64_t planned = time(state);  // the planner, on k alone
+  // With backtracking: at or below a culprit, so that a give-up may discard the motion (a culprit
+  // executed too: SPEC §10 discards what was refined below it and not started).
+  bool discardable = false;
+  for (int j = 0; backtracking_ && j < executed_depth(state); ++j) {
+    discardable = discardable || culprit_[static_cast<std::size_t>(problem_->action_at(k, j))] != 0;
+  }
+  const auto planning_from = [&](int action, Steps pt) {
+    return pt > deadline_ ? kNever
+                          : next_finish_[static_cast<std::size_t>(action) * stride + static_cast<std::size_t>(pt)];
+  };
   for (int j = executed_depth(state); j < length; ++j) {
     const int action = problem_->action_at(k, j);
+    const Steps fastest = fastest_execution_[static_cast<std::size_t>(action)];
+    discardable = discardable || (backtracking_ && culprit_[static_cast<std::size_t>(action)] != 0);
     if (j < refined_count) {
-      robot_free += execution(state, action);  // refined: it can start as soon as the robot is free
+      // Refined: it can start as soon as the robot is free (found again, no sooner than now).
+      if (!discardable) {
+        robot_free += execution(state, action);
+      } else if (fastest == kNever) {
+        return Mdp::kUnreachableNeed;
+      } else {
+        robot_free += std::min<std::int64_t>(execution(state, action), fastest);
+      }
       continue;
     }
-    const Steps pt = j == refined_count ? spent(state, k) : 0;
-    const Steps planning = pt > deadline_
-                               ? kNever
-                               : next_finish_[static_cast<std::size_t>(action) * stride + static_cast<std::size_t>(pt)];
-    const Steps fastest = fastest_execution_[static_cast<std::size_t>(action)];
+    Steps planning = planning_from(action, j == refined_count ? spent(state, k) : 0);
+    // With backtracking the attempt may give up (or be discarded) and start again from 0.
+    if (backtracking_ && j == refined_count) planning = std::min(planning, planning_from(action, 0));
     if (planning == kNever || fastest == kNever) return Mdp::kUnreachableNeed;
     planned += planning;
     robot_free = std::max(robot_free, planned) + fastest;
@@ -107,7 +131,9 @@ void ConcurrentMdp::canonicalise(ConcurrentState& state) const {
   const int depth = executed_depth(state);
   for (int k = 0; k < skeleton_count_; ++k) {
     if (!is_live(state, k)) continue;
-    if (!through_executed(state, k) || problem_->skeleton_length(k) <= depth || earliest_finish(state, k) > deadline_) {
+    // With backtracking a skeleton that cannot finish now may again (class comment): it is kept.
+    if (!through_executed(state, k) || problem_->skeleton_length(k) <= depth ||
+        (!backtracking_ && earliest_finish(state, k) > deadline_)) {
       refined_word(state, k) = kDropped;
       spent_word(state, k) = 0;
     }
@@ -142,7 +168,7 @@ std::vector<int> ConcurrentMdp::startable(const ConcurrentState& state) const {
 }
 
 int ConcurrentMdp::forced_start(const ConcurrentState& state) const noexcept {
-  if (robot_left(state) > 0) return -1;
+  if (backtracking_ || robot_left(state) > 0) return -1;
   const int depth = executed_depth(state);
   int child = -1;
   for (int k = 0; k < skeleton_count_; ++k) {
@@ -164,8 +190,9 @@ std::vector<ConcurrentMdp::Move> ConcurrentMdp::useful_moves(const ConcurrentSta
   }
   if (time(state) < deadline_) {
     const ChoiceList choices = refine_choices(state);
-    if (choices.empty()) moves.push_back({-1, kWait});
     for (const int choice : choices) moves.push_back({-1, choice});
+    // With backtracking an attempt may discard motions: an idle planner is a move of its own.
+    if (choices.empty() || backtracking_) moves.push_back({-1, kWait});
   }
   for (const int action : startable(state)) moves.push_back({action, kWait});
   return moves;
@@ -216,11 +243,6 @@ ChoiceList ConcurrentMdp::refine_choices(const ConcurrentState& state) const {
 }
 
 ConcurrentState ConcurrentMdp::step(const ConcurrentState& state, int choice, const Observation& observation) const {
-  if (observation.is_backtrack()) {
-    throw UsageError(
-        "a backtrack cannot be reported when acting while planning (SPEC §10): backtracking (SPEC §7) "
-        "is not modelled in this mode");
-  }
   if (time(state) >= deadline_) {
     throw UsageError("no step is left at the deadline (step " + std::to_string(deadline_) + ")");
   }
@@ -228,7 +250,9 @@ ConcurrentState ConcurrentMdp::step(const ConcurrentState& state, int choice, co
   ++next[0];
   if (next[1] > 0) --next[1];
   if (choice == kWait) {
-    if (observation.refined) throw UsageError("a motion cannot be found in a step in which the planner idles");
+    if (observation.refined || observation.is_backtrack()) {
+      throw UsageError("a motion cannot be found, nor an attempt give up, in a step in which the planner idles");
+    }
     canonicalise(next);
     return next;
   }
@@ -237,6 +261,17 @@ ConcurrentState ConcurrentMdp::step(const ConcurrentState& state, int choice, co
     reject_choice(choice);
   }
   const int action = problem_->action_at(choice, refined(state, choice));
+  if (observation.is_backtrack()) {
+    const auto culprits = problem_->culprits(action);
+    if (std::none_of(culprits.begin(), culprits.end(),
+                     [&](const Problem::CulpritIndex& culprit) { return culprit.action == observation.culprit; })) {
+      throw UsageError("action " + problem_->action(action).id + " cannot blame action " +
+                       problem_->action(observation.culprit).id + ": not one of its culprits (SPEC §7)");
+    }
+    give_up(next, state, action, observation.culprit);
+    canonicalise(next);
+    return next;
+  }
   if (observation.refined) {
     const Steps saturated = std::min<Steps>(observation.execution, deadline_ + 1);
     execution_word(next, action) = static_cast<std::uint16_t>(saturated);
@@ -267,7 +302,11 @@ ConcurrentState ConcurrentMdp::execution_finished(const ConcurrentState& state) 
 
 int ConcurrentMdp::complete_plan(const ConcurrentState& state) const noexcept {
   for (int k = 0; k < skeleton_count_; ++k) {
-    if (is_live(state, k) && refined(state, k) == problem_->skeleton_length(k)) return k;
+    // Without backtracking a kept skeleton refined in full ends by D (its earliest finish).
+    if (is_live(state, k) && refined(state, k) == problem_->skeleton_length(k) &&
+        (!backtracking_ || robot_free(state, k) <= deadline_)) {
+      return k;
+    }
   }
   return -1;
 }
@@ -279,11 +318,33 @@ ConcurrentMdp::Move ConcurrentMdp::run_complete_plan(const ConcurrentState& stat
 }
 
 bool ConcurrentMdp::certain_success(const ConcurrentState& state) const noexcept {
-  if (problem_->has_rewards()) return false;
-  for (int k = 0; k < skeleton_count_; ++k) {
-    if (is_live(state, k) && refined(state, k) == problem_->skeleton_length(k)) return true;
+  return !problem_->has_rewards() && complete_plan(state) >= 0;
+}
+
+void ConcurrentMdp::give_up(ConcurrentState& next, const ConcurrentState& state, int action, int culprit) const {
+  const int depth = executed_depth(state);
+  const int position = problem_->position(culprit);
+  if (position < depth) {
+    // The culprit's motion is executed (or executing): it cannot be given up. What was refined
+    // below it and not started is discarded as SPEC §7 says (every live skeleton goes back to E,
+    // its effort lost), and the action that gave up is blocked with the skeletons through it.
+    for (int m = 0; m < skeleton_count_; ++m) {
+      if (!is_live(state, m)) continue;
+      const bool through_blocked =
+          std::binary_search(problem_->members(action).begin(), problem_->members(action).end(), m);
+      refined_word(next, m) = through_blocked ? kDropped : static_cast<std::uint16_t>(depth);
+      spent_word(next, m) = 0;
+    }
+    return;
   }
-  return false;
+  // SPEC §7: every skeleton through the culprit that refined it goes back to it; canonicalise
+  // forgets the executions of the culprit and of what was refined below it.
+  for (const int m : problem_->members(culprit)) {
+    if (is_live(state, m) && refined(state, m) > position) {
+      refined_word(next, m) = static_cast<std::uint16_t>(position);
+      spent_word(next, m) = 0;
+    }
+  }
 }
 
 void ConcurrentMdp::reject_choice(int choice) {

@@ -1,11 +1,25 @@
 #include "ontime/solve/concurrent_contiguous_success.hpp"
 
 #include <algorithm>
+#include <string>
+
+#include "ontime/util/error.hpp"
 
 namespace ontime {
 
 ConcurrentContiguousSuccess::ConcurrentContiguousSuccess(const ConcurrentMdp& mdp, Aggregation aggregation)
-    : mdp_(&mdp), aggregation_(aggregation), deadline_(mdp.deadline()) {}
+    : mdp_(&mdp), aggregation_(aggregation), deadline_(mdp.deadline()) {
+  check_supported(mdp);
+}
+
+void ConcurrentContiguousSuccess::check_supported(const ConcurrentMdp& mdp) {
+  if (mdp.has_backtracking()) {
+    throw UsageError(mdp.problem().name() +
+                     ": dp and dp-rerun acting while planning (SPEC §10) do not value backtracking (SPEC §7) yet: "
+                     "Eq. (1) acting while planning has no give-up term (the optimal allocator and the eager "
+                     "kinds take it)");
+  }
+}
 
 // value, fresh and after_found recurse one level per action of the skeleton (at most
 // Problem::kMaxSkeletonLength deep, whatever the deadline), each level memoised by fresh.

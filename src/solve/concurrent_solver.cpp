@@ -130,6 +130,8 @@ double ConcurrentSolver::solve(const ConcurrentState& root) {
         const ChoiceList choices = mdp.refine_choices(state);
         if (choices.empty()) step_value(ConcurrentMdp::kWait);
         for (const int choice : choices) step_value(choice);
+        // With backtracking an attempt may discard motions: an idle planner is a move of its own.
+        if (!choices.empty() && mdp.has_backtracking()) step_value(ConcurrentMdp::kWait);
       }
       for (const int action : mdp.startable(state)) {
         if (forced < 0 || action == forced) start_value(action);

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,18 @@ double optimum(const ConcurrentMdp& mdp) {
 }
 
 Problem acting(Problem problem) { return problem.with_acting(Acting::concurrent); }
+
+// A random walk's start, one time in two when the robot may start something: true when it started
+// the lowest startable action (`state` moved on), false when that ended the episode, nullopt when
+// it started nothing.
+std::optional<bool> maybe_start(const ConcurrentMdp& mdp, ConcurrentState& state, SplitMix64& generator) {
+  const std::vector<int> starts = mdp.startable(state);
+  if (starts.empty() || generator() % 2 != 0) return std::nullopt;
+  const ConcurrentMdp::StartOutcome started = mdp.start_action(state, starts.front());
+  if (started.ends) return false;
+  state = started.next;
+  return true;
+}
 
 TEST(ConcurrentAllocators, TheKindsWithACommitRuleAreThoseDocumented) {
   const std::vector<std::string> expected = {"optimal",         "mcts",        "dp",
@@ -147,12 +160,9 @@ TEST(ConcurrentAllocators, ThePlanFirstViewNeverPromisesWhatActingCannotKeep) {
           EXPECT_LE(mdp.earliest_finish(state, k), mdp.deadline());
         }
       }
-      const std::vector<int> starts = mdp.startable(state);
-      if (!starts.empty() && generator() % 2 == 0) {
-        const ConcurrentMdp::StartOutcome started = mdp.start_action(state, starts.front());
-        if (started.ends) break;
-        state = started.next;
-        continue;
+      if (const std::optional<bool> started = maybe_start(mdp, state, generator)) {
+        if (*started) continue;
+        break;
       }
       const ChoiceList choices = mdp.refine_choices(state);
       const int choice =
@@ -192,6 +202,75 @@ TEST(ConcurrentAllocators, AnObservedStepIsTheModelsOutcome) {
     }
     EXPECT_THROW((void)mdp.step(start, ConcurrentMdp::kWait, Observation::found(1)), UsageError);
     EXPECT_THROW((void)mdp.step(start, choices[0], Observation::backtracked(0)), UsageError);
+  }
+}
+
+TEST(ConcurrentAllocators, WithBacktrackingAnObservedStepIsTheModelsOutcome) {
+  // Along random walks of instances that backtrack (SPEC §7): every observation a world may report
+  // (not yet, a motion, a give-up naming each culprit) leads where the enumeration does, starts
+  // made on the way so that culprits get executed too.
+  int executed_culprits = 0;
+  for (std::uint64_t seed = 0; seed < 60; ++seed) {
+    const ConcurrentMdp mdp(acting(testing::with_backtracking(testing::random_instance(seed + 1900, 4, 3, 10), seed)));
+    if (!mdp.has_backtracking()) continue;
+    const Mdp& plan_first = mdp.plan_first_mdp();
+    SplitMix64 generator(seed);
+    ConcurrentState state = mdp.start();
+    while (mdp.any_live(state) && ConcurrentMdp::time(state) < mdp.deadline()) {
+      if (const std::optional<bool> started = maybe_start(mdp, state, generator)) {
+        if (*started) continue;
+        break;
+      }
+      const ChoiceList choices = mdp.refine_choices(state);
+      if (choices.empty()) break;
+      const int choice = choices[static_cast<std::size_t>(generator() % choices.size())];
+      const int action = mdp.problem().action_at(choice, ConcurrentMdp::refined(state, choice));
+      const Steps spent = mdp.spent(state, choice);
+      std::vector<ConcurrentState> enumerated;
+      mdp.for_each_step_outcome(state, choice,
+                                [&](double, const ConcurrentState& next) { enumerated.push_back(next); });
+      std::vector<ConcurrentState> observed;
+      const double found = plan_first.hazard(action, spent);
+      const double back = plan_first.backtrack_hazard(action, spent);
+      if (found + back < 1.0) observed.push_back(mdp.step(state, choice, Observation::not_yet()));
+      if (found > 0.0) {
+        for (const Mdp::ExecutionOutcome& outcome : plan_first.execution_outcomes(action)) {
+          observed.push_back(
+              mdp.step(state, choice, Observation::found(outcome.steps > mdp.deadline() ? kNever : outcome.steps)));
+        }
+      }
+      if (back > 0.0) {
+        for (const Problem::CulpritIndex& culprit : mdp.problem().culprits(action)) {
+          if (culprit.probability <= 0) continue;
+          observed.push_back(mdp.step(state, choice, Observation::backtracked(culprit.action)));
+          if (mdp.problem().position(culprit.action) < mdp.executed_depth(state)) ++executed_culprits;
+        }
+      }
+      ASSERT_EQ(observed, enumerated) << "seed " << seed;
+      state = enumerated[static_cast<std::size_t>(generator() % enumerated.size())];
+    }
+  }
+  // The walks met give-ups that blame an executed motion (the rule of SPEC §10 for them).
+  EXPECT_GT(executed_culprits, 0);
+}
+
+TEST(ConcurrentAllocators, WithBacktrackingDpAndDpRerunAreRefusedTheEagerKindsTakeIt) {
+  const ConcurrentMdp mdp(acting(testing::with_backtracking(testing::random_instance(2, 4, 3, 10), 4)));
+  ASSERT_TRUE(mdp.has_backtracking());
+  // branch-and-bound and mcts's bound leaves read bounds that assume no give-up.
+  for (const std::string name : {"dp", "dp-rerun", "branch-and-bound"}) {
+    try {
+      (void)make_concurrent_allocator_factory(name, mdp);
+      FAIL() << name << " took backtracking";
+    } catch (const UsageError& error) {
+      EXPECT_NE(std::string(error.what()).find("SPEC §7"), std::string::npos) << error.what();
+    }
+  }
+  EXPECT_THROW((void)make_concurrent_allocator_factory("mcts", mdp, {{"backup", "bellman"}, {"leaf", "upper"}}),
+               UsageError);
+  for (const std::string name : {"optimal", "greedy", "round-robin", "first-found", "thompson", "mcts"}) {
+    const auto allocator = make_concurrent_allocator_factory(name, mdp)();
+    EXPECT_EQ(allocator->name(), name);
   }
 }
 

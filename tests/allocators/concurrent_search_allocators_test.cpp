@@ -44,9 +44,12 @@ TEST(ConcurrentSearchAllocators, MctsAndBranchAndBoundPlayAllowedMovesOnly) {
   const int count = testing::repetitions_to_check(40);
   int moves = 0;
   for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
-    const ConcurrentMdp mdp(acting_instance(seed));
+    // Every fourth instance backtracks (SPEC §7): mcts with rollouts takes it, branch-and-bound not.
+    const Problem problem = acting_instance(seed);
+    const ConcurrentMdp mdp(seed % 4 == 1 ? testing::with_backtracking(problem, seed) : problem);
     const ParameterValues small{{"iterations", "200"}, {"backup", seed % 2 == 0 ? "bellman" : "mean"}};
     for (const std::string name : {"mcts", "branch-and-bound"}) {
+      if (mdp.has_backtracking() && name == "branch-and-bound") continue;
       const auto allocator = make_concurrent_allocator_factory(name, mdp, small)();
       allocator->begin_episode(seed);
       SplitMix64 world(seed);

@@ -14,6 +14,9 @@
 #include <vector>
 
 #include "apps/cli_test_support.hpp"
+#include "ontime/mdp/concurrent_mdp.hpp"
+#include "ontime/model/instance_io.hpp"
+#include "ontime/solve/concurrent_solver.hpp"
 
 namespace ontime {
 namespace {
@@ -83,6 +86,39 @@ TEST(Cli, SolveActsWhilePlanningWhenAsked) {
   for (const auto& [arguments, message] : refused) {
     const auto result = ontime(arguments);
     EXPECT_EQ(result.exit_code, 2) << arguments[1] << " " << arguments.back() << ": " << result.err;
+    EXPECT_NE(result.err.find(message), std::string::npos) << result.err;
+  }
+}
+
+// Backtracking with acting while planning (SPEC §7, §10): the kitchen whose placements may blame
+// their grasps is solved in the mode, and gains by it; chains are refused naming their rule, and
+// so are dp and dp-rerun, whose Eq. (1) has no give-up term.
+TEST(Cli, SolveActsWhilePlanningWithBacktracking) {
+  const std::string kitchen = testing::source_path("data/instances/kitchen-grasps.json").string();
+  const auto plan_first = ontime({"solve", kitchen, "--json", "--method", "memoised"});
+  ASSERT_EQ(plan_first.exit_code, 0) << plan_first.err;
+  const auto concurrent = ontime({"solve", kitchen, "--json", "--act", "concurrent"});
+  ASSERT_EQ(concurrent.exit_code, 0) << concurrent.err;
+  const double acting = json::parse(concurrent.out)["optimal_success_probability"].get<double>();
+  const ConcurrentMdp mdp(load_problem(kitchen));
+  ConcurrentSolver solver(mdp);
+  EXPECT_EQ(acting, solver.solve(mdp.start()));
+  EXPECT_GT(acting, json::parse(plan_first.out)["optimal_success_probability"].get<double>() + 0.01);
+  const auto optimal = ontime({"evaluate", kitchen, "--act", "concurrent", "--solver", "optimal", "--exact", "--json"});
+  ASSERT_EQ(optimal.exit_code, 0) << optimal.err;
+  EXPECT_EQ(json::parse(optimal.out)["exact_success_probability"].get<double>(), acting);
+
+  const std::string cup = testing::source_path("data/instances/chains/cup-through-the-door.json").string();
+  const std::vector<std::pair<std::vector<std::string>, std::string>> refused{
+      {{"solve", cup, "--act", "concurrent"}, "exogenous chains or actions that expire (SPEC §9)"},
+      {{"evaluate", kitchen, "--act", "concurrent", "--solver", "dp-rerun", "--episodes", "10"},
+       "do not value backtracking (SPEC §7) yet"},
+      {{"evaluate", kitchen, "--act", "concurrent", "--solver", "dp", "--episodes", "10"},
+       "do not value backtracking (SPEC §7) yet"},
+  };
+  for (const auto& [arguments, message] : refused) {
+    const auto result = ontime(arguments);
+    EXPECT_EQ(result.exit_code, 2) << arguments[1] << ": " << result.err;
     EXPECT_NE(result.err.find(message), std::string::npos) << result.err;
   }
 }

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ontime/allocators/allocator_registry.hpp"
@@ -120,6 +121,19 @@ double half_width_of(double value, std::uint64_t episodes) {
   return std::sqrt(std::max(value * (1 - value), 0.0) / static_cast<double>(episodes));
 }
 
+// Allocator `name`'s exact value in `mdp` (the solver's policy mode) and `episodes` of its
+// episodes in the runner's hidden worlds (seed `seed`, 2 threads).
+std::pair<ExactEvaluation, MonteCarloResult> exact_and_sampled(const ConcurrentMdp& mdp, const std::string& name,
+                                                               std::uint64_t episodes, std::uint64_t seed) {
+  const ConcurrentAllocatorFactory factory = make_concurrent_allocator_factory(name, mdp);
+  const auto allocator = factory();
+  MonteCarloOptions options;
+  options.episodes = episodes;
+  options.seed = seed;
+  options.threads = 2;
+  return {evaluate_exactly(mdp, *allocator), run_monte_carlo(mdp, factory, options)};
+}
+
 TEST(ConcurrentEpisodes, TheirMeanRewardIsTheExactValue) {
   // The runner's hidden worlds against ConcurrentSolver's policy mode, for allocators of each
   // kind of commit rule (the optimum's, dp-rerun's own, the eager rule), with and without rewards.
@@ -129,14 +143,7 @@ TEST(ConcurrentEpisodes, TheirMeanRewardIsTheExactValue) {
     const Problem problem = base.with_acting(Acting::concurrent);
     const ConcurrentMdp mdp(problem);
     for (const std::string name : {"optimal", "dp-rerun", "greedy", "round-robin"}) {
-      const ConcurrentAllocatorFactory factory = make_concurrent_allocator_factory(name, mdp);
-      const auto allocator = factory();
-      const ExactEvaluation exact = evaluate_exactly(mdp, *allocator);
-      MonteCarloOptions options;
-      options.episodes = episodes;
-      options.seed = 11;
-      options.threads = 2;
-      const MonteCarloResult sampled = run_monte_carlo(mdp, factory, options);
+      const auto [exact, sampled] = exact_and_sampled(mdp, name, episodes, 11);
       // Rewards lie in [0, 1], so their variance is at most the mean's v(1 - v).
       EXPECT_NEAR(sampled.mean_reward, exact.expected_reward,
                   4 * half_width_of(exact.expected_reward, episodes) + 1e-12)
@@ -144,6 +151,27 @@ TEST(ConcurrentEpisodes, TheirMeanRewardIsTheExactValue) {
       EXPECT_NEAR(sampled.success_rate, exact.success_probability,
                   4 * half_width_of(exact.success_probability, episodes) + 1e-12)
           << problem.name() << " " << name;
+    }
+  }
+}
+
+TEST(ConcurrentEpisodes, WithBacktrackingTheirSuccessIsTheExactValue) {
+  // The hidden worlds draw every attempt's end, give-ups and culprits included (SPEC §7), and
+  // start new attempts below a culprit as the model discards them (SPEC §10).
+  const auto episodes = static_cast<std::uint64_t>(testing::repetitions_to_check(20'000));
+  for (const std::uint64_t seed : {4U, 9U}) {
+    const Problem problem =
+        testing::with_backtracking(testing::random_instance(seed + 40, 4, 3, 10), seed).with_acting(Acting::concurrent);
+    ASSERT_TRUE(problem.has_backtracking());
+    const ConcurrentMdp mdp(problem);
+    for (const std::string name : {"optimal", "greedy", "round-robin"}) {
+      const auto [exact, sampled] = exact_and_sampled(mdp, name, episodes, 13);
+      EXPECT_NEAR(sampled.success_rate, exact.success_probability,
+                  4 * half_width_of(exact.success_probability, episodes) + 1e-12)
+          << "seed " << seed << " " << name;
+      // Neither sure nor hopeless, so that the comparison can tell.
+      EXPECT_GT(exact.success_probability, 0.05) << "seed " << seed << " " << name;
+      EXPECT_LT(exact.success_probability, 0.95) << "seed " << seed << " " << name;
     }
   }
 }

@@ -1,6 +1,7 @@
 // Acting while planning (SPEC §10): the exact solver of ConcurrentMdp against the independent
 // reference recursion on random instances, with and without rewards; plan-first as one policy of
-// the model; cases valued by hand; the paper's instances; what the model does not take yet.
+// the model; with backtracking (SPEC §7); cases valued by hand; the paper's instances; what the
+// model does not take yet.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -67,6 +68,73 @@ TEST(Concurrent, TheExpectedRewardIsTheReferenceRecursions) {
   // With rewards a finish that comes sooner is worth more, so it pays more often.
   std::printf("acting while planning worth more on %d of %d\n", better, count);
   EXPECT_GT(better, count / 10);
+}
+
+TEST(Concurrent, WithBacktrackingTheOptimumIsTheReferenceRecursions) {
+  // SPEC §7 read with §10: a give-up blaming a motion not executed sends its skeletons back to it;
+  // blaming an executed one blocks the action that gave up. The reference's plan-first policies
+  // are SPEC §7's plan-first optimum (OptimalSolver with backtracking).
+  const int count = testing::repetitions_to_check(300);
+  int better = 0;
+  int rewarded = 0;
+  for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
+    Problem problem = testing::with_backtracking(testing::random_instance(seed + 3000, 4, 3, 10), seed);
+    // Every third instance with rewards too (SPEC §8).
+    if (seed % 3 == 0) {
+      problem = testing::with_random_rewards(problem, seed);
+      ++rewarded;
+    }
+    if (!problem.has_backtracking()) continue;
+    better += check_against_reference(problem, "seed " + std::to_string(seed)) ? 1 : 0;
+  }
+  std::printf("with backtracking, acting while planning worth more on %d of %d (%d with rewards)\n", better, count,
+              rewarded);
+  EXPECT_GT(better, count / 10);
+}
+
+Problem blamed_grasp(Steps deadline) {
+  // a is found in 1 step and runs 2; b's attempt gives up after 1 step (blaming a) or finds a
+  // motion after 2, each with probability 1/2, and runs 1.
+  return parse_problem(R"({"deadline": )" + std::to_string(deadline) + R"(,
+    "actions": {"a": {"planning": {"pmf": {"1": 1}}, "execution": {"pmf": {"2": 1}}},
+                "b": {"planning": {"pmf": {"2": 0.5}}, "backtrack": {"pmf": {"1": 0.5}},
+                      "culprits": {"a": 1}, "execution": {"pmf": {"1": 1}}}},
+    "skeletons": [["a", "b"]]})",
+                       "blamed-grasp");
+}
+
+TEST(Concurrent, WithBacktrackingTheRobotWaitsRatherThanCommitToAMotionThatMayBeBlamed) {
+  // Deadline 6. Starting a as soon as it is found (step 1) loses the plan when b gives up at step
+  // 2 (a's motion is executing and cannot be replaced): 1/2. Waiting: b is found at 3 (1/2), a
+  // runs 3..5, b 5..6; or b gives up at 2, a is found again at 3 and now starts at once (the
+  // second give-up, at 4, is lost; b found at 5 runs 5..6): 1/2 * 1/2. So 3/4, against 1/2
+  // plan-first (found at 3, then 2 + 1 steps by 6; a give-up makes it 8).
+  const Problem problem = blamed_grasp(6);
+  const ConcurrentMdp mdp(problem);
+  ConcurrentSolver solver(mdp);
+  ConcurrentState state = mdp.start();
+  EXPECT_NEAR(solver.solve(state), 0.75, 1e-15);
+  EXPECT_NEAR(plan_first_optimum(problem), 0.5, 1e-15);
+  EXPECT_NEAR(testing::ConcurrentReference(problem).optimum(), 0.75, 1e-15);
+  // At step 1, a refined and the robot idle, the best move refines b rather than start a.
+  state = mdp.step(state, 0, Observation::found(2));
+  ASSERT_EQ(mdp.startable(state), std::vector<int>{0});
+  EXPECT_EQ(mdp.forced_start(state), -1);
+  const std::optional<ConcurrentMdp::Move> move = solver.best_move(state);
+  ASSERT_TRUE(move.has_value());
+  EXPECT_FALSE(move->is_start());
+  EXPECT_EQ(move->refine, 0);
+  // A give-up blaming the executing motion blocks b: nothing can finish any more.
+  const ConcurrentState started = mdp.start_action(state, 0).next;
+  const ConcurrentState blocked = mdp.step(started, 0, Observation::backtracked(0));
+  EXPECT_FALSE(mdp.any_live(blocked));
+  // Before a starts, the same give-up sends the skeleton back to a, its motion forgotten.
+  const ConcurrentState back = mdp.step(state, 0, Observation::backtracked(0));
+  EXPECT_EQ(ConcurrentMdp::refined(back, 0), 0);
+  EXPECT_EQ(mdp.execution(back, 0), ConcurrentMdp::kUnknown);
+  EXPECT_TRUE(mdp.startable(back).empty());
+  // b cannot blame itself (not one of its culprits).
+  EXPECT_THROW((void)mdp.step(state, 0, Observation::backtracked(1)), UsageError);
 }
 
 Problem two_moves(Steps deadline, const std::string& second_execution) {
@@ -157,9 +225,6 @@ TEST(Concurrent, ThePaperInstancesAgreeWithTheIndependentFigures) {
 
 TEST(Concurrent, WhatTheModelDoesNotTakeYetIsRefused) {
   const Problem base = testing::paper_instance("instance1");
-  const Problem backtracking = testing::with_backtracking(base, 3);
-  ASSERT_TRUE(backtracking.has_backtracking());
-  EXPECT_THROW(ConcurrentMdp{backtracking}, UsageError);
   EXPECT_THROW(ConcurrentMdp(testing::with_random_chains(base, 3, false)), UsageError);
   // The plan-first MDP refuses a concurrent problem rather than read it as plan-first.
   try {

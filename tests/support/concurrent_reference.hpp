@@ -6,6 +6,9 @@
 // waiting), no bound, no dropped skeleton, no shortcut to success: the episode ends only when the
 // robot starts the last action of a skeleton, and fails at the deadline. The only states merged
 // are those that differ in actions no skeleton through the executed path can use any more.
+// Backtracking (SPEC §7 read with §10): an attempt that gives up un-refines the action it blames
+// and every action below it, their effort too, but for what is executed; blaming an executed one
+// also blocks the action that gave up for good.
 //
 // plan_first() values the plan-first policies of the same MDP (SPEC §2 and §8 read as a policy
 // of §10: the robot never moves until a skeleton is refined in full, then runs the first one that
@@ -31,6 +34,7 @@ class ConcurrentReference {
  private:
   static constexpr long kUnrefined = -1;
   static constexpr long kExecuted = -2;  // executed or executing: its time is in robot_left
+  static constexpr long kBlocked = -3;   // gave up blaming an executed action: never refined again
 
   struct Node {
     int time = 0;
@@ -118,7 +122,9 @@ class ConcurrentReference {
         if (!through_executed(node, k)) continue;
         int next_action = -1;
         for (const int action : problem_.skeleton(k)) {
-          if (node.execution[static_cast<std::size_t>(action)] == kUnrefined) {
+          const long x = node.execution[static_cast<std::size_t>(action)];
+          if (x == kBlocked) break;
+          if (x == kUnrefined) {
             next_action = action;
             break;
           }
@@ -136,13 +142,26 @@ class ConcurrentReference {
   double refine_value(const Node& after, int action) {
     const auto slot = static_cast<std::size_t>(action);
     const Distribution& planning = problem_.action(action).planning;
-    const double survival = planning.survival(after.spent[slot]);
-    const double hazard = survival > 0 ? planning.pmf(after.spent[slot] + 1) / survival : 0.0;
+    const Distribution& backtrack = problem_.action(action).backtrack;
+    const Steps spent = after.spent[slot];
+    double survival = planning.survival(spent);
+    double back = 0.0;
+    if (!problem_.culprits(action).empty()) {
+      // An attempt ends by a motion or by giving up: it survives what neither took.
+      survival = 1.0;
+      for (Steps u = 1; u <= spent; ++u) survival -= planning.pmf(u) + backtrack.pmf(u);
+      back = survival > 0 ? backtrack.pmf(spent + 1) / survival : 0.0;
+    }
+    const double hazard = survival > 0 ? planning.pmf(spent + 1) / survival : 0.0;
     double q = 0.0;
-    if (hazard < 1.0) {
+    if (hazard + back < 1.0) {
       Node missed = after;
       ++missed.spent[slot];
-      q += (1.0 - hazard) * value(missed);
+      q += (1.0 - hazard - back) * value(missed);
+    }
+    for (const Problem::CulpritIndex& culprit : problem_.culprits(action)) {
+      if (back <= 0.0 || culprit.probability <= 0.0) continue;
+      q += back * culprit.probability * value(given_up(after, action, culprit.action));
     }
     if (hazard > 0.0) {
       const Distribution& execution = problem_.action(action).execution;
@@ -165,6 +184,27 @@ class ConcurrentReference {
       }
     }
     return q;
+  }
+
+  // The attempt on `action` gave up blaming `culprit` (SPEC §7, §10).
+  Node given_up(const Node& after, int action, int culprit) const {
+    Node next = after;
+    // The culprit and every action below it (whose paths go through it) start again, but for what
+    // is executed (its motion cannot be undone) and what is blocked (what blocked it is executed).
+    const int at = problem_.position(culprit);
+    for (int b = 0; b < problem_.action_count(); ++b) {
+      const auto slot = static_cast<std::size_t>(b);
+      const auto path = problem_.skeleton(problem_.members(b).front());
+      if (static_cast<int>(path.size()) <= at || path[static_cast<std::size_t>(at)] != culprit) continue;
+      if (problem_.position(b) < at || next.execution[slot] == kBlocked || next.execution[slot] == kExecuted) continue;
+      next.execution[slot] = kUnrefined;
+      next.spent[slot] = 0;
+    }
+    // An executed culprit cannot be refined again: the action that gave up never will be.
+    if (std::find(after.executed.begin(), after.executed.end(), culprit) != after.executed.end()) {
+      next.execution[static_cast<std::size_t>(action)] = kBlocked;
+    }
+    return next;
   }
 
   // Actions on no skeleton through the executed path can never be refined or executed again, and

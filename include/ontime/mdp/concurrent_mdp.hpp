@@ -25,8 +25,16 @@
 // kWait), the robot executes one step, CT grows by one. Within a step both work at once; a motion
 // found in the step from CT to CT + 1 can start at CT + 1 at the earliest.
 //
-// Backtracking (SPEC §7) and exogenous chains or expiry (SPEC §9) are not modelled here yet: the
-// constructor refuses them (UsageError naming the rule).
+// Backtracking (SPEC §7, §10 "With backtracking"): a step may also end the attempt by giving up
+// and blaming a culprit c. When c is not executed, every skeleton through c goes back to c (its
+// motion and everything refined below it discarded, effort on them too). When c is executed or
+// executing, its motion cannot be undone: what was refined below it and not started is discarded
+// all the same (every live skeleton goes back to E, effort lost), and the action that gave up is
+// blocked, the skeletons through it dropped. With backtracking a skeleton that cannot finish by D stays in the state
+// (a backtrack may discard a slow motion and make it able again, and refining it may cause such a
+// backtrack), so "live" then means through E only, and the failure test reads the earliest
+// finish. Exogenous chains or expiry (SPEC §9) are not modelled here yet: the constructor refuses
+// them (UsageError naming the rule).
 //
 // Cost: a move copies and canonicalises one state, O(K * A_max + A) word operations; the tables
 // (hazards, execution outcomes: the plan-first Mdp's, so that both models read the same numbers
@@ -66,7 +74,7 @@ class ConcurrentMdp {
   };
 
   // Any acting mode is read as concurrent (the model of this class). Throws UsageError when the
-  // problem has backtracking (SPEC §7), or chains or actions that expire (SPEC §9).
+  // problem has chains or actions that expire (SPEC §9).
   explicit ConcurrentMdp(const Problem& problem);
   ~ConcurrentMdp();
   ConcurrentMdp(const ConcurrentMdp&) = delete;
@@ -78,6 +86,8 @@ class ConcurrentMdp {
   Steps deadline() const noexcept { return deadline_; }
   // The number of skeletons K.
   int skeleton_count() const noexcept { return skeleton_count_; }
+  // Whether some attempt may give up and blame a culprit (SPEC §7).
+  bool has_backtracking() const noexcept { return backtracking_; }
 
   // The start: CT 0, the robot idle, nothing executed or refined (canonical).
   ConcurrentState start() const;
@@ -88,7 +98,7 @@ class ConcurrentMdp {
   static Steps robot_left(const ConcurrentState& state) noexcept { return state[1]; }
   // The last action of E, -1 while nothing has been started.
   static int executed(const ConcurrentState& state) noexcept { return static_cast<int>(state[2]) - 1; }
-  // Whether skeleton k is through E and can still finish by D.
+  // Whether skeleton k is through E and (without backtracking) can still finish by D.
   static bool is_live(const ConcurrentState& state, int k) noexcept { return refined_word(state, k) != kDropped; }
   // l_k of a live skeleton: its actions refined.
   static int refined(const ConcurrentState& state, int k) noexcept { return refined_word(state, k); }
@@ -114,8 +124,12 @@ class ConcurrentMdp {
   // action of k after E in order, started when the robot is free and the action refined (now,
   // for a refined one; for the rest, the planner on k alone with each action's fastest planning,
   // the current one's given PT_k) and run for its execution (the fastest for an unrefined one).
-  // A lower bound on every finish of k; the finish of executing k as soon as possible once k is
-  // refined. Mdp::kUnreachableNeed or more when k cannot finish at all.
+  // With backtracking a refined motion at or below a culprit may be discarded and found again with
+  // a faster execution, and the current attempt may give up and start afresh:
+  // such a motion counts its fastest execution, and the current action the sooner of its
+  // planning given PT_k and from 0. A lower bound on every finish of k; without backtracking the
+  // finish of executing k as soon as possible once k is refined. Mdp::kUnreachableNeed or more
+  // when k cannot finish at all.
   std::int64_t earliest_finish(const ConcurrentState& state, int k) const noexcept;
 
   // The children of E the robot may start now (refined, on a live skeleton), ascending; empty
@@ -123,13 +137,15 @@ class ConcurrentMdp {
   std::vector<int> startable(const ConcurrentState& state) const;
   // The start that is as good as every other move (docs/theory.md, "Acting while planning"): the
   // robot is idle and every live skeleton goes through one child c of E, which is refined; -1
-  // otherwise.
+  // otherwise, and always with backtracking (an executed motion can no longer be blamed and
+  // refined again, so committing may cost).
   int forced_start(const ConcurrentState& state) const noexcept;
 
   // The moves the exact solver considers (ConcurrentSolver), in its tie order: the forced start
-  // alone when there is one; else, before the deadline, the step choices (refine_choices, or kWait
-  // when none has work left), then the startable actions, ascending. Empty when no skeleton can
-  // finish. Leaving the others out loses nothing (docs/theory.md, "Acting while planning").
+  // alone when there is one; else, before the deadline, the step choices (refine_choices), then
+  // kWait when none has work left or with backtracking, then the startable actions, ascending.
+  // Empty when no skeleton can finish. Leaving the others out loses nothing (docs/theory.md,
+  // "Acting while planning").
   std::vector<Move> useful_moves(const ConcurrentState& state) const;
 
   // What starting `action` (a startable child of E) leads to: the end of the episode, when it is
@@ -145,8 +161,9 @@ class ConcurrentMdp {
 
   // The step choices worth considering: one per group of live skeletons sharing their next action
   // (named by the lowest index), ascending; empty when no live skeleton has an action left to
-  // refine (the planner can only wait). Refining never lowers the value (docs/theory.md), so an
-  // idle planner is worth considering only then.
+  // refine. Without backtracking refining never lowers the value (docs/theory.md), so an idle
+  // planner is worth considering only then; with backtracking it always is (an attempt may
+  // discard motions).
   ChoiceList refine_choices(const ConcurrentState& state) const;
 
   // Calls visit(probability, next) for every outcome of one step in which the planner refines
@@ -159,7 +176,8 @@ class ConcurrentMdp {
   // `observation` is what it revealed (a world's answer): the canonical next state, the same as
   // for_each_step_outcome's for that outcome. An execution time beyond the deadline (or kNever)
   // is stored as D + 1. Throws UsageError for a choice for_each_step_outcome refuses, a step at
-  // the deadline, a motion found on an idle step, or a backtrack (not modelled: SPEC §7).
+  // the deadline, a motion found or a backtrack on an idle step, or a culprit the action cannot
+  // blame.
   ConcurrentState step(const ConcurrentState& state, int choice, const Observation& observation) const;
 
   // The state with the robot's current execution finished now (r = 0; canonical): what a robot
@@ -173,11 +191,13 @@ class ConcurrentMdp {
   // rule the allocators follow once a plan is complete. The default Move (the planner idles)
   // when there is no such skeleton (complete_plan(state) < 0).
   Move run_complete_plan(const ConcurrentState& state) const;
-  // The lowest index of a live skeleton refined in full, -1 when there is none.
+  // The lowest index of a live skeleton refined in full whose execution from now, back to back,
+  // ends by D; -1 when there is none.
   int complete_plan(const ConcurrentState& state) const noexcept;
 
-  // Without rewards (SPEC §8): whether some live skeleton is refined in full. Its earliest finish
-  // is then at most D, and executing it as soon as possible succeeds: the state is worth 1.
+  // Without rewards (SPEC §8): whether some live skeleton is refined in full and ends by D when
+  // executed as soon as possible (complete_plan). The planner idling meanwhile, nothing is
+  // attempted, nothing given up: the state is worth 1.
   bool certain_success(const ConcurrentState& state) const noexcept;
 
  private:
@@ -199,6 +219,11 @@ class ConcurrentMdp {
   // Drops the skeletons that are not live and forgets the executions no live skeleton runs.
   void canonicalise(ConcurrentState& state) const;
   [[noreturn]] static void reject_choice(int choice);
+  // The attempt on `action` (the next action of `group`'s live skeletons) gave up and blames
+  // `culprit`; `next` has the step's time and robot applied. Not canonical.
+  void give_up(ConcurrentState& next, const ConcurrentState& state, int action, int culprit) const;
+  // Whether `k` (kept in the state) can still finish by D.
+  bool can_finish(const ConcurrentState& state, int k) const noexcept { return earliest_finish(state, k) <= deadline_; }
 
   std::unique_ptr<const Problem> problem_;  // the problem, plan-first, so that mdp_ can read it
   Mdp mdp_;                                 // its hazards and execution outcomes
@@ -209,6 +234,8 @@ class ConcurrentMdp {
   // when it cannot (the planning PMF's next positive step after PT).
   std::vector<Steps> next_finish_;
   std::vector<Steps> fastest_execution_;  // per action; kNever when none is finite
+  bool backtracking_ = false;
+  std::vector<std::uint8_t> culprit_;  // per action: 1 when some action may blame it
 };
 
 template <class Visitor>
@@ -228,6 +255,7 @@ void ConcurrentMdp::for_each_step_outcome(const ConcurrentState& state, int choi
   const int action = problem_->action_at(choice, refined(state, choice));
   const Steps pt = spent(state, choice);
   const double found = mdp_.hazard(action, pt);
+  const double back = mdp_.backtrack_hazard(action, pt);
   // The live skeletons whose next action is `action` share it (SPEC §1): one step for all of them.
   const auto for_group = [&](auto&& change) {
     for (const int m : problem_->members(action)) {
@@ -237,11 +265,13 @@ void ConcurrentMdp::for_each_step_outcome(const ConcurrentState& state, int choi
       }
     }
   };
-  if (found < 1.0) {
+  // Without backtracking the miss is 1 - found, as the plan-first Mdp computes it (the same bits).
+  const double missed_probability = back > 0.0 ? 1.0 - found - back : 1.0 - found;
+  if (missed_probability > 0.0) {
     ConcurrentState missed = next;
     for_group([&](int m) { ++spent_word(missed, m); });
     canonicalise(missed);
-    visit(1.0 - found, static_cast<const ConcurrentState&>(missed));
+    visit(missed_probability, static_cast<const ConcurrentState&>(missed));
   }
   if (found > 0.0) {
     for (const Mdp::ExecutionOutcome& outcome : mdp_.execution_outcomes(action)) {
@@ -253,6 +283,15 @@ void ConcurrentMdp::for_each_step_outcome(const ConcurrentState& state, int choi
       });
       canonicalise(refined_state);
       visit(found * outcome.probability, static_cast<const ConcurrentState&>(refined_state));
+    }
+  }
+  if (back > 0.0) {
+    for (const Problem::CulpritIndex& culprit : problem_->culprits(action)) {
+      if (culprit.probability <= 0) continue;
+      ConcurrentState gave_up = next;
+      give_up(gave_up, state, action, culprit.action);
+      canonicalise(gave_up);
+      visit(back * culprit.probability, static_cast<const ConcurrentState&>(gave_up));
     }
   }
 }

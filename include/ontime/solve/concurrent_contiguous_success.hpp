@@ -31,7 +31,12 @@ namespace ontime {
 class ConcurrentContiguousSuccess {
  public:
   // The values of `mdp`'s skeletons with Eq. (1)'s `aggregation`; memoised as they are asked for.
+  // Throws UsageError (check_supported) when the problem has backtracking.
   ConcurrentContiguousSuccess(const ConcurrentMdp& mdp, Aggregation aggregation);
+
+  // Eq. (1) here has no give-up term: UsageError naming the rule when `mdp` has backtracking
+  // (SPEC §7), before any allocator built on these values is made.
+  static void check_supported(const ConcurrentMdp& mdp);
 
   // PS(k, l, spent, time, backlog); 0 when the backlog alone passes the deadline.
   double value(int k, int l, Steps spent, Steps time, std::int64_t backlog);

@@ -9,13 +9,15 @@
 // attains it.
 //
 // Guarantees: the value is exact up to floating-point rounding; the moves left out are never
-// better (docs/theory.md, "Acting while planning"): an idle planner while some live skeleton has
-// work left, any move but the start when every live skeleton goes on through one refined child of
-// what the robot executed (ConcurrentMdp::forced_start), and, without rewards, any move once a
-// live skeleton is refined in full (ConcurrentMdp::certain_success: worth 1). Plan-first is one
+// better (docs/theory.md, "Acting while planning"): without backtracking an idle planner while
+// some live skeleton has work left and any move but the start when every live skeleton goes on
+// through one refined child of what the robot executed (ConcurrentMdp::forced_start), and,
+// without rewards, any move once a live skeleton is refined in full and fits
+// (ConcurrentMdp::certain_success: worth 1). With backtracking (SPEC §7) every move is considered
+// but at a certain success. Plan-first is one
 // policy of this MDP, so V* is at least the plan-first optimum (OptimalSolver) of the same problem.
 // Ties (values within kTieTolerance) go to the first move in this order: the steps, ascending by
-// skeleton, then waiting, then the starts, ascending by action; so the robot starts an action
+// skeleton, then the planner idling, then the starts, ascending by action; so the robot starts an action
 // only when starting is worth more than planning on while it waits.
 //
 // Cost: time and memory linear in the reachable states, which grow with the skeletons, the

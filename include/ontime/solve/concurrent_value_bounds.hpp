@@ -41,7 +41,8 @@ class ConcurrentValueBounds {
     double upper = 0;
   };
 
-  // Bounds for the states of `mdp`, which must outlive this object.
+  // Bounds for the states of `mdp`, which must outlive this object. Throws UsageError when the
+  // problem has backtracking (SPEC §7): a give-up may discard motions, which the proofs leave out.
   explicit ConcurrentValueBounds(const ConcurrentMdp& mdp);
 
   // Both bounds at `state` (any state of the MDP, terminal or not).
