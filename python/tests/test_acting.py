@@ -106,7 +106,7 @@ def test_evaluate_acts_while_planning_by_the_allocators_commit_rule(cli):
 
 
 @pytest.mark.parametrize("arguments, message", [
-    ({"solver": "mcts"}, "'mcts' does not act while planning"),
+    ({"solver": "ppo"}, "'ppo' does not act while planning"),
     ({"solver": "dp-rerun", "regret": True}, "regret: acting while planning"),
     ({"solver": "dp-rerun", "belief": PAPER / "instance1.json"}, "belief: acting while planning"),
     ({"solver": "thompson", "exact": True}, "exact evaluation needs an allocator whose move"),
@@ -137,8 +137,8 @@ def test_a_table_sets_both_modes_side_by_side_as_the_command_line(cli):
              row["solvers"][name]["success_rate"] for row in expected["rows"]]
     markdown = ontime.table([problem.with_acting("concurrent")], solvers=["dp-rerun"], episodes=50, format="markdown")
     assert "paper-instance-1 (concurrent)" in markdown
-    with pytest.raises(ontime.UsageError, match="'mcts' does not act while planning"):
-        ontime.table([problem.with_acting("concurrent")], solvers=["mcts"], episodes=10)
+    with pytest.raises(ontime.UsageError, match="'ppo' does not act while planning"):
+        ontime.table([problem.with_acting("concurrent")], solvers=["ppo"], episodes=10)
 
 
 def test_what_does_not_take_the_mode_yet_refuses_it():
@@ -227,7 +227,7 @@ def test_moves_and_reports_out_of_rule_raise_usage_errors(call, message):
 
 
 def test_a_session_refuses_allocators_without_a_commit_rule():
-    with pytest.raises(ontime.UsageError, match="'mcts' does not act while planning"):
-        ontime.ConcurrentSession(two_moves(), "mcts")
+    with pytest.raises(ontime.UsageError, match="'ppo' does not act while planning"):
+        ontime.ConcurrentSession(two_moves(), "ppo")
     with pytest.raises(ontime.UsageError, match="need a solver"):
         ontime.ConcurrentSession(two_moves(), budget=4)

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <memory>
 #include <utility>
+#include <vector>
 
 #include "allocators/detail/anytime_budget.hpp"
 #include "ontime/allocators/allocator_registry.hpp"
@@ -34,6 +35,17 @@ DecisionBudget share_of(const DecisionBudget& budget, double share) {
   }
   if (budget.stop_condition()) scaled.or_until(budget.stop_condition());
   return scaled;
+}
+
+// The counters both forms report (branch_and_bound_kind's declarations).
+void add_search_counters(Statistics& statistics, std::uint64_t searches, std::uint64_t work, std::uint64_t trial_work,
+                         std::uint64_t exact, double gap_sum, double max_gap) {
+  statistics.add(kSearchesCounter, static_cast<double>(searches));
+  statistics.add(kIterationsCounter, static_cast<double>(work));
+  statistics.add("trial_work", static_cast<double>(trial_work));
+  statistics.add("exact_decisions", static_cast<double>(exact));
+  statistics.add("gap_sum", gap_sum);
+  statistics.add("max_gap", max_gap, Statistics::Merge::max);
 }
 
 }  // namespace
@@ -129,52 +141,109 @@ SearchSolution BranchAndBoundAllocator::in_rounds(const State& state, const Budg
 }
 
 void BranchAndBoundAllocator::collect_statistics(Statistics& statistics) const {
-  statistics.add(kSearchesCounter, static_cast<double>(counters_.searches));
-  statistics.add(kIterationsCounter, static_cast<double>(counters_.work));
-  statistics.add("trial_work", static_cast<double>(counters_.trial_work));
-  statistics.add("exact_decisions", static_cast<double>(counters_.exact));
-  statistics.add("gap_sum", counters_.gap_sum);
-  statistics.add("max_gap", counters_.max_gap, Statistics::Merge::max);
+  add_search_counters(statistics, counters_.searches, counters_.work, counters_.trial_work, counters_.exact,
+                      counters_.gap_sum, counters_.max_gap);
+}
+
+ConcurrentBranchAndBoundAllocator::ConcurrentBranchAndBoundAllocator(const ConcurrentMdp& mdp,
+                                                                     BranchAndBoundOptions options)
+    : mdp_(&mdp), options_(std::move(options)), search_(mdp, options_.max_states) {}
+
+void ConcurrentBranchAndBoundAllocator::begin_episode(std::uint64_t seed) {
+  (void)seed;  // the search draws nothing
+  search_.clear();
+  last_gap_ = 0.0;
+}
+
+ConcurrentMdp::Move ConcurrentBranchAndBoundAllocator::choose(const ConcurrentState& state) {
+  last_gap_ = 0.0;
+  if (mdp_->certain_success(state)) return mdp_->run_complete_plan(state);
+  const std::vector<ConcurrentMdp::Move> moves = mdp_->useful_moves(state);
+  if (moves.empty()) return {};
+  if (moves.size() == 1) return moves[0];
+  // Records at their cap start again (the cap counts the records of the episode so far).
+  if (search_.size() >= options_.max_states) search_.clear();
+  const BudgetMonitor monitor(options_.budget);
+  const ConcurrentSearchResult found =
+      search_.search(state, [&](std::uint64_t work) { return monitor.exhausted(work); });
+  ++counters_.searches;
+  counters_.work += found.work;
+  if (found.exact) ++counters_.exact;
+  last_gap_ = found.exact ? 0.0 : std::max(0.0, found.upper - found.lower);
+  counters_.gap_sum += last_gap_;
+  counters_.max_gap = std::max(counters_.max_gap, last_gap_);
+  return found.lower >= 0.0 ? found.move : moves[0];
+}
+
+void ConcurrentBranchAndBoundAllocator::collect_statistics(Statistics& statistics) const {
+  // Its search is all trials.
+  add_search_counters(statistics, counters_.searches, counters_.work, counters_.work, counters_.exact,
+                      counters_.gap_sum, counters_.max_gap);
 }
 
 AllocatorKind branch_and_bound_kind() {
-  return {.name = "branch-and-bound",
-          .summary =
-              "branch and bound from the current state within a budget per decision: optimal where it ends, else "
-              "the best certified lower end and its gap",
-          .capabilities = {Capability::anytime, Capability::certified, Capability::chains},
-          .parameters = {Parameter::integer("iterations", 10'000, 1, Parameter::kNoLimit,
-                                            "work per decision: states expanded by a trial or an upper test, or "
-                                            "solved (no limit when only time-budget is given)"),
-                         Parameter::real("time-budget", 0, 0, Parameter::kNoLimit,
-                                         "seconds per decision, 0: none (with iterations, whichever ends first)"),
-                         Parameter::real("trials", 0.5, 0, 1,
-                                         "share of each decision's budget spent first on trials of bounded RTDP, "
-                                         "which raise the lower ends of all the choices that may be best"),
-                         Parameter::integer("max-states", 10'000'000, 1, Parameter::kNoLimit,
-                                            "states the search may hold in an episode (past it, it starts again)")},
-          .make = [](const Mdp& mdp, const ParameterReader& parameters) -> AllocatorFactory {
-            BranchAndBoundOptions options;
-            options.budget = detail::default_budget(parameters);
-            options.max_states = parameters.integer("max-states");
-            options.trial_share = parameters.real("trials");
-            BranchAndBoundAllocator probe(mdp, options);  // the bounds' tables fit: checked before any episode
-            return [model = &mdp, options] { return std::make_unique<BranchAndBoundAllocator>(*model, options); };
-          },
-          .needs = {.decision_budget = detail::given_budget,
-                    .memory = {.parameter = "max-states",
-                               .bytes =
-                                   [](const Problem& problem, const ParameterReader& parameters) {
-                                     return OptimalSolver::max_bytes(problem, parameters.integer("max-states"));
-                                   },
-                               .per_allocator = true},
-                    .counters = {{kSearchesCounter, "decisions that ran a search"},
-                                 {kIterationsCounter,
-                                  "work of the decisions: states expanded by trials or upper tests, or solved"},
-                                 {"trial_work", "the part of that work spent on trials"},
-                                 {"exact_decisions", "decisions whose search finished (the optimal choice)"},
-                                 {"gap_sum", "certified gaps, summed over the decisions"},
-                                 {"max_gap", "the largest certified gap of a decision"}}}};
+  return {
+      .name = "branch-and-bound",
+      .summary =
+          "branch and bound from the current state within a budget per decision: optimal where it ends, else "
+          "the best certified lower end and its gap",
+      .capabilities = {Capability::anytime, Capability::certified, Capability::chains},
+      .parameters = {Parameter::integer("iterations", 10'000, 1, Parameter::kNoLimit,
+                                        "work per decision: states expanded by a trial or an upper test, or "
+                                        "solved (no limit when only time-budget is given)"),
+                     Parameter::real("time-budget", 0, 0, Parameter::kNoLimit,
+                                     "seconds per decision, 0: none (with iterations, whichever ends first)"),
+                     Parameter::real("trials", 0.5, 0, 1,
+                                     "share of each decision's budget spent first on trials of bounded RTDP, "
+                                     "which raise the lower ends of all the choices that may be best"),
+                     Parameter::integer("max-states", 10'000'000, 1, Parameter::kNoLimit,
+                                        "states the search may hold in an episode (past it, it starts again)")},
+      .make = [](const Mdp& mdp, const ParameterReader& parameters) -> AllocatorFactory {
+        BranchAndBoundOptions options;
+        options.budget = detail::default_budget(parameters);
+        options.max_states = parameters.integer("max-states");
+        options.trial_share = parameters.real("trials");
+        BranchAndBoundAllocator probe(mdp, options);  // the bounds' tables fit: checked before any episode
+        return [model = &mdp, options] { return std::make_unique<BranchAndBoundAllocator>(*model, options); };
+      },
+      .needs = {.decision_budget = detail::given_budget,
+                .memory = {.parameter = "max-states",
+                           .bytes =
+                               [](const Problem& problem, const ParameterReader& parameters) {
+                                 return OptimalSolver::max_bytes(problem, parameters.integer("max-states"));
+                               },
+                           .per_allocator = true},
+                .counters = {{kSearchesCounter, "decisions that ran a search"},
+                             {kIterationsCounter,
+                              "work of the decisions: states expanded by trials or upper tests, or solved"},
+                             {"trial_work", "the part of that work spent on trials"},
+                             {"exact_decisions", "decisions whose search finished (the optimal choice)"},
+                             {"gap_sum", "certified gaps, summed over the decisions"},
+                             {"max_gap", "the largest certified gap of a decision"}}},
+      .commit_rule =
+          "the search's: starts an action when starting has the best certified lower end (the "
+          "optimum's where the search closes)",
+      .make_concurrent = [](const ConcurrentMdp& mdp, const ParameterReader& parameters) -> ConcurrentAllocatorFactory {
+        if (mdp.is_timed()) {
+          throw UsageError(mdp.problem().name() +
+                           ": branch-and-bound acting while planning (SPEC §10) does not take exogenous "
+                           "chains or expiry (SPEC §9) yet: its search takes a start as one outcome (the optimal "
+                           "allocator takes them)");
+        }
+        if (parameters.given("trials")) {
+          throw UsageError(
+              "parameter 'trials': acting while planning (SPEC §10) the search is all trials; it takes no share");
+        }
+        if (mdp.has_backtracking()) {
+          throw UsageError(mdp.problem().name() +
+                           ": branch-and-bound acting while planning (SPEC §10) does not take backtracking (SPEC §7) "
+                           "yet: its bounds assume no give-up");
+        }
+        BranchAndBoundOptions options;
+        options.budget = detail::default_budget(parameters);
+        options.max_states = parameters.integer("max-states");
+        return [model = &mdp, options] { return std::make_unique<ConcurrentBranchAndBoundAllocator>(*model, options); };
+      }};
 }
 
 }  // namespace ontime

@@ -4,8 +4,10 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "allocators/detail/anytime_budget.hpp"
 #include "ontime/allocators/allocator_registry.hpp"
@@ -20,7 +22,44 @@ std::size_t grown_capacity(std::size_t capacity, std::size_t needed) noexcept {
   return needed <= capacity ? capacity : std::max(needed, 2 * capacity);
 }
 
+// The index in [first, first + count) of the edge of the most visits (ties: the first).
+template <class Edge>
+std::uint32_t most_visited(const std::vector<Edge>& edges, std::uint32_t first, std::uint32_t count) {
+  std::uint32_t best = first;
+  for (std::uint32_t e = first + 1; e < first + count; ++e) {
+    if (edges[e].visits > edges[best].visits) best = e;
+  }
+  return best;
+}
+
+// UCT's choice among the edges [first, first + count) of a node visited `visits` times: an edge
+// never visited first (the first such), else the largest estimate(e) + C sqrt(ln visits / n_e).
+template <class Edge, class Estimate>
+std::uint32_t uct_edge(const std::vector<Edge>& edges, std::uint32_t first, std::uint32_t count, std::uint32_t visits,
+                       double exploration, Estimate&& estimate) {
+  const double log_visits = portable_log(static_cast<double>(std::max<std::uint32_t>(visits, 1)));
+  std::uint32_t best = first;
+  double best_score = -1.0;
+  for (std::uint32_t e = first; e < first + count; ++e) {
+    if (edges[e].visits == 0) return e;  // every choice once first, lowest index first
+    const double score = estimate(e) + exploration * std::sqrt(log_visits / static_cast<double>(edges[e].visits));
+    if (score > best_score) {
+      best_score = score;
+      best = e;
+    }
+  }
+  return best;
+}
+
 }  // namespace
+
+void MctsCounters::add_to(Statistics& statistics) const {
+  statistics.add(kSearchesCounter, static_cast<double>(searches));
+  statistics.add(kIterationsCounter, static_cast<double>(iterations));
+  statistics.add("memory_stops", static_cast<double>(memory_stops));
+  statistics.add("peak_tree_nodes", static_cast<double>(peak_tree_nodes), Statistics::Merge::max);
+  statistics.add("peak_tree_bytes", static_cast<double>(peak_tree_bytes), Statistics::Merge::max);
+}
 
 MctsAllocator::MctsAllocator(const Mdp& mdp, MctsOptions options)
     : mdp_(&mdp),
@@ -142,20 +181,8 @@ bool MctsAllocator::expand_outcomes(std::uint32_t edge, const State& state) {
 }
 
 std::uint32_t MctsAllocator::select_edge(const DecisionNode& node) const {
-  const double log_visits = portable_log(static_cast<double>(std::max<std::uint32_t>(node.visits, 1)));
-  std::uint32_t best = node.first_edge;
-  double best_score = -1.0;
-  for (std::uint32_t e = node.first_edge; e < node.first_edge + node.edge_count; ++e) {
-    const Edge& edge = edges_[e];
-    if (edge.visits == 0) return e;  // every choice once first, lowest index first
-    const double visits = edge.visits;
-    const double score = estimate(e) + options_.exploration * std::sqrt(log_visits / visits);
-    if (score > best_score) {
-      best_score = score;
-      best = e;
-    }
-  }
-  return best;
+  return uct_edge(edges_, node.first_edge, node.edge_count, node.visits, options_.exploration,
+                  [&](std::uint32_t e) { return estimate(e); });
 }
 
 double MctsAllocator::rollout(State& state) {
@@ -266,27 +293,12 @@ int MctsAllocator::choose(const State& state, const DecisionBudget& budget) {
   if (choices.empty()) return mdp_->first_with_work_left(state);
   if (choices.size() == 1) return choices[0];
 
-  ++counters_.searches;
-  const BudgetMonitor monitor(budget.is_set() ? budget : options_.budget);
-  std::uint64_t iterations = 0;
-  while (!monitor.exhausted(iterations)) {
-    if (!iterate()) {
-      ++counters_.memory_stops;
-      break;
-    }
-    ++iterations;
-  }
-  counters_.iterations += iterations;
-  counters_.peak_tree_nodes = std::max(counters_.peak_tree_nodes, tree_nodes());
-  counters_.peak_tree_bytes = std::max(counters_.peak_tree_bytes, tree_bytes());
-
+  counters_.search(
+      budget.is_set() ? budget : options_.budget, [&] { return iterate(); }, [&] { return tree_nodes(); },
+      [&] { return tree_bytes(); });
   const DecisionNode& root = nodes_[0];
   if (root.first_edge == kNone) return choices[0];
-  std::uint32_t best = root.first_edge;
-  for (std::uint32_t e = root.first_edge + 1; e < root.first_edge + root.edge_count; ++e) {
-    if (edges_[e].visits > edges_[best].visits) best = e;
-  }
-  return edges_[best].choice;
+  return edges_[most_visited(edges_, root.first_edge, root.edge_count)].choice;
 }
 
 void MctsAllocator::observe(const State& before, int choice, const State& after, Status status) {
@@ -363,13 +375,7 @@ void MctsAllocator::reroot(std::uint32_t new_root) {
   outcome_rewards_ = std::move(outcome_rewards);
 }
 
-void MctsAllocator::collect_statistics(Statistics& statistics) const {
-  statistics.add(kSearchesCounter, static_cast<double>(counters_.searches));
-  statistics.add(kIterationsCounter, static_cast<double>(counters_.iterations));
-  statistics.add("memory_stops", static_cast<double>(counters_.memory_stops));
-  statistics.add("peak_tree_nodes", static_cast<double>(counters_.peak_tree_nodes), Statistics::Merge::max);
-  statistics.add("peak_tree_bytes", static_cast<double>(counters_.peak_tree_bytes), Statistics::Merge::max);
-}
+void MctsAllocator::collect_statistics(Statistics& statistics) const { counters_.add_to(statistics); }
 
 std::vector<MctsAllocator::RootChoice> MctsAllocator::root_choices() const {
   std::vector<RootChoice> result;
@@ -381,6 +387,312 @@ std::vector<MctsAllocator::RootChoice> MctsAllocator::root_choices() const {
   }
   return result;
 }
+
+ConcurrentMctsAllocator::ConcurrentMctsAllocator(const ConcurrentMdp& mdp, ConcurrentMctsOptions options)
+    : mdp_(&mdp), options_(std::move(options)) {
+  if (!(options_.exploration >= 0.0) || !std::isfinite(options_.exploration)) {
+    throw UsageError("the exploration constant of mcts must be a finite number >= 0");
+  }
+  if (options_.leaf != MctsLeaf::rollout) {
+    if (options_.backup != MctsBackup::bellman) {
+      throw UsageError("mcts: leaf values from bounds need bellman backups (a mean counts rewards 0 or 1)");
+    }
+    bounds_ = std::make_unique<ConcurrentValueBounds>(mdp);
+  }
+  if (options_.rollout) {
+    rollout_policy_ = options_.rollout();
+    if (!rollout_policy_->is_stationary()) {
+      throw UsageError("the rollout policy of mcts must choose by the state alone; '" +
+                       std::string(rollout_policy_->name()) + "' does not");
+    }
+  }
+  const Problem& problem = mdp.problem();
+  const std::size_t words =
+      3 + 2 * static_cast<std::size_t>(problem.skeleton_count()) + static_cast<std::size_t>(problem.action_count());
+  state_bytes_ = (words * 2 + 15) / 16 * 16 + 16;  // rounded up to the heap's 16 bytes, plus its header
+}
+
+void ConcurrentMctsAllocator::begin_episode(std::uint64_t seed) {
+  generator_ = SplitMix64(seed);
+  has_tree_ = false;
+  if (rollout_policy_) rollout_policy_->begin_episode(seed);
+}
+
+std::size_t ConcurrentMctsAllocator::tree_bytes() const noexcept {
+  return nodes_.capacity() * sizeof(Node) + nodes_.size() * state_bytes_ + edges_.capacity() * sizeof(Edge) +
+         outcomes_.capacity() * sizeof(Outcome);
+}
+
+bool ConcurrentMctsAllocator::would_exceed_memory(std::size_t nodes, std::size_t edges, std::size_t outcomes) const {
+  const std::size_t projected = grown_capacity(nodes_.capacity(), nodes_.size() + nodes) * sizeof(Node) +
+                                (nodes_.size() + nodes) * state_bytes_ +
+                                grown_capacity(edges_.capacity(), edges_.size() + edges) * sizeof(Edge) +
+                                grown_capacity(outcomes_.capacity(), outcomes_.size() + outcomes) * sizeof(Outcome);
+  return projected > options_.max_tree_bytes;
+}
+
+void ConcurrentMctsAllocator::reset(const ConcurrentState& root) {
+  nodes_.clear();
+  edges_.clear();
+  outcomes_.clear();
+  nodes_.push_back(Node{.state = root});
+  has_tree_ = true;
+}
+
+bool ConcurrentMctsAllocator::expand(std::uint32_t node) {
+  const std::vector<ConcurrentMdp::Move> moves = mdp_->useful_moves(nodes_[node].state);
+  if (would_exceed_memory(0, moves.size(), 0)) return false;
+  nodes_[node].first_edge = static_cast<std::uint32_t>(edges_.size());
+  nodes_[node].edge_count = static_cast<std::uint16_t>(moves.size());
+  for (const ConcurrentMdp::Move& move : moves) edges_.push_back(Edge{.move = move});
+  return true;
+}
+
+bool ConcurrentMctsAllocator::expand_outcomes(std::uint32_t edge, std::uint32_t node) {
+  const ConcurrentState& state = nodes_[node].state;
+  const ConcurrentMdp::Move move = edges_[edge].move;
+  // A state that ends the search: no skeleton can finish (0), or certain success (1).
+  const auto ending = [&](const ConcurrentState& next, Outcome& outcome) {
+    if (!mdp_->any_live(next)) {
+      outcome.ends = true;
+    } else if (mdp_->certain_success(next)) {
+      outcome.ends = true;
+      outcome.reward = 1.0;
+    }
+  };
+  std::vector<Outcome> found;
+  if (move.is_start()) {
+    const ConcurrentMdp::StartOutcome start = mdp_->start_action(state, move.start);
+    Outcome outcome{.probability = 1.0, .ends = start.ends, .reward = start.reward};
+    if (!start.ends) ending(start.next, outcome);
+    found.push_back(outcome);
+  } else {
+    mdp_->for_each_step_outcome(state, move.refine, [&](double probability, const ConcurrentState& next) {
+      Outcome outcome{.probability = probability};
+      ending(next, outcome);
+      found.push_back(outcome);
+    });
+  }
+  if (would_exceed_memory(0, 0, found.size())) return false;
+  edges_[edge].first_outcome = static_cast<std::uint32_t>(outcomes_.size());
+  edges_[edge].outcome_count = static_cast<std::uint16_t>(found.size());
+  outcomes_.insert(outcomes_.end(), found.begin(), found.end());
+  return true;
+}
+
+ConcurrentState ConcurrentMctsAllocator::successor(const ConcurrentState& state, const ConcurrentMdp::Move& move,
+                                                   std::size_t index) const {
+  if (move.is_start()) return mdp_->start_action(state, move.start).next;
+  ConcurrentState result;
+  std::size_t seen = 0;
+  mdp_->for_each_step_outcome(state, move.refine, [&](double, const ConcurrentState& next) {
+    if (seen++ == index) result = next;
+  });
+  return result;
+}
+
+double ConcurrentMctsAllocator::estimate(const Edge& edge) const noexcept {
+  if (edge.visits == 0) return 0.0;
+  return bellman() ? edge.q : edge.returns / edge.visits;
+}
+
+std::uint32_t ConcurrentMctsAllocator::select_edge(const Node& node) const {
+  return uct_edge(edges_, node.first_edge, node.edge_count, node.visits, options_.exploration,
+                  [&](std::uint32_t e) { return estimate(edges_[e]); });
+}
+
+double ConcurrentMctsAllocator::rollout(ConcurrentState state) {
+  for (;;) {
+    if (!mdp_->any_live(state)) return 0.0;
+    if (mdp_->certain_success(state)) return 1.0;
+    ConcurrentMdp::Move move;
+    if (rollout_policy_) {
+      move = rollout_policy_->choose(state);
+      if (!move.is_start() && ConcurrentMdp::time(state) >= mdp_->deadline()) return 0.0;
+    } else {
+      const std::vector<ConcurrentMdp::Move> moves = mdp_->useful_moves(state);
+      if (moves.empty()) return 0.0;
+      move = moves[static_cast<std::size_t>(generator_() % moves.size())];
+    }
+    if (move.is_start()) {
+      ConcurrentMdp::StartOutcome outcome = mdp_->start_action(state, move.start);
+      if (outcome.ends) return outcome.reward;
+      state = std::move(outcome.next);
+      continue;
+    }
+    double u = uniform01(generator_);
+    ConcurrentState drawn;
+    mdp_->for_each_step_outcome(state, move.refine, [&](double probability, const ConcurrentState& next) {
+      if (drawn.empty() || u >= 0.0) drawn = next;  // the first outcome whose cumulative mass passes u
+      u -= probability;
+    });
+    state = std::move(drawn);
+  }
+}
+
+double ConcurrentMctsAllocator::leaf_value(const ConcurrentState& state) {
+  switch (options_.leaf) {
+    case MctsLeaf::upper:
+      return bounds_->upper(state);
+    case MctsLeaf::lower:
+      return bounds_->lower(state);
+    case MctsLeaf::rollout:
+      break;
+  }
+  return rollout(state);
+}
+
+bool ConcurrentMctsAllocator::iterate() {
+  path_.clear();
+  std::uint32_t node = 0;
+  double reward = 0.0;
+  for (;;) {
+    if (nodes_[node].first_edge == kNone && !expand(node)) return false;
+    if (nodes_[node].edge_count == 0) break;  // no skeleton can finish: reward 0
+    const std::uint32_t e = select_edge(nodes_[node]);
+    if (edges_[e].first_outcome == kNone && !expand_outcomes(e, node)) return false;
+    path_.push_back(node);
+    path_.push_back(e);
+    const std::uint32_t first = edges_[e].first_outcome;
+    const std::uint32_t picked =
+        first +
+        static_cast<std::uint32_t>(sample_index(
+            edges_[e].outcome_count, [&](std::size_t o) { return outcomes_[first + o].probability; }, generator_));
+    outcomes_[picked].reached = true;
+    if (outcomes_[picked].ends) {
+      reward = outcomes_[picked].reward;
+      break;
+    }
+    if (outcomes_[picked].child == kNone) {
+      if (would_exceed_memory(1, 0, 0)) return false;
+      ConcurrentState next = successor(nodes_[node].state, edges_[e].move, picked - first);
+      const auto child = static_cast<std::uint32_t>(nodes_.size());
+      nodes_.push_back(Node{.state = std::move(next), .visits = 1});
+      outcomes_[picked].child = child;
+      if (bellman()) {
+        nodes_[child].value = leaf_value(nodes_[child].state);
+      } else {
+        reward = rollout(nodes_[child].state);
+      }
+      break;
+    }
+    node = outcomes_[picked].child;
+  }
+  for (std::size_t i = 0; i < path_.size(); i += 2) {
+    ++nodes_[path_[i]].visits;
+    Edge& edge = edges_[path_[i + 1]];
+    ++edge.visits;
+    edge.returns += reward;
+  }
+  if (bellman()) back_up_bellman();
+  return true;
+}
+
+void ConcurrentMctsAllocator::back_up_bellman() {
+  for (std::size_t i = path_.size(); i >= 2; i -= 2) {
+    Edge& edge = edges_[path_[i - 1]];
+    double weight = 0.0, sum = 0.0;
+    for (std::uint32_t o = edge.first_outcome; o < edge.first_outcome + edge.outcome_count; ++o) {
+      const Outcome& outcome = outcomes_[o];
+      if (!outcome.reached) continue;
+      weight += outcome.probability;
+      sum += outcome.probability * (outcome.ends ? outcome.reward : nodes_[outcome.child].value);
+    }
+    edge.q = weight > 0.0 ? sum / weight : 0.0;
+    Node& node = nodes_[path_[i - 2]];
+    double best = 0.0;
+    for (std::uint32_t e = node.first_edge; e < node.first_edge + node.edge_count; ++e) {
+      if (edges_[e].visits > 0) best = std::max(best, edges_[e].q);
+    }
+    node.value = best;
+  }
+}
+
+bool ConcurrentMctsAllocator::reroot_to(const ConcurrentState& state) {
+  const Node& root = nodes_[0];
+  if (root.first_edge == kNone) return false;
+  std::uint32_t found = kNone;
+  for (std::uint32_t e = root.first_edge; e < root.first_edge + root.edge_count && found == kNone; ++e) {
+    const Edge& edge = edges_[e];
+    if (edge.first_outcome == kNone) continue;
+    for (std::uint32_t o = edge.first_outcome; o < edge.first_outcome + edge.outcome_count; ++o) {
+      const std::uint32_t child = outcomes_[o].child;
+      if (child != kNone && nodes_[child].state == state) {
+        found = child;
+        break;
+      }
+    }
+  }
+  if (found == kNone) return false;
+  // Copies the subtree under `found` into fresh arrays (depth first), so that the memory held
+  // stays proportional to the tree in use.
+  std::vector<Node> nodes;
+  std::vector<Edge> edges;
+  std::vector<Outcome> outcomes;
+  std::vector<std::uint32_t> pending{0};  // copied nodes whose edges still point into the old arrays
+  nodes.push_back(std::move(nodes_[found]));
+  while (!pending.empty()) {
+    const std::uint32_t new_index = pending.back();
+    pending.pop_back();
+    const std::uint32_t old_first = nodes[new_index].first_edge;
+    const std::uint16_t count = nodes[new_index].edge_count;
+    if (old_first == kNone) continue;
+    nodes[new_index].first_edge = static_cast<std::uint32_t>(edges.size());
+    for (std::uint32_t e = old_first; e < old_first + count; ++e) {
+      Edge edge = edges_[e];
+      if (edge.first_outcome != kNone) {
+        const auto first = static_cast<std::uint32_t>(outcomes.size());
+        for (std::uint32_t o = edge.first_outcome; o < edge.first_outcome + edge.outcome_count; ++o) {
+          Outcome outcome = outcomes_[o];
+          if (outcome.child != kNone) {
+            const auto child = static_cast<std::uint32_t>(nodes.size());
+            nodes.push_back(std::move(nodes_[outcome.child]));
+            pending.push_back(child);
+            outcome.child = child;
+          }
+          outcomes.push_back(outcome);
+        }
+        edge.first_outcome = first;
+      }
+      edges.push_back(edge);
+    }
+  }
+  nodes_ = std::move(nodes);
+  edges_ = std::move(edges);
+  outcomes_ = std::move(outcomes);
+  return true;
+}
+
+ConcurrentMdp::Move ConcurrentMctsAllocator::choose(const ConcurrentState& state) {
+  if (has_tree_ && !(nodes_[0].state == state) && !(options_.reuse_tree && reroot_to(state))) has_tree_ = false;
+  if (mdp_->certain_success(state)) return mdp_->run_complete_plan(state);
+  const std::vector<ConcurrentMdp::Move> moves = mdp_->useful_moves(state);
+  if (moves.empty()) return {};
+  if (moves.size() == 1) return moves[0];
+  if (!has_tree_) reset(state);
+
+  counters_.search(
+      options_.budget, [&] { return iterate(); }, [&] { return tree_nodes(); }, [&] { return tree_bytes(); });
+  const Node& root = nodes_[0];
+  if (root.first_edge == kNone) return moves[0];
+  return edges_[most_visited(edges_, root.first_edge, root.edge_count)].move;
+}
+
+void ConcurrentMctsAllocator::collect_statistics(Statistics& statistics) const { counters_.add_to(statistics); }
+
+namespace {
+
+// The backup the parameters ask for; UsageError for bound leaves without bellman backups.
+MctsBackup read_backup(const ParameterReader& parameters) {
+  const MctsBackup backup = parameters.text("backup") == "bellman" ? MctsBackup::bellman : MctsBackup::mean;
+  const std::string leaf = parameters.text("leaf");
+  if (leaf != "rollout" && backup != MctsBackup::bellman) {
+    throw UsageError("parameter 'leaf': '" + leaf + "' needs backup 'bellman' (a mean counts rewards 0 or 1)");
+  }
+  return backup;
+}
+
+}  // namespace
 
 AllocatorKind mcts_kind() {
   return {
@@ -406,12 +718,9 @@ AllocatorKind mcts_kind() {
       .make = [](const Mdp& mdp, const ParameterReader& parameters) -> AllocatorFactory {
         MctsOptions options;
         options.exploration = parameters.real("exploration");
-        options.backup = parameters.text("backup") == "bellman" ? MctsBackup::bellman : MctsBackup::mean;
+        options.backup = read_backup(parameters);
         const std::string leaf = parameters.text("leaf");
         if (leaf != "rollout") {
-          if (options.backup != MctsBackup::bellman) {
-            throw UsageError("parameter 'leaf': '" + leaf + "' needs backup 'bellman' (a mean counts rewards 0 or 1)");
-          }
           if (leaf == "lower" && mdp.is_timed()) {
             throw UsageError(
                 "parameter 'leaf': the commit bound does not value exogenous chains or expiry (SPEC §9); use "
@@ -444,7 +753,43 @@ AllocatorKind mcts_kind() {
                              {kIterationsCounter, "search iterations, summed over the searches"},
                              {"memory_stops", "searches stopped by the tree's memory cap"},
                              {"peak_tree_nodes", "the most nodes a tree held"},
-                             {"peak_tree_bytes", "the most bytes a tree held"}}}};
+                             {"peak_tree_bytes", "the most bytes a tree held"}}},
+      .commit_rule =
+          "the search's: starts an action when the search values starting above planning on (its most "
+          "simulated move)",
+      .make_concurrent = [](const ConcurrentMdp& mdp, const ParameterReader& parameters) -> ConcurrentAllocatorFactory {
+        if (mdp.is_timed()) {
+          throw UsageError(mdp.problem().name() +
+                           ": mcts acting while planning (SPEC §10) does not take exogenous "
+                           "chains or expiry (SPEC §9) yet: its search takes a start as one outcome (the optimal "
+                           "allocator takes them)");
+        }
+        ConcurrentMctsOptions options;
+        options.exploration = parameters.real("exploration");
+        options.backup = read_backup(parameters);
+        const std::string leaf = parameters.text("leaf");
+        if (leaf != "rollout") {
+          if (mdp.has_backtracking()) {
+            throw UsageError("parameter 'leaf': '" + leaf +
+                             "' bounds of acting while planning (SPEC §10) assume no give-up; with backtracking "
+                             "(SPEC §7) use 'rollout'");
+          }
+          options.leaf = leaf == "upper" ? MctsLeaf::upper : MctsLeaf::lower;
+        }
+        options.budget = detail::default_budget(parameters);
+        options.max_tree_bytes = static_cast<std::size_t>(parameters.integer("max-tree-mib")) << 20;
+        const std::string rollout = parameters.text("rollout");
+        if (rollout != "random") {
+          const AllocatorKind& kind = allocator_registry().find(rollout);
+          if (!kind.capabilities.has(Capability::stationary)) {
+            throw UsageError("parameter 'rollout': the rollout policy of mcts must choose by the state alone; '" +
+                             rollout + "' does not");
+          }
+          options.rollout = allocator_registry().make_concurrent_factory(rollout, mdp, parameters.values());
+        }
+        const ConcurrentMctsAllocator probe(mdp, options);  // checks the options once, before any episode
+        return [model = &mdp, options] { return std::make_unique<ConcurrentMctsAllocator>(*model, options); };
+      }};
 }
 
 }  // namespace ontime

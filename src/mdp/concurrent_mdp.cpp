@@ -183,6 +183,23 @@ int ConcurrentMdp::forced_start(const ConcurrentState& state) const noexcept {
   return child;
 }
 
+std::vector<ConcurrentMdp::Move> ConcurrentMdp::useful_moves(const ConcurrentState& state) const {
+  std::vector<Move> moves;
+  if (!any_live(state)) return moves;
+  if (const int forced = forced_start(state); forced >= 0) {
+    moves.push_back({forced, kWait});
+    return moves;
+  }
+  if (time(state) < deadline_) {
+    const ChoiceList choices = refine_choices(state);
+    for (const int choice : choices) moves.push_back({-1, choice});
+    // With backtracking an attempt may discard motions: an idle planner is a move of its own.
+    if (choices.empty() || backtracking_) moves.push_back({-1, kWait});
+  }
+  for (const int action : startable(state)) moves.push_back({action, kWait});
+  return moves;
+}
+
 bool ConcurrentMdp::may_start_now(const ConcurrentState& state, int action) const noexcept {
   const Action& model = problem_->action(action);
   if (model.start_by != kNever && time(state) > model.start_by) return false;

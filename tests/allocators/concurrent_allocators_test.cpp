@@ -51,21 +51,23 @@ std::optional<bool> maybe_start(const ConcurrentMdp& mdp, ConcurrentState& state
 }
 
 TEST(ConcurrentAllocators, TheKindsWithACommitRuleAreThoseDocumented) {
-  const std::vector<std::string> expected = {"optimal", "dp",       "dp-rerun",    "round-robin",
-                                             "greedy",  "thompson", "first-found", "found-order-round-robin"};
+  const std::vector<std::string> expected = {"optimal",         "mcts",        "dp",
+                                             "dp-rerun",        "round-robin", "greedy",
+                                             "thompson",        "first-found", "found-order-round-robin",
+                                             "branch-and-bound"};
   EXPECT_EQ(allocator_registry().acting_names(), expected);
   for (const AllocatorKind& kind : allocator_registry().kinds()) {
     EXPECT_EQ(kind.acts_while_planning(), !kind.commit_rule.empty()) << kind.name;
   }
   const ConcurrentMdp mdp(acting(testing::paper_instance("instance1")));
-  for (const std::string name : {"mcts", "ppo", "branch-and-bound", "averaged"}) {
+  for (const std::string name : {"ppo", "averaged"}) {
     try {
       (void)make_concurrent_allocator_factory(name, mdp);
       ADD_FAILURE() << name << " was accepted";
     } catch (const UsageError& error) {
       const std::string message = error.what();
       EXPECT_NE(message.find("'" + name + "' does not act while planning (SPEC §10)"), std::string::npos) << message;
-      EXPECT_NE(message.find("optimal, dp, dp-rerun, round-robin"), std::string::npos) << message;
+      EXPECT_NE(message.find("optimal, mcts, dp, dp-rerun, round-robin"), std::string::npos) << message;
     }
   }
   // Parameters are checked as for plan-first kinds.
@@ -255,7 +257,8 @@ TEST(ConcurrentAllocators, WithBacktrackingAnObservedStepIsTheModelsOutcome) {
 TEST(ConcurrentAllocators, WithBacktrackingDpAndDpRerunAreRefusedTheEagerKindsTakeIt) {
   const ConcurrentMdp mdp(acting(testing::with_backtracking(testing::random_instance(2, 4, 3, 10), 4)));
   ASSERT_TRUE(mdp.has_backtracking());
-  for (const std::string name : {"dp", "dp-rerun"}) {
+  // branch-and-bound and mcts's bound leaves read bounds that assume no give-up.
+  for (const std::string name : {"dp", "dp-rerun", "branch-and-bound"}) {
     try {
       (void)make_concurrent_allocator_factory(name, mdp);
       FAIL() << name << " took backtracking";
@@ -263,7 +266,9 @@ TEST(ConcurrentAllocators, WithBacktrackingDpAndDpRerunAreRefusedTheEagerKindsTa
       EXPECT_NE(std::string(error.what()).find("SPEC §7"), std::string::npos) << error.what();
     }
   }
-  for (const std::string name : {"optimal", "greedy", "round-robin", "first-found", "thompson"}) {
+  EXPECT_THROW((void)make_concurrent_allocator_factory("mcts", mdp, {{"backup", "bellman"}, {"leaf", "upper"}}),
+               UsageError);
+  for (const std::string name : {"optimal", "greedy", "round-robin", "first-found", "thompson", "mcts"}) {
     const auto allocator = make_concurrent_allocator_factory(name, mdp)();
     EXPECT_EQ(allocator->name(), name);
   }

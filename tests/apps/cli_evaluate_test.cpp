@@ -153,13 +153,13 @@ TEST(Cli, TableSetsPlanFirstBesideActingWhilePlanning) {
   const auto defaults = ontime({"table", paper("instance2"), "--act", "concurrent", "--episodes", "50", "--json"});
   ASSERT_EQ(defaults.exit_code, 0) << defaults.err;
   const auto columns = json::parse(defaults.out)["solvers"].get<std::vector<std::string>>();
-  EXPECT_EQ(columns, (std::vector<std::string>{"dp", "dp-rerun", "round-robin", "greedy", "thompson", "first-found",
-                                               "found-order-round-robin"}));
+  EXPECT_EQ(columns, (std::vector<std::string>{"mcts", "dp", "dp-rerun", "round-robin", "greedy", "thompson",
+                                               "first-found", "found-order-round-robin"}));
   const auto markdown = ontime({"table", paper("instance2"), "--act", "concurrent", "--episodes", "50"});
   EXPECT_NE(markdown.out.find("| instance2 (concurrent)  |"), std::string::npos) << markdown.out;
 
   for (const auto& [arguments, message] : std::vector<std::pair<std::vector<std::string>, std::string>>{
-           {{"--act", "concurrent", "--solvers", "dp-rerun,mcts"}, "allocator 'mcts' does not act while planning"},
+           {{"--act", "concurrent", "--solvers", "dp-rerun,ppo"}, "allocator 'ppo' does not act while planning"},
            {{"--act", "concurrent,concurrent"}, "instance given twice"},
            {{"--act", "plan-first,sometimes"}, "--act"}}) {
     std::vector<std::string> command{"table", paper("instance1"), "--episodes", "10"};

@@ -79,8 +79,8 @@ TEST(Cli, SolveActsWhilePlanningWhenAsked) {
       {{"solve", instance, "--method", "search"}, "solved by --method memoised only"},
       {{"solve", instance, "--tolerance", "0.1"}, "--tolerance is for the layered solver"},
       {{"solve", instance, "--max-seconds", "5"}, "--max-seconds is for the layered solver"},
-      {{"evaluate", instance, "--solver", "mcts", "--episodes", "10"}, "'mcts' does not act while planning"},
-      {{"table", instance, "--episodes", "10", "--solvers", "mcts"}, "'mcts' does not act while planning"},
+      {{"evaluate", instance, "--solver", "ppo", "--episodes", "10"}, "'ppo' does not act while planning"},
+      {{"table", instance, "--episodes", "10", "--solvers", "ppo"}, "'ppo' does not act while planning"},
       {{"solve", paper("instance1"), "--act", "interleaved"}, "--act"},
   };
   for (const auto& [arguments, message] : refused) {
@@ -121,6 +121,10 @@ TEST(Cli, SolveActsWhilePlanningWithBacktracking) {
        "episodes with exogenous chains or expiry (SPEC §9) acting while planning (SPEC §10) are not there yet"},
       {{"evaluate", cup, "--act", "concurrent", "--solver", "greedy", "--episodes", "10"},
        "only the optimal allocator takes chains so far"},
+      {{"evaluate", cup, "--act", "concurrent", "--solver", "mcts", "--episodes", "10"},
+       "mcts acting while planning (SPEC §10) does not take exogenous chains or expiry (SPEC §9) yet"},
+      {{"evaluate", cup, "--act", "concurrent", "--solver", "branch-and-bound", "--episodes", "10"},
+       "branch-and-bound acting while planning (SPEC §10) does not take exogenous chains or expiry"},
       {{"evaluate", kitchen, "--act", "concurrent", "--solver", "dp-rerun", "--episodes", "10"},
        "do not value backtracking (SPEC §7) yet"},
       {{"evaluate", kitchen, "--act", "concurrent", "--solver", "dp", "--episodes", "10"},

@@ -425,7 +425,7 @@ TEST(RunTamp, ActingWhilePlanningCommitsWhilePlanningAndStreamsThroughWhatTheRob
     }
   }
   EXPECT_TRUE(committed_while_planning);
-  options.solver = "mcts";
+  options.solver = "ppo";
   EXPECT_THROW(run_tamp(f.domain, f.library, options), UsageError);
 }
 

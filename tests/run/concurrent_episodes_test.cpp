@@ -177,20 +177,31 @@ TEST(ConcurrentEpisodes, WithBacktrackingTheirSuccessIsTheExactValue) {
 }
 
 TEST(ConcurrentEpisodes, TheSameSeedGivesTheSameEpisodesOnAnyThreadCount) {
-  const Problem problem = testing::navigation_with_deadline(16).with_acting(Acting::concurrent);
-  const ConcurrentMdp mdp(problem);
-  for (const std::string name : {"dp-rerun", "thompson"}) {
-    const ConcurrentAllocatorFactory factory = make_concurrent_allocator_factory(name, mdp);
+  // The randomised kinds (thompson, mcts) and the searches, which keep state within an episode.
+  const ConcurrentMdp navigation(testing::navigation_with_deadline(16).with_acting(Acting::concurrent));
+  const ConcurrentMdp third(testing::paper_instance("instance3").with_acting(Acting::concurrent));
+  struct Case {
+    const ConcurrentMdp* mdp;
+    std::string name;
+    ParameterValues values;
+    std::uint64_t episodes;
+  };
+  const std::vector<Case> cases = {{&navigation, "dp-rerun", {}, 2'000},
+                                   {&navigation, "thompson", {}, 2'000},
+                                   {&third, "mcts", {{"iterations", "300"}}, 200},
+                                   {&third, "branch-and-bound", {{"iterations", "300"}}, 200}};
+  for (const Case& run : cases) {
+    const ConcurrentAllocatorFactory factory = make_concurrent_allocator_factory(run.name, *run.mdp, run.values);
     MonteCarloOptions options;
-    options.episodes = 2'000;
+    options.episodes = run.episodes;
     options.seed = 3;
     options.threads = 1;
-    const MonteCarloResult one = run_monte_carlo(mdp, factory, options);
+    const MonteCarloResult one = run_monte_carlo(*run.mdp, factory, options);
     options.threads = 2;
-    const MonteCarloResult two = run_monte_carlo(mdp, factory, options);
-    EXPECT_EQ(one.successes, two.successes) << name;
-    EXPECT_EQ(one.mean_reward, two.mean_reward) << name;
-    EXPECT_GT(one.successes, 0U) << name;
+    const MonteCarloResult two = run_monte_carlo(*run.mdp, factory, options);
+    EXPECT_EQ(one.successes, two.successes) << run.name;
+    EXPECT_EQ(one.mean_reward, two.mean_reward) << run.name;
+    EXPECT_GT(one.successes, 0U) << run.name;
   }
 }
 

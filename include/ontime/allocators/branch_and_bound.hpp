@@ -32,8 +32,11 @@
 #include <string_view>
 
 #include "ontime/allocators/allocator.hpp"
+#include "ontime/allocators/concurrent_allocator.hpp"
 #include "ontime/allocators/decision_budget.hpp"
+#include "ontime/mdp/concurrent_mdp.hpp"
 #include "ontime/mdp/mdp.hpp"
+#include "ontime/solve/concurrent_search.hpp"
 #include "ontime/solve/search_solver.hpp"
 
 namespace ontime {
@@ -79,6 +82,42 @@ class BranchAndBoundAllocator final : public Allocator {
   std::uint64_t episode_seed_ = 1, restarts_ = 0;
   struct Counters {
     std::uint64_t searches = 0, work = 0, trial_work = 0, exact = 0;
+    double gap_sum = 0.0, max_gap = 0.0;
+  } counters_;
+};
+
+// `branch-and-bound` acting while planning (SPEC §10): before every move it spends its budget
+// (work units: a state backed up; or seconds) on ConcurrentSearch from the current state, keeping
+// what it bounded for the rest of the episode, and makes the move of the best certified lower end,
+// the optimal move where the search closed (the exact solver's value). Its gap, the upper end of
+// V*(state) minus that lower end, bounds the move's loss. The search is all trials (there is no
+// depth-first part), so `trial_share` is not read. The commit rule is the search's: the robot
+// starts an action when starting's certified lower end is the best. Without a search: a complete
+// plan without rewards runs at once (certain success), a forced start or the only useful move is
+// made. Deterministic (the search draws nothing; the records are cleared at each episode and at
+// `max_states`). Not stationary. Cost per decision: its budget; memory: the search's records.
+class ConcurrentBranchAndBoundAllocator final : public ConcurrentAllocator {
+ public:
+  // The ConcurrentMdp must outlive the allocator.
+  ConcurrentBranchAndBoundAllocator(const ConcurrentMdp& mdp, BranchAndBoundOptions options);
+
+  std::string_view name() const noexcept override { return "branch-and-bound"; }
+  void begin_episode(std::uint64_t seed) override;
+  ConcurrentMdp::Move choose(const ConcurrentState& state) override;
+  bool is_stationary() const noexcept override { return false; }
+  // searches, iterations (work), exact_decisions, gap_sum (summed); max_gap (largest).
+  void collect_statistics(Statistics& statistics) const override;
+
+  // The certified gap of the last decision (0 when its search closed or no search was needed).
+  double last_gap() const noexcept { return last_gap_; }
+
+ private:
+  const ConcurrentMdp* mdp_;
+  BranchAndBoundOptions options_;
+  ConcurrentSearch search_;
+  double last_gap_ = 0.0;
+  struct Counters {
+    std::uint64_t searches = 0, work = 0, exact = 0;
     double gap_sum = 0.0, max_gap = 0.0;
   } counters_;
 };

@@ -49,20 +49,55 @@
 // node and per chance node), bounded by `max_tree_bytes`: a search that would exceed
 // it stops with its best answer so far. The bounds' tables are built once per factory.
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <vector>
 
 #include "ontime/allocators/allocator.hpp"
+#include "ontime/allocators/concurrent_allocator.hpp"
 #include "ontime/allocators/decision_budget.hpp"
+#include "ontime/mdp/concurrent_mdp.hpp"
 #include "ontime/mdp/mdp.hpp"
+#include "ontime/solve/concurrent_value_bounds.hpp"
 #include "ontime/solve/value_bounds.hpp"
 #include "ontime/util/random.hpp"
+#include "ontime/util/statistics.hpp"
 
 namespace ontime {
 
 enum class MctsBackup { mean, bellman };
+
+// The counters of an mcts search, in either form (plan-first or acting while planning).
+struct MctsCounters {
+  std::uint64_t searches = 0;       // decisions that ran a search
+  std::uint64_t iterations = 0;     // search iterations over all searches
+  std::size_t peak_tree_nodes = 0;  // largest tree held (decision + chance nodes)
+  std::size_t peak_tree_bytes = 0;  // its memory, capacity included
+  std::uint64_t memory_stops = 0;   // searches ended early by the memory cap
+
+  // One search: `iterate()` (false: the memory cap stopped it) until `budget` is exhausted, then
+  // the tree's size by `nodes()` and `bytes()`.
+  template <class Iterate, class Nodes, class Bytes>
+  void search(const DecisionBudget& budget, Iterate&& iterate, Nodes&& nodes, Bytes&& bytes) {
+    ++searches;
+    const BudgetMonitor monitor(budget);
+    std::uint64_t done = 0;
+    while (!monitor.exhausted(done)) {
+      if (!iterate()) {
+        ++memory_stops;
+        break;
+      }
+      ++done;
+    }
+    iterations += done;
+    peak_tree_nodes = std::max(peak_tree_nodes, nodes());
+    peak_tree_bytes = std::max(peak_tree_bytes, bytes());
+  }
+  // Adds the counters to `statistics` (peaks merged by their maximum).
+  void add_to(Statistics& statistics) const;
+};
 
 struct MctsOptions {
   double exploration = 0.5;  // C of UCT
@@ -171,13 +206,116 @@ class MctsAllocator final : public Allocator {
   std::vector<double> edge_returns_;
   std::vector<double> outcome_rewards_;
   std::vector<std::uint32_t> path_;  // edges visited by the current iteration
-  struct Counters {
-    std::uint64_t searches = 0;       // decisions that ran a search
-    std::uint64_t iterations = 0;     // search iterations over all searches
-    std::size_t peak_tree_nodes = 0;  // largest tree held (decision + chance nodes)
-    std::size_t peak_tree_bytes = 0;  // its memory, capacity included
-    std::uint64_t memory_stops = 0;   // searches ended early by the memory cap
-  } counters_;
+  MctsCounters counters_;
+};
+
+// A new node's value under bellman backups in the concurrent form (ConcurrentMctsAllocator).
+enum class MctsLeaf { rollout, upper, lower };
+
+struct ConcurrentMctsOptions {
+  double exploration = 0.5;  // C of UCT
+  MctsBackup backup = MctsBackup::mean;
+  // Bellman backups: a new node's V, a rollout's reward or a bound of ConcurrentValueBounds.
+  MctsLeaf leaf = MctsLeaf::rollout;
+  DecisionBudget budget = DecisionBudget::iterations(10'000);  // per decision
+  std::size_t max_tree_bytes = std::size_t{1} << 30;           // 1 GiB
+  bool reuse_tree = true;
+  // Rollout policy: null for uniformly random useful moves, else a factory of a stationary
+  // allocator acting while planning.
+  ConcurrentAllocatorFactory rollout;
+};
+
+// `mcts` acting while planning (SPEC §10): the same search over the moves of ConcurrentMdp.
+//
+// A decision node is a state; its edges are the moves the exact solver considers
+// (ConcurrentMdp::useful_moves: the forced start alone where there is one, else the step choices
+// and the starts); a step's chance node has the outcomes of ConcurrentMdp::for_each_step_outcome
+// with their probabilities, a start one outcome. An outcome where no skeleton can finish ends the
+// iteration with 0, one that starts a skeleton's last action with its reward, and without rewards
+// one with a live skeleton refined in full with 1 (ConcurrentMdp::certain_success, proved). UCT,
+// the mean and bellman backups and the leaf values (a rollout's reward, or the upper or lower
+// bound of ConcurrentValueBounds) are those of MctsAllocator above; rollouts play uniformly random
+// useful moves or a stationary allocator acting while planning. The move returned is the root's
+// most simulated (ties: the first in useful_moves' order, the steps before the starts), so the
+// commit rule is the search's: the robot starts an action when the search values starting above
+// planning on. Without a search: a complete plan without rewards runs at once (certain success),
+// a forced start or the only useful move is made.
+//
+// Tree reuse: the node of the state met at the next decision, when it is a child of the root,
+// becomes the new root. Guarantees: as MctsAllocator's (UCT converges; same seed and an iteration
+// budget, same moves). Cost per iteration: O(depth * (K + outcomes)) in the tree, a rollout or
+// ConcurrentValueBounds' cost at the leaf; memory: a node holds its state's words (4 + 2K + A, two
+// bytes each), capped by `max_tree_bytes`.
+class ConcurrentMctsAllocator final : public ConcurrentAllocator {
+ public:
+  // The ConcurrentMdp must outlive the allocator. Throws UsageError for a negative exploration
+  // constant, bound leaves without bellman backups or a rollout policy that is not stationary.
+  ConcurrentMctsAllocator(const ConcurrentMdp& mdp, ConcurrentMctsOptions options);
+
+  std::string_view name() const noexcept override { return "mcts"; }
+  void begin_episode(std::uint64_t seed) override;
+  ConcurrentMdp::Move choose(const ConcurrentState& state) override;
+  bool is_stationary() const noexcept override { return false; }
+  // searches, iterations, memory_stops (summed); peak_tree_nodes, peak_tree_bytes (largest).
+  void collect_statistics(Statistics& statistics) const override;
+
+  // The decision and chance nodes the tree holds now.
+  std::size_t tree_nodes() const noexcept { return nodes_.size() + edges_.size(); }
+  // The bytes the tree holds now (capacities, and the nodes' states): what `max_tree_bytes` caps.
+  std::size_t tree_bytes() const noexcept;
+
+ private:
+  static constexpr std::uint32_t kNone = 0xFFFFFFFFU;
+
+  struct Node {
+    ConcurrentState state;
+    std::uint32_t first_edge = kNone;  // kNone until expanded
+    std::uint32_t visits = 0;
+    std::uint16_t edge_count = 0;
+    double value = 0.0;  // bellman: V (the leaf value until expanded)
+  };
+  struct Edge {
+    ConcurrentMdp::Move move;
+    std::uint32_t first_outcome = kNone;  // kNone until first taken
+    std::uint32_t visits = 0;
+    std::uint16_t outcome_count = 0;
+    double returns = 0.0;  // mean: the sum of the rewards through it
+    double q = 0.0;        // bellman: Q over the outcomes reached
+  };
+  struct Outcome {
+    double probability = 0.0;
+    std::uint32_t child = kNone;  // decision node, kNone until reached (or when it ends)
+    bool ends = false;            // the episode ends here, worth `reward`
+    bool reached = false;
+    double reward = 0.0;
+  };
+
+  void reset(const ConcurrentState& root);
+  bool reroot_to(const ConcurrentState& state);
+  bool expand(std::uint32_t node);
+  bool expand_outcomes(std::uint32_t edge, std::uint32_t node);
+  std::uint32_t select_edge(const Node& node) const;
+  double estimate(const Edge& edge) const noexcept;
+  ConcurrentState successor(const ConcurrentState& state, const ConcurrentMdp::Move& move, std::size_t index) const;
+  bool iterate();
+  double leaf_value(const ConcurrentState& state);
+  double rollout(ConcurrentState state);
+  void back_up_bellman();
+  bool would_exceed_memory(std::size_t nodes, std::size_t edges, std::size_t outcomes) const;
+  bool bellman() const noexcept { return options_.backup == MctsBackup::bellman; }
+
+  const ConcurrentMdp* mdp_;
+  ConcurrentMctsOptions options_;
+  std::unique_ptr<ConcurrentAllocator> rollout_policy_;
+  std::unique_ptr<ConcurrentValueBounds> bounds_;  // bound leaves only (one per allocator: its memo)
+  std::size_t state_bytes_;                        // a node's state on the heap
+  SplitMix64 generator_{0};
+  bool has_tree_ = false;
+  std::vector<Node> nodes_;  // nodes_[0] is the root
+  std::vector<Edge> edges_;
+  std::vector<Outcome> outcomes_;
+  std::vector<std::uint32_t> path_;  // node, edge, node, edge, ... of the current iteration
+  MctsCounters counters_;
 };
 
 }  // namespace ontime

@@ -156,6 +156,13 @@ class ConcurrentMdp {
   // refined again, so committing may cost) or with chains or expiry (waiting may pay).
   int forced_start(const ConcurrentState& state) const noexcept;
 
+  // The moves the exact solver considers (ConcurrentSolver), in its tie order: the forced start
+  // alone when there is one; else, before the deadline, the step choices (refine_choices), then
+  // kWait when none has work left or with backtracking, then the startable actions, ascending.
+  // Empty when no skeleton can finish. Leaving the others out loses nothing (docs/theory.md,
+  // "Acting while planning").
+  std::vector<Move> useful_moves(const ConcurrentState& state) const;
+
   // What starting `action` (a startable child of E) leads to: the end of the episode, when it is
   // the last action of a live skeleton (`reward`: R_k at its finish, 0 past the deadline), or
   // `next` (canonical). Throws UsageError when the action is not startable.

@@ -1,0 +1,70 @@
+#pragma once
+// `ConcurrentSearch`: an anytime search of the acting-while-planning MDP (SPEC §10) from a state,
+// with a certified interval on V* there and a move whose loss it bounds.
+//
+// What it computes. Trials of bounded RTDP (McMahan, Likhachev and Gordon 2005) over the states of
+// ConcurrentMdp: every state met holds an interval [lo, hi] around V*, first the bounds of
+// ConcurrentValueBounds (widened by kBoundSlack against rounding, unless they meet: then the value
+// is the devoted policy's, exact), then the backups of its moves (ConcurrentMdp::useful_moves):
+// Q_lo(m) and Q_hi(m) the expectations of the successors' ends (a start that ends the episode is
+// worth its reward), lo = max_m Q_lo(m), hi = max_m Q_hi(m), each kept no looser than before. A
+// trial walks down from the state by the move of the largest Q_hi (ties: the first) and the
+// outcome of the largest probability times gap (ties: the first), and backs the intervals up
+// along its path; it stops at a state whose interval has closed. There is no randomness.
+//
+// Guarantees. Every lo is at most V* and every hi at least V* (the bounds are certified and a
+// backup of certified bounds is certified), so the answer's `upper - lower` is at least the loss
+// V*(from) - Q*(from, move) of its move. Each trial closes at least one state it entered open (the
+// state space is finite and acyclic: a step raises CT, a start lengthens E), so without a limit
+// the search ends with from's interval closed: the value is V* (up to rounding) and the move is
+// one that attains it. The move is the one of the largest Q_lo in the order of useful_moves, a
+// later move replacing it only when better by more than ConcurrentSolver::kTieTolerance, the
+// exact solver's rule.
+//
+// Cost: one unit of work per state backed up (its moves' outcomes, a table lookup or a bound each);
+// memory: one record (the state's words, two doubles and a hash-table slot) per state met, kept
+// across calls so that later searches from successors start from them; see size().
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+
+#include "ontime/mdp/concurrent_mdp.hpp"
+
+namespace ontime {
+
+struct ConcurrentSearchResult {
+  ConcurrentMdp::Move move;  // the move of the best certified lower end (the default Move: none)
+  double lower = 0;          // that move's certified lower end: at most Q*(from, move)
+  double upper = 0;          // at least V*(from)
+  bool exact = false;        // from's interval closed: lower is V*(from), the move optimal
+  std::uint64_t work = 0;    // states backed up in this call
+};
+
+class ConcurrentSearch {
+ public:
+  // Widening of the bounds of a state first met, against rounding.
+  static constexpr double kBoundSlack = 1e-12;
+
+  // A search of `mdp` (which must outlive it) that stops once it holds `max_states` records (0:
+  // no cap).
+  explicit ConcurrentSearch(const ConcurrentMdp& mdp, std::uint64_t max_states = 0);
+  ~ConcurrentSearch();
+  ConcurrentSearch(const ConcurrentSearch&) = delete;
+  ConcurrentSearch& operator=(const ConcurrentSearch&) = delete;
+
+  // Trials from `from` (a state with some skeleton live) until its interval closes, the record
+  // cap is reached or `stop(work)` returns true (checked after every unit of work, with the units
+  // done in this call); then the move of the best lower end and from's interval.
+  ConcurrentSearchResult search(const ConcurrentState& from, const std::function<bool(std::uint64_t work)>& stop);
+  // Forgets every record.
+  void clear();
+  // Records held: one per state met.
+  std::uint64_t size() const noexcept;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace ontime

@@ -1,0 +1,63 @@
+#pragma once
+// Certified bounds on V*(state) of the acting-while-planning MDP (SPEC §10), cheap enough for
+// every leaf of a search (mcts, branch-and-bound).
+//
+// Both rest on the devoted value P_k = ConcurrentContiguousSuccess::value(state, k) with
+// aggregation `self`: the expected reward of the policy that refines live skeleton k alone,
+// action after action, while the robot executes each of k's actions as soon as it is refined and
+// the robot is free (for a skeleton refined in full: its reward at the end of its backlog). A
+// skeleton k is *eligible* when no other live skeleton is a proper prefix of it and none with a
+// lower index has the same actions: an ineligible one can never be the skeleton whose last start
+// ends the episode (SPEC §10), and for an eligible one the devoted policy earns exactly P_k.
+//   lower(state) = max over eligible k of P_k: the value of an actual policy, so at most V*;
+//   upper(state) = min(R_cap, sum over eligible k of P_k), R_cap the largest reward an eligible
+//   skeleton can still earn (R_k at its earliest finish; 1 without rewards): with each action's
+//   planning and execution time a fixed latent draw, any policy that ends the episode through k
+//   has refined and started each of k's actions no sooner than the devoted policy, so it succeeds
+//   only where the devoted policy does, and earns at most its reward (SPEC §8's rewards do not
+//   rise with the finish); the union of these events over k bounds V*. Without rewards, also
+//   1 - prod over groups g of (1 - min(1, sum over k in g of P_k)), the skeletons grouped by their
+//   next unrefined action: groups share no unrefined action, so their events are independent.
+// docs/theory.md, "Acting while planning", has the proofs. A state where no skeleton can finish
+// is worth 0; without rewards one with a live skeleton refined in full is worth 1 (both exact).
+//
+// Cost: per state O(K^2) to find the eligible skeletons and group them, plus K queries of
+// ConcurrentContiguousSuccess (each a sum over at most D - CT planning steps of memoised values);
+// memory: that memo. Not thread-safe (the memo): one object per thread.
+
+#include <utility>
+#include <vector>
+
+#include "ontime/mdp/concurrent_mdp.hpp"
+#include "ontime/solve/concurrent_contiguous_success.hpp"
+
+namespace ontime {
+
+class ConcurrentValueBounds {
+ public:
+  // An interval [lower, upper] around V*(state).
+  struct Interval {
+    double lower = 0;
+    double upper = 0;
+  };
+
+  // Bounds for the states of `mdp`, which must outlive this object. Throws UsageError when the
+  // problem has backtracking (SPEC §7): a give-up may discard motions, which the proofs leave out.
+  explicit ConcurrentValueBounds(const ConcurrentMdp& mdp);
+
+  // Both bounds at `state` (any state of the MDP, terminal or not).
+  Interval bounds(const ConcurrentState& state);
+  // The lower bound alone: the best devoted policy's value.
+  double lower(const ConcurrentState& state) { return bounds(state).lower; }
+  // The upper bound alone: the union bound over the devoted policies.
+  double upper(const ConcurrentState& state) { return bounds(state).upper; }
+
+ private:
+  bool eligible(const ConcurrentState& state, int k) const;
+
+  const ConcurrentMdp* mdp_;
+  ConcurrentContiguousSuccess devoted_;
+  std::vector<std::pair<int, double>> groups_;  // scratch: next unrefined action, summed devoted values
+};
+
+}  // namespace ontime

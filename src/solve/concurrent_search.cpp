@@ -1,0 +1,165 @@
+#include "ontime/solve/concurrent_search.hpp"
+
+#include <absl/container/flat_hash_map.h>
+#include <absl/hash/hash.h>
+
+#include <algorithm>
+#include <utility>
+#include <vector>
+
+#include "ontime/solve/concurrent_solver.hpp"
+#include "ontime/solve/concurrent_value_bounds.hpp"
+
+namespace ontime {
+
+using Interval = ConcurrentValueBounds::Interval;
+using Move = ConcurrentMdp::Move;
+
+struct ConcurrentSearch::Impl {
+  const ConcurrentMdp* mdp;
+  std::uint64_t max_states;
+  ConcurrentValueBounds heuristic;
+  absl::flat_hash_map<ConcurrentState, Interval> table;
+  // Scratch of one backup: the successors of the move to descend by, with probability times gap.
+  std::vector<std::pair<double, ConcurrentState>> descent;
+  std::vector<ConcurrentState> path;
+
+  Impl(const ConcurrentMdp& model, std::uint64_t cap) : mdp(&model), max_states(cap), heuristic(model) {}
+
+  // The interval of `state`: exact when terminal, else the table's, else the heuristic's (kept).
+  Interval interval(const ConcurrentState& state) {
+    if (!mdp->any_live(state)) return {};
+    if (mdp->certain_success(state)) return {1.0, 1.0};
+    if (const auto found = table.find(state); found != table.end()) return found->second;
+    Interval bounds = heuristic.bounds(state);
+    if (bounds.lower < bounds.upper) {
+      bounds.lower = std::max(0.0, bounds.lower - kBoundSlack);
+      bounds.upper += kBoundSlack;
+    }
+    table.emplace(state, bounds);
+    return bounds;
+  }
+
+  struct Backup {
+    Interval interval;     // the state's interval after the backup (kept no looser than before)
+    double lower_max = 0;  // max_m Q_lo(m)
+    double upper_max = 0;  // max_m Q_hi(m)
+    Move best_lower;       // the move of the largest Q_lo (the tie rule of the exact solver)
+    double best_lower_value = -1.0;
+  };
+
+  // Backs `state` (not terminal) up from its successors; fills `descent` with the successors of the
+  // move of the largest Q_hi (ties: the first).
+  Backup back_up(const ConcurrentState& state) {
+    const Interval before = interval(state);
+    Backup result;
+    double best_upper = -1.0;
+    std::vector<std::pair<double, ConcurrentState>> successors;
+    for (const Move& move : mdp->useful_moves(state)) {
+      Interval q;
+      successors.clear();
+      if (move.is_start()) {
+        ConcurrentMdp::StartOutcome outcome = mdp->start_action(state, move.start);
+        if (outcome.ends) {
+          q = {outcome.reward, outcome.reward};
+        } else {
+          q = interval(outcome.next);
+          successors.emplace_back(q.upper - q.lower, std::move(outcome.next));
+        }
+      } else {
+        mdp->for_each_step_outcome(state, move.refine, [&](double probability, const ConcurrentState& next) {
+          const Interval v = interval(next);
+          q.lower += probability * v.lower;
+          q.upper += probability * v.upper;
+          successors.emplace_back(probability * (v.upper - v.lower), next);
+        });
+      }
+      if (q.upper > best_upper) {
+        best_upper = q.upper;
+        descent.swap(successors);
+      }
+      if (q.lower > result.best_lower_value + ConcurrentSolver::kTieTolerance) {
+        result.best_lower_value = q.lower;
+        result.best_lower = move;
+      }
+      result.lower_max = std::max(result.lower_max, q.lower);
+    }
+    result.upper_max = std::max(best_upper, 0.0);
+    Interval kept{std::max(before.lower, result.lower_max), std::min(before.upper, result.upper_max)};
+    if (result.lower_max >= result.upper_max) {
+      kept = {result.upper_max, result.upper_max};  // closed: its moves' ends met
+    } else if (kept.lower > kept.upper) {
+      kept.lower = kept.upper;  // rounding only
+    }
+    table[state] = kept;
+    result.interval = kept;
+    return result;
+  }
+
+  // The successor of `descent` of the largest probability times gap (ties: the first), or null
+  // when none has a gap.
+  ConcurrentState* widest() {
+    auto next = descent.begin();
+    for (auto it = descent.begin(); it != descent.end(); ++it) {
+      if (it->first > next->first) next = it;
+    }
+    return next == descent.end() || !(next->first > 0.0) ? nullptr : &next->second;
+  }
+};
+
+ConcurrentSearch::ConcurrentSearch(const ConcurrentMdp& mdp, std::uint64_t max_states)
+    : impl_(std::make_unique<Impl>(mdp, max_states)) {}
+
+ConcurrentSearch::~ConcurrentSearch() = default;
+
+void ConcurrentSearch::clear() { impl_->table.clear(); }
+
+std::uint64_t ConcurrentSearch::size() const noexcept { return impl_->table.size(); }
+
+ConcurrentSearchResult ConcurrentSearch::search(const ConcurrentState& from,
+                                                const std::function<bool(std::uint64_t work)>& stop) {
+  Impl& impl = *impl_;
+  const ConcurrentMdp& mdp = *impl.mdp;
+  ConcurrentSearchResult result;
+  if (!mdp.any_live(from)) return result;
+  if (mdp.certain_success(from)) {
+    result.move = mdp.run_complete_plan(from);
+    result.lower = result.upper = 1.0;
+    result.exact = true;
+    return result;
+  }
+  const auto stopped = [&] {
+    return (stop && stop(result.work)) || (impl.max_states > 0 && impl.table.size() >= impl.max_states);
+  };
+  for (;;) {
+    // From's own interval may have closed on its bounds alone (one eligible skeleton): the move is
+    // known to be optimal only once its lower end reaches every move's upper end.
+    const Impl::Backup root = impl.back_up(from);
+    ++result.work;
+    result.move = root.best_lower;
+    result.lower = root.best_lower_value;
+    result.upper = std::min(root.interval.upper, root.upper_max);
+    result.exact = root.lower_max >= root.upper_max;
+    if (result.exact || stopped()) break;
+    const ConcurrentState* next = impl.widest();
+    if (next == nullptr) break;  // closed but for rounding
+    impl.path.assign(1, *next);
+    for (;;) {
+      const Impl::Backup backup = impl.back_up(impl.path.back());
+      ++result.work;
+      if (backup.interval.lower >= backup.interval.upper || stopped()) break;
+      next = impl.widest();
+      if (next == nullptr) break;
+      impl.path.push_back(*next);
+    }
+    // The path's last state was just backed up; the others again, deepest first (from's at the
+    // top of the loop).
+    for (std::size_t i = impl.path.size() - 1; i-- > 0;) {
+      impl.back_up(impl.path[i]);
+      ++result.work;
+    }
+  }
+  return result;
+}
+
+}  // namespace ontime

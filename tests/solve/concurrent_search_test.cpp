@@ -1,0 +1,180 @@
+// Acting while planning (SPEC §10): the bounds of ConcurrentValueBounds against the exact optimum
+// on random states of random instances; the devoted policy's exact value against the lower bound's
+// term; ConcurrentSearch's answers against ConcurrentSolver, searched in full and cut short.
+#include "ontime/solve/concurrent_search.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "ontime/mdp/concurrent_mdp.hpp"
+#include "ontime/solve/concurrent_contiguous_success.hpp"
+#include "ontime/solve/concurrent_solver.hpp"
+#include "ontime/solve/concurrent_value_bounds.hpp"
+#include "ontime/util/random.hpp"
+#include "support/random_instances.hpp"
+
+namespace ontime {
+namespace {
+
+using Move = ConcurrentMdp::Move;
+
+// Rounding of sums of a few dozen products of probabilities.
+constexpr double kSearchRounding = 1e-12;
+
+Problem search_instance(std::uint64_t seed) {
+  const Problem problem = testing::random_instance(seed, 4, 4, 12);
+  return seed % 3 == 0 ? testing::with_random_rewards(problem, seed) : problem;
+}
+
+// States met by `walks` random walks from the start (uniform useful moves, outcomes drawn by
+// their probabilities), the running ones only.
+std::vector<ConcurrentState> random_states(const ConcurrentMdp& mdp, std::uint64_t seed, int walks) {
+  SplitMix64 generator(seed);
+  std::vector<ConcurrentState> states;
+  for (int walk = 0; walk < walks; ++walk) {
+    ConcurrentState state = mdp.start();
+    for (;;) {
+      const std::vector<Move> moves = mdp.useful_moves(state);
+      if (moves.empty()) break;
+      states.push_back(state);
+      const Move move = moves[generator() % moves.size()];
+      if (move.is_start()) {
+        ConcurrentMdp::StartOutcome outcome = mdp.start_action(state, move.start);
+        if (outcome.ends) break;
+        state = std::move(outcome.next);
+        continue;
+      }
+      double u = uniform01(generator);
+      ConcurrentState chosen;
+      mdp.for_each_step_outcome(state, move.refine, [&](double probability, const ConcurrentState& next) {
+        if (chosen.empty() || u >= 0.0) chosen = next;
+        u -= probability;
+      });
+      state = std::move(chosen);
+    }
+  }
+  return states;
+}
+
+// Q*(state, move) from the exact solver.
+double exact_q(const ConcurrentMdp& mdp, ConcurrentSolver& solver, const ConcurrentState& state, const Move& move) {
+  if (move.is_start()) {
+    const ConcurrentMdp::StartOutcome outcome = mdp.start_action(state, move.start);
+    return outcome.ends ? outcome.reward : solver.solve(outcome.next);
+  }
+  double q = 0.0;
+  mdp.for_each_step_outcome(state, move.refine, [&](double probability, const ConcurrentState& next) {
+    q += probability * solver.solve(next);
+  });
+  return q;
+}
+
+TEST(ConcurrentValueBounds, SandwichTheOptimumOnRandomStates) {
+  const int count = testing::repetitions_to_check(120);
+  int states = 0, open = 0;
+  for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
+    const Problem problem = search_instance(seed);
+    const ConcurrentMdp mdp(problem);
+    ConcurrentSolver solver(mdp);
+    ConcurrentValueBounds bounds(mdp);
+    for (const ConcurrentState& state : random_states(mdp, seed, 4)) {
+      const double optimum = solver.solve(state);
+      const ConcurrentValueBounds::Interval interval = bounds.bounds(state);
+      ASSERT_LE(interval.lower, optimum + kSearchRounding) << "seed " << seed;
+      ASSERT_GE(interval.upper, optimum - kSearchRounding) << "seed " << seed;
+      ++states;
+      open += interval.upper - interval.lower > 1e-9 ? 1 : 0;
+    }
+  }
+  // Hundreds of states, and dozens of them with the bounds apart (the check sees real intervals).
+  EXPECT_GT(states, 4 * count);
+  EXPECT_GT(open, 50);
+}
+
+// The lower bound's term for skeleton k is the exact value of the policy it names: refine k alone,
+// start k's next action as soon as it is refined and the robot is idle.
+TEST(ConcurrentValueBounds, TheDevotedValueIsThePolicysExactValue) {
+  const int count = testing::repetitions_to_check(100);
+  int checked = 0;
+  for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
+    const Problem problem = search_instance(seed);
+    const ConcurrentMdp mdp(problem);
+    ConcurrentContiguousSuccess devoted(mdp, Aggregation::self);
+    for (int k = 0; k < problem.skeleton_count(); ++k) {
+      // Only skeletons no other one is a prefix of (or spells again with a lower index).
+      bool alone = true;
+      for (int m = 0; m < problem.skeleton_count(); ++m) {
+        const int length = problem.skeleton_length(m);
+        if (m != k && length <= problem.skeleton_length(k) &&
+            problem.action_at(m, length - 1) == problem.action_at(k, length - 1) &&
+            (length < problem.skeleton_length(k) || m < k)) {
+          alone = false;
+        }
+      }
+      if (!alone || !ConcurrentMdp::is_live(mdp.start(), k)) continue;
+      const auto policy = [&](const ConcurrentState& state) -> Move {
+        if (!ConcurrentMdp::is_live(state, k)) return {};
+        const int depth = mdp.executed_depth(state);
+        if (ConcurrentMdp::robot_left(state) == 0 && ConcurrentMdp::refined(state, k) > depth) {
+          return {problem.action_at(k, depth), ConcurrentMdp::kWait};
+        }
+        if (ConcurrentMdp::refined(state, k) < problem.skeleton_length(k)) return {-1, k};
+        return {};
+      };
+      ConcurrentSolver evaluation(mdp, policy);
+      EXPECT_NEAR(evaluation.solve(mdp.start()), devoted.value(mdp.start(), k), kSearchRounding)
+          << "seed " << seed << " skeleton " << k;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, count / 2);
+}
+
+TEST(ConcurrentSearch, WithoutALimitItsMoveAttainsTheOptimum) {
+  const int count = testing::repetitions_to_check(80);
+  int searched = 0;
+  for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
+    const Problem problem = search_instance(seed);
+    const ConcurrentMdp mdp(problem);
+    ConcurrentSolver solver(mdp);
+    ConcurrentSearch search(mdp);
+    for (const ConcurrentState& state : random_states(mdp, seed + 500, 2)) {
+      const double optimum = solver.solve(state);
+      const ConcurrentSearchResult result = search.search(state, nullptr);
+      ASSERT_TRUE(result.exact) << "seed " << seed;
+      EXPECT_NEAR(result.lower, optimum, kSearchRounding) << "seed " << seed;
+      EXPECT_NEAR(result.upper, optimum, kSearchRounding) << "seed " << seed;
+      if (mdp.certain_success(state)) continue;
+      EXPECT_NEAR(exact_q(mdp, solver, state, result.move), optimum, kSearchRounding) << "seed " << seed;
+      ++searched;
+    }
+  }
+  EXPECT_GT(searched, 2 * count);
+}
+
+TEST(ConcurrentSearch, CutShortItsGapBoundsTheLoss) {
+  const int count = testing::repetitions_to_check(80);
+  int cut = 0;
+  for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
+    const Problem problem = testing::random_instance(seed + 2000, 5, 4, 20);
+    const ConcurrentMdp mdp(problem);
+    ConcurrentSolver solver(mdp);
+    const ConcurrentState start = mdp.start();
+    if (!mdp.any_live(start)) continue;
+    for (const std::uint64_t budget : {1, 2, 4}) {
+      ConcurrentSearch search(mdp);
+      const ConcurrentSearchResult result = search.search(start, [&](std::uint64_t work) { return work >= budget; });
+      const double optimum = solver.solve(start);
+      EXPECT_GE(result.upper, optimum - kSearchRounding) << "seed " << seed;
+      EXPECT_LE(result.lower, exact_q(mdp, solver, start, result.move) + kSearchRounding) << "seed " << seed;
+      cut += result.exact ? 0 : 1;
+    }
+  }
+  EXPECT_GT(cut, count / 10);
+}
+
+}  // namespace
+}  // namespace ontime
