@@ -143,6 +143,7 @@ void add_run_command(CLI::App& app) {
     run.decision_share = options->decision_share;
     run.ranks = job_ranks();
     domains::check_planner_run_request(problem, instance.string(), run, flag_spelling());
+    domains::check_domain_actions(*loaded.domain, problem, instance.string());
     const domains::PlannerRun result = domains::run_planner_episodes(*loaded.domain, problem, run);
     if (!timeline_data.empty() && is_job_root()) {  // rank 0 writes
       const EpisodeResult& shown = result.episodes[options->timeline_episode];

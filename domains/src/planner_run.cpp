@@ -1,6 +1,7 @@
 #include "ontime/domains/planner_run.hpp"
 
 #include <optional>
+#include <stdexcept>
 
 #include "episode_options.hpp"
 #include "ontime/allocators/optimal.hpp"
@@ -20,6 +21,18 @@ void check_planner_run_request(const Problem& problem, const std::string& source
                                     worker_count(options.episodes, options.threads), spelling);
   if (options.exact || allocator_registry().find(options.solver).capabilities.has(Capability::optimal)) {
     check_exact_work(problem, max_states_of(options.parameters), source, spelling);
+  }
+}
+
+void check_domain_actions(const Domain& domain, const Problem& problem, const std::string& source) {
+  if (domain.feature_names().empty()) return;
+  for (const Action& action : problem.actions()) {
+    try {
+      (void)domain.action_features(action.id);
+    } catch (const std::invalid_argument& error) {
+      throw InputError(source, "actions." + action.id,
+                       "not an action of the world '" + domain.name() + "' (" + error.what() + ")");
+    }
   }
 }
 

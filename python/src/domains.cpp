@@ -227,6 +227,7 @@ void bind_domains(py::module_& m) {
         options.live = live;
         options.decision_share = decision_share;
         domains::check_planner_run_request(*chosen, instance, options, python_spelling());
+        domains::check_domain_actions(*domain->loaded.domain, *chosen, instance);
         domains::PlannerRun result;
         run_interruptibly(
             [&](const std::function<bool()>& stop, Progress& counters) {

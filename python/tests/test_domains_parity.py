@@ -106,6 +106,15 @@ def test_tamp_refuses_what_the_cli_refuses():
         ontime.domains.tamp(building, paper, "dp-rerun", 45)
 
 
+def test_run_refuses_an_instance_whose_actions_are_not_the_worlds():
+    """Before any episode, as the command line does (exit 2 there), in either acting mode."""
+    navigation = ontime.domains.load("navigation", NAVIGATION)
+    paper = str(SOURCE_DIR / "data" / "instances" / "paper" / "instance1.json")
+    for act in ("plan-first", "concurrent"):
+        with pytest.raises(ontime.InputError, match=r"instance1.json: actions\.\S+: not an action of the world"):
+            ontime.domains.run(navigation, paper, "greedy", episodes=2, act=act)
+
+
 def test_map_data_is_the_drawing_the_cli_writes(cli, tmp_path):
     png = tmp_path / "map.png"
     done = cli("map", "--domain", "navigation", "--world", NAVIGATION, "--seed", 2, "-o", png, expect_json=False)

@@ -443,6 +443,23 @@ TEST(Cli, AWorldWhoseGoalCannotBeReachedIsRefused) {
   EXPECT_FALSE(std::filesystem::exists(dir / "map.png"));
 }
 
+// An instance whose actions are not the world's (the paper's abstract actions in the building, the
+// kitchen with grasps, whose objects the kitchen world does not have) is refused before any
+// episode, naming the instance, the action and the world, in either acting mode.
+TEST(Cli, RunRefusesAnInstanceWhoseActionsAreNotTheWorlds) {
+  const std::string kitchen = testing::source_path("data/instances/kitchen-grasps.json").string();
+  for (const auto& [domain, file] : {std::pair<std::string, std::string>{"navigation", paper("instance1")},
+                                     std::pair<std::string, std::string>{"manipulation", kitchen}}) {
+    for (const std::string act : {"plan-first", "concurrent"}) {
+      const auto result = ontime(
+          {"run", "--domain", domain, "--instance", file, "--solver", "greedy", "--episodes", "2", "--act", act});
+      EXPECT_EQ(result.exit_code, 2) << domain << " " << act << ": " << result.err;
+      EXPECT_NE(result.err.find(file + ": actions."), std::string::npos) << result.err;
+      EXPECT_NE(result.err.find(": not an action of the world"), std::string::npos) << result.err;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace ontime
 

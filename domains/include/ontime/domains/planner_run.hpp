@@ -68,6 +68,11 @@ struct PlannerRun {
 void check_planner_run_request(const Problem& problem, const std::string& source, const PlannerRunOptions& options,
                                const ParameterSpelling& spelling = nullptr);
 
+// Refuses, before any episode, an instance with an action the domain's world does not have
+// (InputError "source: actions.ID: ...", read from Domain::action_features); a domain without
+// features cannot say, and is not checked.
+void check_domain_actions(const Domain& domain, const Problem& problem, const std::string& source);
+
 // The episodes (and the exact value). The instance's action ids must be actions of the domain. An
 // instance acting while planning (SPEC §10) runs the allocator by its commit rule on the model's
 // steps (UsageError for live episodes or a belief, not there yet in that mode).
