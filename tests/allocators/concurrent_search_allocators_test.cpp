@@ -136,8 +136,10 @@ TEST(ConcurrentSearchAllocators, BranchAndBoundWithoutALimitMakesOptimalMoves) {
       state = std::move(drawn);
     }
   }
-  // About a third of these instances has a choice to make at all.
-  EXPECT_GT(decided, count / 2);
+  // About a third of these instances has a choice to make at all, some of them several: the
+  // searched decisions are at least a quarter of the instances (about half of them in full runs,
+  // a quarter in the sanitizers' share of the first ones).
+  EXPECT_GT(decided, count / 4);
 }
 
 // The sampled rate of `episodes` episodes against the optimum: within four standard errors

@@ -89,9 +89,10 @@ TEST(ConcurrentValueBounds, SandwichTheOptimumOnRandomStates) {
       open += interval.upper - interval.lower > 1e-9 ? 1 : 0;
     }
   }
-  // Hundreds of states, and dozens of them with the bounds apart (the check sees real intervals).
+  // Hundreds of states, and dozens of them with the bounds apart (the check sees real intervals):
+  // 99 of 1,050 states over the 120 instances, 19 of 219 over the sanitizers' first 30.
   EXPECT_GT(states, 4 * count);
-  EXPECT_GT(open, 50);
+  EXPECT_GT(open, count / 3);
 }
 
 // The lower bound's term for skeleton k is the exact value of the policy it names: refine k alone,
