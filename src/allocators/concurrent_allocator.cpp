@@ -1,6 +1,7 @@
 #include "ontime/allocators/concurrent_allocator.hpp"
 
 #include <algorithm>
+#include <string>
 #include <utility>
 
 #include "ontime/util/error.hpp"
@@ -105,13 +106,16 @@ void EagerCommitAllocator::observe(const ConcurrentState& before, int choice, co
 }
 
 ConcurrentAllocatorFactory eager_commit_factory(const ConcurrentMdp& mdp, AllocatorFactory plan_first) {
-  if (mdp.is_timed()) {
-    throw UsageError(mdp.problem().name() +
-                     ": the eager commit rule reads a plan-first view without the chains' state or expiry (SPEC "
-                     "§9): with acting while planning (SPEC §10) only the optimal allocator takes chains so far");
-  }
+  refuse_chains(mdp, "the eager commit rule", "its plan-first view has no chains' state nor expiry");
   return
       [&mdp, plan_first = std::move(plan_first)] { return std::make_unique<EagerCommitAllocator>(mdp, plan_first()); };
+}
+
+void refuse_chains(const ConcurrentMdp& mdp, std::string_view rule, std::string_view why) {
+  if (!mdp.is_timed()) return;
+  throw UsageError(mdp.problem().name() + ": " + std::string(rule) +
+                   " acting while planning (SPEC §10) does not take exogenous chains or expiry (SPEC §9) yet (" +
+                   std::string(why) + "): only the optimal allocator takes chains so far");
 }
 
 }  // namespace ontime

@@ -758,12 +758,7 @@ AllocatorKind mcts_kind() {
           "the search's: starts an action when the search values starting above planning on (its most "
           "simulated move)",
       .make_concurrent = [](const ConcurrentMdp& mdp, const ParameterReader& parameters) -> ConcurrentAllocatorFactory {
-        if (mdp.is_timed()) {
-          throw UsageError(mdp.problem().name() +
-                           ": mcts acting while planning (SPEC §10) does not take exogenous "
-                           "chains or expiry (SPEC §9) yet: its search takes a start as one outcome (the optimal "
-                           "allocator takes them)");
-        }
+        refuse_chains(mdp, "mcts", "its search takes a start as one outcome");
         ConcurrentMctsOptions options;
         options.exploration = parameters.real("exploration");
         options.backup = read_backup(parameters);

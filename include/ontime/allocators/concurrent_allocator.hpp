@@ -81,8 +81,13 @@ class EagerCommitAllocator final : public ConcurrentAllocator {
 };
 
 // A factory of EagerCommitAllocator around the allocators `plan_first` makes (for
-// mdp.plan_first_mdp()).
+// mdp.plan_first_mdp()). Refuses chains or expiry (refuse_chains).
 ConcurrentAllocatorFactory eager_commit_factory(const ConcurrentMdp& mdp, AllocatorFactory plan_first);
+
+// Only the optimal allocator takes exogenous chains or expiry (SPEC §9) acting while planning so
+// far: UsageError naming `rule` (the commit rule of the kind refused) and `why` when `mdp` has
+// them; nothing otherwise.
+void refuse_chains(const ConcurrentMdp& mdp, std::string_view rule, std::string_view why);
 
 // The state of SPEC §10 seen plan-first (SPEC §2), for a plan-first allocator: CT; per live
 // skeleton its l_k and PT_k, and as ET_k the steps the robot still needs for its refined actions
