@@ -15,6 +15,7 @@
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/model/instance_io.hpp"
 #include "ontime/report/report.hpp"
+#include "ontime/solve/concurrent_search.hpp"
 #include "ontime/solve/concurrent_solver.hpp"
 #include "ontime/solve/layered_solver.hpp"
 #include "ontime/solve/search_solver.hpp"
@@ -60,7 +61,7 @@ void run_memoised(const SolveOptions& options, const Problem& problem, const Mdp
   fmt::print("{}", options.json ? report::to_json(solve) + "\n" : report::to_text(solve));
 }
 
-// Acting while planning (SPEC §10): the memoised solver of its MDP.
+// Acting while planning (SPEC §10): the memoised solver of its MDP, or the search.
 void run_concurrent(const SolveOptions& options, const Problem& problem) {
   const std::size_t max_states = options.max_states != 0 ? options.max_states : ConcurrentSolver::kDefaultMaxStates;
   // The exact solvers' limits (skeletons) hold in this mode too.
@@ -68,13 +69,21 @@ void run_concurrent(const SolveOptions& options, const Problem& problem) {
   const ConcurrentMdp mdp(problem);
   check_memory_for(flag_spelling()("max-states"), ConcurrentSolver::max_bytes(problem, max_states));
   const auto started = std::chrono::steady_clock::now();
-  ConcurrentSolver solver(mdp, max_states);
-  report::ConcurrentSolve solve{.instance = options.instance, .problem = &problem};
-  solve.value = solver.solve(mdp.start());
+  ConcurrentSolveOptions settings;
+  settings.max_states = max_states;
+  if (options.method == "search") {
+    settings.method = ConcurrentSolveOptions::Method::search;
+    settings.gap = options.gap;
+    if (options.max_seconds > 0) {
+      const auto deadline = started + std::chrono::duration<double>(options.max_seconds);
+      settings.stop = [deadline] { return std::chrono::steady_clock::now() >= deadline; };
+    }
+  }
+  report::ConcurrentSolve solve{.instance = options.instance,
+                                .problem = &problem,
+                                .method = options.method == "search" ? "search" : "memoised",
+                                .solution = solve_concurrent(mdp, settings)};
   solve.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  const std::optional<ConcurrentSolver::Move> first = solver.best_move(mdp.start());
-  solve.first_choice = first && !first->is_start() ? first->refine : -1;
-  solve.states = solver.states();
   solve.timing = !options.no_timing;
   fmt::print("{}", options.json ? report::to_json(solve) + "\n" : report::to_text(solve));
 }
@@ -212,15 +221,18 @@ void add_solve_command(CLI::App& app) {
     Problem problem = load_problem(options->instance);
     if (!options->act.empty()) problem = problem.with_acting(*parse_acting(options->act));
     if (problem.acting() == Acting::concurrent) {
-      if (method_option->count() > 0 && options->method != "memoised") {
+      if (method_option->count() > 0 && options->method != "memoised" && options->method != "search") {
         throw UsageError("--method " + options->method +
-                         ": acting while planning (concurrent, SPEC §10) is solved by --method memoised only so far");
+                         ": acting while planning (concurrent, SPEC §10) is solved by --method memoised or search "
+                         "only so far");
       }
-      for (const char* flag :
-           {"--policy", "--tolerance", "--scratch", "--max-memory-mib", "--max-disk-mib", "--max-seconds"}) {
+      if (options->method != "search" && command->get_option("--max-seconds")->count() > 0) {
+        throw UsageError("--max-seconds: acting while planning (concurrent, SPEC §10) takes it with --method search");
+      }
+      for (const char* flag : {"--policy", "--tolerance", "--scratch", "--max-memory-mib", "--max-disk-mib"}) {
         if (command->get_option(flag)->count() > 0) {
           throw UsageError(std::string(flag) +
-                           " is for the layered solver and the search, which do not solve "
+                           " is for the layered solver, which does not solve "
                            "acting while planning (concurrent, SPEC §10) yet");
         }
       }

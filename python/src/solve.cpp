@@ -9,6 +9,7 @@
 
 #include "bindings.hpp"
 #include "ontime/report/report.hpp"
+#include "ontime/solve/concurrent_search.hpp"
 #include "ontime/solve/concurrent_solver.hpp"
 #include "ontime/solve/knapsack.hpp"
 #include "ontime/solve/layered_solver.hpp"
@@ -93,30 +94,32 @@ void bind_solve(py::module_& m) {
         const std::shared_ptr<const Problem> chosen =
             act || !py::isinstance<MdpHandle>(problem) ? problem_with_acting(problem, act) : nullptr;
         if (chosen && chosen->acting() == Acting::concurrent) {
-          if (method_given && *method_given != "memoised") {
+          const bool search = method_given && *method_given == "search";
+          if (method_given && *method_given != "memoised" && !search) {
             throw UsageError("method '" + *method_given +
                              "': acting while planning (act='concurrent', SPEC §10) is solved by method='memoised' "
-                             "only so far");
+                             "or 'search' only so far");
           }
-          if (tolerance > 0 || max_memory_mib > 0 || max_disk_mib > 0 || !scratch.is_none() || !policy.is_none() ||
-              gap > 0) {
+          if (gap > 0 && !search) throw UsageError("gap is for method='search'");
+          if (tolerance > 0 || max_memory_mib > 0 || max_disk_mib > 0 || !scratch.is_none() || !policy.is_none()) {
             throw UsageError(
-                "tolerance, max_memory_mib, max_disk_mib, scratch, policy and gap are for the layered solver and the "
-                "search, which do not solve acting while planning (act='concurrent', SPEC §10) yet");
+                "tolerance, max_memory_mib, max_disk_mib, scratch and policy are for the layered solver, which does "
+                "not solve acting while planning (act='concurrent', SPEC §10) yet");
           }
           check_exact_work(*chosen, 1, instance_label(problem, *chosen), python_spelling());
           check_memory_for("max_states", ConcurrentSolver::max_bytes(*chosen, max_states));
           report::ConcurrentSolve solve{.instance = instance_label(problem, *chosen), .problem = chosen.get()};
           const ConcurrentMdp concurrent(*chosen);
+          solve.method = search ? "search" : "memoised";
           run_interruptibly([&](const std::function<bool()>& stop, Progress&) {
             const auto started = std::chrono::steady_clock::now();
-            ConcurrentSolver solver(concurrent, max_states);
-            solver.set_stop(stop);
-            solve.value = solver.solve(concurrent.start());
+            ConcurrentSolveOptions options;
+            options.method = search ? ConcurrentSolveOptions::Method::search : ConcurrentSolveOptions::Method::memoised;
+            options.max_states = max_states;
+            options.gap = gap;
+            options.stop = stop;
+            solve.solution = solve_concurrent(concurrent, options);
             solve.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-            const std::optional<ConcurrentSolver::Move> first = solver.best_move(concurrent.start());
-            solve.first_choice = first && !first->is_start() ? first->refine : -1;
-            solve.states = solver.states();
           });
           return json_object(report::to_json(solve));
         }

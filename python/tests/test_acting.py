@@ -39,6 +39,18 @@ def test_the_optimum_of_acting_while_planning():
             ontime.solve(instance, method="memoised")["optimal_success_probability"], abs=1e-12)
 
 
+def test_the_search_gives_the_memoised_optimum_to_the_bit():
+    instance = PAPER / "instance4.json"
+    memoised = ontime.solve(instance, act="concurrent")
+    search = ontime.solve(instance, act="concurrent", method="search")
+    assert search["method"] == "search" and search["exact"]
+    assert search["optimal_success_probability"] == memoised["optimal_success_probability"]
+    assert search["first_choice"] == memoised["first_choice"]
+    assert search["states"] < memoised["states"]
+    cut = ontime.solve(instance, act="concurrent", method="search", gap=0.5)
+    assert cut["lower_bound"] <= memoised["optimal_success_probability"] <= cut["upper_bound"]
+
+
 def test_the_same_figures_as_the_command_line(cli):
     instance = PAPER / "instance2.json"
     from_cli = cli("solve", str(instance), "--act", "concurrent", "--json", "--no-timing")
@@ -79,8 +91,9 @@ def test_chains_acting_while_planning_as_the_command_line(cli):
 @pytest.mark.parametrize("arguments, message", [
     ({"act": "interleaved"}, "act must be 'plan-first' or 'concurrent'"),
     ({"act": 1}, "act must be 'plan-first' or 'concurrent'"),
-    ({"act": "concurrent", "method": "layered"}, "method='memoised' only"),
-    ({"act": "concurrent", "tolerance": 0.1}, "do not solve acting while planning"),
+    ({"act": "concurrent", "method": "layered"}, "method='memoised' or 'search' only"),
+    ({"act": "concurrent", "gap": 0.1}, "gap is for method='search'"),
+    ({"act": "concurrent", "tolerance": 0.1}, "does not solve acting while planning"),
 ])
 def test_bad_requests_raise_usage_errors(arguments, message):
     with pytest.raises(ontime.UsageError, match=message):

@@ -211,6 +211,7 @@ def sweep_calls(tmp_path):
              policy_layers=1, gap=0.0),
         Call("solve search", ontime.solve, problem, method="search", gap=0.5),
         Call("solve concurrent", ontime.solve, two, method="memoised", act="concurrent"),
+        Call("solve concurrent search", ontime.solve, two, method="search", act="concurrent", gap=0.01),
         Call("evaluate", ontime.evaluate, problem, "dp-rerun", episodes=20, seed=1, threads=1, exact=False,
              regret=False, belief=problem, progress=lambda done, total: None),
         Call("evaluate with parameters", ontime.evaluate, two, "mcts", episodes=2, threads=1, iterations=10),

@@ -428,4 +428,35 @@ void ConcurrentMdp::reject_choice(int choice) {
                    "to finish by the deadline) or has nothing left to refine");
 }
 
+void ConcurrentMdp::merge_backlogs(ConcurrentState& key) const {
+  if (!merges_backlogs()) return;
+  const int depth = executed_depth(key);
+  int live = 0;
+  for (int k = 0; k < skeleton_count_; ++k) live += is_live(key, k) ? 1 : 0;
+  const auto runs_alone = [&](int action, int k) {
+    for (const int m : problem_->members(action)) {
+      if (m != k && is_live(key, m)) return false;
+    }
+    return true;
+  };
+  for (int k = 0; k < skeleton_count_; ++k) {
+    if (!is_live(key, k)) continue;
+    const int refined_count = refined(key, k);
+    // The first position after E from which every action of k is k's alone.
+    int first = problem_->skeleton_length(k);
+    while (first > depth && runs_alone(problem_->action_at(k, first - 1), k)) --first;
+    if (first >= refined_count) continue;
+    const bool into_robot = live == 1 && robot_left(key) > 0;
+    std::uint32_t backlog = into_robot ? key[1] : 0;
+    for (int j = first; j < refined_count; ++j) {
+      std::uint16_t& word = execution_word(key, problem_->action_at(k, j));
+      backlog += word;
+      word = 0;
+    }
+    // A live skeleton's backlog ends by D (canonicalise drops it otherwise): the sum fits a word.
+    const auto merged = static_cast<std::uint16_t>(std::min<std::uint32_t>(backlog, deadline_ + 1U));
+    (into_robot ? key[1] : execution_word(key, problem_->action_at(k, first))) = merged;
+  }
+}
+
 }  // namespace ontime

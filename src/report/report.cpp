@@ -269,38 +269,60 @@ std::string to_json(const Solve& solve) {
   return dump(out);
 }
 
+namespace {
+
+// The skeleton refined first, -1 when none can finish by the deadline.
+int first_refined(const ConcurrentSolve& solve) {
+  const ConcurrentMdp::Move& first = solve.solution.first;
+  return first.is_start() ? -1 : first.refine;
+}
+
+}  // namespace
+
 std::string to_json(const ConcurrentSolve& solve) {
   const Problem& problem = *solve.problem;
+  const ConcurrentSolution& solution = solve.solution;
   Json out;
   out["instance"] = solve.instance;
   out["name"] = problem.name();
-  out["method"] = "memoised";
+  out["method"] = solve.method;
   out["acting"] = std::string(acting_name(Acting::concurrent));
-  out[problem.has_rewards() ? "optimal_expected_reward" : "optimal_success_probability"] = solve.value;
-  out["lower_bound"] = solve.value;
-  out["upper_bound"] = solve.value;
-  out["exact"] = true;
-  out["states"] = solve.states;
+  out[problem.has_rewards() ? "optimal_expected_reward" : "optimal_success_probability"] =
+      solution.exact ? Json(solution.lower) : Json(nullptr);
+  out["lower_bound"] = solution.lower;
+  out["upper_bound"] = solution.upper;
+  out["exact"] = solution.exact;
+  if (!solution.exact) out["stopped_by"] = solution.stopped_by;
+  out["states"] = solution.solved;
+  if (solve.method == "search") out["records"] = solution.records;
   if (solve.timing) out["seconds"] = solve.seconds;
-  out["first_choice"] = solve.first_choice;
-  out["first_action"] = solve.first_choice >= 0 ? problem.action(problem.action_at(solve.first_choice, 0)).id : "";
+  const int first = first_refined(solve);
+  out["first_choice"] = first;
+  out["first_action"] = first >= 0 ? problem.action(problem.action_at(first, 0)).id : "";
   return dump(out);
 }
 
 std::string to_text(const ConcurrentSolve& solve) {
   const Problem& problem = *solve.problem;
+  const ConcurrentSolution& solution = solve.solution;
   std::string out = fmt::format("instance                     {} ({}), deadline {}, {} skeletons\n", solve.instance,
                                 problem.name(), problem.deadline(), problem.skeleton_count());
   out += "acting                       concurrent: the robot executes refined actions while the rest is planned\n";
   const char* objective = problem.has_rewards() ? "optimal expected reward    " : "optimal success probability";
-  out += fmt::format("{}  {:.6f}\n", objective, solve.value);
-  if (solve.first_choice >= 0) {
-    out += fmt::format("first choice                 skeleton {} (refine {})\n", solve.first_choice,
-                       problem.action(problem.action_at(solve.first_choice, 0)).id);
+  if (solution.exact) {
+    out += fmt::format("{}  {:.6f}\n", objective, solution.lower);
+  } else {
+    out += fmt::format("{}  in [{:.6f}, {:.6f}] (width {:.6f}; ended by {})\n", objective, solution.lower,
+                       solution.upper, solution.upper - solution.lower, solution.stopped_by);
+  }
+  if (const int first = first_refined(solve); first >= 0) {
+    out += fmt::format("first choice                 skeleton {} (refine {})\n", first,
+                       problem.action(problem.action_at(first, 0)).id);
   } else {
     out += "first choice                 none (no skeleton can meet the deadline)\n";
   }
-  out += fmt::format("states                       {}\n", solve.states);
+  out += fmt::format("states                       {}\n", solution.solved);
+  if (solve.method == "search") out += fmt::format("states bounded               {}\n", solution.records);
   if (solve.timing) out += fmt::format("time                         {:.4f} s\n", solve.seconds);
   return out;
 }

@@ -9,6 +9,7 @@
 
 #include "ontime/solve/concurrent_solver.hpp"
 #include "ontime/solve/concurrent_value_bounds.hpp"
+#include "ontime/util/error.hpp"
 
 namespace ontime {
 
@@ -112,6 +113,8 @@ ConcurrentSearch::ConcurrentSearch(const ConcurrentMdp& mdp, std::uint64_t max_s
 
 ConcurrentSearch::~ConcurrentSearch() = default;
 
+Interval ConcurrentSearch::interval(const ConcurrentState& state) { return impl_->interval(state); }
+
 void ConcurrentSearch::clear() { impl_->table.clear(); }
 
 std::uint64_t ConcurrentSearch::size() const noexcept { return impl_->table.size(); }
@@ -160,6 +163,108 @@ ConcurrentSearchResult ConcurrentSearch::search(const ConcurrentState& from,
     }
   }
   return result;
+}
+
+namespace {
+
+ConcurrentSolution solve_memoised(const ConcurrentMdp& mdp, const ConcurrentSolveOptions& options) {
+  ConcurrentSolver solver(mdp, options.max_states > 0 ? options.max_states : ConcurrentSolver::kDefaultMaxStates);
+  if (options.stop) solver.set_stop(options.stop);
+  ConcurrentSolution solution;
+  solution.lower = solution.upper = solver.solve(mdp.start());
+  solution.exact = true;
+  solution.first = solver.best_move(mdp.start()).value_or(ConcurrentMdp::Move{});
+  solution.solved = solver.states();
+  return solution;
+}
+
+ConcurrentSolution solve_by_search(const ConcurrentMdp& mdp, const ConcurrentSolveOptions& options) {
+  if (mdp.is_timed()) {
+    throw UsageError(
+        "the search acting while planning (SPEC §10) does not take exogenous chains or expiry (SPEC §9) yet: its "
+        "bounds take a start as one outcome; use --method memoised");
+  }
+  ConcurrentSearch search(mdp, options.max_states);  // refuses backtracking (its bounds)
+  ConcurrentSolution solution;
+  const ConcurrentState start = mdp.start();
+  const auto from_records = [&](std::string stopped_by) {
+    const ConcurrentSearchResult trials = search.search(start, [](std::uint64_t) { return true; });
+    solution.lower = trials.lower;
+    solution.upper = trials.upper;
+    solution.exact = trials.exact;
+    solution.first = trials.move;
+    solution.records = search.size();
+    if (!trials.exact) solution.stopped_by = std::move(stopped_by);
+  };
+  if (options.gap > 0) {
+    // Trials in rounds of a few thousand backups, until the start's interval is narrow enough.
+    constexpr std::uint64_t kRound = 4096;
+    bool stopped = false;
+    ConcurrentSearchResult trials;
+    for (;;) {
+      trials = search.search(start, [&](std::uint64_t work) {
+        if (work < kRound) return false;
+        stopped = options.stop && options.stop();
+        return true;
+      });
+      const bool capped = options.max_states > 0 && search.size() >= options.max_states;
+      if (trials.exact || trials.upper - trials.lower <= options.gap || stopped || capped) {
+        if (!trials.exact) {
+          solution.stopped_by = trials.upper - trials.lower <= options.gap ? "the gap"
+                                : stopped                                  ? "the stop condition"
+                                                                           : "the state cap";
+        }
+        break;
+      }
+    }
+    solution.lower = trials.lower;
+    solution.upper = trials.upper;
+    solution.exact = trials.exact;
+    solution.first = trials.move;
+    solution.records = search.size();
+    return solution;
+  }
+  // Trials first: they narrow the intervals where the optimum goes, so that the exact pass below
+  // solves few moves beyond the optimal ones.
+  bool stopped = false;
+  search.search(start, [&](std::uint64_t work) {
+    if (work % 4096 == 0 && options.stop && options.stop()) stopped = true;
+    return stopped;
+  });
+  if (stopped) {
+    from_records("the stop condition");
+    return solution;
+  }
+  ConcurrentSolver solver(mdp, options.max_states > 0 ? options.max_states : ConcurrentSolver::kDefaultMaxStates);
+  solver.set_bounds([&](const ConcurrentState& state) {
+    if (options.max_states > 0 && search.size() >= options.max_states) {
+      throw ResourceLimitError("the search reached its cap of states");
+    }
+    const Interval bounds = search.interval(state);
+    return std::pair<double, double>{bounds.lower, bounds.upper};
+  });
+  if (options.stop) solver.set_stop(options.stop);
+  try {
+    solution.lower = solution.upper = solver.solve(start);
+  } catch (const ResourceLimitError&) {
+    from_records("the state cap");
+    return solution;
+  } catch (const Cancelled&) {
+    from_records("the stop condition");
+    return solution;
+  }
+  solution.exact = true;
+  solution.first = solver.best_move(start).value_or(ConcurrentMdp::Move{});
+  solution.solved = solver.states();
+  solution.records = search.size();
+  return solution;
+}
+
+}  // namespace
+
+ConcurrentSolution solve_concurrent(const ConcurrentMdp& mdp, const ConcurrentSolveOptions& options) {
+  if (options.method == ConcurrentSolveOptions::Method::memoised) return solve_memoised(mdp, options);
+  return solve_by_search(mdp, options);
 }
 
 }  // namespace ontime

@@ -21,20 +21,35 @@ struct ConcurrentSolver::Impl {
   absl::flat_hash_map<ConcurrentState, Entry> memo;
   std::size_t max_states = 0;
   std::function<bool()> stop;
-  Policy policy;  // set: the policy's value, not the optimum
+  Policy policy;        // set: the policy's value, not the optimum
+  Bounds bounds;        // set: branch and bound
+  bool merge = false;   // the optimum's memo is keyed by ConcurrentMdp::merge_backlogs
+  ConcurrentState key;  // scratch
+
+  // The memo's key of `state`.
+  const ConcurrentState& key_of(const ConcurrentMdp& mdp, const ConcurrentState& state) {
+    if (!merge) return state;
+    key = state;
+    mdp.merge_backlogs(key);
+    return key;
+  }
 };
 
 ConcurrentSolver::ConcurrentSolver(const ConcurrentMdp& mdp, std::size_t max_states)
     : mdp_(&mdp), impl_(std::make_unique<Impl>()) {
   impl_->max_states = max_states;
+  impl_->merge = mdp.merges_backlogs();
 }
 
 ConcurrentSolver::ConcurrentSolver(const ConcurrentMdp& mdp, Policy policy, std::size_t max_states)
     : ConcurrentSolver(mdp, max_states) {
   impl_->policy = std::move(policy);
+  impl_->merge = false;
 }
 
 ConcurrentSolver::~ConcurrentSolver() = default;
+
+void ConcurrentSolver::set_bounds(Bounds bounds) { impl_->bounds = std::move(bounds); }
 
 void ConcurrentSolver::set_stop(std::function<bool()> stop) { impl_->stop = std::move(stop); }
 
@@ -68,99 +83,127 @@ double ConcurrentSolver::solve(const ConcurrentState& root) {
   const bool optimum = !impl_->policy;
   if (const std::optional<double> value = terminal_value(mdp, root, optimum)) return *value;
   auto& memo = impl_->memo;
-  // A successor's value when it is known (terminal or memoised); otherwise it is queued.
-  std::vector<ConcurrentState> missing;
+  const Bounds& bounds = impl_->bounds;
+  // A successor's value when it is known (terminal or memoised).
   const auto known = [&](const ConcurrentState& next) -> std::optional<double> {
     if (const std::optional<double> value = terminal_value(mdp, next, optimum)) return value;
-    if (const auto found = memo.find(next); found != memo.end()) return found->second.value;
-    missing.push_back(next);
+    if (const auto found = memo.find(impl_->key_of(mdp, next)); found != memo.end()) return found->second.value;
     return std::nullopt;
+  };
+  // A move's value Q, summed over its outcomes in the MDP's order from the successors' values, or,
+  // while some successor is unknown, an interval around it from their bounds ([0, R] without
+  // them); the unknown successors go to `missing` when it is given.
+  struct MoveValue {
+    Move move;
+    double lower = 0;
+    double upper = 0;
+    bool exact = true;
+  };
+  const double most = mdp.problem().has_rewards() ? mdp.problem().max_reward() : 1.0;
+  const auto add = [&](MoveValue& q, double probability, const ConcurrentState& next,
+                       std::vector<ConcurrentState>* missing) {
+    if (const std::optional<double> value = known(next)) {
+      q.lower += probability * *value;
+      q.upper += probability * *value;
+      return;
+    }
+    q.exact = false;
+    const std::pair<double, double> interval = bounds ? bounds(next) : std::pair<double, double>{0.0, most};
+    q.lower += probability * interval.first;
+    q.upper += probability * interval.second;
+    if (missing != nullptr) missing->push_back(next);
+  };
+  const auto value_of = [&](const ConcurrentState& state, Move move, std::vector<ConcurrentState>* missing) {
+    MoveValue q{.move = move};
+    if (move.is_start()) {
+      // One outcome, or one per execution time drawn from a chain when the action starts.
+      mdp.for_each_start_outcome(state, move.start,
+                                 [&](double probability, const ConcurrentMdp::StartOutcome& outcome) {
+                                   if (outcome.ends) {
+                                     q.lower += probability * outcome.reward;
+                                     q.upper += probability * outcome.reward;
+                                   } else {
+                                     add(q, probability, outcome.next, missing);
+                                   }
+                                 });
+    } else if (ConcurrentMdp::time(state) < mdp.deadline()) {
+      mdp.for_each_step_outcome(state, move.refine, [&](double probability, const ConcurrentState& next) {
+        add(q, probability, next, missing);
+      });
+    }  // a policy's step asked for at the deadline ends the episode: worth 0
+    return q;
   };
 
   std::vector<ConcurrentState> stack{root};
+  std::vector<MoveValue> values;
   std::size_t visits = 0;
   while (!stack.empty()) {
-    if (memo.contains(stack.back())) {
+    if (memo.contains(impl_->key_of(mdp, stack.back()))) {
       stack.pop_back();
       continue;
     }
     if (++visits % 4096 == 0 && impl_->stop && impl_->stop()) throw Cancelled("solve stopped");
     const ConcurrentState state = stack.back();
-    missing.clear();
-    double best = -1.0;
-    Move best_move;
-    const auto consider = [&](double value, Move move) {
-      if (value > best + kTieTolerance) {
-        best = value;
-        best_move = move;
-      }
-    };
-    const auto step_value = [&](int refine) {
-      double q = 0.0;
-      bool complete = true;
-      mdp.for_each_step_outcome(state, refine, [&](double probability, const ConcurrentState& next) {
-        if (const std::optional<double> value = known(next)) {
-          q += probability * *value;
-        } else {
-          complete = false;
-        }
-      });
-      if (complete) consider(q, Move{-1, refine});
-    };
-    const auto start_value = [&](int action) {
-      // One outcome, or one per execution time drawn from a chain when the action starts.
-      double q = 0.0;
-      bool complete = true;
-      mdp.for_each_start_outcome(state, action, [&](double probability, const ConcurrentMdp::StartOutcome& outcome) {
-        if (outcome.ends) {
-          q += probability * outcome.reward;
-        } else if (const std::optional<double> value = known(outcome.next)) {
-          q += probability * *value;
-        } else {
-          complete = false;
-        }
-      });
-      if (complete) consider(q, Move{action, ConcurrentMdp::kWait});
-    };
+    const std::size_t depth = stack.size();
+    values.clear();
     if (!optimum) {
-      const Move move = impl_->policy(state);
-      if (move.is_start()) {
-        start_value(move.start);
-      } else if (ConcurrentMdp::time(state) < mdp.deadline()) {
-        step_value(move.refine);
-      } else {
-        consider(0.0, move);  // no step is left at the deadline
-      }
+      values.push_back(value_of(state, impl_->policy(state), &stack));
+    } else if (!bounds) {
+      for (const Move& move : mdp.useful_moves(state)) values.push_back(value_of(state, move, &stack));
     } else {
-      const int forced = mdp.forced_start(state);
-      if (forced < 0 && ConcurrentMdp::time(state) < mdp.deadline()) {
-        const ChoiceList choices = mdp.refine_choices(state);
-        if (choices.empty()) step_value(ConcurrentMdp::kWait);
-        for (const int choice : choices) step_value(choice);
-        // With backtracking an attempt may discard motions: an idle planner is a move of its own.
-        if (!choices.empty() && mdp.has_backtracking()) step_value(ConcurrentMdp::kWait);
+      // Branch and bound: the move of the largest lower end first, exactly; then only the moves
+      // whose upper end reaches within the tie tolerance of its value (the others can be neither
+      // the best nor tied with it).
+      const std::vector<Move> moves = mdp.useful_moves(state);
+      for (const Move& move : moves) values.push_back(value_of(state, move, nullptr));
+      std::size_t lead = 0;
+      for (std::size_t m = 1; m < values.size(); ++m) {
+        if (values[m].lower > values[lead].lower) lead = m;
       }
-      for (const int action : mdp.startable(state)) {
-        if (forced < 0 || action == forced) start_value(action);
+      if (!values.empty() && !values[lead].exact) {
+        value_of(state, values[lead].move, &stack);
+      } else if (!values.empty()) {
+        const double floor = values[lead].lower - kTieTolerance;
+        std::size_t kept = 0;
+        for (std::size_t m = 0; m < values.size(); ++m) {
+          if (values[m].exact) {
+            values[kept++] = values[m];
+          } else if (values[m].upper >= floor) {
+            value_of(state, values[m].move, &stack);
+          }
+        }
+        values.resize(kept);
       }
     }
-    if (!missing.empty()) {
-      for (ConcurrentState& next : missing) stack.push_back(std::move(next));
-      continue;
+    if (stack.size() > depth) continue;
+    // Ties: the first move in the order of useful_moves whose value is within kTieTolerance of
+    // the best.
+    double best = -1.0;
+    for (const MoveValue& q : values) best = std::max(best, q.lower);
+    Move best_move;
+    double value = 0.0;
+    for (const MoveValue& q : values) {
+      if (q.lower >= best - kTieTolerance) {
+        best_move = q.move;
+        value = q.lower;
+        break;
+      }
     }
     if (memo.size() >= impl_->max_states) {
       throw ResourceLimitError("the acting-while-planning solver reached its cap of " +
                                std::to_string(impl_->max_states) + " states");
     }
     // A live state always has a move (docs/theory.md); 0 is kept as a guard.
-    memo.emplace(state, Impl::Entry{best < 0 ? 0.0 : best, best_move});
+    memo.emplace(impl_->key_of(mdp, state), Impl::Entry{value, best_move});
     stack.pop_back();
   }
-  return memo.at(root).value;
+  return memo.at(impl_->key_of(mdp, root)).value;
 }
 
 std::optional<ConcurrentSolver::Move> ConcurrentSolver::best_move(const ConcurrentState& state) const {
-  const auto found = impl_->memo.find(state);
+  ConcurrentState key = state;
+  if (impl_->merge) mdp_->merge_backlogs(key);
+  const auto found = impl_->memo.find(key);
   if (found == impl_->memo.end()) return std::nullopt;
   return found->second.move;
 }

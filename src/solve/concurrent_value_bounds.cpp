@@ -3,9 +3,21 @@
 #include <algorithm>
 #include <utility>
 
+#include "ontime/util/error.hpp"
+
 namespace ontime {
 
-ConcurrentValueBounds::ConcurrentValueBounds(const ConcurrentMdp& mdp) : mdp_(&mdp), devoted_(mdp, Aggregation::self) {}
+ConcurrentValueBounds::ConcurrentValueBounds(const ConcurrentMdp& mdp)
+    : mdp_(&mdp), devoted_((refuse_backtracking(mdp), mdp), Aggregation::self) {}  // refused first
+
+void ConcurrentValueBounds::refuse_backtracking(const ConcurrentMdp& mdp) {
+  if (!mdp.has_backtracking()) return;
+  throw UsageError(mdp.problem().name() +
+                   ": the bounds on the optimum acting while planning (SPEC §10), which the search and the bound "
+                   "leaves of mcts and branch-and-bound use, do not value backtracking (SPEC §7) yet: a give-up may "
+                   "discard motions, which their proofs leave out (--method memoised and the optimal allocator "
+                   "take it)");
+}
 
 bool ConcurrentValueBounds::eligible(const ConcurrentState& state, int k) const {
   const Problem& problem = mdp_->problem();

@@ -75,10 +75,10 @@ TEST(Cli, SolveActsWhilePlanningWhenAsked) {
   EXPECT_NEAR(json::parse(overridden.out)["optimal_success_probability"].get<double>(), 0.942, 1e-12);
 
   const std::vector<std::pair<std::vector<std::string>, std::string>> refused{
-      {{"solve", instance, "--method", "layered"}, "solved by --method memoised only"},
-      {{"solve", instance, "--method", "search"}, "solved by --method memoised only"},
+      {{"solve", instance, "--method", "layered"}, "solved by --method memoised or search only"},
       {{"solve", instance, "--tolerance", "0.1"}, "--tolerance is for the layered solver"},
-      {{"solve", instance, "--max-seconds", "5"}, "--max-seconds is for the layered solver"},
+      {{"solve", instance, "--max-seconds", "5"}, "takes it with --method search"},
+      {{"solve", instance, "--gap", "0.1"}, "--gap is for --method search"},
       {{"evaluate", instance, "--solver", "ppo", "--episodes", "10"}, "'ppo' does not act while planning"},
       {{"table", instance, "--episodes", "10", "--solvers", "ppo"}, "'ppo' does not act while planning"},
       {{"solve", paper("instance1"), "--act", "interleaved"}, "--act"},
@@ -88,6 +88,40 @@ TEST(Cli, SolveActsWhilePlanningWhenAsked) {
     EXPECT_EQ(result.exit_code, 2) << arguments[1] << " " << arguments.back() << ": " << result.err;
     EXPECT_NE(result.err.find(message), std::string::npos) << result.err;
   }
+}
+
+// Acting while planning, `--method search` gives the memoised solver's optimum to the bit (JSON's
+// shortest round trip of the same double), its first choice, and an interval when cut short.
+TEST(Cli, SolveSearchesActingWhilePlanning) {
+  const std::string navigation = testing::source_path("data/instances/navigation.json").string();
+  for (const std::string& name : {paper("instance2"), paper("instance4")}) {
+    const auto memoised = ontime({"solve", name, "--json", "--act", "concurrent"});
+    const auto search = ontime({"solve", name, "--json", "--act", "concurrent", "--method", "search"});
+    ASSERT_EQ(memoised.exit_code, 0) << memoised.err;
+    ASSERT_EQ(search.exit_code, 0) << search.err;
+    const json by_memo = json::parse(memoised.out);
+    const json by_search = json::parse(search.out);
+    EXPECT_EQ(by_search["method"], "search");
+    EXPECT_TRUE(by_search["exact"].get<bool>());
+    EXPECT_EQ(by_search["optimal_success_probability"].get<double>(),
+              by_memo["optimal_success_probability"].get<double>());
+    EXPECT_EQ(by_search["first_choice"], by_memo["first_choice"]);
+    EXPECT_LT(by_search["states"].get<int>(), by_memo["states"].get<int>());
+  }
+  const auto cut = ontime({"solve", navigation, "--json", "--act", "concurrent", "--method", "search", "--gap", "0.2"});
+  ASSERT_EQ(cut.exit_code, 0) << cut.err;
+  const json interval = json::parse(cut.out);
+  EXPECT_FALSE(interval["exact"].get<bool>());
+  EXPECT_EQ(interval["stopped_by"], "the gap");
+  EXPECT_TRUE(interval["optimal_success_probability"].is_null());
+  // Navigation's optimum at its own deadline (0.876693, `solve --method search`, 34 s) lies inside.
+  EXPECT_LE(interval["lower_bound"].get<double>(), 0.8766933308900257);
+  EXPECT_GE(interval["upper_bound"].get<double>(), 0.8766933308900257);
+  EXPECT_LE(interval["upper_bound"].get<double>() - interval["lower_bound"].get<double>(), 0.2);
+  const std::string kitchen = testing::source_path("data/instances/kitchen-grasps.json").string();
+  const auto refused = ontime({"solve", kitchen, "--act", "concurrent", "--method", "search"});
+  EXPECT_EQ(refused.exit_code, 2) << refused.err;
+  EXPECT_NE(refused.err.find("backtracking"), std::string::npos) << refused.err;
 }
 
 // `ontime solve INSTANCE --json` plan-first (memoised) and acting while planning: the two optima

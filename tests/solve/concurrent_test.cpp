@@ -293,9 +293,13 @@ TEST(Concurrent, WhatTheModelDoesNotTakeYetIsRefused) {
 
 // The optimal moves, followed as a stationary policy and valued by the solver's policy mode, are
 // worth the optimum. Where the optimum stopped early (a plan refined in full, worth 1 without
-// rewards) the policy runs that plan back to back.
+// rewards) the policy runs that plan back to back. The policy mode values full states, not the
+// memo's keys (ConcurrentMdp::merge_backlogs): the policy meets states whose key the optimum's
+// solve did not, and follows moves memoised for other states of the same key, so this also checks
+// that states sharing a key share their optimal moves and value.
 TEST(Concurrent, ThePolicyModeValuesTheOptimalMovesAtTheOptimum) {
-  const auto check = [](const Problem& problem, const std::string& label) {
+  int solved_later = 0;
+  const auto check = [&solved_later](const Problem& problem, const std::string& label) {
     const ConcurrentMdp mdp(problem);
     ConcurrentSolver optimal(mdp);
     const double optimum = optimal.solve(mdp.start());
@@ -307,8 +311,11 @@ TEST(Concurrent, ThePolicyModeValuesTheOptimalMovesAtTheOptimum) {
           return {problem.action_at(k, mdp.executed_depth(state)), ConcurrentMdp::kWait};
         }
       }
-      ADD_FAILURE() << label << ": a state the optimum did not solve";
-      return {};
+      // A state whose key the start's solve did not meet (its backlog merged otherwise): solved
+      // now, as the optimal allocator does.
+      optimal.solve(state);
+      ++solved_later;
+      return optimal.best_move(state).value_or(ConcurrentMdp::Move{});
     };
     ConcurrentSolver evaluation(mdp, follow);
     EXPECT_NEAR(evaluation.solve(mdp.start()), optimum, 1e-12) << label;
@@ -319,6 +326,8 @@ TEST(Concurrent, ThePolicyModeValuesTheOptimalMovesAtTheOptimum) {
           "rewards " + std::to_string(seed));
   }
   check(testing::paper_instance("instance1"), "instance1");
+  std::printf("states solved after the start's solve: %d\n", solved_later);
+  EXPECT_GT(solved_later, 0);
 }
 
 TEST(Concurrent, ThePolicyModeRefusesAMoveTheStateDoesNotAllow) {

@@ -243,6 +243,20 @@ class ConcurrentMdp {
   // ends by D; -1 when there is none.
   int complete_plan(const ConcurrentState& state) const noexcept;
 
+  // Whether value_key may merge executions: neither backtracking (SPEC §7) nor chains or expiry
+  // (SPEC §9), under which the order and the timing of a skeleton's motions matter.
+  bool merges_backlogs() const noexcept { return !backtracking_ && !timed_; }
+  // A key of `state` (canonical) such that two states with equal keys have equal optimal values
+  // V* and allow the same moves, for the exact solver's memo (docs/theory.md, "Backlogs"): where
+  // merges_backlogs(), the execution times of the refined actions that only one live skeleton k
+  // runs, from the first such action after E on, are summed into that first action (the rest
+  // hold 0), and when k is the only live skeleton and the robot executes, into r. Once the robot
+  // starts an action no other live skeleton runs, k is the only live one and runs its refined
+  // actions back to back (the forced start), so only their sum can change V*. The state itself
+  // otherwise. Policy values are not keyed so: a policy may read each execution time.
+  // Cost: O(K * A_max) word operations.
+  void merge_backlogs(ConcurrentState& key) const;
+
   // Without rewards (SPEC §8), chains or expiry (SPEC §9): whether some live skeleton is refined
   // in full and ends by D when executed as soon as possible (complete_plan). The planner idling
   // meanwhile, nothing is attempted, nothing given up: the state is worth 1.

@@ -22,6 +22,7 @@
 #include "ontime/run/experiments.hpp"
 #include "ontime/run/regret.hpp"
 #include "ontime/run/table.hpp"
+#include "ontime/solve/concurrent_search.hpp"
 #include "ontime/solve/layered_solver.hpp"
 #include "ontime/solve/search_solver.hpp"
 
@@ -74,14 +75,14 @@ std::string to_text(const Solve& solve);
 // its choice and the bounds of its value.
 std::string policy_lines(const Solve& solve);
 
-// The exact optimum of acting while planning (SPEC §10, ConcurrentSolver): its value, the first
-// move (always a refinement: nothing is refined at the start), the states solved.
+// The optimum of acting while planning (SPEC §10, solve_concurrent): its value (or a certified
+// interval where a cap, a stop or a gap ended the search), the first move (always a refinement:
+// nothing is refined at the start), the states solved.
 struct ConcurrentSolve {
   std::string instance = {};
   const Problem* problem = nullptr;
-  double value = 0;
-  int first_choice = -1;  // the skeleton refined first, -1 when none can finish by the deadline
-  std::size_t states = 0;
+  std::string method = "memoised";  // or "search"
+  ConcurrentSolution solution = {};
   double seconds = 0;
   bool timing = true;
 };

@@ -28,8 +28,10 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <string>
 
 #include "ontime/mdp/concurrent_mdp.hpp"
+#include "ontime/solve/concurrent_value_bounds.hpp"
 
 namespace ontime {
 
@@ -57,6 +59,10 @@ class ConcurrentSearch {
   // cap is reached or `stop(work)` returns true (checked after every unit of work, with the units
   // done in this call); then the move of the best lower end and from's interval.
   ConcurrentSearchResult search(const ConcurrentState& from, const std::function<bool(std::uint64_t work)>& stop);
+  // The certified interval around V*(state) held for `state` (any state of the MDP): exact when
+  // terminal, else its record's, else ConcurrentValueBounds' (widened by kBoundSlack unless they
+  // meet), then kept as its record.
+  ConcurrentValueBounds::Interval interval(const ConcurrentState& state);
   // Forgets every record.
   void clear();
   // Records held: one per state met.
@@ -66,5 +72,43 @@ class ConcurrentSearch {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+struct ConcurrentSolveOptions {
+  enum class Method { memoised, search };
+  Method method = Method::memoised;
+  // States held (memoised: states solved; search: each of those and each record of an interval);
+  // 0: ConcurrentSolver::kDefaultMaxStates.
+  std::uint64_t max_states = 0;
+  // Search only, above 0: no exact search, but trials until the start's interval is at most this
+  // wide (or the cap or the stop ends them); 0: the exact search.
+  double gap = 0.0;
+  // Checked every few thousand states: the search ends as at a cap; the memoised solver throws
+  // Cancelled.
+  std::function<bool()> stop;
+};
+
+struct ConcurrentSolution {
+  double lower = 0;  // V* when exact
+  double upper = 0;  // equal to lower when exact
+  bool exact = false;
+  ConcurrentMdp::Move first;  // the optimal first move (else: that of the best lower end)
+  std::uint64_t solved = 0;   // states solved exactly
+  std::uint64_t records = 0;  // search: states holding an interval
+  std::string stopped_by;     // when not exact: "the gap", "the state cap" or "the stop condition"
+};
+
+// The optimum of acting while planning from the start (`ontime solve --act concurrent`, Python's
+// `solve(act='concurrent')`), by either method:
+//  - memoised: ConcurrentSolver; always exact; ResourceLimitError past the cap.
+//  - search: branch and bound (ConcurrentSolver::set_bounds) over the intervals of a
+//    ConcurrentSearch whose trials run first; the value and the first move to the bit the
+//    memoised solver's. With a gap, trials of bounded RTDP until the start's certified interval is
+//    that narrow. Where the cap or the stop ends it, the start's certified interval from the
+//    records (lower: a certified bound, not a policy's value). Refuses backtracking (SPEC §7) and
+//    chains or expiry (SPEC §9) with UsageError, as ConcurrentValueBounds does.
+// Cost: the search's time and memory are linear in the states it solves or bounds (a
+// ConcurrentSolver entry or a ConcurrentSearch record each); it solves at most the memoised
+// solver's states, far fewer where the bounds are tight.
+ConcurrentSolution solve_concurrent(const ConcurrentMdp& mdp, const ConcurrentSolveOptions& options);
 
 }  // namespace ontime

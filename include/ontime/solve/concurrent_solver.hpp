@@ -18,9 +18,20 @@
 // success (waiting for a chain may pay), and a start whose execution a chain's state draws is a
 // chance move over that draw. Plan-first is one
 // policy of this MDP, so V* is at least the plan-first optimum (OptimalSolver) of the same problem.
-// Ties (values within kTieTolerance) go to the first move in this order: the steps, ascending by
-// skeleton, then the planner idling, then the starts, ascending by action; so the robot starts an action
-// only when starting is worth more than planning on while it waits.
+// Ties: the move is the first, in this order, whose value is within kTieTolerance of the largest:
+// the steps, ascending by skeleton, then the planner idling, then the starts, ascending by action;
+// so the robot starts an action only when starting is worth more than planning on while it waits.
+// Without backtracking, chains or expiry the memo is keyed by ConcurrentMdp::merge_backlogs
+// (states whose refined motions differ only within what one skeleton alone runs, with the same
+// sums, share their value).
+//
+// Branch and bound (set_bounds, `solve --method search`): given certified intervals around V* of
+// the states not solved yet, a state's moves get intervals from their successors (exact where
+// solved); the move of the largest lower end is solved first, then only the moves whose upper
+// end reaches within kTieTolerance of its value. The others can be neither the largest nor tied
+// with it, so the value and the move of every state solved are the memoised solver's to the bit
+// (each value summed over the same outcomes in the same order from the same successor values),
+// while far fewer states are solved where the bounds are tight.
 //
 // Cost: time and memory linear in the reachable states, which grow with the skeletons, the
 // deadline and the execution times the robot may still run (one word each, per refined action);
@@ -32,6 +43,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <utility>
 
 #include "ontime/mdp/concurrent_mdp.hpp"
 
@@ -65,6 +77,12 @@ class ConcurrentSolver {
 
   // The best move in a state already solved that is not terminal, or nullopt.
   std::optional<Move> best_move(const ConcurrentState& state) const;
+
+  // Certified bounds {lower, upper} around V* of a live state (lower <= V* <= upper).
+  using Bounds = std::function<std::pair<double, double>(const ConcurrentState&)>;
+  // Branch and bound with `bounds` (class comment); the optimum only (a policy's value ignores
+  // them). Empty: every move solved.
+  void set_bounds(Bounds bounds);
 
   // A condition checked every few thousand states while solving.
   void set_stop(std::function<bool()> stop);

@@ -53,6 +53,7 @@ class ConcurrentValueBounds {
   double upper(const ConcurrentState& state) { return bounds(state).upper; }
 
  private:
+  static void refuse_backtracking(const ConcurrentMdp& mdp);
   bool eligible(const ConcurrentState& state, int k) const;
 
   const ConcurrentMdp* mdp_;
