@@ -45,7 +45,8 @@ void plan_first_view(const ConcurrentMdp& mdp, const ConcurrentState& state, Sta
       for (int j = mdp.executed_depth(state); j < ConcurrentMdp::refined(state, k); ++j) {
         const int action = problem.action_at(k, j);
         if (const int timed_slot = problem.timed_slot(action); timed_slot >= 0) {
-          view.restore[static_cast<std::size_t>(timed_slot)] = static_cast<std::uint16_t>(std::min(robot_needs, too_late));
+          view.restore[static_cast<std::size_t>(timed_slot)] =
+              static_cast<std::uint16_t>(std::min(robot_needs, too_late));
         }
         robot_needs += backlog_of(action);
       }

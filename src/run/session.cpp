@@ -19,9 +19,9 @@
 #include <utility>
 #include <vector>
 
-#include "run/detail/exogenous_stream.hpp"
 #include "ontime/util/error.hpp"
 #include "ontime/util/random.hpp"
+#include "run/detail/exogenous_stream.hpp"
 
 namespace ontime {
 

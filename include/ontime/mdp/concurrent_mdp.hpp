@@ -241,9 +241,10 @@ class ConcurrentMdp {
 
   // When some live skeleton is refined in full (the lowest index of them, k): the move that runs
   // it as soon as it can, the start of k's next action while the robot is idle and (with expiry,
-  // SPEC §9) that action may start now, else a step in which the planner idles. Without rewards that is optimal (certain_success); it is the commit
-  // rule the allocators follow once a plan is complete. The default Move (the planner idles)
-  // when there is no such skeleton (complete_plan(state) < 0).
+  // SPEC §9) that action may start now, else a step in which the planner idles. Without rewards,
+  // chains or expiry that is optimal (certain_success); it is the commit rule the allocators follow
+  // once a plan is complete. The default Move (the planner idles) when there is no such skeleton
+  // (complete_plan(state) < 0).
   Move run_complete_plan(const ConcurrentState& state) const;
   // The lowest index of a live skeleton refined in full whose execution from now, back to back,
   // ends by D; -1 when there is none.
