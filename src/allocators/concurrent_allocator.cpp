@@ -16,9 +16,10 @@ void plan_first_view(const ConcurrentMdp& mdp, const ConcurrentState& state, Sta
   view.time = static_cast<std::uint16_t>(ConcurrentMdp::time(state));
   if (timed) {
     view.chains = ConcurrentMdp::chains(state);
-    for (int slot = 0; slot < problem.timed_slot_count(); ++slot) {
-      view.restore[static_cast<std::size_t>(problem.culprit_slot_count() + slot)] = 0;
-    }
+    // The timed slots follow the culprit slots (Problem::timed_slot).
+    const auto first = static_cast<std::size_t>(problem.culprit_slot_count());
+    const std::size_t end = first + static_cast<std::size_t>(problem.timed_slot_count());
+    for (std::size_t slot = first; slot < end; ++slot) view.restore[slot] = 0;
   }
   // What a refined action after E adds to the robot's backlog in the view: its execution; with
   // chains or expiry a chain-dependent one adds nothing, as the plan-first Mdp counts it (drawn
