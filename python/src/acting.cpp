@@ -30,7 +30,7 @@ struct ConcurrentSessionHandle {
         throw UsageError("allocator parameters (" + values.all().begin()->first +
                          ", ...) need a solver: without one the caller decides every move");
       }
-      session = std::make_unique<ConcurrentSession>(*mdp);
+      session = std::make_unique<ConcurrentSession>(*mdp, seed);
     }
   }
   std::shared_ptr<const Problem> problem;

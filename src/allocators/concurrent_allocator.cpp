@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "ontime/util/error.hpp"
 
@@ -11,7 +12,22 @@ namespace ontime {
 void plan_first_view(const ConcurrentMdp& mdp, const ConcurrentState& state, State& view) {
   const Problem& problem = mdp.problem();
   const std::int64_t too_late = std::int64_t{mdp.deadline()} + 1;
+  const bool timed = mdp.is_timed();
   view.time = static_cast<std::uint16_t>(ConcurrentMdp::time(state));
+  if (timed) {
+    view.chains = ConcurrentMdp::chains(state);
+    // The timed slots follow the culprit slots (Problem::timed_slot).
+    const auto first = static_cast<std::size_t>(problem.culprit_slot_count());
+    const std::size_t end = first + static_cast<std::size_t>(problem.timed_slot_count());
+    for (std::size_t slot = first; slot < end; ++slot) view.restore[slot] = 0;
+  }
+  // What a refined action after E adds to the robot's backlog in the view: its execution; with
+  // chains or expiry a chain-dependent one adds nothing, as the plan-first Mdp counts it (drawn
+  // when it starts, SPEC §9).
+  const auto backlog_of = [&](int action) -> std::int64_t {
+    const std::uint16_t word = mdp.execution(state, action);
+    return word == ConcurrentMdp::kDrawnAtStart ? 0 : std::int64_t{word};
+  };
   for (int k = 0; k < mdp.skeleton_count(); ++k) {
     const auto slot = static_cast<std::size_t>(k);
     if (!ConcurrentMdp::is_live(state, k)) {
@@ -22,7 +38,20 @@ void plan_first_view(const ConcurrentMdp& mdp, const ConcurrentState& state, Sta
     }
     view.refined[slot] = static_cast<std::uint8_t>(ConcurrentMdp::refined(state, k));
     view.spent[slot] = static_cast<std::uint16_t>(mdp.spent(state, k));
-    const std::int64_t robot_needs = mdp.robot_free(state, k) - ConcurrentMdp::time(state);
+    std::int64_t robot_needs = mdp.robot_free(state, k) - ConcurrentMdp::time(state);
+    if (timed) {
+      // The timed plan-first view: ET_k the static backlog, and each refined timed action after E
+      // restored to the static backlog before it (the plan-first Mdp's restore value).
+      robot_needs = ConcurrentMdp::robot_left(state);
+      for (int j = mdp.executed_depth(state); j < ConcurrentMdp::refined(state, k); ++j) {
+        const int action = problem.action_at(k, j);
+        if (const int timed_slot = problem.timed_slot(action); timed_slot >= 0) {
+          view.restore[static_cast<std::size_t>(timed_slot)] =
+              static_cast<std::uint16_t>(std::min(robot_needs, too_late));
+        }
+        robot_needs += backlog_of(action);
+      }
+    }
     view.execution[slot] = static_cast<std::uint16_t>(std::min(robot_needs, too_late));
   }
   if (!mdp.has_backtracking()) return;
@@ -37,7 +66,7 @@ void plan_first_view(const ConcurrentMdp& mdp, const ConcurrentState& state, Sta
       if (const int culprit_slot = problem.culprit_slot(action); culprit_slot >= 0) {
         view.restore[static_cast<std::size_t>(culprit_slot)] = static_cast<std::uint16_t>(std::min(backlog, too_late));
       }
-      backlog += mdp.execution(state, action);
+      backlog += timed ? backlog_of(action) : mdp.execution(state, action);
     }
   }
 }
@@ -93,7 +122,11 @@ ConcurrentMdp::Move EagerCommitAllocator::choose(const ConcurrentState& state) {
   if (k < 0) return {};  // no live skeleton has work left (none is complete either): nothing helps
   const int depth = mdp_->executed_depth(state);
   if (ConcurrentMdp::robot_left(state) == 0 && ConcurrentMdp::refined(state, k) > depth) {
-    return {mdp_->problem().action_at(k, depth), ConcurrentMdp::kWait};
+    const int next = mdp_->problem().action_at(k, depth);
+    // With expiry (SPEC §9) it starts as soon as it may: until then the planner refines k.
+    if (!mdp_->is_timed()) return {next, ConcurrentMdp::kWait};
+    const std::vector<int> startable = mdp_->startable(state);
+    if (std::binary_search(startable.begin(), startable.end(), next)) return {next, ConcurrentMdp::kWait};
   }
   return {-1, k};
 }
@@ -106,7 +139,6 @@ void EagerCommitAllocator::observe(const ConcurrentState& before, int choice, co
 }
 
 ConcurrentAllocatorFactory eager_commit_factory(const ConcurrentMdp& mdp, AllocatorFactory plan_first) {
-  refuse_chains(mdp, "the eager commit rule", "its plan-first view has no chains' state nor expiry");
   return
       [&mdp, plan_first = std::move(plan_first)] { return std::make_unique<EagerCommitAllocator>(mdp, plan_first()); };
 }
@@ -115,7 +147,7 @@ void refuse_chains(const ConcurrentMdp& mdp, std::string_view rule, std::string_
   if (!mdp.is_timed()) return;
   throw UsageError(mdp.problem().name() + ": " + std::string(rule) +
                    " acting while planning (SPEC §10) does not take exogenous chains or expiry (SPEC §9) yet (" +
-                   std::string(why) + "): only the optimal allocator takes chains so far");
+                   std::string(why) + "): the optimal allocator and the eager commit rule take them");
 }
 
 }  // namespace ontime

@@ -31,7 +31,7 @@ ConcurrentOptimalAllocator::ConcurrentOptimalAllocator(const ConcurrentMdp& mdp,
     : mdp_(&mdp), solved_(std::move(solved)), max_states_(max_states) {}
 
 ConcurrentMdp::Move ConcurrentOptimalAllocator::choose(const ConcurrentState& state) {
-  if (mdp_->complete_plan(state) >= 0) return mdp_->run_complete_plan(state);
+  if (mdp_->certain_success(state)) return mdp_->run_complete_plan(state);
   if (const auto move = solved_->best_move(state)) return *move;
   if (!private_) private_ = std::make_unique<ConcurrentSolver>(*mdp_, max_states_);
   if (const auto move = private_->best_move(state)) return *move;

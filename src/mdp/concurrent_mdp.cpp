@@ -389,7 +389,10 @@ int ConcurrentMdp::complete_plan(const ConcurrentState& state) const noexcept {
 ConcurrentMdp::Move ConcurrentMdp::run_complete_plan(const ConcurrentState& state) const {
   const int k = complete_plan(state);
   if (k < 0 || robot_left(state) > 0) return {};
-  return {problem_->action_at(k, executed_depth(state)), kWait};
+  const int next = problem_->action_at(k, executed_depth(state));
+  // With expiry its chain may block it now (SPEC §9): the planner idles until it may start.
+  if (timed_ && !may_start_now(state, next)) return {};
+  return {next, kWait};
 }
 
 bool ConcurrentMdp::certain_success(const ConcurrentState& state) const noexcept {

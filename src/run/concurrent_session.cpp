@@ -11,32 +11,36 @@
 
 #include "ontime/util/error.hpp"
 #include "ontime/util/random.hpp"
+#include "run/detail/exogenous_stream.hpp"
 
 namespace ontime {
 
 namespace {
 
-// Episodes with chains would simulate them and draw executions at starts (SPEC §9): not yet.
-void refuse_timed(const ConcurrentMdp& mdp) {
+// Chains or expiry (SPEC §9) in a session on the robot's clock, or in one whose skeletons change:
+// not yet (the model clock's episodes take them).
+void refuse_timed(const ConcurrentMdp& mdp, const char* session) {
   if (!mdp.is_timed()) return;
-  throw UsageError(mdp.problem().name() +
-                   ": episodes with exogenous chains or expiry (SPEC §9) acting while planning (SPEC §10) are not "
-                   "there yet: the session would simulate the chains and draw executions when they start; solve "
-                   "the instance exactly instead (ontime solve --act concurrent)");
+  throw UsageError(mdp.problem().name() + ": " + session +
+                   " acting while planning (SPEC §10) does not take exogenous chains or expiry (SPEC §9) yet: its "
+                   "chains would have to follow the clock (or the skeletons' changes); episodes on the model clock "
+                   "take them (ontime evaluate --act concurrent without --live)");
 }
 
 }  // namespace
 
 ConcurrentSession::ConcurrentSession(const ConcurrentMdp& mdp, ConcurrentAllocator& allocator, std::uint64_t seed)
-    : ConcurrentSession(mdp, &allocator) {
+    : ConcurrentSession(mdp, &allocator, seed) {
   allocator.begin_episode(seed);
 }
 
-ConcurrentSession::ConcurrentSession(const ConcurrentMdp& mdp) : ConcurrentSession(mdp, nullptr) {}
+ConcurrentSession::ConcurrentSession(const ConcurrentMdp& mdp, std::uint64_t seed)
+    : ConcurrentSession(mdp, nullptr, seed) {}
 
 ConcurrentSession::ConcurrentSession(const ConcurrentMdp& mdp, ConcurrentAllocator& allocator, std::uint64_t seed,
                                      const Clock& clock, LiveOptions options)
-    : ConcurrentSession(mdp, &allocator) {
+    : ConcurrentSession(mdp, &allocator, seed) {
+  refuse_timed(mdp, "a live session");
   live_.start(clock, options, mdp.problem().step_seconds(), mdp.deadline());
   execution_seconds_.assign(static_cast<std::size_t>(mdp.problem().action_count()), -1.0);
   allocator.begin_episode(seed);
@@ -46,13 +50,13 @@ ConcurrentSession::ConcurrentSession(const Problem& problem, AllocatorMaker make
                                      const Clock* clock, LiveOptions options)
     : mdp_(nullptr),
       allocator_(nullptr),
+      seed_(seed),
       owned_mdp_(std::make_unique<ConcurrentMdp>(problem)),
       owned_allocator_(made_allocator(make_allocator, *owned_mdp_)),  // before the maker moves below
-      make_allocator_(std::move(make_allocator)),
-      seed_(seed) {
+      make_allocator_(std::move(make_allocator)) {
   // The members before the owned ones point into them.
   mdp_ = owned_mdp_.get();
-  refuse_timed(*mdp_);
+  refuse_timed(*mdp_, "a session whose skeletons change");
   allocator_ = owned_allocator_.get();
   before_ = state_ = mdp_->start();
   const auto actions = static_cast<std::size_t>(problem.action_count());
@@ -67,18 +71,20 @@ ConcurrentSession::ConcurrentSession(const Problem& problem, AllocatorMaker make
 }
 
 ConcurrentSession::ConcurrentSession(const ConcurrentMdp& mdp, const Clock& clock, LiveOptions options)
-    : ConcurrentSession(mdp, nullptr) {
+    : ConcurrentSession(mdp, nullptr, 0) {
+  refuse_timed(mdp, "a live session");
   live_.start(clock, options, mdp.problem().step_seconds(), mdp.deadline());
   execution_seconds_.assign(static_cast<std::size_t>(mdp.problem().action_count()), -1.0);
 }
 
-ConcurrentSession::ConcurrentSession(const ConcurrentMdp& mdp, ConcurrentAllocator* allocator)
+ConcurrentSession::ConcurrentSession(const ConcurrentMdp& mdp, ConcurrentAllocator* allocator, std::uint64_t seed)
     : mdp_(&mdp),
       allocator_(allocator),
       state_(mdp.start()),
       before_(state_),
-      attempts_(static_cast<std::size_t>(mdp.problem().action_count())) {
-  refuse_timed(mdp);
+      attempts_(static_cast<std::size_t>(mdp.problem().action_count())),
+      seed_(seed),
+      exogenous_(detail::exogenous_stream(seed)) {
   end_if_stuck();
 }
 
@@ -146,8 +152,13 @@ ConcurrentDecision ConcurrentSession::start(int action) {
   const Problem& problem = mdp_->problem();
   const bool live = live_.is_live();
   const double elapsed = live ? live_.elapsed() : 0.0;
-  Steps finish = ConcurrentMdp::time(state_) + mdp_->execution(state_, action);
-  ConcurrentMdp::StartOutcome outcome = mdp_->start_action(state_, action);  // checks the start
+  // An execution drawn from a chain's state when it starts (SPEC §9): the world's draw, now.
+  const std::vector<int> startable = mdp_->startable(state_);
+  const bool may_start = std::binary_search(startable.begin(), startable.end(), action);
+  const Steps drawn = may_start ? mdp_->sample_start_execution(state_, action, exogenous_) : -1;
+  const Steps steps = drawn >= 0 ? drawn : Steps{mdp_->execution(state_, action)};
+  Steps finish = steps == kNever ? kNever : ConcurrentMdp::time(state_) + steps;
+  ConcurrentMdp::StartOutcome outcome = mdp_->start_action(state_, action, drawn);  // checks the start
   started_.push_back(action);
   double end = 0;
   if (live) {
@@ -245,7 +256,12 @@ Status ConcurrentSession::report_with_seconds(const Observation& observation, do
   }
   if (live_.is_live()) return report_on_clock(observation, execution_seconds);
   before_ = state_;
-  state_ = mdp_->step(before_, pending_skeleton_, observation);  // checks what the step cannot reveal
+  // The simulated chains (SPEC §9) move one step of their joint transition, whatever the step.
+  const Observation seen = mdp_->plan_first_mdp().has_chains()
+                               ? observation.with_chains(mdp_->plan_first_mdp().sample_chain_step(
+                                     ConcurrentMdp::chains(before_), exogenous_))
+                               : observation;
+  state_ = mdp_->step(before_, pending_skeleton_, seen);  // checks what the step cannot reveal
   pending_ = false;
   if (pending_action_ >= 0) {
     ActionAttempt& attempt = attempts_[static_cast<std::size_t>(pending_action_)];

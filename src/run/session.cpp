@@ -21,6 +21,7 @@
 
 #include "ontime/util/error.hpp"
 #include "ontime/util/random.hpp"
+#include "run/detail/exogenous_stream.hpp"
 
 namespace ontime {
 
@@ -220,7 +221,7 @@ void Session::end_attempts_below(int culprit, int backtracking) {
 Status Session::carry_out_timed(World& world) {
   if (!exogenous_seeded_) {
     // A stream of its own: the allocator's draws stay those of the same seed without chains.
-    exogenous_ = SplitMix64(stream_seed(seed_, 0x65786f67));
+    exogenous_ = detail::exogenous_stream(seed_);
     exogenous_seeded_ = true;
   }
   if (live_.is_live() && !simulated_chains_) {

@@ -16,7 +16,7 @@ void ConcurrentContiguousSuccess::check_supported(const ConcurrentMdp& mdp) {
   if (mdp.is_timed()) {
     throw UsageError(mdp.problem().name() +
                      ": dp and dp-rerun acting while planning (SPEC §10) do not value exogenous chains or expiry "
-                     "(SPEC §9) yet (the optimal allocator takes them)");
+                     "(SPEC §9) yet (the optimal allocator and the eager kinds take them)");
   }
   if (mdp.has_backtracking()) {
     throw UsageError(mdp.problem().name() +

@@ -14,6 +14,7 @@
 #include "ontime/run/concurrent_session.hpp"
 #include "ontime/run/evaluation.hpp"
 #include "ontime/run/simulator.hpp"
+#include "ontime/solve/concurrent_solver.hpp"
 #include "ontime/util/error.hpp"
 #include "support/paper.hpp"
 #include "support/random_instances.hpp"
@@ -210,6 +211,137 @@ TEST(ConcurrentEpisodes, AThompsonAllocatorIsNotValuedExactly) {
   const auto allocator = make_concurrent_allocator_factory("thompson", mdp)();
   EXPECT_FALSE(allocator->is_stationary());
   EXPECT_THROW((void)evaluate_exactly(mdp, *allocator), UsageError);
+}
+
+// Exogenous chains and expiry (SPEC §9) acting while planning: the session moves the simulated
+// chains one step per step and draws a chain-dependent execution from the chain's state when the
+// action starts; an action starts only while the MDP says it may.
+
+Problem chain_instance(const std::string& name) {
+  return load_problem(testing::source_path("data/instances/chains/" + name + ".json")).with_acting(Acting::concurrent);
+}
+
+// Allocator `name`'s episodes against its exact value (4 standard errors of the reward, which
+// lies in [0, 1]); for optimal the exact value is also ConcurrentSolver's optimum V*.
+void expect_episodes_at_the_exact_value(const Problem& problem, const std::string& name, std::uint64_t episodes,
+                                        const std::string& label) {
+  const ConcurrentMdp mdp(problem);
+  const auto [exact, sampled] = exact_and_sampled(mdp, name, episodes, 17);
+  EXPECT_NEAR(sampled.mean_reward, exact.expected_reward, 4 * half_width_of(exact.expected_reward, episodes) + 1e-12)
+      << label << " " << name;
+  EXPECT_NEAR(sampled.success_rate, exact.success_probability,
+              4 * half_width_of(exact.success_probability, episodes) + 1e-12)
+      << label << " " << name;
+  if (name == "optimal") {
+    ConcurrentSolver solver(mdp);
+    EXPECT_NEAR(exact.expected_reward, solver.solve(mdp.start()), 1e-12) << label;
+  }
+}
+
+TEST(ConcurrentEpisodesWithChains, TheirRewardIsTheExactValueOnTheChainInstances) {
+  // The cup through a door that locks at random (with give-ups, SPEC §7) and the meeting through
+  // the coffee queue (an execution drawn from the queue's state when it starts; a door that locks
+  // for good), for the optimum's commit rule and the eager one.
+  const auto episodes = static_cast<std::uint64_t>(testing::repetitions_to_check(20'000));
+  for (const std::string instance : {"cup-through-the-door", "meeting-through-the-queue"}) {
+    const Problem problem = chain_instance(instance);
+    ASSERT_TRUE(problem.is_timed());
+    for (const std::string name : {"optimal", "greedy", "round-robin"}) {
+      expect_episodes_at_the_exact_value(problem, name, episodes, instance);
+    }
+  }
+}
+
+TEST(ConcurrentEpisodesWithChains, TheirRewardIsTheExactValueOnRandomInstances) {
+  // Random chains, chain-dependent executions and expiry (half with rewards, one with give-ups).
+  const auto episodes = static_cast<std::uint64_t>(testing::repetitions_to_check(10'000));
+  for (const std::uint64_t seed : {2U, 3U, 6U}) {
+    Problem problem = testing::with_random_chains(testing::random_instance(seed + 5000, 4, 3, 10), seed, seed % 2 == 0);
+    if (seed % 3 == 0) problem = testing::with_backtracking(problem, seed);
+    problem = problem.with_acting(Acting::concurrent);
+    ASSERT_TRUE(problem.is_timed());
+    for (const std::string name : {"optimal", "greedy", "round-robin"}) {
+      expect_episodes_at_the_exact_value(problem, name, episodes, "seed " + std::to_string(seed));
+    }
+  }
+}
+
+TEST(ConcurrentEpisodesWithChains, TheRobotWaitsForTheDoorInItsEpisodes) {
+  // go then through, each found in 1 step and run in 1; through cannot start while the door is
+  // locked, locked at 0 and opening with probability 1/2 per step for good; deadline 6. The
+  // optimum waits at the door and starts through at the first open step up to 5: 1 - 1/32.
+  const Problem problem = parse_problem(R"({"deadline": 6, "acting": "concurrent",
+    "chains": {"door": {"states": ["open", "locked"], "start": "locked", "transitions": [[1, 0], [0.5, 0.5]]}},
+    "actions": {"go": {"planning": {"pmf": {"1": 1}}, "execution": {"pmf": {"1": 1}}},
+                "through": {"planning": {"pmf": {"1": 1}}, "execution": {"pmf": {"1": 1}},
+                            "expires": {"chain": "door", "states": ["locked"]}}},
+    "skeletons": [["go", "through"]]})",
+                                        "door");
+  const ConcurrentMdp mdp(problem);
+  const auto episodes = static_cast<std::uint64_t>(testing::repetitions_to_check(20'000));
+  for (const std::string name : {"optimal", "greedy"}) {
+    const auto [exact, sampled] = exact_and_sampled(mdp, name, episodes, 5);
+    EXPECT_NEAR(exact.success_probability, 1.0 - 1.0 / 32, 1e-15) << name;
+    EXPECT_NEAR(sampled.success_rate, 1.0 - 1.0 / 32, 4 * half_width_of(1.0 - 1.0 / 32, episodes)) << name;
+  }
+}
+
+TEST(ConcurrentEpisodesWithChains, TheSameSeedGivesTheSameEpisodesOnAnyThreadCount) {
+  const ConcurrentMdp mdp(chain_instance("meeting-through-the-queue"));
+  for (const std::string name : {"optimal", "greedy", "thompson"}) {
+    const ConcurrentAllocatorFactory factory = make_concurrent_allocator_factory(name, mdp);
+    MonteCarloOptions options;
+    options.episodes = 2'000;
+    options.seed = 3;
+    options.threads = 1;
+    const MonteCarloResult one = run_monte_carlo(mdp, factory, options);
+    options.threads = 2;
+    const MonteCarloResult two = run_monte_carlo(mdp, factory, options);
+    EXPECT_EQ(one.successes, two.successes) << name;
+    EXPECT_EQ(one.mean_reward, two.mean_reward) << name;
+    EXPECT_GT(one.successes, 0U) << name;
+    EXPECT_LT(one.successes, options.episodes) << name;
+  }
+}
+
+TEST(ConcurrentEpisodesWithChains, WhatIsNotThereYetIsRefusedNamingTheRule) {
+  const Problem problem = chain_instance("cup-through-the-door");
+  const ConcurrentMdp mdp(problem);
+  const auto refused = [](const auto& make, const std::string& rule) {
+    try {
+      make();
+      ADD_FAILURE() << "not refused: " << rule;
+    } catch (const UsageError& error) {
+      EXPECT_NE(std::string(error.what()).find(rule), std::string::npos) << error.what();
+      EXPECT_NE(std::string(error.what()).find("SPEC §9"), std::string::npos) << error.what();
+    }
+  };
+  const ManualClock clock;
+  refused([&] { ConcurrentSession session(mdp, clock); }, "a live session");
+  refused([&] { ConcurrentSession session(problem, {}, 1); }, "a session whose skeletons change");
+  refused([&] { (void)make_concurrent_allocator_factory("mcts", mdp); }, "mcts");
+  refused([&] { (void)make_concurrent_allocator_factory("branch-and-bound", mdp); }, "branch-and-bound");
+}
+
+TEST(ConcurrentEpisodesWithChains, AStartTheChainsBlockIsRefused) {
+  // The door is locked for good: through, once refined, may never start.
+  const Problem problem = parse_problem(R"({"deadline": 6, "acting": "concurrent",
+    "chains": {"door": {"states": ["open", "locked"], "start": "locked", "transitions": [[1, 0], [0, 1]]}},
+    "actions": {"go": {"planning": {"pmf": {"1": 1}}, "execution": {"pmf": {"0": 1}}},
+                "through": {"planning": {"pmf": {"1": 1}}, "execution": {"pmf": {"1": 1}},
+                            "expires": {"chain": "door", "states": ["locked"]}}},
+    "skeletons": [["go", "through"]]})",
+                                        "locked");
+  const ConcurrentMdp mdp(problem);
+  ConcurrentSession session(mdp, 4);
+  session.decide({-1, 0});
+  EXPECT_EQ(session.report_refined(0), Status::running);
+  session.decide({0, ConcurrentMdp::kWait});  // go: no time
+  session.decide({-1, 0});
+  EXPECT_EQ(session.report_refined(1), Status::running);
+  EXPECT_THROW(session.decide({1, ConcurrentMdp::kWait}), UsageError);
+  EXPECT_EQ(session.started(), std::vector<int>{0});
+  EXPECT_EQ(session.status(), Status::running);
 }
 
 }  // namespace

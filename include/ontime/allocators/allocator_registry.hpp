@@ -255,8 +255,8 @@ std::optional<double> iterations_per_search(const AllocatorKind& kind, const Sta
 
 // The commit rule of the kinds that choose a skeleton plan-first (EagerCommitAllocator).
 inline constexpr const char* kEagerCommitRule =
-    "eager: starts the next action of the skeleton it chooses as soon as that action is refined and the robot is "
-    "idle; a complete plan runs at once";
+    "eager: starts the next action of the skeleton it chooses as soon as that action is refined, the robot is idle "
+    "and (chains, expiry) the action may start; a complete plan runs at once";
 
 // Shorthand for allocator_registry().make_concurrent_factory(...).
 ConcurrentAllocatorFactory make_concurrent_allocator_factory(std::string_view name, const ConcurrentMdp& mdp,

@@ -55,6 +55,10 @@ using ConcurrentAllocatorFactory = std::function<std::unique_ptr<ConcurrentAlloc
 // soon as it can and the planner idles (ConcurrentMdp::run_complete_plan). A choice of a skeleton
 // that is dropped or has nothing left to refine goes to the live skeleton with work left whose
 // earliest finish is least (ties: lowest index).
+// With exogenous chains or expiry (SPEC §9) the rule is the same, "as soon as it can" meaning as
+// soon as the action may start (ConcurrentMdp::startable): while k's next action to execute is
+// blocked the planner refines k, and while a complete plan's next action is blocked the planner
+// idles; the plan-first allocator sees the timed plan-first view (plan_first_view).
 // A stationary plan-first allocator is asked anew before every move (so the rule is stationary
 // too); any other is asked once per step, its choice kept across the starts within the step, and
 // observes each step plan-first.
@@ -81,20 +85,26 @@ class EagerCommitAllocator final : public ConcurrentAllocator {
 };
 
 // A factory of EagerCommitAllocator around the allocators `plan_first` makes (for
-// mdp.plan_first_mdp()). Refuses chains or expiry (refuse_chains).
+// mdp.plan_first_mdp()), chains and expiry (SPEC §9) included.
 ConcurrentAllocatorFactory eager_commit_factory(const ConcurrentMdp& mdp, AllocatorFactory plan_first);
 
-// Only the optimal allocator takes exogenous chains or expiry (SPEC §9) acting while planning so
-// far: UsageError naming `rule` (the commit rule of the kind refused) and `why` when `mdp` has
-// them; nothing otherwise.
+// Only the optimal allocator and the eager commit rule take exogenous chains or expiry (SPEC §9)
+// acting while planning so far: UsageError naming `rule` (the commit rule of the kind refused) and
+// `why` when `mdp` has them; nothing otherwise.
 void refuse_chains(const ConcurrentMdp& mdp, std::string_view rule, std::string_view why);
 
 // The state of SPEC §10 seen plan-first (SPEC §2), for a plan-first allocator: CT; per live
 // skeleton its l_k and PT_k, and as ET_k the steps the robot still needs for its refined actions
 // (ConcurrentMdp::robot_free less CT, at most D + 1), so that plan-first success from the view
 // (CT' + ET <= D) implies success acting while planning; a dropped skeleton appears refined in full
-// with ET_k = D + 1, which no plan-first rule chooses or counts as able to succeed. Writes into
-// `view` (sized for the problem's skeletons) without allocating.
+// with ET_k = D + 1, which no plan-first rule chooses or counts as able to succeed.
+// With chains or expiry (SPEC §9) it is the timed plan-first state: the chains' joint state, ET_k
+// the static backlog (r and the refined executions after E; one drawn from a chain when it starts
+// counts 0, as the plan-first Mdp counts it) and each refined timed action after E restored to the
+// static backlog before it. A plan-first state has no executed prefix: a timed action the robot
+// already started reads as starting now (restore 0) to a rule that values plans in the chains
+// (round-robin and greedy read none of it). Writes into `view` (sized for the problem's
+// skeletons and slots) without allocating.
 void plan_first_view(const ConcurrentMdp& mdp, const ConcurrentState& state, State& view);
 
 }  // namespace ontime

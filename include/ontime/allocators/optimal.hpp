@@ -46,12 +46,14 @@ class OptimalAllocator final : public Allocator {
   std::unique_ptr<OptimalSolver> private_;
 };
 
-// `optimal` acting while planning (SPEC §10): follows ConcurrentSolver's best move, and runs a
-// complete plan at once (ConcurrentMdp::run_complete_plan, optimal where the solver stops at a
-// certain success). Its commit rule is the optimum's: the robot starts an action exactly when
-// starting is worth more than planning on while it waits. The solve from the start is shared by
-// the allocators of one factory; a state outside it (a session driven elsewhere by its caller) is
-// solved on demand by a private solver under the same cap. Cost: one hash lookup per move.
+// `optimal` acting while planning (SPEC §10): follows ConcurrentSolver's best move, and at a
+// certain success (ConcurrentMdp::certain_success, where the solver stops) runs the complete plan
+// at once (ConcurrentMdp::run_complete_plan). With rewards, chains or expiry a complete plan is
+// not a certain success and the solver's move is followed there too. Its commit rule is the
+// optimum's: the robot starts an action exactly when starting is worth more than planning on
+// while it waits. The solve from the start is shared by the allocators of one factory; a state
+// outside it (a session driven elsewhere by its caller) is solved on demand by a private solver
+// under the same cap. Cost: one hash lookup per move.
 class ConcurrentOptimalAllocator final : public ConcurrentAllocator {
  public:
   // Follows `solved` (which has solved mdp.start()); `max_states` caps a private solve.

@@ -180,6 +180,12 @@ class ConcurrentMdp {
   template <class Visitor>
   void for_each_start_outcome(const ConcurrentState& state, int action, Visitor&& visit) const;
 
+  // The world's draw of `action`'s execution when it starts (SPEC §9): with an execution drawn from
+  // a chain when it starts, one draw from the chain's state now (the distribution
+  // for_each_start_outcome enumerates; kNever: none); -1 for any other action. O(1) draws.
+  template <class Generator>
+  Steps sample_start_execution(const ConcurrentState& state, int action, Generator& generator) const;
+
   // The step choices worth considering: one per group of live skeletons sharing their next action
   // (named by the lowest index), ascending; empty when no live skeleton has an action left to
   // refine. Without backtracking refining never lowers the value (docs/theory.md), so an idle
@@ -234,10 +240,11 @@ class ConcurrentMdp {
   ConcurrentState execution_finished(const ConcurrentState& state) const;
 
   // When some live skeleton is refined in full (the lowest index of them, k): the move that runs
-  // it as soon as it can, the start of k's next action while the robot is idle, else a step in
-  // which the planner idles. Without rewards that is optimal (certain_success); it is the commit
-  // rule the allocators follow once a plan is complete. The default Move (the planner idles)
-  // when there is no such skeleton (complete_plan(state) < 0).
+  // it as soon as it can, the start of k's next action while the robot is idle and (with expiry,
+  // SPEC §9) that action may start now, else a step in which the planner idles. Without rewards,
+  // chains or expiry that is optimal (certain_success); it is the commit rule the allocators follow
+  // once a plan is complete. The default Move (the planner idles) when there is no such skeleton
+  // (complete_plan(state) < 0).
   Move run_complete_plan(const ConcurrentState& state) const;
   // The lowest index of a live skeleton refined in full whose execution from now, back to back,
   // ends by D; -1 when there is none.
@@ -352,6 +359,15 @@ void ConcurrentMdp::for_each_start_outcome(const ConcurrentState& state, int act
   // Too slow or never: one outcome, as in SPEC §2.
   if (1.0 - in_time > 1e-15)
     visit(1.0 - in_time, static_cast<const StartOutcome&>(start_action(state, action, kNever)));
+}
+
+template <class Generator>
+Steps ConcurrentMdp::sample_start_execution(const ConcurrentState& state, int action, Generator& generator) const {
+  if (execution(state, action) != kDrawnAtStart) return -1;
+  const int chain = problem_->execution_chain(action);
+  return problem_->action(action)
+      .execution_by_state[static_cast<std::size_t>(mdp_.chain_state(chains(state), chain))]
+      .sample(generator);
 }
 
 template <class Visitor>

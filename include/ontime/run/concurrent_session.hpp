@@ -17,6 +17,15 @@
 // robot has run one more step of its current execution. The session fails when no skeleton can
 // finish by the deadline any more.
 //
+// Exogenous chains and expiry (SPEC §9), on the model's clock: the session simulates the chains
+// from its seed (the stream plan-first Session draws them from): every step moves them by one draw
+// of their joint transition, whatever the report says (its `chains` is not used), and an action
+// whose execution depends on a chain has it drawn when it starts, from the chain's state then
+// (ConcurrentMdp::sample_start_execution). A start is carried out only while the action may start
+// (ConcurrentMdp::startable; UsageError otherwise). A live session and one that owns its problem
+// refuse chains or expiry (UsageError naming the rule): their chains would have to follow the clock
+// or carry over to new skeletons.
+//
 // A live session (constructed with a Clock) runs on the robot's seconds as a live Session does
 // (session.hpp, docs/live.md; the ledger is the same, live_ledger.hpp). The deadline is
 // D * step_seconds after the session began, and the state the allocator sees is derived from the
@@ -48,6 +57,7 @@
 #include "ontime/run/live_ledger.hpp"
 #include "ontime/run/session.hpp"
 #include "ontime/run/world.hpp"
+#include "ontime/util/random.hpp"
 
 namespace ontime {
 
@@ -68,10 +78,11 @@ class ConcurrentSession {
 
   // Calls allocator.begin_episode(seed). The Mdp and the allocator must outlive the session.
   ConcurrentSession(const ConcurrentMdp& mdp, ConcurrentAllocator& allocator, std::uint64_t seed = 0);
-  // A session without an allocator: the caller decides every move (decide()).
-  explicit ConcurrentSession(const ConcurrentMdp& mdp);
+  // A session without an allocator: the caller decides every move (decide()). `seed` draws the
+  // simulated chains (SPEC §9), as the allocator's session's seed does.
+  explicit ConcurrentSession(const ConcurrentMdp& mdp, std::uint64_t seed = 0);
   // The same two live on `clock` (which must outlive the session); the deadline starts now. Throw
-  // UsageError for a decision share outside (0, 1e6].
+  // UsageError for a decision share outside (0, 1e6] or a problem with chains or expiry.
   ConcurrentSession(const ConcurrentMdp& mdp, ConcurrentAllocator& allocator, std::uint64_t seed, const Clock& clock,
                     LiveOptions options = {});
   ConcurrentSession(const ConcurrentMdp& mdp, const Clock& clock, LiveOptions options = {});
@@ -183,7 +194,7 @@ class ConcurrentSession {
   double finish_seconds() const noexcept { return finish_seconds_; }
 
  private:
-  ConcurrentSession(const ConcurrentMdp& mdp, ConcurrentAllocator* allocator);
+  ConcurrentSession(const ConcurrentMdp& mdp, ConcurrentAllocator* allocator, std::uint64_t seed);
   // Carries out a move; live, the decision began at clock reading `begin` with CT `steps_before`.
   ConcurrentDecision carry_out_move(const ConcurrentMdp::Move& move, double begin = 0, Steps steps_before = 0);
   ConcurrentDecision start(int action);
@@ -214,12 +225,13 @@ class ConcurrentSession {
   Steps finish_ = -1;
   std::vector<int> started_;
   std::vector<ActionAttempt> attempts_;
+  std::uint64_t seed_ = 0;
+  SplitMix64 exogenous_{0};  // the simulated chains' draws (chains or expiry, SPEC §9)
 
   // Sessions that own their problem.
   std::unique_ptr<ConcurrentMdp> owned_mdp_;
   std::unique_ptr<ConcurrentAllocator> owned_allocator_;
   AllocatorMaker make_allocator_;
-  std::uint64_t seed_ = 0;
   std::uint64_t changes_ = 0;           // skeleton changes so far: the allocator's seed stream
   bool more_expected_ = false;          // expect_more_skeletons()
   std::vector<Steps> execution_steps_;  // per action, once refined (-1 before)
