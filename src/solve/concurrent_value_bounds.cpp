@@ -3,9 +3,17 @@
 #include <algorithm>
 #include <utility>
 
+#include "ontime/util/error.hpp"
+
 namespace ontime {
 
-ConcurrentValueBounds::ConcurrentValueBounds(const ConcurrentMdp& mdp) : mdp_(&mdp), devoted_(mdp, Aggregation::self) {}
+ConcurrentValueBounds::ConcurrentValueBounds(const ConcurrentMdp& mdp) : mdp_(&mdp), devoted_(mdp, Aggregation::self) {
+  if (mdp.has_backtracking()) {
+    throw UsageError(mdp.problem().name() +
+                     ": the bounds on V* acting while planning (SPEC §10) assume no give-up; backtracking (SPEC §7) "
+                     "is not taken");
+  }
+}
 
 bool ConcurrentValueBounds::eligible(const ConcurrentState& state, int k) const {
   const Problem& problem = mdp_->problem();
