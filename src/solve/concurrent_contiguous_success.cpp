@@ -18,18 +18,15 @@ void ConcurrentContiguousSuccess::check_supported(const ConcurrentMdp& mdp) {
                      ": dp and dp-rerun acting while planning (SPEC §10) do not value exogenous chains or expiry "
                      "(SPEC §9) yet (the optimal allocator and the eager kinds take them)");
   }
-  if (mdp.has_backtracking()) {
-    throw UsageError(mdp.problem().name() +
-                     ": dp and dp-rerun acting while planning (SPEC §10) do not value backtracking (SPEC §7) yet: "
-                     "Eq. (1) acting while planning has no give-up term (the optimal allocator and the eager "
-                     "kinds take it)");
-  }
 }
 
 // value, fresh and after_found recurse one level per action of the skeleton (at most
 // Problem::kMaxSkeletonLength deep, whatever the deadline), each level memoised by fresh.
 // NOLINTNEXTLINE(misc-no-recursion)
 double ConcurrentContiguousSuccess::value(int k, int l, Steps spent, Steps time, std::int64_t backlog) {
+  if (mdp_->has_backtracking()) {
+    throw UsageError("Eq. (1) acting while planning with backtracking needs the restore values: value it from a state");
+  }
   if (time + backlog > deadline_) return 0.0;
   const Problem& problem = mdp_->problem();
   const Distribution& planning = problem.action(problem.action_at(k, l)).planning;
@@ -44,6 +41,7 @@ double ConcurrentContiguousSuccess::value(int k, int l, Steps spent, Steps time,
 }
 
 double ConcurrentContiguousSuccess::value(const ConcurrentState& state, int k) {
+  if (mdp_->has_backtracking()) return give_up_value(state, k);
   const Problem& problem = mdp_->problem();
   const std::int64_t free = mdp_->robot_free(state, k);
   const Steps now = ConcurrentMdp::time(state);
@@ -93,6 +91,148 @@ double ConcurrentContiguousSuccess::after_found(int k, int l, Steps time, std::i
     total += outcome.probability * combined;
   }
   return total;
+}
+
+std::uint32_t ConcurrentContiguousSuccess::append_restore(std::uint32_t list, std::uint32_t value) {
+  const std::uint64_t edge = (std::uint64_t{list} << 32U) | value;
+  const auto [child, added] = restore_child_.try_emplace(edge, static_cast<std::uint32_t>(restore_parent_.size()));
+  if (added) {
+    restore_parent_.push_back(list);
+    restore_value_.push_back(value);
+  }
+  return child->second;
+}
+
+std::uint32_t ConcurrentContiguousSuccess::restore_prefix(std::uint32_t list, int length, int position) const {
+  for (; length > position; --length) list = restore_parent_[list];
+  return list;
+}
+
+double ConcurrentContiguousSuccess::give_up_need(const GiveUpKey& key, bool& ready) {
+  if (key.time >= deadline_) return 0.0;  // no step left, and position l is not refined
+  if (const auto known = give_up_memo_.find(key); known != give_up_memo_.end()) return known->second;
+  pending_.push_back(key);
+  ready = false;
+  return 0.0;
+}
+
+double ConcurrentContiguousSuccess::give_up_attempt(const GiveUpKey& key, Steps spent, bool& ready) {
+  const Problem& problem = mdp_->problem();
+  const int k = key.skeleton;
+  const int l = key.position;
+  const int action_index = problem.action_at(k, l);
+  const Action& action = problem.action(action_index);
+  const bool blamed = problem.culprit_slot(action_index) >= 0;
+  const std::int64_t beyond = std::int64_t{deadline_} + 1;
+  const auto ending = [&](int m, std::int64_t finish) {
+    if (finish > deadline_) return 0.0;
+    return problem.has_rewards() ? problem.reward_at(m, static_cast<Steps>(finish)) : 1.0;
+  };
+  double total = 0.0;
+  for (std::int64_t t = 1; key.time + t <= deadline_; ++t) {
+    const auto now = static_cast<std::int32_t>(key.time + t);
+    const double found = action.planning.pmf(static_cast<Steps>(spent + t));
+    if (found > 0.0) {
+      // The robot starts the motion when it is free; the later positions see that start.
+      const std::int64_t start = std::max<std::int64_t>(key.free, now);
+      const std::uint32_t next_restores = append_restore(key.restores, blamed ? static_cast<std::uint32_t>(start) : 0U);
+      double continuation = 0.0;
+      for (const Mdp::ExecutionOutcome& outcome : mdp_->plan_first_mdp().execution_outcomes(action_index)) {
+        const std::int64_t finish = std::min(start + outcome.steps, beyond);
+        const auto worth = [&](int m) {
+          if (problem.skeleton_length(m) == l + 1) return ending(m, finish);
+          return give_up_need(GiveUpKey{m, l + 1, now, static_cast<std::int32_t>(finish), next_restores}, ready);
+        };
+        double combined = 0.0;
+        if (aggregation_ == Aggregation::self) {
+          combined = worth(k);
+        } else {
+          for (const int m : problem.members(action_index)) {
+            combined = aggregation_ == Aggregation::sum ? combined + worth(m) : std::max(combined, worth(m));
+          }
+        }
+        continuation += outcome.probability * combined;
+      }
+      total += found * continuation;
+    }
+    const double back = action.backtrack.pmf(static_cast<Steps>(spent + t));
+    if (back > 0.0) {
+      // A culprit already started (S < now) cannot be undone: the action is blocked, k dropped.
+      double continuation = 0.0;
+      for (const Problem::CulpritIndex& culprit : problem.culprits(action_index)) {
+        const int position = problem.position(culprit.action);
+        const std::uint32_t before = restore_prefix(key.restores, l, position);
+        // Not started by now: it was found before now, so it waits for the robot, free at its start.
+        const auto start = static_cast<std::int32_t>(restore_value_[restore_prefix(key.restores, l, position + 1)]);
+        if (start < now) continue;
+        continuation += culprit.probability * give_up_need(GiveUpKey{k, position, now, start, before}, ready);
+      }
+      total += back * continuation;
+    }
+  }
+  return total;
+}
+
+double ConcurrentContiguousSuccess::give_up_settled(const GiveUpKey& key, Steps spent) {
+  for (;;) {
+    bool ready = true;
+    const double total = give_up_attempt(key, spent, ready);
+    if (ready) return total;
+    while (!pending_.empty()) {
+      const GiveUpKey needed = pending_.back();
+      if (give_up_memo_.contains(needed)) {
+        pending_.pop_back();
+        continue;
+      }
+      bool settled = true;
+      const double value = give_up_attempt(needed, 0, settled);
+      // Not settled: what it needs is now above it on the stack, and it is summed again after.
+      if (settled) {
+        give_up_memo_.emplace(needed, value);
+        pending_.pop_back();
+      }
+    }
+  }
+}
+
+double ConcurrentContiguousSuccess::give_up_value(const ConcurrentState& state, int k) {
+  const Problem& problem = mdp_->problem();
+  const Steps now = ConcurrentMdp::time(state);
+  const int refined = ConcurrentMdp::refined(state, k);
+  const int depth = mdp_->executed_depth(state);
+  const std::int64_t beyond = std::int64_t{deadline_} + 1;
+  // The robot goes on eagerly from now: each refined action after E starts when the robot is free.
+  std::int64_t free = std::int64_t{now} + ConcurrentMdp::robot_left(state);
+  std::uint32_t restores = 0;
+  for (int position = 0; position < refined; ++position) {
+    const int action = problem.action_at(k, position);
+    if (position < depth) {  // executed or executing: blamed, it blocks (S = 0 < any later step)
+      restores = append_restore(restores, 0U);
+      continue;
+    }
+    const std::int64_t start = std::min(free, beyond);
+    restores = append_restore(restores, problem.culprit_slot(action) >= 0 ? (static_cast<std::uint32_t>(start) << 16U) |
+                                                                                static_cast<std::uint32_t>(start)
+                                                                          : 0U);
+    free = std::min(start + mdp_->execution(state, action), beyond);
+  }
+  if (refined == problem.skeleton_length(k)) {
+    if (free > deadline_) return 0.0;
+    return problem.has_rewards() ? problem.reward_at(k, static_cast<Steps>(free)) : 1.0;
+  }
+  const Action& action = problem.action(problem.action_at(k, refined));
+  const Steps spent = mdp_->spent(state, k);
+  double ended = 0.0;
+  for (Steps u = 1; u <= spent; ++u) ended += action.planning.pmf(u) + action.backtrack.pmf(u);
+  const double alive = 1.0 - ended;
+  if (alive <= 0.0 || now >= deadline_) return 0.0;
+  const GiveUpKey key{k, refined, static_cast<std::int32_t>(now), static_cast<std::int32_t>(free), restores};
+  if (spent == 0) {
+    bool ready = true;
+    const double known = give_up_need(key, ready);
+    if (ready) return known;
+  }
+  return give_up_settled(key, spent) / alive;
 }
 
 }  // namespace ontime

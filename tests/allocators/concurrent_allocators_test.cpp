@@ -254,11 +254,11 @@ TEST(ConcurrentAllocators, WithBacktrackingAnObservedStepIsTheModelsOutcome) {
   EXPECT_GT(executed_culprits, 0);
 }
 
-TEST(ConcurrentAllocators, WithBacktrackingDpAndDpRerunAreRefusedTheEagerKindsTakeIt) {
+TEST(ConcurrentAllocators, WithBacktrackingBranchAndBoundIsRefusedTheOthersTakeIt) {
   const ConcurrentMdp mdp(acting(testing::with_backtracking(testing::random_instance(2, 4, 3, 10), 4)));
   ASSERT_TRUE(mdp.has_backtracking());
   // branch-and-bound and mcts's bound leaves read bounds that assume no give-up.
-  for (const std::string name : {"dp", "dp-rerun", "branch-and-bound"}) {
+  for (const std::string name : {"branch-and-bound"}) {
     try {
       (void)make_concurrent_allocator_factory(name, mdp);
       FAIL() << name << " took backtracking";
@@ -268,7 +268,8 @@ TEST(ConcurrentAllocators, WithBacktrackingDpAndDpRerunAreRefusedTheEagerKindsTa
   }
   EXPECT_THROW((void)make_concurrent_allocator_factory("mcts", mdp, {{"backup", "bellman"}, {"leaf", "upper"}}),
                UsageError);
-  for (const std::string name : {"optimal", "greedy", "round-robin", "first-found", "thompson", "mcts"}) {
+  for (const std::string name :
+       {"optimal", "greedy", "round-robin", "first-found", "thompson", "mcts", "dp", "dp-rerun"}) {
     const auto allocator = make_concurrent_allocator_factory(name, mdp)();
     EXPECT_EQ(allocator->name(), name);
   }

@@ -19,9 +19,33 @@
 // T, w) reached; a query is one sum over at most D - T planning steps of such values, each a sum
 // over the execution support. No table is built up front, so a long deadline costs only what
 // its queries reach.
+//
+// With backtracking (SPEC §7, §10 "With backtracking") an attempt may also give up after t steps
+// (q_a) and blame a culprit c (w_a(c)) at position p. With the robot eager, refined action i
+// starts at S_i = max(F_i, found_i), F_i the step the robot is done with the actions before it;
+// a give-up observed at T' finds c executed iff S_p < T'. Then c's motion stays, the action that
+// gave up is blocked and the skeleton is dropped: 0. Else refinement goes back to c with the time
+// kept, and the robot is free at S_p (c was found before T' <= S_p, so S_p = F_p), as §7. In
+// absolute times, F the robot's free step before position l and B the starts S_i, i < l:
+//   V(k, l, spent, T, F, B) = (1 / S_a(spent)) sum_{t >= 1, T + t <= D}
+//       [ p_a(spent + t) G(T + t) + q_a(spent + t) sum_c w_a(c) [S_p >= T + t] V(k, p, 0, T + t, S_p, B below p) ]
+//   G(T') = sum_x e_a(x) R_k(max(F, T') + x) within D, for the last action; otherwise
+//   G(T') = sum_x e_a(x) AGG_{k' in N(k,l)} V(k', l + 1, 0, T', max(F, T') + x, B + max(F, T'))
+// with S_a(spent) = 1 - sum_{u <= spent} (p_a(u) + q_a(u)). With aggregation self it is the exact
+// value of the policy that refines k alone and starts each of its actions as soon as it is refined
+// and the robot is free (docs/theory.md), unless another skeleton is a prefix of k (the episode
+// would end through it). With every give-up probability zero it is the value above. These values
+// are memoised per (skeleton, position, T, F, starts), the lists of starts interned, and settled
+// with an explicit stack (a give-up sends a value back to an earlier position at a later time, so
+// recursion could go D deep). The first query of a state costs O(positions x D x (|supp e| |N| +
+// |culprits|)) per value it reaches; later ones a hash lookup or one sum over the attempt.
+
+#include <absl/container/flat_hash_map.h>
 
 #include <cstdint>
 #include <unordered_map>
+#include <utility>
+#include <vector>
 
 #include "ontime/mdp/concurrent_mdp.hpp"
 #include "ontime/solve/contiguous_success.hpp"
@@ -31,18 +55,21 @@ namespace ontime {
 class ConcurrentContiguousSuccess {
  public:
   // The values of `mdp`'s skeletons with Eq. (1)'s `aggregation`; memoised as they are asked for.
-  // Throws UsageError (check_supported) when the problem has backtracking, chains or expiry.
+  // Throws UsageError (check_supported) when the problem has chains or expiry.
   ConcurrentContiguousSuccess(const ConcurrentMdp& mdp, Aggregation aggregation);
 
-  // Eq. (1) here has no give-up term nor chains: UsageError naming the rule when `mdp` has
-  // backtracking (SPEC §7) or chains or expiry (SPEC §9), before any allocator built on these
-  // values is made.
+  // Eq. (1) here has no form for chains: UsageError naming the rule when `mdp` has chains or
+  // expiry (SPEC §9), before any allocator built on these values is made. Backtracking (SPEC §7)
+  // is taken (the give-up term above).
   static void check_supported(const ConcurrentMdp& mdp);
 
-  // PS(k, l, spent, time, backlog); 0 when the backlog alone passes the deadline.
+  // PS(k, l, spent, time, backlog); 0 when the backlog alone passes the deadline. Without
+  // backtracking only (with it a value needs the restore values: UsageError).
   double value(int k, int l, Steps spent, Steps time, std::int64_t backlog);
   // The same for live skeleton k in `state` (its backlog: ConcurrentMdp::robot_free(state, k) -
-  // CT); for a skeleton refined in full, its reward at the end of that backlog (0 past D).
+  // CT); for a skeleton refined in full, its reward at the end of that backlog (0 past D). With
+  // backtracking, V above from the state (the executed actions blamed: 0; each refined action not
+  // started keeps its robot-free time and its start, the robot going on eagerly from now).
   double value(const ConcurrentState& state, int k);
 
   // How the skeletons that share an action are combined.
@@ -52,10 +79,43 @@ class ConcurrentContiguousSuccess {
   double fresh(int k, int l, Steps time, std::int64_t backlog);
   double after_found(int k, int l, Steps time, std::int64_t backlog);
 
+  // With backtracking: a fresh attempt at position l of skeleton k at time T, the robot free at
+  // F (absolute, at least T, saturated at D + 1), and the interned list of the starts S_i of the
+  // positions i < l (saturated at D + 1; 0 for one executed or one no later action may blame).
+  struct GiveUpKey {
+    std::int32_t skeleton;
+    std::int32_t position;
+    std::int32_t time;
+    std::int32_t free;
+    std::uint32_t restores;
+    bool operator==(const GiveUpKey&) const = default;
+    template <typename H>
+    friend H AbslHashValue(H hash, const GiveUpKey& key) {
+      return H::combine(std::move(hash), key.skeleton, key.position, key.time, key.free, key.restores);
+    }
+  };
+  // V's sum over the attempt's steps for `key`, the attempt already `spent` steps old (not divided
+  // by its survival); values not known yet are pushed on pending_ and `ready` cleared.
+  double give_up_attempt(const GiveUpKey& key, Steps spent, bool& ready);
+  // A needed value: 0 at the deadline, memoised, or pending (0, `ready` cleared).
+  double give_up_need(const GiveUpKey& key, bool& ready);
+  // give_up_attempt made complete: settles what it needs first.
+  double give_up_settled(const GiveUpKey& key, Steps spent);
+  double give_up_value(const ConcurrentState& state, int k);
+  std::uint32_t append_restore(std::uint32_t list, std::uint32_t value);
+  // The list's entry at `position` and its prefix of that length (the list has `length` entries).
+  std::uint32_t restore_prefix(std::uint32_t list, int length, int position) const;
+
   const ConcurrentMdp* mdp_;
   Aggregation aggregation_;
   Steps deadline_;
   std::unordered_map<std::uint64_t, double> fresh_;  // (k, l, T, w) packed
+  absl::flat_hash_map<GiveUpKey, double> give_up_memo_;
+  std::vector<GiveUpKey> pending_;
+  // Interned restore lists: list 0 is empty, list i > 0 is restore_parent_[i] then restore_value_[i].
+  std::vector<std::uint32_t> restore_parent_{0};
+  std::vector<std::uint32_t> restore_value_{0};
+  absl::flat_hash_map<std::uint64_t, std::uint32_t> restore_child_;
 };
 
 }  // namespace ontime
