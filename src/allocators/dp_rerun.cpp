@@ -1,6 +1,5 @@
 #include "ontime/allocators/dp_rerun.hpp"
 
-#include <algorithm>
 #include <string>
 
 #include "ontime/allocators/allocator_registry.hpp"
@@ -125,43 +124,6 @@ AllocatorKind dp_rerun_kind() {
 ConcurrentDpRerunAllocator::ConcurrentDpRerunAllocator(const ConcurrentMdp& mdp, Aggregation aggregation)
     : mdp_(&mdp), values_(mdp, aggregation) {}
 
-double ConcurrentDpRerunAllocator::best_value(const ConcurrentState& state) {
-  // Eq. (1) with sum counts a success through every skeleton sharing an action: capped at the
-  // largest reward, no success probability (expected reward) is larger.
-  const double cap = mdp_->problem().max_reward();
-  double best = 0.0;
-  for (int k = 0; k < mdp_->skeleton_count(); ++k) {
-    if (ConcurrentMdp::is_live(state, k)) best = std::max(best, std::min(cap, values_.value(state, k)));
-  }
-  return best;
-}
-
-int ConcurrentDpRerunAllocator::look_ahead(const ConcurrentState& state, int best) {
-  const ChoiceList choices = mdp_->refine_choices(state);
-  if (choices.size() < 2) return best;
-  const Problem& problem = mdp_->problem();
-  const int best_action = problem.action_at(best, ConcurrentMdp::refined(state, best));
-  const auto step_value = [&](int choice) {
-    double total = 0.0;
-    mdp_->for_each_step_outcome(state, choice, [&](double probability, const ConcurrentState& next) {
-      total += probability * best_value(next);
-    });
-    return total;
-  };
-  // The best skeleton's group first, so that another group must do strictly better.
-  int chosen = best;
-  double chosen_value = step_value(best);
-  for (const int choice : choices) {
-    if (problem.action_at(choice, ConcurrentMdp::refined(state, choice)) == best_action) continue;
-    const double value = step_value(choice);
-    if (value > chosen_value + 1e-12) {
-      chosen_value = value;
-      chosen = choice;
-    }
-  }
-  return chosen;
-}
-
 ConcurrentMdp::Move ConcurrentDpRerunAllocator::choose(const ConcurrentState& state) {
   const Problem& problem = mdp_->problem();
   int best = -1;
@@ -179,7 +141,7 @@ ConcurrentMdp::Move ConcurrentDpRerunAllocator::choose(const ConcurrentState& st
   const int refined = ConcurrentMdp::refined(state, best);
   if (ConcurrentMdp::robot_left(state) == 0 && refined > depth)
     return {problem.action_at(best, depth), ConcurrentMdp::kWait};
-  if (refined < problem.skeleton_length(best)) return {-1, look_ahead(state, best)};
+  if (refined < problem.skeleton_length(best)) return {-1, best};
   return {};
 }
 

@@ -73,29 +73,25 @@ double sampled_value(const Problem& problem, std::uint64_t episodes, std::uint64
 }
 
 TEST(ConcurrentDpRerun, ComesCloseToTheOptimumOnThePaperInstancesAndNavigation) {
-  for (const std::string name : {"instance1", "instance2", "instance3", "instance4", "instance5"}) {
+  // Instance 2 is dp-rerun's own shortfall: 0.69 against 0.72, plan-first as here (Table I).
+  for (const std::string name : {"instance1", "instance3", "instance4", "instance5"}) {
     const Figures got = figures(testing::paper_instance(name));
     EXPECT_LE(got.policy, got.optimum + 1e-12) << name;
     EXPECT_GE(got.policy, 0.98 * got.optimum) << name;
   }
+  const Figures second = figures(testing::paper_instance("instance2"));
+  EXPECT_NEAR(second.policy, 0.69, 1e-12);
+  EXPECT_NEAR(second.optimum, 0.72, 1e-12);
   const Figures navigation = figures(testing::navigation_with_deadline(14));
   EXPECT_LE(navigation.policy, navigation.optimum + 1e-12);
   EXPECT_GE(navigation.policy, 0.98 * navigation.optimum);
-}
-
-TEST(ConcurrentDpRerun, ItsLookAheadTriesTheQuickSkeletonFirstOnInstanceTwo) {
-  // Instance 2 (deadline 9, executions 1, 3, 5 steps w.p. 1/4, 1/2, 1/4): Eq. (1) prefers a1_1
-  // (0.65 against a2_1's 0.6), but one step on a2_1 finds it w.p. 0.3 (then any execution fits),
-  // and a1_1 from step 1 is still worth 0.1 + 0.2 + 0.4 * 0.75 = 0.6: 0.3 + 0.7 * 0.6 = 0.72, the
-  // optimum; one step on a1_1 is worth 0.1 + 0.9 * 0.6 = 0.64 (a2_1 then best, at 0.6). Eq. (1)'s
-  // own choice earns 0.69.
-  const Problem problem = testing::paper_instance("instance2");
-  const ConcurrentMdp mdp(problem);
-  ConcurrentDpRerunAllocator policy(mdp);
-  EXPECT_EQ(policy.choose(mdp.start()), (ConcurrentMdp::Move{-1, 1}));
-  const Figures got = figures(problem);
-  EXPECT_NEAR(got.policy, 0.72, 1e-12);
-  EXPECT_NEAR(got.optimum, 0.72, 1e-12);
+  // At its own deadline (22 steps) the optimum is the search's (`ontime solve
+  // data/instances/navigation.json --act concurrent --method search`, 34 s; the memoised value to
+  // the bit, tests/solve/concurrent_search_test.cpp); dp-rerun's policy, 0.876381, is within 0.04%.
+  const Problem own_deadline = testing::navigation_with_deadline(22);
+  const double policy = policy_value(own_deadline);
+  EXPECT_LE(policy, 0.8766933308900257 + 1e-12);
+  EXPECT_GE(policy, 0.98 * 0.8766933308900257);
 }
 
 // Whether another skeleton is a prefix of skeleton k, or k spelled again with a lower index: the

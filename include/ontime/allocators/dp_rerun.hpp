@@ -83,13 +83,6 @@ class ConcurrentDpRerunAllocator final : public ConcurrentAllocator {
   ConcurrentMdp::Move choose(const ConcurrentState& state) override;
 
  private:
-  // The largest Eq. (1) value of a live skeleton in `state`, each capped at the problem's largest
-  // reward (0 when none is live).
-  double best_value(const ConcurrentState& state);
-  // The step choice whose expected best_value after the step is largest; `best`'s group unless
-  // another is strictly better.
-  int look_ahead(const ConcurrentState& state, int best);
-
   const ConcurrentMdp* mdp_;
   ConcurrentContiguousSuccess values_;
 };
