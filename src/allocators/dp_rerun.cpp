@@ -111,8 +111,7 @@ AllocatorKind dp_rerun_kind() {
       },
       .commit_rule =
           "eager along the best skeleton by Eq. (1) acting while planning (its refined actions run "
-          "back to back while the rest is planned; give-ups blaming a started motion block); the step "
-          "by one step of look-ahead over that Eq. (1)",
+          "back to back while the rest is planned; give-ups blaming a started motion block)",
       .make_concurrent = [](const ConcurrentMdp& mdp, const ParameterReader& parameters) -> ConcurrentAllocatorFactory {
         const Aggregation aggregation = parse_aggregation(parameters.text("aggregation"));
         ConcurrentContiguousSuccess::check_supported(mdp);

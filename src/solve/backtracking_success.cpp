@@ -14,25 +14,6 @@ BacktrackingSuccess::BacktrackingSuccess(const Mdp& mdp, Aggregation aggregation
   }
 }
 
-std::uint32_t BacktrackingSuccess::append_restore(std::uint32_t parent, std::uint16_t value) {
-  const std::uint64_t edge = (std::uint64_t{parent} << 16) | value;
-  const auto [child, added] = restore_child_.try_emplace(edge, static_cast<std::uint32_t>(restore_parent_.size()));
-  if (added) {
-    restore_parent_.push_back(parent);
-    restore_value_.push_back(value);
-  }
-  return child->second;
-}
-
-std::uint32_t BacktrackingSuccess::restore_prefix(std::uint32_t list, int length, int position) const {
-  for (; length > position; --length) list = restore_parent_[list];
-  return list;
-}
-
-std::uint16_t BacktrackingSuccess::restore_at(std::uint32_t list, int length, int position) const {
-  return restore_value_[restore_prefix(list, length, position + 1)];
-}
-
 double BacktrackingSuccess::need(const Key& key, bool& ready) {
   if (key.time >= deadline_ || key.execution > deadline_) return 0.0;
   if (const auto known = memo_.find(key); known != memo_.end()) return known->second;
@@ -53,10 +34,10 @@ double BacktrackingSuccess::attempt(const Key& key, Steps spent, bool& ready) {
   // may blame it.
   const std::uint32_t next_restores =
       last ? 0
-           : append_restore(key.restores, problem.culprit_slot(action_index) >= 0
-                                              ? static_cast<std::uint16_t>(
-                                                    std::min<std::int64_t>(key.execution, std::int64_t{deadline_} + 1))
-                                              : std::uint16_t{0});
+           : restores_.append(key.restores, problem.culprit_slot(action_index) >= 0
+                                                ? static_cast<std::uint16_t>(std::min<std::int64_t>(
+                                                      key.execution, std::int64_t{deadline_} + 1))
+                                                : std::uint16_t{0});
   double total = 0;
   for (std::int64_t t = 1; key.time + t <= deadline_; ++t) {
     const auto ct = static_cast<std::int32_t>(key.time + t);
@@ -108,8 +89,8 @@ double BacktrackingSuccess::attempt(const Key& key, Steps spent, bool& ready) {
       double continuation = 0;
       for (const Problem::CulpritIndex& culprit : problem.culprits(action_index)) {
         const int position = problem.position(culprit.action);
-        continuation += culprit.probability * need(Key{k, position, ct, restore_at(key.restores, l, position),
-                                                       restore_prefix(key.restores, l, position)},
+        continuation += culprit.probability * need(Key{k, position, ct, restores_.at(key.restores, l, position),
+                                                       restores_.prefix(key.restores, l, position)},
                                                    ready);
       }
       total += back * continuation;
@@ -151,7 +132,7 @@ double BacktrackingSuccess::success_probability(const State& state, int k) {
   std::uint32_t restores = 0;
   for (int position = 0; position < l; ++position) {
     const int culprit_slot = problem.culprit_slot(problem.action_at(k, position));
-    restores = append_restore(
+    restores = restores_.append(
         restores, culprit_slot >= 0 ? state.restore[static_cast<std::size_t>(culprit_slot)] : std::uint16_t{0});
   }
   const Key key{k, l, static_cast<std::int32_t>(state.time), static_cast<std::int32_t>(state.execution[slot]),

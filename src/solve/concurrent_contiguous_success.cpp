@@ -93,21 +93,6 @@ double ConcurrentContiguousSuccess::after_found(int k, int l, Steps time, std::i
   return total;
 }
 
-std::uint32_t ConcurrentContiguousSuccess::append_restore(std::uint32_t list, std::uint32_t value) {
-  const std::uint64_t edge = (std::uint64_t{list} << 32U) | value;
-  const auto [child, added] = restore_child_.try_emplace(edge, static_cast<std::uint32_t>(restore_parent_.size()));
-  if (added) {
-    restore_parent_.push_back(list);
-    restore_value_.push_back(value);
-  }
-  return child->second;
-}
-
-std::uint32_t ConcurrentContiguousSuccess::restore_prefix(std::uint32_t list, int length, int position) const {
-  for (; length > position; --length) list = restore_parent_[list];
-  return list;
-}
-
 double ConcurrentContiguousSuccess::give_up_need(const GiveUpKey& key, bool& ready) {
   if (key.time >= deadline_) return 0.0;  // no step left, and position l is not refined
   if (const auto known = give_up_memo_.find(key); known != give_up_memo_.end()) return known->second;
@@ -135,7 +120,8 @@ double ConcurrentContiguousSuccess::give_up_attempt(const GiveUpKey& key, Steps 
     if (found > 0.0) {
       // The robot starts the motion when it is free; the later positions see that start.
       const std::int64_t start = std::max<std::int64_t>(key.free, now);
-      const std::uint32_t next_restores = append_restore(key.restores, blamed ? static_cast<std::uint32_t>(start) : 0U);
+      const std::uint32_t next_restores =
+          restores_.append(key.restores, blamed ? static_cast<std::uint32_t>(start) : 0U);
       double continuation = 0.0;
       for (const Mdp::ExecutionOutcome& outcome : mdp_->plan_first_mdp().execution_outcomes(action_index)) {
         const std::int64_t finish = std::min(start + outcome.steps, beyond);
@@ -161,9 +147,9 @@ double ConcurrentContiguousSuccess::give_up_attempt(const GiveUpKey& key, Steps 
       double continuation = 0.0;
       for (const Problem::CulpritIndex& culprit : problem.culprits(action_index)) {
         const int position = problem.position(culprit.action);
-        const std::uint32_t before = restore_prefix(key.restores, l, position);
+        const std::uint32_t before = restores_.prefix(key.restores, l, position);
         // Not started by now: it was found before now, so it waits for the robot, free at its start.
-        const auto start = static_cast<std::int32_t>(restore_value_[restore_prefix(key.restores, l, position + 1)]);
+        const auto start = static_cast<std::int32_t>(restores_.at(key.restores, l, position));
         if (start < now) continue;
         continuation += culprit.probability * give_up_need(GiveUpKey{k, position, now, start, before}, ready);
       }
@@ -207,13 +193,14 @@ double ConcurrentContiguousSuccess::give_up_value(const ConcurrentState& state, 
   for (int position = 0; position < refined; ++position) {
     const int action = problem.action_at(k, position);
     if (position < depth) {  // executed or executing: blamed, it blocks (S = 0 < any later step)
-      restores = append_restore(restores, 0U);
+      restores = restores_.append(restores, 0U);
       continue;
     }
     const std::int64_t start = std::min(free, beyond);
-    restores = append_restore(restores, problem.culprit_slot(action) >= 0 ? (static_cast<std::uint32_t>(start) << 16U) |
-                                                                                static_cast<std::uint32_t>(start)
-                                                                          : 0U);
+    restores =
+        restores_.append(restores, problem.culprit_slot(action) >= 0
+                                       ? (static_cast<std::uint32_t>(start) << 16U) | static_cast<std::uint32_t>(start)
+                                       : 0U);
     free = std::min(start + mdp_->execution(state, action), beyond);
   }
   if (refined == problem.skeleton_length(k)) {

@@ -16,6 +16,7 @@
 #include "ontime/run/simulator.hpp"
 #include "ontime/solve/concurrent_solver.hpp"
 #include "ontime/util/error.hpp"
+#include "support/chain_reference.hpp"
 #include "support/paper.hpp"
 #include "support/random_instances.hpp"
 
@@ -270,13 +271,7 @@ TEST(ConcurrentEpisodesWithChains, TheRobotWaitsForTheDoorInItsEpisodes) {
   // go then through, each found in 1 step and run in 1; through cannot start while the door is
   // locked, locked at 0 and opening with probability 1/2 per step for good; deadline 6. The
   // optimum waits at the door and starts through at the first open step up to 5: 1 - 1/32.
-  const Problem problem = parse_problem(R"({"deadline": 6, "acting": "concurrent",
-    "chains": {"door": {"states": ["open", "locked"], "start": "locked", "transitions": [[1, 0], [0.5, 0.5]]}},
-    "actions": {"go": {"planning": {"pmf": {"1": 1}}, "execution": {"pmf": {"1": 1}}},
-                "through": {"planning": {"pmf": {"1": 1}}, "execution": {"pmf": {"1": 1}},
-                            "expires": {"chain": "door", "states": ["locked"]}}},
-    "skeletons": [["go", "through"]]})",
-                                        "door");
+  const Problem problem = testing::door_opening_at_random().with_acting(Acting::concurrent);
   const ConcurrentMdp mdp(problem);
   const auto episodes = static_cast<std::uint64_t>(testing::repetitions_to_check(20'000));
   for (const std::string name : {"optimal", "greedy"}) {

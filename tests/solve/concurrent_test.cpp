@@ -250,13 +250,7 @@ TEST(Concurrent, WithChainsTheRobotWaitsForTheDoor) {
   // open. Plan-first executes the plan as soon as it is refined (step 2): through starts at 3,
   // open with probability 1 - 1/8. Acting while planning the robot waits at the door: through
   // starts at the first open step up to 5 (finishing by 6), 1 - 1/32.
-  const Problem problem = parse_problem(R"({"deadline": 6,
-    "chains": {"door": {"states": ["open", "locked"], "start": "locked", "transitions": [[1, 0], [0.5, 0.5]]}},
-    "actions": {"go": {"planning": {"pmf": {"1": 1}}, "execution": {"pmf": {"1": 1}}},
-                "through": {"planning": {"pmf": {"1": 1}}, "execution": {"pmf": {"1": 1}},
-                            "expires": {"chain": "door", "states": ["locked"]}}},
-    "skeletons": [["go", "through"]]})",
-                                        "door");
+  const Problem problem = testing::door_opening_at_random();
   EXPECT_NEAR(plan_first_optimum(problem), 0.875, 1e-15);
   EXPECT_NEAR(concurrent_optimum(problem), 1.0 - 1.0 / 32, 1e-15);
   EXPECT_NEAR(testing::ConcurrentReference(problem).optimum(), 1.0 - 1.0 / 32, 1e-15);

@@ -30,6 +30,20 @@ inline Problem queue_wait_instance(const std::string& expires) {
                        "wait.json");
 }
 
+// go then through, each found in 1 step and run in 1; through cannot start while the door is
+// locked, locked at 0 and opening with probability 1/2 per step for good; deadline 6. Plan-first
+// is worth 1 - 1/8 (through starts at 3), acting while planning 1 - 1/32 (the robot waits at the
+// door and starts through at the first open step up to 5).
+inline Problem door_opening_at_random() {
+  return parse_problem(R"({"deadline": 6,
+    "chains": {"door": {"states": ["open", "locked"], "start": "locked", "transitions": [[1, 0], [0.5, 0.5]]}},
+    "actions": {"go": {"planning": {"pmf": {"1": 1}}, "execution": {"pmf": {"1": 1}}},
+                "through": {"planning": {"pmf": {"1": 1}}, "execution": {"pmf": {"1": 1}},
+                            "expires": {"chain": "door", "states": ["locked"]}}},
+    "skeletons": [["go", "through"]]})",
+                       "door");
+}
+
 // A door open at even steps only, and a plan through it found in one step: entering as soon as the
 // motion is found (step 1) fails; a step spent elsewhere first (on a plan that cannot succeed)
 // waits for the door and succeeds.

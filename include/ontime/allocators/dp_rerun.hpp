@@ -66,14 +66,11 @@ class DpRerunAllocator final : public Allocator {
 // (ConcurrentContiguousSuccess: the robot runs the skeleton's refined actions back to back while the
 // rest is planned) and follows the best (ties: lowest index): while the robot is idle and the
 // best skeleton's next action to execute is refined, it starts it (committing to the skeletons
-// through it); otherwise it spends the step by one step of look-ahead: the group of live skeletons
-// sharing a next action whose step maximises the expected best Eq. (1) value (each capped at the
-// largest reward) after it, the best skeleton's group unless another is strictly better; it waits
-// when the best skeleton is refined in full. With backtracking (SPEC §7) Eq. (1) has its give-up
-// term. Stationary: ConcurrentSolver's policy mode values it exactly.
+// through it); otherwise it spends the step on the best skeleton's next action, or waits when that
+// skeleton is refined in full. With backtracking (SPEC §7) Eq. (1) has its give-up term.
+// Stationary: ConcurrentSolver's policy mode values it exactly.
 // Cost: per move, one Eq. (1) query per live skeleton: a sum over at most D - CT planning steps of
-// memoised values (memoised per allocator, so each thread's allocator has its own memo), and with
-// two groups or more K more per outcome of each group's step (0.7 µs per move on paper instance 1).
+// memoised values (memoised per allocator, so each thread's allocator has its own memo).
 class ConcurrentDpRerunAllocator final : public ConcurrentAllocator {
  public:
   // The allocator for `mdp`, Eq. (1) combining sharing skeletons by `aggregation` (sum: Table I's).

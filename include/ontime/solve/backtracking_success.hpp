@@ -34,6 +34,7 @@
 
 #include "ontime/mdp/mdp.hpp"
 #include "ontime/solve/contiguous_success.hpp"
+#include "ontime/solve/interned_lists.hpp"
 
 namespace ontime {
 
@@ -75,22 +76,12 @@ class BacktrackingSuccess {
   // Settles pending_ until it is empty.
   void settle();
 
-  // The list `parent` with `value` appended, and the value at `position` of a list of length
-  // `length` and its prefix of that length.
-  std::uint32_t append_restore(std::uint32_t parent, std::uint16_t value);
-  std::uint16_t restore_at(std::uint32_t list, int length, int position) const;
-  std::uint32_t restore_prefix(std::uint32_t list, int length, int position) const;
-
   const Mdp* mdp_;
   Aggregation aggregation_;
   Steps deadline_;
   absl::flat_hash_map<Key, double> memo_;
   std::vector<Key> pending_;
-  // Interned restore lists: list 0 is empty, list i > 0 is list restore_parent_[i] followed by
-  // restore_value_[i]; restore_child_ finds a list from (parent << 16 | value).
-  std::vector<std::uint32_t> restore_parent_{0};
-  std::vector<std::uint16_t> restore_value_{0};
-  absl::flat_hash_map<std::uint64_t, std::uint32_t> restore_child_;
+  InternedLists<std::uint16_t> restores_;  // the restore lists of the keys
 };
 
 }  // namespace ontime

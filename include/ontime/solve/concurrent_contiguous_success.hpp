@@ -49,6 +49,7 @@
 
 #include "ontime/mdp/concurrent_mdp.hpp"
 #include "ontime/solve/contiguous_success.hpp"
+#include "ontime/solve/interned_lists.hpp"
 
 namespace ontime {
 
@@ -102,9 +103,6 @@ class ConcurrentContiguousSuccess {
   // give_up_attempt made complete: settles what it needs first.
   double give_up_settled(const GiveUpKey& key, Steps spent);
   double give_up_value(const ConcurrentState& state, int k);
-  std::uint32_t append_restore(std::uint32_t list, std::uint32_t value);
-  // The list's entry at `position` and its prefix of that length (the list has `length` entries).
-  std::uint32_t restore_prefix(std::uint32_t list, int length, int position) const;
 
   const ConcurrentMdp* mdp_;
   Aggregation aggregation_;
@@ -112,10 +110,7 @@ class ConcurrentContiguousSuccess {
   std::unordered_map<std::uint64_t, double> fresh_;  // (k, l, T, w) packed
   absl::flat_hash_map<GiveUpKey, double> give_up_memo_;
   std::vector<GiveUpKey> pending_;
-  // Interned restore lists: list 0 is empty, list i > 0 is restore_parent_[i] then restore_value_[i].
-  std::vector<std::uint32_t> restore_parent_{0};
-  std::vector<std::uint32_t> restore_value_{0};
-  absl::flat_hash_map<std::uint64_t, std::uint32_t> restore_child_;
+  InternedLists<std::uint32_t> restores_;  // the lists of starts of the give-up keys
 };
 
 }  // namespace ontime
