@@ -37,12 +37,6 @@ void check_tamp_request(const Domain& domain, const Problem& library, const Tamp
                                  *options.picture_episode, options.episodes - 1));
   }
   if (options.acting == Acting::concurrent) {
-    if (options.adaptation) {
-      throw UsageError(
-          fmt::format("{} with {} concurrent: learning across episodes acting while planning (SPEC §10) "
-                      "is not there yet",
-                      spell_parameter(spelling, "adapt-strength"), spell_parameter(spelling, "act")));
-    }
     if (!allocator_registry().find(options.solver).acts_while_planning()) {
       throw UsageError(
           fmt::format("allocator '{}' does not act while planning (SPEC §10) yet: it has no commit rule; "

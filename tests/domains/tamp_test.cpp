@@ -262,12 +262,16 @@ TEST(RunTamp, TheModelledClockGivesTheSameEpisodesForAnyThreadCount) {
   EXPECT_THROW(run_tamp(f.domain, f.library, options), UsageError);
 }
 
-// Learning across episodes (the online update): sequences give the same episodes for any thread
-// count, each sequence's first episode is the plain run's episode of the same index (it plans with
-// the library itself), and the successes by episode add up to the run's.
-TEST(RunTamp, SequencesThatLearnAcrossEpisodesStartFromTheLibraryAndReproduce) {
+// Learning across episodes (the online update), planning first and acting while planning (SPEC
+// §10): sequences give the same episodes for any thread count, each sequence's first episode is the
+// plain run's episode of the same index (it plans with the library itself), and the successes by
+// episode add up to the run's.
+class RunTampLearning : public ::testing::TestWithParam<Acting> {};
+
+TEST_P(RunTampLearning, SequencesThatLearnAcrossEpisodesStartFromTheLibraryAndReproduce) {
   const Fixture& f = fixture();
   TampOptions options = modelled_tamp(6, 5);
+  options.acting = GetParam();
   const TampResult plain = run_tamp(f.domain, f.library, options);
 
   options.episodes = 3;
@@ -305,6 +309,12 @@ TEST(RunTamp, SequencesThatLearnAcrossEpisodesStartFromTheLibraryAndReproduce) {
   options.picture_episode = 0;
   EXPECT_THROW(run_tamp(f.domain, f.library, options), UsageError);
 }
+
+INSTANTIATE_TEST_SUITE_P(BothActingModes, RunTampLearning, ::testing::Values(Acting::plan_first, Acting::concurrent),
+                         [](const ::testing::TestParamInfo<Acting>& mode) {
+                           return mode.param == Acting::concurrent ? std::string("Concurrent")
+                                                                   : std::string("PlanFirst");
+                         });
 
 // The kitchen whose cubby takes one pair of grasps (a refinement there gives up and blames the grasp,
 // SPEC §7), with data/instances/kitchen-grasps.json as the library and a prior of strength 10:
