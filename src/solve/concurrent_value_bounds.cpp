@@ -8,7 +8,9 @@
 namespace ontime {
 
 ConcurrentValueBounds::ConcurrentValueBounds(const ConcurrentMdp& mdp)
-    : mdp_(&mdp), devoted_((refuse_backtracking(mdp), mdp), Aggregation::self) {}  // refused first
+    : mdp_(&mdp), devoted_((refuse_backtracking(mdp), mdp), Aggregation::self) {  // refused first
+  if (!mdp.is_timed()) clairvoyant_.emplace(mdp);
+}
 
 void ConcurrentValueBounds::refuse_backtracking(const ConcurrentMdp& mdp) {
   if (!mdp.has_backtracking()) return;
@@ -66,6 +68,7 @@ ConcurrentValueBounds::Interval ConcurrentValueBounds::bounds(const ConcurrentSt
     for (const auto& group : groups_) none *= 1.0 - std::min(1.0, group.second);
     upper = std::min(upper, 1.0 - none);
   }
+  if (clairvoyant_) upper = std::min(upper, cap * clairvoyant_->union_probability(state));
   // Rounding aside, upper >= V* >= lower; the max keeps the interval ordered when it rounds.
   return {best, std::max(best, upper)};
 }

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <string>
@@ -13,6 +14,8 @@
 #include <vector>
 
 #include "ontime/mdp/concurrent_mdp.hpp"
+#include "ontime/model/instance_io.hpp"
+#include "ontime/solve/concurrent_clairvoyant_bound.hpp"
 #include "ontime/solve/concurrent_contiguous_success.hpp"
 #include "ontime/solve/concurrent_solver.hpp"
 #include "ontime/solve/concurrent_value_bounds.hpp"
@@ -268,6 +271,128 @@ TEST(ConcurrentSearchSolve, RefusesWhatItsBoundsDoNotTake) {
   EXPECT_THROW(solve_concurrent(backtracking, search_options()), UsageError);
   const ConcurrentMdp chains(testing::with_random_chains(testing::random_instance(5, 4, 3, 10), 5, false));
   EXPECT_THROW(solve_concurrent(chains, search_options()), UsageError);
+}
+
+// P(union of the devoted successes) by brute force: every joint draw of the actions' planning
+// times (effort until found) and execution times, each skeleton's devoted timeline (its actions
+// found one after another, each run as soon as it is found and the robot is free), the draws in
+// which some skeleton finishes by the deadline. Written from the definition, not from the tree.
+double union_by_enumeration(const Problem& problem) {
+  const Steps deadline = problem.deadline();
+  struct Draw {
+    Steps found;  // kNever: never
+    Steps runs;   // kNever: too slow or never
+    double probability;
+  };
+  std::vector<std::vector<Draw>> draws(static_cast<std::size_t>(problem.action_count()));
+  for (int a = 0; a < problem.action_count(); ++a) {
+    const Action& action = problem.action(a);
+    double found_mass = 0.0;
+    for (Steps t = 1; t <= deadline; ++t) {
+      found_mass += action.planning.pmf(t);
+      double run_mass = 0.0;
+      for (Steps x = 0; x <= deadline; ++x) {
+        run_mass += action.execution.pmf(x);
+        if (action.planning.pmf(t) * action.execution.pmf(x) > 0)
+          draws[static_cast<std::size_t>(a)].push_back({t, x, action.planning.pmf(t) * action.execution.pmf(x)});
+      }
+      if (1.0 - run_mass > 1e-15)
+        draws[static_cast<std::size_t>(a)].push_back({t, kNever, action.planning.pmf(t) * (1.0 - run_mass)});
+    }
+    if (1.0 - found_mass > 1e-15) draws[static_cast<std::size_t>(a)].push_back({kNever, kNever, 1.0 - found_mass});
+  }
+  std::vector<std::size_t> pick(draws.size(), 0);
+  double total = 0.0;
+  for (;;) {
+    double probability = 1.0;
+    for (std::size_t a = 0; a < draws.size(); ++a) probability *= draws[a][pick[a]].probability;
+    bool any = false;
+    for (int k = 0; k < problem.skeleton_count() && !any; ++k) {
+      std::int64_t found = 0, free = 0;
+      bool fits = true;
+      for (int j = 0; j < problem.skeleton_length(k) && fits; ++j) {
+        const Draw& draw = draws[static_cast<std::size_t>(problem.action_at(k, j))]
+                                [pick[static_cast<std::size_t>(problem.action_at(k, j))]];
+        if (draw.found == kNever || draw.runs == kNever) {
+          fits = false;
+          break;
+        }
+        found += draw.found;
+        free = std::max(free, found) + draw.runs;
+        fits = found <= deadline && free <= deadline;
+      }
+      any = fits;
+    }
+    if (any) total += probability;
+    std::size_t a = 0;
+    while (a < pick.size() && ++pick[a] == draws[a].size()) pick[a++] = 0;
+    if (a == pick.size()) break;
+  }
+  return total;
+}
+
+// The clairvoyant bound is the chance of the union of the devoted successes: the brute force's at
+// the start of small random instances, the devoted value itself where one skeleton is live, never
+// below the optimum, never above the union bound.
+TEST(ConcurrentClairvoyantBound, IsTheChanceThatSomeDevotedPolicySucceeds) {
+  const int count = testing::repetitions_to_check(200);
+  int shared = 0, alone = 0, states = 0;
+  for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
+    const Problem small = testing::random_instance(seed + 9000, 3, 2, 7);
+    if (small.action_count() <= 4) {
+      const ConcurrentMdp mdp(small);
+      ConcurrentClairvoyantBound bound(mdp);
+      EXPECT_NEAR(bound.union_probability(mdp.start()), union_by_enumeration(small), 1e-12) << "seed " << seed;
+      for (int a = 0; a < small.action_count(); ++a) shared += small.members(a).size() > 1 ? 1 : 0;
+    }
+    const Problem problem = testing::random_instance(seed, 4, 4, 12);
+    const ConcurrentMdp mdp(problem);
+    ConcurrentSolver solver(mdp);
+    ConcurrentClairvoyantBound bound(mdp);
+    ConcurrentContiguousSuccess devoted(mdp, Aggregation::self);
+    for (const ConcurrentState& state : random_states(mdp, seed + 300, 3)) {
+      const double union_chance = bound.union_probability(state);
+      EXPECT_GE(union_chance, solver.solve(state) - kSearchRounding) << "seed " << seed;
+      double sum = 0.0;
+      int live = 0, only = -1;
+      for (int k = 0; k < problem.skeleton_count(); ++k) {
+        if (!ConcurrentMdp::is_live(state, k)) continue;
+        sum += devoted.value(state, k);
+        ++live;
+        only = k;
+      }
+      EXPECT_LE(union_chance, sum + kSearchRounding) << "seed " << seed;
+      if (live == 1) {
+        EXPECT_NEAR(union_chance, devoted.value(state, only), kSearchRounding) << "seed " << seed;
+        ++alone;
+      }
+      ++states;
+    }
+  }
+  // The brute force met shared actions (so the tree's conditioning was checked), and the single
+  // skeleton case came up often.
+  EXPECT_GT(shared, count / 10);
+  EXPECT_GT(alone, count / 2);
+  EXPECT_GT(states, 3 * count);
+}
+
+// Two skeletons sharing a first action: the union bound counts their common success twice, the
+// tree once. a (found in 1 step w.p. 1/2 per step, run in 1) then b or c (each found in 1 step
+// w.p. 1/2 only, run in 1), deadline 3: a at step 1 (1/2) leaves one step for b or c: 1 - 1/4;
+// a at step 2 leaves none. The chance is 1/2 * 3/4 = 3/8; each devoted value is 1/4, summing to 1/2.
+TEST(ConcurrentClairvoyantBound, CountsASharedPrefixOnce) {
+  const Problem problem = parse_problem(R"({"deadline": 3,
+    "actions": {"a": {"planning": {"pmf": {"1": 0.5, "2": 0.5}}, "execution": {"pmf": {"1": 1}}},
+                "b": {"planning": {"pmf": {"1": 0.5}}, "execution": {"pmf": {"1": 1}}},
+                "c": {"planning": {"pmf": {"1": 0.5}}, "execution": {"pmf": {"1": 1}}}},
+    "skeletons": [["a", "b"], ["a", "c"]]})",
+                                        "shared");
+  const ConcurrentMdp mdp(problem);
+  ConcurrentClairvoyantBound bound(mdp);
+  EXPECT_NEAR(bound.union_probability(mdp.start()), 3.0 / 8, 1e-15);
+  ConcurrentContiguousSuccess devoted(mdp, Aggregation::self);
+  EXPECT_NEAR(devoted.value(mdp.start(), 0) + devoted.value(mdp.start(), 1), 0.5, 1e-15);
+  EXPECT_NEAR(union_by_enumeration(problem), 3.0 / 8, 1e-15);
 }
 
 }  // namespace

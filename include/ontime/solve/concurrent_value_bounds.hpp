@@ -18,6 +18,8 @@
 //   rise with the finish); the union of these events over k bounds V*. Without rewards, also
 //   1 - prod over groups g of (1 - min(1, sum over k in g of P_k)), the skeletons grouped by their
 //   next unrefined action: groups share no unrefined action, so their events are independent.
+//   Tighter still, without chains or expiry, R_cap times the chance of the union of those events
+//   itself, computed exactly over the skeletons' tree (ConcurrentClairvoyantBound).
 // docs/theory.md, "Acting while planning", has the proofs. A state where no skeleton can finish
 // is worth 0; without rewards one with a live skeleton refined in full is worth 1 (both exact).
 //
@@ -25,10 +27,12 @@
 // ConcurrentContiguousSuccess (each a sum over at most D - CT planning steps of memoised values);
 // memory: that memo. Not thread-safe (the memo): one object per thread.
 
+#include <optional>
 #include <utility>
 #include <vector>
 
 #include "ontime/mdp/concurrent_mdp.hpp"
+#include "ontime/solve/concurrent_clairvoyant_bound.hpp"
 #include "ontime/solve/concurrent_contiguous_success.hpp"
 
 namespace ontime {
@@ -58,7 +62,8 @@ class ConcurrentValueBounds {
 
   const ConcurrentMdp* mdp_;
   ConcurrentContiguousSuccess devoted_;
-  std::vector<std::pair<int, double>> groups_;  // scratch: next unrefined action, summed devoted values
+  std::optional<ConcurrentClairvoyantBound> clairvoyant_;  // without chains or expiry
+  std::vector<std::pair<int, double>> groups_;             // scratch: next unrefined action, summed devoted values
 };
 
 }  // namespace ontime
