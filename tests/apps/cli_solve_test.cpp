@@ -167,8 +167,8 @@ TEST(Cli, SolveActsWhilePlanningWithBacktracking) {
       {{"solve", cup, "--act", "concurrent", "--method", "search"}, "do not value backtracking (SPEC §7)"},
   };
   // Chains alone are no longer refused by the searches: mcts with rollouts takes the cup too.
-  const auto mcts = ontime({"evaluate", cup, "--act", "concurrent", "--solver", "mcts", "--iterations", "100",
-                            "--episodes", "10"});
+  const auto mcts =
+      ontime({"evaluate", cup, "--act", "concurrent", "--solver", "mcts", "--iterations", "100", "--episodes", "10"});
   EXPECT_EQ(mcts.exit_code, 0) << mcts.err;
   for (const std::string solver : {"dp", "dp-rerun"}) {
     const auto result = ontime({"evaluate", kitchen, "--act", "concurrent", "--solver", solver, "--exact", "--json"});
