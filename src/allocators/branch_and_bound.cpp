@@ -224,7 +224,6 @@ AllocatorKind branch_and_bound_kind() {
           "the search's: starts an action when starting has the best certified lower end (the "
           "optimum's where the search closes)",
       .make_concurrent = [](const ConcurrentMdp& mdp, const ParameterReader& parameters) -> ConcurrentAllocatorFactory {
-        refuse_chains(mdp, "branch-and-bound", "its search takes a start as one outcome");
         if (parameters.given("trials")) {
           throw UsageError(
               "parameter 'trials': acting while planning (SPEC §10) the search is all trials; it takes no share");

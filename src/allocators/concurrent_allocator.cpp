@@ -143,11 +143,4 @@ ConcurrentAllocatorFactory eager_commit_factory(const ConcurrentMdp& mdp, Alloca
       [&mdp, plan_first = std::move(plan_first)] { return std::make_unique<EagerCommitAllocator>(mdp, plan_first()); };
 }
 
-void refuse_chains(const ConcurrentMdp& mdp, std::string_view rule, std::string_view why) {
-  if (!mdp.is_timed()) return;
-  throw UsageError(mdp.problem().name() + ": " + std::string(rule) +
-                   " acting while planning (SPEC §10) does not take exogenous chains or expiry (SPEC §9) yet (" +
-                   std::string(why) + "): the optimal allocator and the eager commit rule take them");
-}
-
 }  // namespace ontime

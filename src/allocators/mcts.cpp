@@ -462,10 +462,12 @@ bool ConcurrentMctsAllocator::expand_outcomes(std::uint32_t edge, std::uint32_t 
   };
   std::vector<Outcome> found;
   if (move.is_start()) {
-    const ConcurrentMdp::StartOutcome start = mdp_->start_action(state, move.start);
-    Outcome outcome{.probability = 1.0, .ends = start.ends, .reward = start.reward};
-    if (!start.ends) ending(start.next, outcome);
-    found.push_back(outcome);
+    // One outcome, or one per execution time a chain draws when the action starts (SPEC §9).
+    mdp_->for_each_start_outcome(state, move.start, [&](double probability, const ConcurrentMdp::StartOutcome& start) {
+      Outcome outcome{.probability = probability, .ends = start.ends, .reward = start.reward};
+      if (!start.ends) ending(start.next, outcome);
+      found.push_back(outcome);
+    });
   } else {
     mdp_->for_each_step_outcome(state, move.refine, [&](double probability, const ConcurrentState& next) {
       Outcome outcome{.probability = probability};
@@ -482,9 +484,14 @@ bool ConcurrentMctsAllocator::expand_outcomes(std::uint32_t edge, std::uint32_t 
 
 ConcurrentState ConcurrentMctsAllocator::successor(const ConcurrentState& state, const ConcurrentMdp::Move& move,
                                                    std::size_t index) const {
-  if (move.is_start()) return mdp_->start_action(state, move.start).next;
   ConcurrentState result;
   std::size_t seen = 0;
+  if (move.is_start()) {
+    mdp_->for_each_start_outcome(state, move.start, [&](double, const ConcurrentMdp::StartOutcome& outcome) {
+      if (seen++ == index) result = outcome.next;
+    });
+    return result;
+  }
   mdp_->for_each_step_outcome(state, move.refine, [&](double, const ConcurrentState& next) {
     if (seen++ == index) result = next;
   });
@@ -515,7 +522,9 @@ double ConcurrentMctsAllocator::rollout(ConcurrentState state) {
       move = moves[static_cast<std::size_t>(generator_() % moves.size())];
     }
     if (move.is_start()) {
-      ConcurrentMdp::StartOutcome outcome = mdp_->start_action(state, move.start);
+      // An execution a chain draws when the action starts: the world's draw (SPEC §9).
+      const Steps drawn = mdp_->sample_start_execution(state, move.start, generator_);
+      ConcurrentMdp::StartOutcome outcome = mdp_->start_action(state, move.start, drawn);
       if (outcome.ends) return outcome.reward;
       state = std::move(outcome.next);
       continue;
@@ -758,7 +767,6 @@ AllocatorKind mcts_kind() {
           "the search's: starts an action when the search values starting above planning on (its most "
           "simulated move)",
       .make_concurrent = [](const ConcurrentMdp& mdp, const ParameterReader& parameters) -> ConcurrentAllocatorFactory {
-        refuse_chains(mdp, "mcts", "its search takes a start as one outcome");
         ConcurrentMctsOptions options;
         options.exploration = parameters.real("exploration");
         options.backup = read_backup(parameters);

@@ -1,15 +1,21 @@
 #include "ontime/solve/concurrent_contiguous_success.hpp"
 
 #include <algorithm>
+#include <array>
+#include <span>
 #include <string>
 
 #include "ontime/util/error.hpp"
 
 namespace ontime {
 
-ConcurrentContiguousSuccess::ConcurrentContiguousSuccess(const ConcurrentMdp& mdp, Aggregation aggregation)
-    : mdp_(&mdp), aggregation_(aggregation), deadline_(mdp.deadline()) {
-  check_supported(mdp);
+ConcurrentContiguousSuccess::ConcurrentContiguousSuccess(const ConcurrentMdp& mdp, Aggregation aggregation,
+                                                         Timing timing)
+    : mdp_(&mdp),
+      aggregation_(aggregation),
+      relaxed_(timing == Timing::relax && mdp.is_timed()),
+      deadline_(mdp.deadline()) {
+  if (timing == Timing::refuse) check_supported(mdp);
 }
 
 void ConcurrentContiguousSuccess::check_supported(const ConcurrentMdp& mdp) {
@@ -73,8 +79,16 @@ double ConcurrentContiguousSuccess::after_found(int k, int l, Steps time, std::i
     if (finish > deadline_) return 0.0;
     return problem.has_rewards() ? problem.reward_at(m, static_cast<Steps>(finish)) : 1.0;
   };
+  // Relaxed (Timing::relax), an execution drawn from a chain when it starts takes its fastest.
+  std::span<const Mdp::ExecutionOutcome> outcomes = mdp_->plan_first_mdp().execution_outcomes(action);
+  std::array<Mdp::ExecutionOutcome, 1> fastest{};
+  if (relaxed_ && problem.execution_chain(action) >= 0) {
+    const Steps steps = mdp_->fastest_execution(action);
+    fastest[0] = {steps == kNever ? deadline_ + 1 : steps, 1.0};
+    outcomes = fastest;
+  }
   double total = 0.0;
-  for (const Mdp::ExecutionOutcome& outcome : mdp_->plan_first_mdp().execution_outcomes(action)) {
+  for (const Mdp::ExecutionOutcome& outcome : outcomes) {
     const std::int64_t after = backlog + outcome.steps;
     if (time + after > deadline_) continue;
     const auto worth = [&](int m) {  // NOLINT(misc-no-recursion)

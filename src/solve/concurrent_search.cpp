@@ -60,13 +60,20 @@ struct ConcurrentSearch::Impl {
       Interval q;
       successors.clear();
       if (move.is_start()) {
-        ConcurrentMdp::StartOutcome outcome = mdp->start_action(state, move.start);
-        if (outcome.ends) {
-          q = {outcome.reward, outcome.reward};
-        } else {
-          q = interval(outcome.next);
-          successors.emplace_back(q.upper - q.lower, std::move(outcome.next));
-        }
+        // One outcome, or with an execution drawn from a chain when it starts, one per execution
+        // time (SPEC §9); an outcome that ends the episode is worth its reward.
+        mdp->for_each_start_outcome(state, move.start,
+                                    [&](double probability, const ConcurrentMdp::StartOutcome& outcome) {
+                                      if (outcome.ends) {
+                                        q.lower += probability * outcome.reward;
+                                        q.upper += probability * outcome.reward;
+                                        return;
+                                      }
+                                      const Interval v = interval(outcome.next);
+                                      q.lower += probability * v.lower;
+                                      q.upper += probability * v.upper;
+                                      successors.emplace_back(probability * (v.upper - v.lower), outcome.next);
+                                    });
       } else {
         mdp->for_each_step_outcome(state, move.refine, [&](double probability, const ConcurrentState& next) {
           const Interval v = interval(next);
@@ -179,11 +186,6 @@ ConcurrentSolution solve_memoised(const ConcurrentMdp& mdp, const ConcurrentSolv
 }
 
 ConcurrentSolution solve_by_search(const ConcurrentMdp& mdp, const ConcurrentSolveOptions& options) {
-  if (mdp.is_timed()) {
-    throw UsageError(
-        "the search acting while planning (SPEC §10) does not take exogenous chains or expiry (SPEC §9) yet: its "
-        "bounds take a start as one outcome; use --method memoised");
-  }
   ConcurrentSearch search(mdp, options.max_states);  // refuses backtracking (its bounds)
   ConcurrentSolution solution;
   const ConcurrentState start = mdp.start();

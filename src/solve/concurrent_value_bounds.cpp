@@ -8,7 +8,9 @@
 namespace ontime {
 
 ConcurrentValueBounds::ConcurrentValueBounds(const ConcurrentMdp& mdp)
-    : mdp_(&mdp), devoted_((refuse_backtracking(mdp), mdp), Aggregation::self) {  // refused first
+    : mdp_(&mdp),
+      devoted_((refuse_backtracking(mdp), mdp), Aggregation::self,  // refused first
+               ConcurrentContiguousSuccess::Timing::relax) {
   if (!mdp.is_timed()) clairvoyant_.emplace(mdp);
 }
 
@@ -68,9 +70,26 @@ ConcurrentValueBounds::Interval ConcurrentValueBounds::bounds(const ConcurrentSt
     for (const auto& group : groups_) none *= 1.0 - std::min(1.0, group.second);
     upper = std::min(upper, 1.0 - none);
   }
+  // With chains or expiry the devoted values are of the relaxed problem (upper bounds only); the
+  // lower end is the best start that ends the episode now, or 0.
+  if (mdp_->is_timed()) best = ending_start(state);
   if (clairvoyant_) upper = std::min(upper, cap * clairvoyant_->union_probability(state));
   // Rounding aside, upper >= V* >= lower; the max keeps the interval ordered when it rounds.
   return {best, std::max(best, upper)};
+}
+
+double ConcurrentValueBounds::ending_start(const ConcurrentState& state) const {
+  double best = 0.0;
+  for (const int action : mdp_->startable(state)) {
+    double value = 0.0;
+    bool ends = true;
+    mdp_->for_each_start_outcome(state, action, [&](double probability, const ConcurrentMdp::StartOutcome& outcome) {
+      ends = ends && outcome.ends;
+      value += probability * outcome.reward;
+    });
+    if (ends) best = std::max(best, value);
+  }
+  return best;
 }
 
 }  // namespace ontime

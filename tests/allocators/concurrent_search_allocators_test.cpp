@@ -12,6 +12,7 @@
 #include "ontime/allocators/branch_and_bound.hpp"
 #include "ontime/allocators/mcts.hpp"
 #include "ontime/mdp/concurrent_mdp.hpp"
+#include "ontime/model/instance_io.hpp"
 #include "ontime/run/evaluation.hpp"
 #include "ontime/solve/concurrent_solver.hpp"
 #include "ontime/util/error.hpp"
@@ -79,6 +80,112 @@ TEST(ConcurrentSearchAllocators, MctsAndBranchAndBoundPlayAllowedMovesOnly) {
   EXPECT_GT(moves, 4 * count);
 }
 
+// With chains and expiry (SPEC §9), half with rewards; a start whose execution a chain draws is a
+// chance move.
+Problem timed_instance(std::uint64_t seed) {
+  return testing::with_random_chains(testing::random_instance(seed + 5000, 4, 3, 10), seed, seed % 2 == 0)
+      .with_acting(Acting::concurrent);
+}
+
+Problem chain_instance(const std::string& name) {
+  return load_problem(testing::source_path("data/instances/chains/" + name + ".json")).with_acting(Acting::concurrent);
+}
+
+// One episode of `allocator` in `mdp` from a world seeded `seed`: visit(state, move) before each
+// move, the world's draws for the outcomes (a chain's draw at a start, SPEC §9).
+template <class Visitor>
+void play(const ConcurrentMdp& mdp, ConcurrentAllocator& allocator, std::uint64_t seed, Visitor&& visit) {
+  allocator.begin_episode(seed);
+  SplitMix64 world(seed);
+  ConcurrentState state = mdp.start();
+  while (mdp.any_live(state)) {
+    const Move move = allocator.choose(state);
+    visit(state, move);
+    if (move.is_start()) {
+      const Steps drawn = mdp.sample_start_execution(state, move.start, world);
+      ConcurrentMdp::StartOutcome outcome = mdp.start_action(state, move.start, drawn);
+      if (outcome.ends) break;
+      state = std::move(outcome.next);
+      continue;
+    }
+    if (ConcurrentMdp::time(state) >= mdp.deadline()) break;
+    double u = uniform01(world);
+    ConcurrentState drawn;
+    mdp.for_each_step_outcome(state, move.refine, [&](double probability, const ConcurrentState& next) {
+      if (drawn.empty() || u >= 0.0) drawn = next;
+      u -= probability;
+    });
+    allocator.observe(state, move.refine, drawn);
+    state = std::move(drawn);
+  }
+}
+
+TEST(ConcurrentSearchAllocators, WithChainsTheyPlayAllowedMovesOnly) {
+  const int count = testing::repetitions_to_check(30);
+  int moves = 0;
+  const std::vector<ParameterValues> kinds{{{"iterations", "200"}},
+                                           {{"iterations", "200"}, {"backup", "bellman"}, {"leaf", "upper"}},
+                                           {{"iterations", "200"}, {"backup", "bellman"}, {"leaf", "lower"}}};
+  for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
+    const ConcurrentMdp mdp(timed_instance(seed));
+    ASSERT_TRUE(mdp.is_timed());
+    for (const ParameterValues& values : kinds) {
+      const auto allocator = make_concurrent_allocator_factory("mcts", mdp, values)();
+      play(mdp, *allocator, seed, [&](const ConcurrentState& state, const Move& move) {
+        ASSERT_TRUE(allowed(mdp, state, move)) << "mcts seed " << seed;
+        ++moves;
+      });
+    }
+    const auto allocator = make_concurrent_allocator_factory("branch-and-bound", mdp, {{"iterations", "200"}})();
+    play(mdp, *allocator, seed, [&](const ConcurrentState& state, const Move& move) {
+      ASSERT_TRUE(allowed(mdp, state, move)) << "branch-and-bound seed " << seed;
+      ++moves;
+    });
+  }
+  // The cup through the door also gives up (SPEC §7): mcts with rollouts takes it.
+  const ConcurrentMdp cup(chain_instance("cup-through-the-door"));
+  const auto allocator = make_concurrent_allocator_factory("mcts", cup, {{"iterations", "200"}})();
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    play(cup, *allocator, seed, [&](const ConcurrentState& state, const Move& move) {
+      ASSERT_TRUE(allowed(cup, state, move)) << "cup seed " << seed;
+      ++moves;
+    });
+  }
+  EXPECT_GT(moves, 16 * count);
+}
+
+TEST(ConcurrentSearchAllocators, WithChainsBranchAndBoundWithoutALimitMakesOptimalMoves) {
+  // Every decision of an episode: the move's Q (by the exact solver, over a start's draws too) is
+  // V* of its state.
+  const int count = testing::repetitions_to_check(100);
+  int decided = 0;
+  for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
+    const ConcurrentMdp mdp(timed_instance(seed + 300));
+    ConcurrentSolver solver(mdp);
+    BranchAndBoundOptions options;
+    options.budget = DecisionBudget::iterations(~std::uint64_t{0});
+    ConcurrentBranchAndBoundAllocator allocator(mdp, options);
+    play(mdp, allocator, seed, [&](const ConcurrentState& state, const Move& move) {
+      if (mdp.useful_moves(state).size() < 2) return;
+      double q = 0.0;
+      if (move.is_start()) {
+        mdp.for_each_start_outcome(state, move.start,
+                                   [&](double probability, const ConcurrentMdp::StartOutcome& outcome) {
+                                     q += probability * (outcome.ends ? outcome.reward : solver.solve(outcome.next));
+                                   });
+      } else {
+        mdp.for_each_step_outcome(state, move.refine, [&](double probability, const ConcurrentState& next) {
+          q += probability * solver.solve(next);
+        });
+      }
+      EXPECT_NEAR(q, solver.solve(state), 1e-12) << "seed " << seed;
+      EXPECT_EQ(allocator.last_gap(), 0.0) << "seed " << seed;
+      ++decided;
+    });
+  }
+  EXPECT_GT(decided, count);
+}
+
 TEST(ConcurrentSearchAllocators, OptionsWithoutAMeaningInThisModeAreRefused) {
   const ConcurrentMdp mdp(testing::paper_instance("instance1").with_acting(Acting::concurrent));
   try {
@@ -144,8 +251,8 @@ TEST(ConcurrentSearchAllocators, BranchAndBoundWithoutALimitMakesOptimalMoves) {
 
 // The sampled rate of `episodes` episodes against the optimum: within four standard errors
 // (rewards in [0, 1]: variance at most v(1 - v)).
-void expect_at_the_optimum(const ConcurrentMdp& mdp, const std::string& name, const ParameterValues& values,
-                           std::uint64_t episodes) {
+MonteCarloResult expect_at_the_optimum(const ConcurrentMdp& mdp, const std::string& name, const ParameterValues& values,
+                                       std::uint64_t episodes) {
   ConcurrentSolver solver(mdp);
   const double optimum = solver.solve(mdp.start());
   MonteCarloOptions options;
@@ -155,6 +262,7 @@ void expect_at_the_optimum(const ConcurrentMdp& mdp, const std::string& name, co
   const MonteCarloResult sampled = run_monte_carlo(mdp, make_concurrent_allocator_factory(name, mdp, values), options);
   const double error = std::sqrt(std::max(optimum * (1 - optimum), 0.0) / static_cast<double>(episodes));
   EXPECT_NEAR(sampled.mean_reward, optimum, 4 * error + 1e-12) << mdp.problem().name() << " " << name;
+  return sampled;
 }
 
 TEST(ConcurrentSearchAllocators, WithALargeBudgetTheyReachTheOptimum) {
@@ -170,6 +278,22 @@ TEST(ConcurrentSearchAllocators, WithALargeBudgetTheyReachTheOptimum) {
     const ConcurrentMdp mdp(testing::paper_instance(instance).with_acting(Acting::concurrent));
     expect_at_the_optimum(mdp, "branch-and-bound", {{"iterations", "1000000"}}, episodes);
   }
+}
+
+TEST(ConcurrentSearchAllocators, WithChainsBranchAndBoundReachesTheOptimum) {
+  // The meeting through the coffee queue (an execution drawn from the queue's state when it
+  // starts, a door that locks for good, SPEC §9); the cup through the door also gives up (SPEC §7),
+  // which branch-and-bound's bounds do not take.
+  // Every decision's search closes (about 900 backups each: the relaxed upper ends are loose), so
+  // its moves are optimal and its mean reward is V* within four standard errors.
+  const auto episodes = static_cast<std::uint64_t>(testing::repetitions_to_check(600));
+  const ConcurrentMdp mdp(chain_instance("meeting-through-the-queue"));
+  const MonteCarloResult sampled =
+      expect_at_the_optimum(mdp, "branch-and-bound", {{"iterations", "1000000"}}, episodes);
+  EXPECT_EQ(sampled.statistics.find("exact_decisions"), sampled.statistics.find(kSearchesCounter));
+  EXPECT_GT(sampled.statistics.find(kSearchesCounter).value_or(0.0), static_cast<double>(episodes));
+  const ConcurrentMdp cup(chain_instance("cup-through-the-door"));
+  EXPECT_THROW((void)make_concurrent_allocator_factory("branch-and-bound", cup), UsageError);
 }
 
 }  // namespace

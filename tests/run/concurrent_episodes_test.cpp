@@ -314,8 +314,6 @@ TEST(ConcurrentEpisodesWithChains, WhatIsNotThereYetIsRefusedNamingTheRule) {
   const ManualClock clock;
   refused([&] { ConcurrentSession session(mdp, clock); }, "a live session");
   refused([&] { ConcurrentSession session(problem, {}, 1); }, "a session whose skeletons change");
-  refused([&] { (void)make_concurrent_allocator_factory("mcts", mdp); }, "mcts");
-  refused([&] { (void)make_concurrent_allocator_factory("branch-and-bound", mdp); }, "branch-and-bound");
 }
 
 TEST(ConcurrentEpisodesWithChains, AStartTheChainsBlockIsRefused) {

@@ -43,6 +43,30 @@ Problem search_instance(std::uint64_t seed) {
   return seed % 3 == 0 ? testing::with_random_rewards(problem, seed) : problem;
 }
 
+// With exogenous chains, chain-dependent executions and expiry (SPEC §9); half with rewards.
+Problem timed_instance(std::uint64_t seed) {
+  return testing::with_random_chains(testing::random_instance(seed + 5000, 4, 3, 10), seed, seed % 2 == 0);
+}
+
+// An instance of data/instances/chains.
+Problem chain_instance(const std::string& name) {
+  return load_problem(testing::source_path("data/instances/chains/" + name + ".json"));
+}
+
+// The outcomes of `move` in `state`: visit(probability, ends, reward, next) per outcome.
+template <class Visitor>
+void for_each_outcome(const ConcurrentMdp& mdp, const ConcurrentState& state, const Move& move, Visitor&& visit) {
+  if (move.is_start()) {
+    mdp.for_each_start_outcome(state, move.start, [&](double probability, const ConcurrentMdp::StartOutcome& outcome) {
+      visit(probability, outcome.ends, outcome.reward, outcome.next);
+    });
+    return;
+  }
+  mdp.for_each_step_outcome(state, move.refine, [&](double probability, const ConcurrentState& next) {
+    visit(probability, false, 0.0, next);
+  });
+}
+
 // States met by `walks` random walks from the start (uniform useful moves, outcomes drawn by
 // their probabilities), the running ones only.
 std::vector<ConcurrentState> random_states(const ConcurrentMdp& mdp, std::uint64_t seed, int walks) {
@@ -56,7 +80,9 @@ std::vector<ConcurrentState> random_states(const ConcurrentMdp& mdp, std::uint64
       states.push_back(state);
       const Move move = moves[generator() % moves.size()];
       if (move.is_start()) {
-        ConcurrentMdp::StartOutcome outcome = mdp.start_action(state, move.start);
+        // An execution a chain draws when the action starts (SPEC §9): the world's draw.
+        const Steps drawn = mdp.sample_start_execution(state, move.start, generator);
+        ConcurrentMdp::StartOutcome outcome = mdp.start_action(state, move.start, drawn);
         if (outcome.ends) break;
         state = std::move(outcome.next);
         continue;
@@ -75,13 +101,9 @@ std::vector<ConcurrentState> random_states(const ConcurrentMdp& mdp, std::uint64
 
 // Q*(state, move) from the exact solver.
 double exact_q(const ConcurrentMdp& mdp, ConcurrentSolver& solver, const ConcurrentState& state, const Move& move) {
-  if (move.is_start()) {
-    const ConcurrentMdp::StartOutcome outcome = mdp.start_action(state, move.start);
-    return outcome.ends ? outcome.reward : solver.solve(outcome.next);
-  }
   double q = 0.0;
-  mdp.for_each_step_outcome(state, move.refine, [&](double probability, const ConcurrentState& next) {
-    q += probability * solver.solve(next);
+  for_each_outcome(mdp, state, move, [&](double probability, bool ends, double reward, const ConcurrentState& next) {
+    q += probability * (ends ? reward : solver.solve(next));
   });
   return q;
 }
@@ -107,6 +129,34 @@ TEST(ConcurrentValueBounds, SandwichTheOptimumOnRandomStates) {
   // 99 of 1,050 states over the 120 instances, 19 of 219 over the sanitizers' first 30.
   EXPECT_GT(states, 4 * count);
   EXPECT_GT(open, count / 3);
+}
+
+// With chains and expiry (SPEC §9) the upper end is the union bound of the relaxed problem and the
+// lower end the best start that ends the episode now.
+TEST(ConcurrentValueBounds, SandwichTheOptimumOnRandomStatesWithChains) {
+  const int count = testing::repetitions_to_check(120);
+  int states = 0, open = 0, raised = 0;
+  for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
+    const Problem problem = timed_instance(seed).with_acting(Acting::concurrent);
+    const ConcurrentMdp mdp(problem);
+    ASSERT_TRUE(mdp.is_timed());
+    ConcurrentSolver solver(mdp);
+    ConcurrentValueBounds bounds(mdp);
+    for (const ConcurrentState& state : random_states(mdp, seed, 4)) {
+      const double optimum = solver.solve(state);
+      const ConcurrentValueBounds::Interval interval = bounds.bounds(state);
+      ASSERT_LE(interval.lower, optimum + kSearchRounding) << "seed " << seed;
+      ASSERT_GE(interval.upper, optimum - kSearchRounding) << "seed " << seed;
+      ++states;
+      open += interval.upper - interval.lower > 1e-9 ? 1 : 0;
+      raised += interval.lower > 0.0 ? 1 : 0;
+    }
+  }
+  // Hundreds of states, most with the bounds apart, and some with a lower end above 0.
+  std::printf("%d states, %d open, %d with a lower end above 0\n", states, open, raised);
+  EXPECT_GT(states, 4 * count);
+  EXPECT_GT(open, count);
+  EXPECT_GT(raised, count / 10);
 }
 
 // The lower bound's term for skeleton k is the exact value of the policy it names: refine k alone,
@@ -163,6 +213,27 @@ TEST(ConcurrentSearch, WithoutALimitItsMoveAttainsTheOptimum) {
       EXPECT_NEAR(result.lower, optimum, kSearchRounding) << "seed " << seed;
       EXPECT_NEAR(result.upper, optimum, kSearchRounding) << "seed " << seed;
       if (mdp.certain_success(state)) continue;
+      EXPECT_NEAR(exact_q(mdp, solver, state, result.move), optimum, kSearchRounding) << "seed " << seed;
+      ++searched;
+    }
+  }
+  EXPECT_GT(searched, 2 * count);
+}
+
+TEST(ConcurrentSearch, WithChainsWithoutALimitItsMoveAttainsTheOptimum) {
+  const int count = testing::repetitions_to_check(80);
+  int searched = 0;
+  for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
+    const Problem problem = timed_instance(seed + 300).with_acting(Acting::concurrent);
+    const ConcurrentMdp mdp(problem);
+    ConcurrentSolver solver(mdp);
+    ConcurrentSearch search(mdp);
+    for (const ConcurrentState& state : random_states(mdp, seed + 500, 2)) {
+      const double optimum = solver.solve(state);
+      const ConcurrentSearchResult result = search.search(state, nullptr);
+      ASSERT_TRUE(result.exact) << "seed " << seed;
+      EXPECT_NEAR(result.lower, optimum, kSearchRounding) << "seed " << seed;
+      EXPECT_NEAR(result.upper, optimum, kSearchRounding) << "seed " << seed;
       EXPECT_NEAR(exact_q(mdp, solver, state, result.move), optimum, kSearchRounding) << "seed " << seed;
       ++searched;
     }
@@ -234,6 +305,11 @@ TEST(ConcurrentSearchSolve, TheValueAndTheFirstMoveAreTheMemoisedSolversToTheBit
   // Where the bounds are tight the search solves a small share: 3,940 of 269,605 states here.
   const auto [solved, states] = check(testing::navigation_with_deadline(14), "navigation at 14 steps");
   EXPECT_LT(solved * 20, states);
+  // With chains and expiry (SPEC §9): starts whose execution a chain draws are chance moves.
+  for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
+    check(timed_instance(seed + 7000), "chains, seed " + std::to_string(seed));
+  }
+  check(chain_instance("meeting-through-the-queue"), "meeting-through-the-queue");
 }
 
 // Cut short by its cap or its stop, or asked for a gap, the search gives an interval around the
@@ -269,8 +345,9 @@ TEST(ConcurrentSearchSolve, CutShortItsIntervalHoldsTheOptimum) {
 TEST(ConcurrentSearchSolve, RefusesWhatItsBoundsDoNotTake) {
   const ConcurrentMdp backtracking(testing::with_backtracking(testing::random_instance(3, 4, 3, 10), 3));
   EXPECT_THROW(solve_concurrent(backtracking, search_options()), UsageError);
-  const ConcurrentMdp chains(testing::with_random_chains(testing::random_instance(5, 4, 3, 10), 5, false));
-  EXPECT_THROW(solve_concurrent(chains, search_options()), UsageError);
+  // The cup through the door gives up (SPEC §7) as well as following its chains.
+  const ConcurrentMdp cup(chain_instance("cup-through-the-door"));
+  EXPECT_THROW(solve_concurrent(cup, search_options()), UsageError);
 }
 
 // P(union of the devoted successes) by brute force: every joint draw of the actions' planning

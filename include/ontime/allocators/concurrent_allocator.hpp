@@ -88,11 +88,6 @@ class EagerCommitAllocator final : public ConcurrentAllocator {
 // mdp.plan_first_mdp()), chains and expiry (SPEC §9) included.
 ConcurrentAllocatorFactory eager_commit_factory(const ConcurrentMdp& mdp, AllocatorFactory plan_first);
 
-// Only the optimal allocator and the eager commit rule take exogenous chains or expiry (SPEC §9)
-// acting while planning so far: UsageError naming `rule` (the commit rule of the kind refused) and
-// `why` when `mdp` has them; nothing otherwise.
-void refuse_chains(const ConcurrentMdp& mdp, std::string_view rule, std::string_view why);
-
 // The state of SPEC §10 seen plan-first (SPEC §2), for a plan-first allocator: CT; per live
 // skeleton its l_k and PT_k, and as ET_k the steps the robot still needs for its refined actions
 // (ConcurrentMdp::robot_free less CT, at most D + 1), so that plan-first success from the view

@@ -133,6 +133,10 @@ class ConcurrentMdp {
   std::int64_t robot_free(const ConcurrentState& state, int k) const noexcept;
   // The plan-first Mdp of the same problem: its hazards and execution outcomes are this model's.
   const Mdp& plan_first_mdp() const noexcept { return mdp_; }
+  // The fastest execution `action` may take within D: the least step of its execution
+  // distribution, or with an execution drawn from a chain when it starts, the least over every
+  // state of the chain; kNever when none is within D. O(1).
+  Steps fastest_execution(int action) const noexcept { return fastest_execution_[static_cast<std::size_t>(action)]; }
 
   // The earliest step at which live skeleton k can finish: the robot free at CT + r, then each
   // action of k after E in order, started when the robot is free and the action refined (now,

@@ -55,9 +55,23 @@ namespace ontime {
 
 class ConcurrentContiguousSuccess {
  public:
+  // How a problem with exogenous chains or expiry (SPEC §9) is taken.
+  enum class Timing {
+    // UsageError (check_supported): Eq. (1) here has no form for chains.
+    refuse,
+    // The relaxation of ConcurrentValueBounds' upper bound: every execution drawn from a chain
+    // when it starts takes its fastest over the chain's states (ConcurrentMdp::fastest_execution),
+    // and no action expires or is blocked. With `self` the value is then at least what the devoted
+    // policy earns in the model (docs/theory.md, "Acting while planning: bounds on V* for the
+    // searches"), not its value. Without backtracking (SPEC §7): the give-up term is not relaxed.
+    // Without chains or expiry it changes nothing.
+    relax,
+  };
+
   // The values of `mdp`'s skeletons with Eq. (1)'s `aggregation`; memoised as they are asked for.
-  // Throws UsageError (check_supported) when the problem has chains or expiry.
-  ConcurrentContiguousSuccess(const ConcurrentMdp& mdp, Aggregation aggregation);
+  // Throws UsageError (check_supported) when the problem has chains or expiry, unless `timing`
+  // relaxes them.
+  ConcurrentContiguousSuccess(const ConcurrentMdp& mdp, Aggregation aggregation, Timing timing = Timing::refuse);
 
   // Eq. (1) here has no form for chains: UsageError naming the rule when `mdp` has chains or
   // expiry (SPEC §9), before any allocator built on these values is made. Backtracking (SPEC §7)
@@ -106,6 +120,7 @@ class ConcurrentContiguousSuccess {
 
   const ConcurrentMdp* mdp_;
   Aggregation aggregation_;
+  bool relaxed_ = false;  // Timing::relax on a problem with chains or expiry
   Steps deadline_;
   std::unordered_map<std::uint64_t, double> fresh_;  // (k, l, T, w) packed
   absl::flat_hash_map<GiveUpKey, double> give_up_memo_;

@@ -6,8 +6,10 @@
 // ConcurrentMdp: every state met holds an interval [lo, hi] around V*, first the bounds of
 // ConcurrentValueBounds (widened by kBoundSlack against rounding, unless they meet: then the value
 // is the devoted policy's, exact), then the backups of its moves (ConcurrentMdp::useful_moves):
-// Q_lo(m) and Q_hi(m) the expectations of the successors' ends (a start that ends the episode is
-// worth its reward), lo = max_m Q_lo(m), hi = max_m Q_hi(m), each kept no looser than before. A
+// Q_lo(m) and Q_hi(m) the expectations of the successors' ends over the move's outcomes (a step's,
+// or a start's: one, or with an execution a chain draws when the action starts, one per execution
+// time, ConcurrentMdp::for_each_start_outcome; an outcome that ends the episode is worth its
+// reward), lo = max_m Q_lo(m), hi = max_m Q_hi(m), each kept no looser than before. A
 // trial walks down from the state by the move of the largest Q_hi (ties: the first) and the
 // outcome of the largest probability times gap (ties: the first), and backs the intervals up
 // along its path; it stops at a state whose interval has closed. There is no randomness.
@@ -104,8 +106,8 @@ struct ConcurrentSolution {
 //    ConcurrentSearch whose trials run first; the value and the first move to the bit the
 //    memoised solver's. With a gap, trials of bounded RTDP until the start's certified interval is
 //    that narrow. Where the cap or the stop ends it, the start's certified interval from the
-//    records (lower: a certified bound, not a policy's value). Refuses backtracking (SPEC §7) and
-//    chains or expiry (SPEC §9) with UsageError, as ConcurrentValueBounds does.
+//    records (lower: a certified bound, not a policy's value). Refuses backtracking (SPEC §7) with
+//    UsageError, as ConcurrentValueBounds does; takes chains and expiry (SPEC §9).
 // Cost: the search's time and memory are linear in the states it solves or bounds (a
 // ConcurrentSolver entry or a ConcurrentSearch record each); it solves at most the memoised
 // solver's states, far fewer where the bounds are tight.

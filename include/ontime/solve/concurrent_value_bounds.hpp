@@ -23,9 +23,20 @@
 // docs/theory.md, "Acting while planning", has the proofs. A state where no skeleton can finish
 // is worth 0; without rewards one with a live skeleton refined in full is worth 1 (both exact).
 //
+// With exogenous chains or expiry (SPEC §9) P_k is the devoted value of the relaxed problem
+// (ConcurrentContiguousSuccess::Timing::relax: each execution drawn from a chain when it starts at
+// its fastest over the chain's states, nothing expires or is blocked), which is at least the
+// devoted policy's value in the model and no more than that policy's value in the relaxation:
+//   upper(state) is the same formula over these values, still at least V* (the coupling of the
+//   proof gives every execution in the model at least its relaxed time, and expiry only removes
+//   starts);
+//   lower(state) = the largest expected reward of a start that ends the episode now (a last
+//   action the robot may start; 0 when there is none): the value of that start, at most V*.
+//
 // Cost: per state O(K^2) to find the eligible skeletons and group them, plus K queries of
-// ConcurrentContiguousSuccess (each a sum over at most D - CT planning steps of memoised values);
-// memory: that memo. Not thread-safe (the memo): one object per thread.
+// ConcurrentContiguousSuccess (each a sum over at most D - CT planning steps of memoised values),
+// with chains or expiry plus one pass over the execution times of each startable action; memory:
+// that memo. Not thread-safe (the memo): one object per thread.
 
 #include <optional>
 #include <utility>
@@ -51,13 +62,18 @@ class ConcurrentValueBounds {
 
   // Both bounds at `state` (any state of the MDP, terminal or not).
   Interval bounds(const ConcurrentState& state);
-  // The lower bound alone: the best devoted policy's value.
+  // The lower bound alone: the best devoted policy's value (with chains or expiry: the best
+  // start that ends the episode now).
   double lower(const ConcurrentState& state) { return bounds(state).lower; }
-  // The upper bound alone: the union bound over the devoted policies.
+  // The upper bound alone: the union bound over the devoted policies (with chains or expiry: of
+  // the relaxed problem).
   double upper(const ConcurrentState& state) { return bounds(state).upper; }
 
  private:
   static void refuse_backtracking(const ConcurrentMdp& mdp);
+  // With chains or expiry: the largest expected reward of starting now an action whose every
+  // outcome ends the episode (0 when there is none).
+  double ending_start(const ConcurrentState& state) const;
   bool eligible(const ConcurrentState& state, int k) const;
 
   const ConcurrentMdp* mdp_;
