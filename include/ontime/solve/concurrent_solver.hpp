@@ -77,6 +77,10 @@ class ConcurrentSolver {
 
   // The best move in a state already solved that is not terminal, or nullopt.
   std::optional<Move> best_move(const ConcurrentState& state) const;
+  // The value solve() gives `state` when that needs no solving: a state already solved, or one
+  // worth 0 (no skeleton can finish) or, for the optimum, 1 (ConcurrentMdp::certain_success);
+  // nullopt otherwise. O(1) after copying the state's key.
+  std::optional<double> value(const ConcurrentState& state) const;
 
   // Certified bounds {lower, upper} around V* of a live state (lower <= V* <= upper).
   using Bounds = std::function<std::pair<double, double>(const ConcurrentState&)>;
