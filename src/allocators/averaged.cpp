@@ -27,8 +27,7 @@ int AveragedAllocator::choose(const State& state) {
   return follow_.choose(seen_);
 }
 
-ConcurrentAveragedPlan::ConcurrentAveragedPlan(const Problem& real_problem, std::int64_t horizon,
-                                               std::size_t state_cap)
+ConcurrentAveragedPlan::ConcurrentAveragedPlan(const Problem& real_problem, std::int64_t horizon, std::size_t state_cap)
     : problem(average_chains(real_problem, horizon)), mdp(problem), max_states(state_cap) {
   auto solver = std::make_shared<ConcurrentSolver>(mdp, max_states);
   solver->solve(mdp.start());
@@ -57,6 +56,8 @@ double ConcurrentAveragedAllocator::averaged_value(const ConcurrentState& seen) 
 }
 
 ConcurrentMdp::Move ConcurrentAveragedAllocator::choose(const ConcurrentState& state) {
+  // Without chains the averaged instance is the instance: the optimum's move, ties and all.
+  if (!mdp_->problem().has_chains()) return follow_.choose(state);
   const ConcurrentMdp& averaged = plan_->mdp;
   // The chains' word (the fourth, SPEC §10's layout) is 0 in the averaged model, whose chains have
   // one state each; the rest means the same there, once canonical in the averaged model (an
@@ -64,20 +65,17 @@ ConcurrentMdp::Move ConcurrentAveragedAllocator::choose(const ConcurrentState& s
   ConcurrentState seen = state;
   seen[3] = 0;
   seen = averaged.on_clock(seen, {.time = ConcurrentMdp::time(state), .robot_left = ConcurrentMdp::robot_left(state)});
-  const ConcurrentMdp::Move move = follow_.choose(seen);
-  if (allowed(state, move)) return move;
-  // A start the real state refuses (a chain blocks it now): the robot waits, and the move is the
-  // best the real state allows by the averaged values, ties as ConcurrentSolver breaks them.
+  // The averaged values Q of the moves the real state allows (a start a chain blocks now is not).
   std::vector<std::pair<ConcurrentMdp::Move, double>> values;
   double best = -1.0;
   for (const ConcurrentMdp::Move& candidate : averaged.useful_moves(seen)) {
     if (!allowed(state, candidate)) continue;
     double q = 0.0;
     if (candidate.is_start()) {
-      averaged.for_each_start_outcome(seen, candidate.start,
-                                      [&](double probability, const ConcurrentMdp::StartOutcome& outcome) {
-                                        q += probability * (outcome.ends ? outcome.reward : averaged_value(outcome.next));
-                                      });
+      averaged.for_each_start_outcome(
+          seen, candidate.start, [&](double probability, const ConcurrentMdp::StartOutcome& outcome) {
+            q += probability * (outcome.ends ? outcome.reward : averaged_value(outcome.next));
+          });
     } else {
       averaged.for_each_step_outcome(seen, candidate.refine, [&](double probability, const ConcurrentState& next) {
         q += probability * averaged_value(next);
@@ -86,10 +84,15 @@ ConcurrentMdp::Move ConcurrentAveragedAllocator::choose(const ConcurrentState& s
     values.emplace_back(candidate, q);
     best = std::max(best, q);
   }
+  // Ties: a start first (the lowest action), else the first in ConcurrentSolver's order.
+  const ConcurrentMdp::Move* chosen = nullptr;
   for (const auto& [candidate, q] : values) {
-    if (q >= best - ConcurrentSolver::kTieTolerance) return candidate;
+    if (q < best - ConcurrentSolver::kTieTolerance) continue;
+    if (candidate.is_start()) return candidate;
+    if (chosen == nullptr) chosen = &candidate;
   }
-  return {};  // nothing allowed: the planner idles (as the optimum does where no move is left)
+  // Nothing allowed: the planner idles (as the optimum does where no move is left).
+  return chosen != nullptr ? *chosen : ConcurrentMdp::Move{};
 }
 
 AllocatorKind averaged_kind() {
@@ -110,8 +113,9 @@ AllocatorKind averaged_kind() {
         return [plan] { return std::make_unique<AveragedAllocator>(plan); };
       },
       .needs = exact_solve_needs(),
-      .commit_rule = "the averaged instance's concurrent optimum, blind to the chains: starts an action when starting "
-                     "is worth more there than planning on; where a chain blocks that start now, waits",
+      .commit_rule =
+          "the averaged instance's concurrent optimum, blind to the chains: starts an action when starting "
+          "is worth at least planning on there; where a chain blocks that start now, waits",
       .make_concurrent = [](const ConcurrentMdp& mdp, const ParameterReader& parameters) -> ConcurrentAllocatorFactory {
         std::shared_ptr<const ConcurrentAveragedPlan> plan = std::make_shared<ConcurrentAveragedPlan>(
             mdp.problem(), static_cast<std::int64_t>(parameters.integer("horizon")), parameters.integer("max-states"));

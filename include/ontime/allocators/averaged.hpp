@@ -88,21 +88,27 @@ struct ConcurrentAveragedPlan {
 // the averaged instance too, from its averaged distribution (average_chains keeps its chain, with
 // one state): refined and not started it is kDrawnAtStart in both states, and once started its
 // draw is in r in both. So the averaged optimum plans with the averaged distribution of every
-// execution it has not seen start, and with each one it has seen.
+// execution it has not seen start, and with each one it has seen. An action a chain may block
+// (and whose execution no chain draws) has its execution revealed with its motion in both; the
+// real one is never the averaged model's "too slow" of a block, so once such a motion is found
+// the averaged model counts on it, and the block is met only when the start is refused.
 //
-// The averaged optimum's move is taken when the real state allows it. What the real state may
-// refuse is a start that a chain's state blocks now (the averaged instance sees a block as an
-// execution too slow with the block's weight, and expiry by step the same as the real one): then
-// the robot waits, and the move is the best one the real state allows by the averaged model's
-// values Q (ties in ConcurrentSolver's order: the steps, the planner idling, the starts), the
-// planner refining what the averaged optimum values most while the robot waits.
+// The move is the best one the real state allows by the averaged model's values Q (V* of the
+// averaged model at the successors). What the real state may refuse is a start that a chain's
+// state blocks now (the averaged instance sees a block as an execution too slow, with the block's
+// weight; expiry by step it sees as the real one does): then the robot waits, the planner refining
+// what the averaged optimum values most meanwhile. Ties go to a start (the lowest action), else
+// to the first move in ConcurrentSolver's order: where the averaged model sees nothing to gain by
+// waiting the robot starts at once, as a planner blind to the chains would (the solver's order,
+// starting only when starting is worth more, would put off every start that costs nothing to put
+// off in the averaged model, up to the last step, and give the chains that long to block it).
 //
-// Guarantees: without chains it is the `optimal` allocator's (ConcurrentOptimalAllocator) move in
-// every state (the averaged instance is the instance itself); it is stationary, so its exact value
+// Guarantees: without chains it is the `optimal` allocator (ConcurrentOptimalAllocator), ties and
+// all (the averaged instance is the instance itself); it is stationary, so its exact value
 // (evaluate_exactly) is at most the concurrent optimum. Cost: one exact solve of the averaged
-// instance shared by the allocators of a factory; a move is a hash lookup after copying the
-// state, plus, where a start is refused, the values of the other moves' successors (from the
-// shared solve, else a private one kept across the episodes, capped by max_states).
+// instance shared by the allocators of a factory; with chains a move then costs the successors'
+// values of every useful move of the averaged model (hash lookups into the shared solve, else a
+// private one kept across the episodes, capped by max_states).
 class ConcurrentAveragedAllocator final : public ConcurrentAllocator {
  public:
   // Acts in `mdp` (the real instance's; it must outlive this object) following `plan`'s optimum.
@@ -119,7 +125,7 @@ class ConcurrentAveragedAllocator final : public ConcurrentAllocator {
 
   const ConcurrentMdp* mdp_;
   std::shared_ptr<const ConcurrentAveragedPlan> plan_;
-  ConcurrentOptimalAllocator follow_;
+  ConcurrentOptimalAllocator follow_;         // without chains
   std::unique_ptr<ConcurrentSolver> values_;  // the averaged values the shared solve lacks
 };
 
