@@ -70,17 +70,8 @@ ConcurrentMdp::Move ConcurrentAveragedAllocator::choose(const ConcurrentState& s
   double best = -1.0;
   for (const ConcurrentMdp::Move& candidate : averaged.useful_moves(seen)) {
     if (!allowed(state, candidate)) continue;
-    double q = 0.0;
-    if (candidate.is_start()) {
-      averaged.for_each_start_outcome(
-          seen, candidate.start, [&](double probability, const ConcurrentMdp::StartOutcome& outcome) {
-            q += probability * (outcome.ends ? outcome.reward : averaged_value(outcome.next));
-          });
-    } else {
-      averaged.for_each_step_outcome(seen, candidate.refine, [&](double probability, const ConcurrentState& next) {
-        q += probability * averaged_value(next);
-      });
-    }
+    const double q =
+        move_value(averaged, seen, candidate, [&](const ConcurrentState& next) { return averaged_value(next); });
     values.emplace_back(candidate, q);
     best = std::max(best, q);
   }

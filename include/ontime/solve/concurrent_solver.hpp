@@ -106,4 +106,23 @@ class ConcurrentSolver {
   std::unique_ptr<Impl> impl_;
 };
 
+// Q of `move` in `state`, a running state of `mdp` that allows it: the expected reward over its
+// outcomes in the MDP's order, value(next) at each successor (a start that ends the episode: its
+// reward). A step at the deadline ends the episode: 0. With value = V* it is Q*; cost: the
+// outcomes, one call of value each.
+template <class Value>
+double move_value(const ConcurrentMdp& mdp, const ConcurrentState& state, const ConcurrentMdp::Move& move,
+                  Value&& value) {
+  double q = 0.0;
+  if (move.is_start()) {
+    mdp.for_each_start_outcome(state, move.start, [&](double probability, const ConcurrentMdp::StartOutcome& outcome) {
+      q += probability * (outcome.ends ? outcome.reward : value(outcome.next));
+    });
+  } else if (ConcurrentMdp::time(state) < mdp.deadline()) {
+    mdp.for_each_step_outcome(state, move.refine,
+                              [&](double probability, const ConcurrentState& next) { q += probability * value(next); });
+  }
+  return q;
+}
+
 }  // namespace ontime
