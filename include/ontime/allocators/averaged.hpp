@@ -64,8 +64,8 @@ class AveragedAllocator final : public Allocator {
 // optimum from the start, solved once.
 struct ConcurrentAveragedPlan {
   // Solves the instance of `real_problem` averaged over `horizon` steps (0: its deadline), acting
-  // while planning; throws ResourceLimitError at the cap.
-  ConcurrentAveragedPlan(const Problem& real_problem, std::int64_t horizon, std::size_t max_states);
+  // while planning, holding at most `state_cap` states; throws ResourceLimitError past them.
+  ConcurrentAveragedPlan(const Problem& real_problem, std::int64_t horizon, std::size_t state_cap);
   // (mdp points into problem: the plan stays where it was made.)
   ConcurrentAveragedPlan(const ConcurrentAveragedPlan&) = delete;
   ConcurrentAveragedPlan& operator=(const ConcurrentAveragedPlan&) = delete;
