@@ -38,11 +38,6 @@ void run_concurrent(const EvaluateOptions& options, const Problem& problem) {
         "--belief: acting while planning (concurrent, SPEC §10) is evaluated with the instance's own "
         "distributions only so far");
   }
-  if (options.regret) {
-    throw UsageError(
-        "--regret: acting while planning (concurrent, SPEC §10) has no regret estimate yet (--exact "
-        "values a stationary allocator exactly)");
-  }
   const ParameterValues parameters = options.allocator.values();
   options.monte_carlo.check_allocator_memory(options.solver, problem, parameters);
   if (options.exact || allocator_registry().find(options.solver).capabilities.has(Capability::optimal)) {
@@ -54,7 +49,8 @@ void run_concurrent(const EvaluateOptions& options, const Problem& problem) {
   monte_carlo.time_decisions = !options.no_timing;
   ProgressBar bar("evaluate " + options.solver);
   monte_carlo.progress = [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); };
-  const MonteCarloResult result = run_monte_carlo(mdp, factory, monte_carlo);
+  const MonteCarloResult result = run_monte_carlo(
+      mdp, options.regret ? with_regret(mdp, factory, max_states_of(parameters)) : factory, monte_carlo);
   std::optional<ExactEvaluation> exact;
   if (options.exact) {
     const auto allocator = factory();
@@ -67,6 +63,7 @@ void run_concurrent(const EvaluateOptions& options, const Problem& problem) {
                                       .seed = options.monte_carlo.seed,
                                       .result = result,
                                       .exact = exact,
+                                      .regret = options.regret ? regret_estimate(result.statistics) : std::nullopt,
                                       .timing = !options.no_timing};
   fmt::print("{}", options.json ? report::to_json(evaluation) + "\n" : report::to_text(evaluation));
 }
@@ -84,7 +81,7 @@ void add_evaluate_command(CLI::App& app) {
                       "INSTANCE's actions, matched by id; the episodes and the exact value are drawn from INSTANCE");
   add_act_option(*command, options->act,
                  "Concurrent takes the allocators with a commit rule ('ontime allocators' names them), not --belief "
-                 "or --regret yet");
+                 "yet");
   command->add_flag("--exact", options->exact, "Also compute the exact success probability (no sampling)");
   command->add_flag("--regret", options->regret,
                     "Also estimate the regret V* - V (the optimum less the allocator's success probability) from the "

@@ -208,7 +208,6 @@ py::dict evaluate_concurrent(const py::object& source, const Problem& problem, c
         "belief: acting while planning (concurrent, SPEC §10) is evaluated with the problem's own "
         "distributions only so far");
   }
-  if (regret) throw UsageError("regret: acting while planning (concurrent, SPEC §10) has no regret estimate yet");
   MonteCarloResult result;
   std::optional<ExactEvaluation> exact_result;
   run_interruptibly(
@@ -219,7 +218,8 @@ py::dict evaluate_concurrent(const py::object& source, const Problem& problem, c
         options.episodes = episodes;
         options.seed = seed;
         options.threads = threads;
-        result = run_monte_carlo(mdp, factory, with_hooks(options, stop, counters));
+        result = run_monte_carlo(mdp, regret ? with_regret(mdp, factory, max_states_of(values)) : factory,
+                                 with_hooks(options, stop, counters));
         if (exact) {
           const auto allocator = factory();
           exact_result = evaluate_exactly(mdp, *allocator, max_states_of(values), stop);
@@ -233,6 +233,7 @@ py::dict evaluate_concurrent(const py::object& source, const Problem& problem, c
                                                         .seed = seed,
                                                         .result = result,
                                                         .exact = exact_result,
+                                                        .regret = regret_estimate(result.statistics),
                                                         .timing = true}));
 }
 
@@ -514,7 +515,8 @@ void bind_run(py::module_& m) {
       "path or a Problem): the allocator plans with its distributions for the problem's actions (matched by "
       "id) while the episodes and the exact value are drawn from `problem` (`ontime evaluate --belief`). "
       "act='concurrent' (or a problem whose acting is concurrent): the robot acts while planning (SPEC §10), "
-      "the allocator by its commit rule (`ontime evaluate --act`); not yet with belief or regret. "
+      "the allocator by its commit rule (`ontime evaluate --act`), regret=True by the concurrent optimum's "
+      "losses; not yet with belief. "
       "Parameters of the allocator as keyword arguments. The GIL is released; Ctrl-C stops it "
       "(KeyboardInterrupt).");
 

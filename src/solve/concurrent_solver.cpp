@@ -200,6 +200,15 @@ double ConcurrentSolver::solve(const ConcurrentState& root) {
   return memo.at(impl_->key_of(mdp, root)).value;
 }
 
+std::optional<double> ConcurrentSolver::value(const ConcurrentState& state) const {
+  if (const std::optional<double> terminal = terminal_value(*mdp_, state, !impl_->policy)) return terminal;
+  ConcurrentState key = state;
+  if (impl_->merge) mdp_->merge_backlogs(key);
+  const auto found = impl_->memo.find(key);
+  if (found == impl_->memo.end()) return std::nullopt;
+  return found->second.value;
+}
+
 std::optional<ConcurrentSolver::Move> ConcurrentSolver::best_move(const ConcurrentState& state) const {
   ConcurrentState key = state;
   if (impl_->merge) mdp_->merge_backlogs(key);

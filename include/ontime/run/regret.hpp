@@ -27,6 +27,8 @@
 #include <optional>
 
 #include "ontime/allocators/allocator.hpp"
+#include "ontime/allocators/concurrent_allocator.hpp"
+#include "ontime/mdp/concurrent_mdp.hpp"
 #include "ontime/mdp/mdp.hpp"
 #include "ontime/util/statistics.hpp"
 
@@ -43,6 +45,16 @@ inline constexpr double kRegretUnit = kSumUnit;
 // Allocators of `allocators`, each measuring its losses against `mdp`'s optimum (see above). Each
 // solves V*(s0) when made: ResourceLimitError when that needs more than `max_states` states.
 AllocatorFactory with_regret(const Mdp& mdp, AllocatorFactory allocators, std::uint64_t max_states);
+
+// The same acting while planning (SPEC §10): allocators of `allocators` measuring their losses
+// against `mdp`'s optimum, with the same counters. Every move, a start or a step, is a decision;
+// its loss is V*(s) - Q*(s, move) by ConcurrentSolver's exact values (memoised per thread, capped by
+// `max_states`, 0: no cap; ResourceLimitError past it), added outside the decision's timing (a start's state
+// is copied when it is chosen, its loss added after it). The identity above holds move by move, so
+// the estimate means the same: V*(s0) - V^pi(s0) of the concurrent optimum and the allocator's
+// concurrent policy. Each solves V*(s0) when made.
+ConcurrentAllocatorFactory with_regret(const ConcurrentMdp& mdp, ConcurrentAllocatorFactory allocators,
+                                       std::uint64_t max_states);
 
 struct RegretEstimate {
   double optimum = 0;  // V*(s0)

@@ -77,6 +77,10 @@ class ConcurrentSolver {
 
   // The best move in a state already solved that is not terminal, or nullopt.
   std::optional<Move> best_move(const ConcurrentState& state) const;
+  // The value solve() gives `state` when that needs no solving: a state already solved, or one
+  // worth 0 (no skeleton can finish) or, for the optimum, 1 (ConcurrentMdp::certain_success);
+  // nullopt otherwise. O(1) after copying the state's key.
+  std::optional<double> value(const ConcurrentState& state) const;
 
   // Certified bounds {lower, upper} around V* of a live state (lower <= V* <= upper).
   using Bounds = std::function<std::pair<double, double>(const ConcurrentState&)>;
@@ -101,5 +105,24 @@ class ConcurrentSolver {
   const ConcurrentMdp* mdp_;
   std::unique_ptr<Impl> impl_;
 };
+
+// Q of `move` in `state`, a running state of `mdp` that allows it: the expected reward over its
+// outcomes in the MDP's order, value(next) at each successor (a start that ends the episode: its
+// reward). A step at the deadline ends the episode: 0. With value = V* it is Q*; cost: the
+// outcomes, one call of value each.
+template <class Value>
+double move_value(const ConcurrentMdp& mdp, const ConcurrentState& state, const ConcurrentMdp::Move& move,
+                  Value&& value) {
+  double q = 0.0;
+  if (move.is_start()) {
+    mdp.for_each_start_outcome(state, move.start, [&](double probability, const ConcurrentMdp::StartOutcome& outcome) {
+      q += probability * (outcome.ends ? outcome.reward : value(outcome.next));
+    });
+  } else if (ConcurrentMdp::time(state) < mdp.deadline()) {
+    mdp.for_each_step_outcome(state, move.refine,
+                              [&](double probability, const ConcurrentState& next) { q += probability * value(next); });
+  }
+  return q;
+}
 
 }  // namespace ontime
