@@ -41,56 +41,6 @@ bool allowed(const ConcurrentMdp& mdp, const ConcurrentState& state, const Move&
          ConcurrentMdp::refined(state, move.refine) < mdp.problem().skeleton_length(move.refine);
 }
 
-TEST(ConcurrentSearchAllocators, MctsAndBranchAndBoundPlayAllowedMovesOnly) {
-  const int count = testing::repetitions_to_check(40);
-  int moves = 0;
-  for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
-    // Every fourth instance backtracks (SPEC §7): mcts with rollouts takes it, branch-and-bound not.
-    const Problem problem = acting_instance(seed);
-    const ConcurrentMdp mdp(seed % 4 == 1 ? testing::with_backtracking(problem, seed) : problem);
-    const ParameterValues small{{"iterations", "200"}, {"backup", seed % 2 == 0 ? "bellman" : "mean"}};
-    for (const std::string name : {"mcts", "branch-and-bound"}) {
-      if (mdp.has_backtracking() && name == "branch-and-bound") continue;
-      const auto allocator = make_concurrent_allocator_factory(name, mdp, small)();
-      allocator->begin_episode(seed);
-      SplitMix64 world(seed);
-      ConcurrentState state = mdp.start();
-      while (mdp.any_live(state)) {
-        const Move move = allocator->choose(state);
-        ASSERT_TRUE(allowed(mdp, state, move)) << name << " seed " << seed;
-        ++moves;
-        if (move.is_start()) {
-          ConcurrentMdp::StartOutcome outcome = mdp.start_action(state, move.start);
-          if (outcome.ends) break;
-          state = std::move(outcome.next);
-          continue;
-        }
-        if (ConcurrentMdp::time(state) >= mdp.deadline()) break;
-        double u = uniform01(world);
-        ConcurrentState drawn;
-        mdp.for_each_step_outcome(state, move.refine, [&](double probability, const ConcurrentState& next) {
-          if (drawn.empty() || u >= 0.0) drawn = next;
-          u -= probability;
-        });
-        allocator->observe(state, move.refine, drawn);
-        state = std::move(drawn);
-      }
-    }
-  }
-  EXPECT_GT(moves, 4 * count);
-}
-
-// With chains and expiry (SPEC §9), half with rewards; a start whose execution a chain draws is a
-// chance move.
-Problem timed_instance(std::uint64_t seed) {
-  return testing::with_random_chains(testing::random_instance(seed + 5000, 4, 3, 10), seed, seed % 2 == 0)
-      .with_acting(Acting::concurrent);
-}
-
-Problem chain_instance(const std::string& name) {
-  return load_problem(testing::source_path("data/instances/chains/" + name + ".json")).with_acting(Acting::concurrent);
-}
-
 // One episode of `allocator` in `mdp` from a world seeded `seed`: visit(state, move) before each
 // move, the world's draws for the outcomes (a chain's draw at a start, SPEC §9).
 template <class Visitor>
@@ -118,6 +68,37 @@ void play(const ConcurrentMdp& mdp, ConcurrentAllocator& allocator, std::uint64_
     allocator.observe(state, move.refine, drawn);
     state = std::move(drawn);
   }
+}
+
+TEST(ConcurrentSearchAllocators, MctsAndBranchAndBoundPlayAllowedMovesOnly) {
+  const int count = testing::repetitions_to_check(40);
+  int moves = 0;
+  for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
+    // Every fourth instance backtracks (SPEC §7): mcts with rollouts takes it, branch-and-bound not.
+    const Problem problem = acting_instance(seed);
+    const ConcurrentMdp mdp(seed % 4 == 1 ? testing::with_backtracking(problem, seed) : problem);
+    const ParameterValues small{{"iterations", "200"}, {"backup", seed % 2 == 0 ? "bellman" : "mean"}};
+    for (const std::string name : {"mcts", "branch-and-bound"}) {
+      if (mdp.has_backtracking() && name == "branch-and-bound") continue;
+      const auto allocator = make_concurrent_allocator_factory(name, mdp, small)();
+      play(mdp, *allocator, seed, [&](const ConcurrentState& state, const Move& move) {
+        ASSERT_TRUE(allowed(mdp, state, move)) << name << " seed " << seed;
+        ++moves;
+      });
+    }
+  }
+  EXPECT_GT(moves, 4 * count);
+}
+
+// With chains and expiry (SPEC §9), half with rewards; a start whose execution a chain draws is a
+// chance move.
+Problem timed_instance(std::uint64_t seed) {
+  return testing::with_random_chains(testing::random_instance(seed + 5000, 4, 3, 10), seed, seed % 2 == 0)
+      .with_acting(Acting::concurrent);
+}
+
+Problem chain_instance(const std::string& name) {
+  return load_problem(testing::source_path("data/instances/chains/" + name + ".json")).with_acting(Acting::concurrent);
 }
 
 TEST(ConcurrentSearchAllocators, WithChainsTheyPlayAllowedMovesOnly) {
@@ -154,34 +135,40 @@ TEST(ConcurrentSearchAllocators, WithChainsTheyPlayAllowedMovesOnly) {
   EXPECT_GT(moves, 16 * count);
 }
 
+// Branch and bound without a limit along one episode of `mdp`: at every decision with a choice to
+// make, the move's Q (by the exact solver, over a start's draws too) is V* of its state, with no
+// gap. The decisions checked.
+int check_moves_are_optimal(const ConcurrentMdp& mdp, std::uint64_t seed) {
+  ConcurrentSolver solver(mdp);
+  BranchAndBoundOptions options;
+  options.budget = DecisionBudget::iterations(~std::uint64_t{0});
+  ConcurrentBranchAndBoundAllocator allocator(mdp, options);
+  int decided = 0;
+  play(mdp, allocator, seed, [&](const ConcurrentState& state, const Move& move) {
+    if (mdp.certain_success(state) || mdp.useful_moves(state).size() < 2) return;
+    double q = 0.0;
+    if (move.is_start()) {
+      mdp.for_each_start_outcome(state, move.start,
+                                 [&](double probability, const ConcurrentMdp::StartOutcome& outcome) {
+                                   q += probability * (outcome.ends ? outcome.reward : solver.solve(outcome.next));
+                                 });
+    } else {
+      mdp.for_each_step_outcome(state, move.refine, [&](double probability, const ConcurrentState& next) {
+        q += probability * solver.solve(next);
+      });
+    }
+    EXPECT_NEAR(q, solver.solve(state), 1e-12) << "seed " << seed;
+    EXPECT_EQ(allocator.last_gap(), 0.0) << "seed " << seed;
+    ++decided;
+  });
+  return decided;
+}
+
 TEST(ConcurrentSearchAllocators, WithChainsBranchAndBoundWithoutALimitMakesOptimalMoves) {
-  // Every decision of an episode: the move's Q (by the exact solver, over a start's draws too) is
-  // V* of its state.
   const int count = testing::repetitions_to_check(100);
   int decided = 0;
   for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
-    const ConcurrentMdp mdp(timed_instance(seed + 300));
-    ConcurrentSolver solver(mdp);
-    BranchAndBoundOptions options;
-    options.budget = DecisionBudget::iterations(~std::uint64_t{0});
-    ConcurrentBranchAndBoundAllocator allocator(mdp, options);
-    play(mdp, allocator, seed, [&](const ConcurrentState& state, const Move& move) {
-      if (mdp.useful_moves(state).size() < 2) return;
-      double q = 0.0;
-      if (move.is_start()) {
-        mdp.for_each_start_outcome(state, move.start,
-                                   [&](double probability, const ConcurrentMdp::StartOutcome& outcome) {
-                                     q += probability * (outcome.ends ? outcome.reward : solver.solve(outcome.next));
-                                   });
-      } else {
-        mdp.for_each_step_outcome(state, move.refine, [&](double probability, const ConcurrentState& next) {
-          q += probability * solver.solve(next);
-        });
-      }
-      EXPECT_NEAR(q, solver.solve(state), 1e-12) << "seed " << seed;
-      EXPECT_EQ(allocator.last_gap(), 0.0) << "seed " << seed;
-      ++decided;
-    });
+    decided += check_moves_are_optimal(ConcurrentMdp(timed_instance(seed + 300)), seed);
   }
   EXPECT_GT(decided, count);
 }
@@ -200,48 +187,10 @@ TEST(ConcurrentSearchAllocators, OptionsWithoutAMeaningInThisModeAreRefused) {
 }
 
 TEST(ConcurrentSearchAllocators, BranchAndBoundWithoutALimitMakesOptimalMoves) {
-  // Every decision of an episode: the move's Q (by the exact solver) is V* of its state.
   const int count = testing::repetitions_to_check(200);
   int decided = 0;
   for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
-    const ConcurrentMdp mdp(acting_instance(seed + 300));
-    ConcurrentSolver solver(mdp);
-    BranchAndBoundOptions options;
-    options.budget = DecisionBudget::iterations(~std::uint64_t{0});
-    ConcurrentBranchAndBoundAllocator allocator(mdp, options);
-    allocator.begin_episode(seed);
-    SplitMix64 world(seed);
-    ConcurrentState state = mdp.start();
-    while (mdp.any_live(state)) {
-      const Move move = allocator.choose(state);
-      const bool searched = !mdp.certain_success(state) && mdp.useful_moves(state).size() > 1;
-      if (move.is_start()) {
-        ConcurrentMdp::StartOutcome outcome = mdp.start_action(state, move.start);
-        if (searched) {
-          EXPECT_NEAR(outcome.ends ? outcome.reward : solver.solve(outcome.next), solver.solve(state), 1e-12)
-              << "seed " << seed;
-        }
-        decided += searched ? 1 : 0;
-        if (outcome.ends) break;
-        state = std::move(outcome.next);
-        continue;
-      }
-      if (ConcurrentMdp::time(state) >= mdp.deadline()) break;
-      double q = 0.0;
-      double u = uniform01(world);
-      ConcurrentState drawn;
-      mdp.for_each_step_outcome(state, move.refine, [&](double probability, const ConcurrentState& next) {
-        q += probability * solver.solve(next);
-        if (drawn.empty() || u >= 0.0) drawn = next;
-        u -= probability;
-      });
-      if (searched) {
-        EXPECT_NEAR(q, solver.solve(state), 1e-12) << "seed " << seed;
-        EXPECT_EQ(allocator.last_gap(), 0.0) << "seed " << seed;
-        ++decided;
-      }
-      state = std::move(drawn);
-    }
+    decided += check_moves_are_optimal(ConcurrentMdp(acting_instance(seed + 300)), seed);
   }
   // About a third of these instances has a choice to make at all, some of them several: the
   // searched decisions are at least a quarter of the instances (about half of them in full runs,

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -108,55 +109,52 @@ double exact_q(const ConcurrentMdp& mdp, ConcurrentSolver& solver, const Concurr
   return q;
 }
 
-TEST(ConcurrentValueBounds, SandwichTheOptimumOnRandomStates) {
-  const int count = testing::repetitions_to_check(120);
-  int states = 0, open = 0;
+// lower <= V* <= upper at the states of random walks over `count` instances made by `make`: the
+// states checked, those with the ends apart and those with a lower end above 0.
+struct SandwichCounts {
+  int states = 0;
+  int open = 0;
+  int raised = 0;
+};
+SandwichCounts check_sandwich(int count, const std::function<Problem(std::uint64_t)>& make) {
+  SandwichCounts counts;
   for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
-    const Problem problem = search_instance(seed);
-    const ConcurrentMdp mdp(problem);
+    const ConcurrentMdp mdp(make(seed));
     ConcurrentSolver solver(mdp);
     ConcurrentValueBounds bounds(mdp);
     for (const ConcurrentState& state : random_states(mdp, seed, 4)) {
       const double optimum = solver.solve(state);
       const ConcurrentValueBounds::Interval interval = bounds.bounds(state);
-      ASSERT_LE(interval.lower, optimum + kSearchRounding) << "seed " << seed;
-      ASSERT_GE(interval.upper, optimum - kSearchRounding) << "seed " << seed;
-      ++states;
-      open += interval.upper - interval.lower > 1e-9 ? 1 : 0;
+      EXPECT_LE(interval.lower, optimum + kSearchRounding) << "seed " << seed;
+      EXPECT_GE(interval.upper, optimum - kSearchRounding) << "seed " << seed;
+      ++counts.states;
+      counts.open += interval.upper - interval.lower > 1e-9 ? 1 : 0;
+      counts.raised += interval.lower > 0.0 ? 1 : 0;
     }
   }
-  // Hundreds of states, and dozens of them with the bounds apart (the check sees real intervals):
-  // 99 of 1,050 states over the 120 instances, 19 of 219 over the sanitizers' first 30.
-  EXPECT_GT(states, 4 * count);
-  EXPECT_GT(open, count / 3);
+  return counts;
+}
+
+TEST(ConcurrentValueBounds, SandwichTheOptimumOnRandomStates) {
+  const int count = testing::repetitions_to_check(120);
+  const SandwichCounts counts = check_sandwich(count, search_instance);
+  // Hundreds of states, and dozens of them with the bounds apart (the check sees real intervals).
+  std::printf("%d states, %d open\n", counts.states, counts.open);
+  EXPECT_GT(counts.states, 4 * count);
+  EXPECT_GT(counts.open, count / 3);
 }
 
 // With chains and expiry (SPEC §9) the upper end is the union bound of the relaxed problem and the
 // lower end the best start that ends the episode now.
 TEST(ConcurrentValueBounds, SandwichTheOptimumOnRandomStatesWithChains) {
   const int count = testing::repetitions_to_check(120);
-  int states = 0, open = 0, raised = 0;
-  for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
-    const Problem problem = timed_instance(seed).with_acting(Acting::concurrent);
-    const ConcurrentMdp mdp(problem);
-    ASSERT_TRUE(mdp.is_timed());
-    ConcurrentSolver solver(mdp);
-    ConcurrentValueBounds bounds(mdp);
-    for (const ConcurrentState& state : random_states(mdp, seed, 4)) {
-      const double optimum = solver.solve(state);
-      const ConcurrentValueBounds::Interval interval = bounds.bounds(state);
-      ASSERT_LE(interval.lower, optimum + kSearchRounding) << "seed " << seed;
-      ASSERT_GE(interval.upper, optimum - kSearchRounding) << "seed " << seed;
-      ++states;
-      open += interval.upper - interval.lower > 1e-9 ? 1 : 0;
-      raised += interval.lower > 0.0 ? 1 : 0;
-    }
-  }
+  const SandwichCounts counts =
+      check_sandwich(count, [](std::uint64_t seed) { return timed_instance(seed).with_acting(Acting::concurrent); });
   // Hundreds of states, most with the bounds apart, and some with a lower end above 0.
-  std::printf("%d states, %d open, %d with a lower end above 0\n", states, open, raised);
-  EXPECT_GT(states, 4 * count);
-  EXPECT_GT(open, count);
-  EXPECT_GT(raised, count / 10);
+  std::printf("%d states, %d open, %d with a lower end above 0\n", counts.states, counts.open, counts.raised);
+  EXPECT_GT(counts.states, 4 * count);
+  EXPECT_GT(counts.open, count);
+  EXPECT_GT(counts.raised, count / 10);
 }
 
 // The lower bound's term for skeleton k is the exact value of the policy it names: refine k alone,
@@ -198,18 +196,18 @@ TEST(ConcurrentValueBounds, TheDevotedValueIsThePolicysExactValue) {
   EXPECT_GT(checked, count / 2);
 }
 
-TEST(ConcurrentSearch, WithoutALimitItsMoveAttainsTheOptimum) {
-  const int count = testing::repetitions_to_check(80);
+// Without a limit the search closes at the states of random walks over `count` instances made by
+// `make`: its interval is V*, and its move attains it. The states checked.
+int check_search_closes(int count, const std::function<Problem(std::uint64_t)>& make) {
   int searched = 0;
   for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
-    const Problem problem = search_instance(seed);
-    const ConcurrentMdp mdp(problem);
+    const ConcurrentMdp mdp(make(seed));
     ConcurrentSolver solver(mdp);
     ConcurrentSearch search(mdp);
     for (const ConcurrentState& state : random_states(mdp, seed + 500, 2)) {
       const double optimum = solver.solve(state);
       const ConcurrentSearchResult result = search.search(state, nullptr);
-      ASSERT_TRUE(result.exact) << "seed " << seed;
+      EXPECT_TRUE(result.exact) << "seed " << seed;
       EXPECT_NEAR(result.lower, optimum, kSearchRounding) << "seed " << seed;
       EXPECT_NEAR(result.upper, optimum, kSearchRounding) << "seed " << seed;
       if (mdp.certain_success(state)) continue;
@@ -217,28 +215,19 @@ TEST(ConcurrentSearch, WithoutALimitItsMoveAttainsTheOptimum) {
       ++searched;
     }
   }
-  EXPECT_GT(searched, 2 * count);
+  return searched;
+}
+
+TEST(ConcurrentSearch, WithoutALimitItsMoveAttainsTheOptimum) {
+  const int count = testing::repetitions_to_check(80);
+  EXPECT_GT(check_search_closes(count, search_instance), 2 * count);
 }
 
 TEST(ConcurrentSearch, WithChainsWithoutALimitItsMoveAttainsTheOptimum) {
   const int count = testing::repetitions_to_check(80);
-  int searched = 0;
-  for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
-    const Problem problem = timed_instance(seed + 300).with_acting(Acting::concurrent);
-    const ConcurrentMdp mdp(problem);
-    ConcurrentSolver solver(mdp);
-    ConcurrentSearch search(mdp);
-    for (const ConcurrentState& state : random_states(mdp, seed + 500, 2)) {
-      const double optimum = solver.solve(state);
-      const ConcurrentSearchResult result = search.search(state, nullptr);
-      ASSERT_TRUE(result.exact) << "seed " << seed;
-      EXPECT_NEAR(result.lower, optimum, kSearchRounding) << "seed " << seed;
-      EXPECT_NEAR(result.upper, optimum, kSearchRounding) << "seed " << seed;
-      EXPECT_NEAR(exact_q(mdp, solver, state, result.move), optimum, kSearchRounding) << "seed " << seed;
-      ++searched;
-    }
-  }
-  EXPECT_GT(searched, 2 * count);
+  EXPECT_GT(check_search_closes(
+                count, [](std::uint64_t seed) { return timed_instance(seed + 300).with_acting(Acting::concurrent); }),
+            2 * count);
 }
 
 TEST(ConcurrentSearch, CutShortItsGapBoundsTheLoss) {
