@@ -28,6 +28,7 @@ struct StudyOptions {
   std::string out = "out/studies";
   std::string multipliers = "0,0.5,1,1.5,2,2.5,3,3.5,4,4.5,5";
   bool no_plot = false;
+  std::string act;         // empty: each instance's own "acting"
   StudySettings settings;  // the library's defaults: the paper's mcts against dp-rerun
   AllocatorFlags allocator;
 };
@@ -66,7 +67,9 @@ void run(const StudyOptions& given, StudyKind kind) {
   // bad file, path or cap stops the study before any computation.
   std::vector<StudyInstance> instances;
   for (const std::string& path : options.instances) {
-    instances.push_back({load_problem(path), path, std::filesystem::path(path).stem().string()});
+    Problem problem = load_problem(path);
+    if (!options.act.empty()) problem = problem.with_acting(*parse_acting(options.act));
+    instances.push_back({std::move(problem), path, std::filesystem::path(path).stem().string()});
   }
   std::vector<OutputFile> outputs{{"--out", output_of(options, kind, ".csv")}};
   if (!options.no_plot) outputs.push_back({"--out", output_of(options, kind, ".png")});
@@ -107,6 +110,9 @@ void add_study_command(CLI::App& app) {
     add_number_option(*command, "--seed", options->settings.seed, "Seed of the hidden worlds");
     add_threads_option(*command, options->settings.threads, "Worker threads (0: one per hardware thread)");
     command->add_flag("--no-plot", options->no_plot, "Write the CSV only");
+    add_act_option(*command, options->act,
+                   "Concurrent: both allocators by their commit rules, every move a decision; the searcher's time "
+                   "per decision is its time-budget");
     command
         ->add_option("--searcher", options->settings.searcher,
                      "The anytime allocator studied (" +

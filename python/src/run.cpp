@@ -683,10 +683,11 @@ void bind_run(py::module_& m) {
         // Each item held while it is used: a numpy array's items are new objects.
         for (std::size_t i = 0; i < static_cast<std::size_t>(py::len(instances)); ++i) {
           const py::object object = instances[i];
-          const std::shared_ptr<MdpHandle> mdp = to_mdp(object, "instances");
-          const std::string label = instance_label(object, *mdp->problem);
+          // Read as a problem (not an Mdp): one acting while planning is studied in that mode.
+          const std::shared_ptr<const Problem> problem = problem_with_acting(object, std::nullopt, "instances");
+          const std::string label = instance_label(object, *problem);
           const bool is_file = py::isinstance<py::str>(object) || py::hasattr(object, "__fspath__");
-          rows.push_back({*mdp->problem, label, is_file ? std::filesystem::path(label).stem().string() : label});
+          rows.push_back({*problem, label, is_file ? std::filesystem::path(label).stem().string() : label});
         }
         check_study_request(kind, rows, settings, python_spelling());
         StudyRows result;
@@ -707,7 +708,9 @@ void bind_run(py::module_& m) {
       py::arg("log10_multipliers") = py::none(), py::arg("progress") = py::none(),
       "A computation-time study of the paper's Figs. 4-6, as `ontime study KIND` runs it: 'compute-time', "
       "'equal-time' or 'anytime' (the searcher, mcts, against the reference, dp-rerun, by default), over the "
-      "instances (files or Problems). Returns the CSV the command line writes (python/plot_study.py draws it). "
+      "instances (files or Problems; one acting while planning, Problem.with_acting('concurrent'), is studied in "
+      "that mode, as `ontime study --act concurrent`). Returns the CSV the command line writes "
+      "(python/plot_study.py draws it). "
       "Times are wall-clock: the success counts of iteration budgets repeat for a seed, those of time budgets do "
       "not. Parameters as keyword arguments. The GIL is released; Ctrl-C stops it.");
 }

@@ -81,6 +81,24 @@ def test_studies_give_the_cli_counts(cli, tmp_path):
         ontime.study("equal-time", [str(instance)], searcher="dp")
 
 
+def test_studies_acting_while_planning_give_the_cli_counts(cli, tmp_path):
+    instance = PAPER_INSTANCES[3]
+    done = cli("study", "compute-time", instance, "--act", "concurrent", "--episodes", 60, "--seed", 4,
+               "--iterations", 30, "--out", tmp_path, "--no-plot", expect_json=False)
+    assert done.returncode == 0, done.stderr
+    problem = ontime.load_problem(instance).with_acting("concurrent")
+    text = ontime.study("compute-time", [problem], episodes=60, seed=4, iterations=30)
+    with open(tmp_path / "compute_time.csv") as file:
+        expected = list(csv.DictReader(file))
+    got = list(csv.DictReader(io.StringIO(text)))
+    for mine, theirs in zip(got, expected):
+        for key in ("episodes", "success_rate", "ci95", "iterations_per_search"):
+            assert mine[key] == theirs[key], key
+    assert float(got[0]["iterations_per_search"]) == 30
+    with pytest.raises(ontime.UsageError, match="does not act while planning"):
+        ontime.study("compute-time", [problem], reference="ppo", episodes=2)
+
+
 def test_histogram_csv_is_the_data_of_the_cli_plot(cli, tmp_path):
     instance = PAPER_INSTANCES[1]
     done = cli("plot", instance, "-o", tmp_path / "h.png", expect_json=False)

@@ -18,6 +18,8 @@
 #include <vector>
 
 #include "ontime/allocators/allocator_registry.hpp"
+#include "ontime/allocators/concurrent_allocator.hpp"
+#include "ontime/mdp/concurrent_mdp.hpp"
 #include "ontime/run/evaluation.hpp"
 #include "ontime/util/memory.hpp"
 
@@ -42,6 +44,9 @@ struct StudySettings {
 // its own episodes, timed in bulk (no clock read per decision).
 double mean_decision_seconds(const Mdp& mdp, const AllocatorFactory& factory, std::uint64_t seed,
                              std::uint64_t episodes = 500);
+// The same acting while planning (SPEC §10): every move, a start or a step, is a decision.
+double mean_decision_seconds(const ConcurrentMdp& mdp, const ConcurrentAllocatorFactory& factory, std::uint64_t seed,
+                             std::uint64_t episodes = 500);
 
 // Fig. 4: total decision time per episode, the searcher (its own default budget) against the
 // reference.
@@ -51,6 +56,9 @@ struct ComputeTimeStudy {
 };
 // Runs `settings.episodes` episodes of each allocator on `mdp`, the searcher within its default budget.
 ComputeTimeStudy compute_time_study(const Mdp& mdp, const StudySettings& settings);
+// The same acting while planning (SPEC §10): each allocator by its commit rule, every move a
+// decision; the searcher's time per decision is its `time-budget` parameter.
+ComputeTimeStudy compute_time_study(const ConcurrentMdp& mdp, const StudySettings& settings);
 
 // Fig. 5: the searcher given exactly the reference's measured time per decision.
 struct EqualTimeStudy {
@@ -61,6 +69,8 @@ struct EqualTimeStudy {
 // Measures the reference's mean seconds per decision, then runs the episodes of each allocator, the searcher
 // within that time per decision.
 EqualTimeStudy equal_time_study(const Mdp& mdp, const StudySettings& settings);
+// The same acting while planning (SPEC §10), the searcher made with that time as its `time-budget`.
+EqualTimeStudy equal_time_study(const ConcurrentMdp& mdp, const StudySettings& settings);
 
 // Fig. 6: the searcher's success against log10 of a multiplier of the reference's time per
 // decision.
@@ -78,6 +88,9 @@ struct AnytimeStudy {
 // The reference's time per decision, its episodes and the exact optimum, then the searcher's episodes at that
 // time times 10^m for each m of `log10_multipliers` (each within [-3, 9], else UsageError).
 AnytimeStudy anytime_study(const Mdp& mdp, const std::vector<double>& log10_multipliers, const StudySettings& settings);
+// The same acting while planning (SPEC §10); the optimum is ConcurrentSolver's.
+AnytimeStudy anytime_study(const ConcurrentMdp& mdp, const std::vector<double>& log10_multipliers,
+                           const StudySettings& settings);
 
 // A study over several instances: one of the three above on each, in order.
 enum class StudyKind { compute_time, equal_time, anytime };
@@ -107,7 +120,8 @@ struct StudyRows {
 void check_study_request(StudyKind kind, const std::vector<StudyInstance>& instances, const StudySettings& settings,
                          const ParameterSpelling& spelling = nullptr);
 
-// Runs the study on every instance. `settings.progress` sees the episodes done over all of them.
+// Runs the study on every instance, each in its acting mode (Problem::acting(): planning first,
+// or acting while planning, SPEC §10). `settings.progress` sees the episodes done over all of them.
 StudyRows run_study(StudyKind kind, const std::vector<StudyInstance>& instances, const StudySettings& settings,
                     const std::vector<double>& log10_multipliers = {});
 
