@@ -25,7 +25,7 @@ run instance_fuzzer ../data/instances/paper ../data/instances/backtracking ../da
   ../data/instances/rewards ../tests/data/bad ../tests/data/fuzz_regressions ../data/knapsack
 run planner_log_fuzzer ../tests/data/bad_logs ../tests/data/fuzz_regressions ../fuzz/seeds/planner_log
 run ompl_benchmark_log_fuzzer ../tests/data/bad_ompl_logs ../fuzz/seeds/ompl_benchmark_log
-run conditional_model_fuzzer ../fuzz/seeds/conditional_model
+run conditional_model_fuzzer ../fuzz/seeds/conditional_model ../tests/data/fuzz_regressions
 # The chain fuzzer's first byte picks the reader: seeds are prefixed ("0": a chain file, "1": a log).
 mkdir -p build-fuzz/seeds/chain
 for seed in fuzz/seeds/chain/*.chain.json; do { printf 0; cat "$seed"; } > "build-fuzz/seeds/chain/$(basename "$seed")"; done

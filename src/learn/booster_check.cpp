@@ -247,6 +247,11 @@ void check_booster(const Json& root, std::size_t features) {
 }  // namespace
 
 std::optional<BoosterFault> booster_fault(std::string_view text, std::size_t features) {
+  // XGBoost takes a buffer that does not begin with '{' for its binary format, whose string
+  // lengths it trusts (a leading space made it allocate exabytes): the JSON must begin at once.
+  if (text.empty() || text.front() != '{') {
+    return BoosterFault{"booster", "must begin with '{' (XGBoost reads anything else as its binary format)"};
+  }
   try {
     check_booster(parse_json_strict<Json>(text, "booster"), features);
   } catch (const InputError& error) {

@@ -272,6 +272,9 @@ TEST(BoostedTimeModel, RefusesBadSettingsAndBadFiles) {
   refused(with("never_booster", booster("never_booster").substr(0, 300)), "parameters.never_booster",
           "not a booster OnTime reads: at line 1, column 301: invalid JSON");
   refused(with("never_booster", "{}"), "parameters.never_booster", "not a booster OnTime reads: at version: missing");
+  // XGBoost reads a buffer that does not begin with '{' as its binary format, trusting its lengths.
+  refused(with("never_booster", " " + booster("never_booster")), "parameters.never_booster",
+          "not a booster OnTime reads: at booster: must begin with '{'");
   refused(with("planning_booster", "{\"version\": [1, 7, 4], \"learner\": 3}"), "parameters.planning_booster",
           "at learner: must be an object");
   refused(with("planning_booster", 3), "parameters.planning_booster", "must be a string");
