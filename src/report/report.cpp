@@ -209,6 +209,11 @@ std::string search_text(const Solve& solve, std::string out) {
   return out;
 }
 
+// The skeleton refined first acting while planning, -1 when none can finish by the deadline.
+int first_refined(const ConcurrentSolve& solve) {
+  return solve.solution.first.is_start() ? -1 : solve.solution.first.refine;
+}
+
 }  // namespace
 
 std::string to_json(const Solve& solve) {
@@ -268,16 +273,6 @@ std::string to_json(const Solve& solve) {
   }
   return dump(out);
 }
-
-namespace {
-
-// The skeleton refined first, -1 when none can finish by the deadline.
-int first_refined(const ConcurrentSolve& solve) {
-  const ConcurrentMdp::Move& first = solve.solution.first;
-  return first.is_start() ? -1 : first.refine;
-}
-
-}  // namespace
 
 std::string to_json(const ConcurrentSolve& solve) {
   const Problem& problem = *solve.problem;
