@@ -1,6 +1,7 @@
-// `ontime train INSTANCE --solver ppo --out POLICY`: learns a policy by PPO from simulated
-// episodes, writes it with its learning curve (CSV and PNG) as one set (OutputSet: all or
-// nothing), and reports the exact success probability of the trained policy.
+// `ontime train INSTANCE --solver ppo --out POLICY [--act concurrent]`: learns a policy by PPO from
+// simulated episodes (plan-first or acting while planning), writes it with its learning curve (CSV
+// and PNG) as one set (OutputSet: all or nothing), and reports the exact success probability of the
+// trained policy.
 
 #include <fmt/format.h>
 
@@ -28,6 +29,7 @@ void add_train_command(CLI::App& app) {
     std::uint64_t episodes = 10'000;
     std::uint64_t seed = 1;
     std::string out;
+    std::string act;
     bool no_plot = false;
     bool json = false;
   };
@@ -41,11 +43,23 @@ void add_train_command(CLI::App& app) {
   add_number_option(*command, "--seed", options->seed, "Seed of initialisation, sampling and hidden worlds");
   command->add_option("--out", options->out, "Policy file to write (JSON); the learning curve goes beside it")
       ->required();
+  add_act_option(*command, options->act,
+                 "Concurrent trains a policy that chooses each start and step (the ppo allocator acting while "
+                 "planning)");
   command->add_flag("--no-plot", options->no_plot, "Write the learning curve CSV only");
   command->add_flag("--json", options->json, "Print JSON");
   command->callback([options] {
-    const Problem problem = load_problem(options->instance);
-    const Mdp mdp(problem);
+    Problem problem = load_problem(options->instance);
+    if (!options->act.empty()) problem = problem.with_acting(*parse_acting(options->act));
+    const bool concurrent = problem.acting() == Acting::concurrent;
+    // The model of the mode (the plan-first Mdp refuses a problem acting while planning).
+    std::optional<ConcurrentMdp> concurrent_mdp;
+    std::optional<Mdp> plan_first_mdp;
+    if (concurrent) {
+      concurrent_mdp.emplace(problem);
+    } else {
+      plan_first_mdp.emplace(problem);
+    }
     const std::filesystem::path policy_path(options->out);
     const std::filesystem::path curve_csv = learning_curve_path(policy_path);
     const std::filesystem::path curve_png = learning_curve_path(policy_path, ".curve.png");
@@ -53,9 +67,10 @@ void add_train_command(CLI::App& app) {
     if (!options->no_plot) outputs.push_back({"--out (learning curve plot)", curve_png});
     check_outputs(outputs, {options->instance}, MissingFolder::create);
     ProgressBar bar("train ppo");
+    const auto progress = [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); };
     const PpoTraining training =
-        train_ppo(mdp, options->episodes, options->seed, PpoHyperparameters{},
-                  [&bar](std::uint64_t done, std::uint64_t total) { bar.update(done, total); });
+        concurrent ? train_ppo(*concurrent_mdp, options->episodes, options->seed, PpoHyperparameters{}, progress)
+                   : train_ppo(*plan_first_mdp, options->episodes, options->seed, PpoHyperparameters{}, progress);
 
     // The files are one output: all are staged, then renamed together, so that an interruption
     // leaves the previous set or this one. Without a plot, an older PNG beside the policy would
@@ -83,8 +98,15 @@ void add_train_command(CLI::App& app) {
     // Exact evaluation takes at most kMaxExactSkeletons skeletons; a wider instance trains all
     // the same, without the exact figure.
     if (problem.skeleton_count() <= kMaxExactSkeletons) {
-      PpoAllocator greedy(mdp, std::make_shared<const PpoPolicy>(training.policy));
-      const ExactEvaluation exact = evaluate_exactly(mdp, greedy);
+      const auto policy = std::make_shared<const PpoPolicy>(training.policy);
+      ExactEvaluation exact;
+      if (concurrent) {
+        ConcurrentPpoAllocator greedy(*concurrent_mdp, policy);
+        exact = evaluate_exactly(*concurrent_mdp, greedy);
+      } else {
+        PpoAllocator greedy(*plan_first_mdp, policy);
+        exact = evaluate_exactly(*plan_first_mdp, greedy);
+      }
       trained.exact = exact.success_probability;
       // As evaluate reports it: the expected reward beside the success for an instance with rewards.
       if (problem.has_rewards()) trained.exact_reward = exact.expected_reward;

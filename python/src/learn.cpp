@@ -388,19 +388,28 @@ void bind_learn(py::module_& m) {
 
   m.def(
       "train_ppo",
-      [](const py::object& problem, const py::object& out, Episodes episodes, Seed seed, const py::object& progress) {
+      [](const py::object& problem, const py::object& out, Episodes episodes, Seed seed, const py::object& progress,
+         const std::optional<std::string>& act) {
         check_episodes(episodes);
         check_callable(progress, "progress");
-        const std::shared_ptr<MdpHandle> mdp = to_mdp(problem);
+        // Read as a problem: one acting while planning makes no plan-first Mdp.
+        const std::shared_ptr<const Problem> chosen = problem_with_acting(problem, act);
         const std::string path = path_argument(out, "out");
         std::optional<PpoTraining> training;
         run_interruptibly(
             [&](const std::function<bool()>& stop, Progress& counters) {
               counters.total = episodes;
-              training = train_ppo(mdp->mdp, episodes, seed, {}, [&](std::uint64_t done, std::uint64_t) {
+              const auto report = [&](std::uint64_t done, std::uint64_t) {
                 if (stop()) throw Cancelled("training stopped at the caller's request");
                 counters.done = done;
-              });
+              };
+              if (chosen->acting() == Acting::concurrent) {
+                const ConcurrentMdp mdp(*chosen);
+                training = train_ppo(mdp, episodes, seed, {}, report);
+              } else {
+                const Mdp mdp(*chosen);
+                training = train_ppo(mdp, episodes, seed, {}, report);
+              }
               // The policy and its learning curve as one set, as `ontime train --no-plot` writes them
               // (an older plot beside the policy would describe another training: it goes).
               const std::filesystem::path policy(path);
@@ -425,11 +434,13 @@ void bind_learn(py::module_& m) {
         return curve;
       },
       py::arg("problem"), py::arg("out"), py::kw_only(), py::arg("episodes") = 10'000, py::arg("seed") = 1,
-      py::arg("progress") = py::none(),
+      py::arg("progress") = py::none(), py::arg("act") = py::none(),
       "Trains the ppo policy on simulated episodes (as `ontime train`), writes it to `out` with its learning curve "
       "beside it (OUT.curve.csv; both only when training finished, together) and returns the learning curve as a "
       "list of dicts. Use it with "
-      "make_allocator(problem, 'ppo', policy=out).");
+      "make_allocator(problem, 'ppo', policy=out). act='concurrent' (or a problem acting while planning; `--act`, "
+      "SPEC §10) trains a policy that chooses each start and step, for evaluate(act='concurrent', solver='ppo', "
+      "policy=out).");
 }
 
 }  // namespace ontime::python

@@ -131,7 +131,7 @@ def test_evaluate_acts_while_planning_by_the_allocators_commit_rule(cli):
 
 
 @pytest.mark.parametrize("arguments, message", [
-    ({"solver": "ppo"}, "'ppo' does not act while planning"),
+    ({"solver": "ppo"}, "ppo needs a trained policy"),
     ({"solver": "dp-rerun", "belief": PAPER / "instance1.json"}, "belief: acting while planning"),
     ({"solver": "thompson", "exact": True}, "exact evaluation needs an allocator whose move"),
     ({"solver": "dp-rerun", "act": "sometimes"}, "act must be 'plan-first' or 'concurrent'"),
@@ -177,7 +177,7 @@ def test_a_table_sets_both_modes_side_by_side_as_the_command_line(cli):
              row["solvers"][name]["success_rate"] for row in expected["rows"]]
     markdown = ontime.table([problem.with_acting("concurrent")], solvers=["dp-rerun"], episodes=50, format="markdown")
     assert "paper-instance-1 (concurrent)" in markdown
-    with pytest.raises(ontime.UsageError, match="'ppo' does not act while planning"):
+    with pytest.raises(ontime.UsageError, match="ppo needs a trained policy"):
         ontime.table([problem.with_acting("concurrent")], solvers=["ppo"], episodes=10)
 
 
@@ -267,7 +267,26 @@ def test_moves_and_reports_out_of_rule_raise_usage_errors(call, message):
 
 
 def test_a_session_refuses_allocators_without_a_commit_rule():
-    with pytest.raises(ontime.UsageError, match="'ppo' does not act while planning"):
+    with pytest.raises(ontime.UsageError, match="ppo needs a trained policy"):
         ontime.ConcurrentSession(two_moves(), "ppo")
     with pytest.raises(ontime.UsageError, match="need a solver"):
         ontime.ConcurrentSession(two_moves(), budget=4)
+
+
+def test_ppo_trained_acting_while_planning_drives_concurrent_episodes(cli, tmp_path):
+    # train_ppo(act='concurrent') writes the command line's policy, byte for byte; evaluate takes it
+    # acting while planning with the exact value the command line prints, and refuses it plan-first.
+    instance = PAPER / "instance2.json"
+    policy = tmp_path / "py.json"
+    curve = ontime.train_ppo(instance, policy, episodes=200, seed=2, act="concurrent")
+    assert curve[-1]["episodes"] == 200
+    trained = cli("train", instance, "--act", "concurrent", "--episodes", 200, "--seed", 2, "--out",
+                  tmp_path / "cli.json", "--no-plot", "--json")
+    assert policy.read_bytes() == (tmp_path / "cli.json").read_bytes()
+    assert json.loads(policy.read_text())["acting"] == "concurrent"
+    result = ontime.evaluate(instance, "ppo", act="concurrent", policy=str(policy), episodes=400, seed=3, exact=True)
+    assert result["exact_success_probability"] == trained["exact_success_probability"]
+    assert result["exact_success_probability"] <= ontime.solve(instance, act="concurrent")[
+        "optimal_success_probability"] + 1e-12
+    with pytest.raises(ontime.UsageError, match=r"trained acting while planning .*not plan-first \(SPEC §10\)"):
+        ontime.evaluate(instance, "ppo", policy=str(policy), episodes=10)

@@ -230,6 +230,8 @@ def sweep_calls(tmp_path):
         Call("study anytime", ontime.study, "anytime", [two], episodes=2, threads=1, log10_multipliers=[0.0, 0.5]),
         Call("train_ppo", ontime.train_ppo, two, str(tmp_path / "policy.json"), episodes=2, seed=1,
              progress=lambda done, total: None),
+        Call("train_ppo concurrent", ontime.train_ppo, two, str(tmp_path / "policy-concurrent.json"), episodes=2,
+             seed=1, progress=lambda done, total: None, act="concurrent"),
         Call("score", ontime.score, problem, [str(sampled)], horizon=0, floor=1e-6, skip_unknown=True),
         Call("fit_strength", ontime.fit_strength, model, [str(log)], strengths=[1.0, 2.0]),
         Call("fit_conditional", ontime.fit_conditional, str(log), step=1.0, kind="hazard", horizon=0, ridge=1e-3,

@@ -95,7 +95,7 @@ def test_studies_acting_while_planning_give_the_cli_counts(cli, tmp_path):
         for key in ("episodes", "success_rate", "ci95", "iterations_per_search"):
             assert mine[key] == theirs[key], key
     assert float(got[0]["iterations_per_search"]) == 30
-    with pytest.raises(ontime.UsageError, match="does not act while planning"):
+    with pytest.raises(ontime.UsageError, match="ppo needs a trained policy"):
         ontime.study("compute-time", [problem], reference="ppo", episodes=2)
 
 

@@ -4,8 +4,10 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "allocators/detail/ppo_networks.hpp"
+#include "ontime/run/concurrent_session.hpp"
 #include "ontime/run/session.hpp"
 #include "ontime/run/simulator.hpp"
 #include "ontime/util/error.hpp"
@@ -116,21 +118,110 @@ template double clipped_surrogate_loss<double>(const Eigen::MatrixXd&, const std
 
 namespace {
 
+// The episodes a trainer plays plan-first (SPEC §2): a Session whose outputs are the skeletons.
+class PlanFirstEpisodes {
+ public:
+  explicit PlanFirstEpisodes(const Mdp& mdp)
+      : mdp_(mdp),
+        world_(mdp.problem(), 0),
+        inputs_(feature_count(mdp.skeleton_count(), chain_feature_count(mdp.problem()))) {
+    choices_.reserve(static_cast<std::size_t>(mdp.skeleton_count()));
+  }
+  int inputs() const noexcept { return inputs_; }
+  int outputs() const noexcept { return mdp_.skeleton_count(); }
+  void begin(std::uint64_t world_seed) {
+    world_.begin_episode(world_seed);
+    session_.emplace(mdp_, world_seed);  // (its simulated chains, SPEC §9)
+  }
+  // The outputs the learner may choose now: the useful choices.
+  const std::vector<int>& choices() {
+    const ChoiceList useful = mdp_.useful_choices(session_->state());
+    choices_.assign(useful.begin(), useful.end());
+    return choices_;
+  }
+  void features(Vector& out) const { state_features(mdp_, session_->state(), out); }
+  Status act(int output) {
+    session_->decide(output);
+    return session_->carry_out(world_);
+  }
+  double reward() const noexcept { return session_->reward(); }
+
+ private:
+  const Mdp& mdp_;
+  HiddenWorld world_;  // redrawn for every episode
+  int inputs_;
+  std::optional<Session> session_;
+  std::vector<int> choices_;
+};
+
+// The episodes a trainer plays acting while planning (SPEC §10): a ConcurrentSession whose outputs
+// are the moves (ppo_move_output). At a certain success the complete plan runs by itself, as
+// ConcurrentPpoAllocator runs it: no decision is left to learn there.
+class ConcurrentEpisodes {
+ public:
+  explicit ConcurrentEpisodes(const ConcurrentMdp& mdp)
+      : mdp_(mdp),
+        world_(mdp.problem(), 0),
+        inputs_(concurrent_feature_count(mdp.skeleton_count(), concurrent_chain_feature_count(mdp.problem()))) {}
+  int inputs() const noexcept { return inputs_; }
+  int outputs() const noexcept { return concurrent_move_count(mdp_.skeleton_count()); }
+  void begin(std::uint64_t world_seed) {
+    world_.begin_episode(world_seed);
+    session_.emplace(mdp_, world_seed);  // (its simulated chains, SPEC §9)
+    settle();
+  }
+  // The outputs of the useful moves (ConcurrentMdp::useful_moves), in the solver's order.
+  const std::vector<int>& choices() {
+    moves_ = mdp_.useful_moves(session_->state());
+    choices_.clear();
+    for (const ConcurrentMdp::Move& move : moves_) choices_.push_back(ppo_move_output(mdp_, session_->state(), move));
+    return choices_;
+  }
+  void features(Vector& out) const { concurrent_state_features(mdp_, session_->state(), out); }
+  Status act(int output) {
+    const auto chosen = std::find(choices_.begin(), choices_.end(), output) - choices_.begin();
+    carry_out(moves_[static_cast<std::size_t>(chosen)]);
+    settle();
+    return session_->status();
+  }
+  double reward() const noexcept { return session_->reward(); }
+
+ private:
+  void carry_out(const ConcurrentMdp::Move& move) {
+    if (!session_->decide(move).is_start() && session_->status() == Status::running) session_->carry_out(world_);
+  }
+  // Runs a complete plan that is sure to succeed.
+  void settle() {
+    while (session_->status() == Status::running && mdp_.certain_success(session_->state())) {
+      carry_out(mdp_.run_complete_plan(session_->state()));
+    }
+  }
+
+  const ConcurrentMdp& mdp_;
+  HiddenWorld world_;  // redrawn for every episode
+  int inputs_;
+  std::optional<ConcurrentSession> session_;
+  std::vector<ConcurrentMdp::Move> moves_;
+  std::vector<int> choices_;
+};
+
 // One training run: the networks, their optimisers, the sampling stream and the scratch buffers
-// that every episode and update reuse. train_ppo alternates play_episode (until an epoch's steps
-// are collected) and update.
+// that every episode and update reuse, over the episodes of one acting mode (PlanFirstEpisodes,
+// ConcurrentEpisodes). train_ppo alternates play_episode (until an epoch's steps are collected)
+// and update.
+template <class Episodes>
 class PpoTrainer {
  public:
-  PpoTrainer(const Mdp& mdp, std::uint64_t seed, const PpoHyperparameters& h)
-      : mdp_(mdp),
+  template <class Model>
+  PpoTrainer(const Model& mdp, std::uint64_t seed, const PpoHyperparameters& h)
+      : episodes_(mdp),
         h_(h),
-        count_(mdp.skeleton_count()),
-        inputs_(feature_count(count_, chain_feature_count(mdp.problem()))),
+        count_(episodes_.outputs()),
+        inputs_(episodes_.inputs()),
         networks_(initial_networks(stream_seed(seed, 0))),
         actor_optimiser_(networks_.actor, h.actor_learning_rate),
         critic_optimiser_(networks_.critic, h.critic_learning_rate),
         sampling_(stream_seed(seed, 1)),
-        world_(mdp.problem(), 0),
         features_(inputs_),
         log_probabilities_(static_cast<std::size_t>(count_)),
         valid_(static_cast<std::size_t>(count_)) {}
@@ -140,16 +231,15 @@ class PpoTrainer {
 
   // Plays one episode in the hidden world of `world_seed` with the current actor (choices
   // sampled), appends its steps to the batch with their advantages (GAE) and returns, and
-  // returns how it ended. The episode steps through a Session (session.hpp) with the actor's
-  // choices, as the episode runner's allocators step through theirs.
+  // returns how it ended. The episode steps through a session (session.hpp,
+  // concurrent_session.hpp) with the actor's choices, as the episode runner's allocators step
+  // through theirs.
   Status play_episode(std::uint64_t world_seed) {
-    world_.begin_episode(world_seed);
-    Session session(mdp_, world_seed);  // (its simulated chains, SPEC §9)
-    const State& state = session.state();
+    episodes_.begin(world_seed);
     const std::size_t first = batch_.steps();
     Status status = Status::running;
     for (int step = 0; step < h_.max_episode_steps && status == Status::running; ++step) {
-      const ChoiceList choices = mdp_.useful_choices(state);
+      const std::vector<int>& choices = episodes_.choices();
       // No skeleton can succeed any more (the start state of an instance where success is
       // impossible: `apply` reports this as failure only after a step): the episode is lost
       // whatever the learner does, and a step without a choice teaches it nothing.
@@ -157,7 +247,7 @@ class PpoTrainer {
         status = Status::failure;
         break;
       }
-      state_features(mdp_, state, features_);
+      episodes_.features(features_);
       std::fill(valid_.begin(), valid_.end(), std::uint8_t{0});
       for (const int choice : choices) valid_[choice] = 1;
       const std::uint8_t* valid = valid_.data();
@@ -168,21 +258,20 @@ class PpoTrainer {
         return portable_exp(log_probabilities_[static_cast<std::size_t>(choices[i])]);
       };
       const int action = choices[sample_index(choices.size(), probability, sampling_)];
-      session.decide(action);
-      status = session.carry_out(world_);
+      status = episodes_.act(action);
 
       batch_.features.insert(batch_.features.end(), features_.data(), features_.data() + inputs_);
       batch_.valid.insert(batch_.valid.end(), valid, valid + count_);
       batch_.actions.push_back(action);
       batch_.log_probabilities.push_back(log_probabilities_[static_cast<std::size_t>(action)]);
       batch_.values.push_back(value);
-      batch_.rewards.push_back(session.reward());
+      batch_.rewards.push_back(episodes_.reward());
     }
     // Advantages (GAE) and discounted returns of the episode; a cut-off episode (step
     // limit) is completed by the critic's value of its last state.
     double next_value = 0;
     if (status == Status::running) {
-      state_features(mdp_, state, features_);
+      episodes_.features(features_);
       next_value = networks_.critic.evaluate(features_)(0);
     }
     const std::size_t last = batch_.steps();
@@ -255,41 +344,39 @@ class PpoTrainer {
     return PpoNetworks{std::move(actor), std::move(critic)};
   }
 
-  const Mdp& mdp_;
+  Episodes episodes_;
   const PpoHyperparameters& h_;
-  int count_;
+  int count_;  // the actor's outputs
   int inputs_;
   PpoNetworks networks_;
   Adam<float> actor_optimiser_;
   Adam<float> critic_optimiser_;
   SplitMix64 sampling_;
-  HiddenWorld world_;  // redrawn for every episode
   Batch batch_;
   Vector features_;
   std::vector<double> log_probabilities_;
-  std::vector<std::uint8_t> valid_;  // 1 for the useful choices of the current state
+  std::vector<std::uint8_t> valid_;  // 1 for the outputs of the useful choices of the current state
   Matrix inputs_matrix_, logits_gradient_, value_gradient_;
 };
 
 }  // namespace
 
-PpoTraining train_ppo(const Mdp& mdp, std::uint64_t episodes, std::uint64_t seed, const PpoHyperparameters& h,
-                      const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
+namespace {
+
+// Trains on `episodes` episodes of one acting mode; `policy` already says what it is trained for.
+template <class Episodes, class Model>
+PpoTraining train(const Model& mdp, PpoPolicy policy, std::uint64_t episodes, std::uint64_t seed,
+                  const PpoHyperparameters& h, const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
   check(h);
   if (episodes == 0) throw UsageError("training needs at least one episode");
   const auto started = std::chrono::steady_clock::now();
 
   PpoTraining training;
-  PpoPolicy& policy = training.policy;
-  policy.instance = mdp.problem().name();
-  policy.instance_digest = instance_digest(mdp.problem());
-  policy.skeleton_count = mdp.skeleton_count();
-  policy.chain_inputs = chain_feature_count(mdp.problem());
-  policy.deadline = mdp.deadline();
-  policy.seed = seed;
-  policy.episodes = episodes;
-  policy.hyperparameters = h;
-  PpoTrainer trainer(mdp, seed, h);
+  training.policy = std::move(policy);
+  training.policy.seed = seed;
+  training.policy.episodes = episodes;
+  training.policy.hyperparameters = h;
+  PpoTrainer<Episodes> trainer(mdp, seed, h);
   const std::uint64_t world_seed = stream_seed(seed, 2);
 
   std::uint64_t episodes_done = 0;
@@ -319,8 +406,40 @@ PpoTraining train_ppo(const Mdp& mdp, std::uint64_t episodes, std::uint64_t seed
     training.curve.push_back(point);
     if (progress) progress(episodes_done, episodes);
   }
-  policy.networks = std::make_shared<const PpoNetworks>(trainer.take_networks());
+  training.policy.networks = std::make_shared<const PpoNetworks>(trainer.take_networks());
   return training;
+}
+
+}  // namespace
+
+namespace {
+
+// What a policy of `mdp` records of its instance before training.
+template <class Model>
+PpoPolicy untrained_policy(const Model& mdp, Acting acting, int chain_inputs) {
+  PpoPolicy policy;
+  policy.acting = acting;
+  policy.instance = mdp.problem().name();
+  policy.instance_digest = instance_digest(mdp.problem());
+  policy.skeleton_count = mdp.skeleton_count();
+  policy.chain_inputs = chain_inputs;
+  policy.deadline = mdp.deadline();
+  return policy;
+}
+
+}  // namespace
+
+PpoTraining train_ppo(const Mdp& mdp, std::uint64_t episodes, std::uint64_t seed, const PpoHyperparameters& h,
+                      const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
+  return train<PlanFirstEpisodes>(mdp, untrained_policy(mdp, Acting::plan_first, chain_feature_count(mdp.problem())),
+                                  episodes, seed, h, progress);
+}
+
+PpoTraining train_ppo(const ConcurrentMdp& mdp, std::uint64_t episodes, std::uint64_t seed, const PpoHyperparameters& h,
+                      const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
+  return train<ConcurrentEpisodes>(
+      mdp, untrained_policy(mdp, Acting::concurrent, concurrent_chain_feature_count(mdp.problem())), episodes, seed, h,
+      progress);
 }
 
 }  // namespace ontime

@@ -552,6 +552,7 @@ std::string to_json(const Training& training) {
   out["learning_curve"] = training.files.size() > 1 ? training.files[1] : std::string();
   out["episodes"] = training.episodes;
   out["seed"] = training.seed;
+  out["acting"] = acting_name(training.problem != nullptr ? training.problem->acting() : Acting::plan_first);
   out["epochs"] = training.epochs;
   out["seconds"] = training.seconds;
   out["exact_success_probability"] = training.exact ? Json(*training.exact) : Json(nullptr);
@@ -560,8 +561,10 @@ std::string to_json(const Training& training) {
 }
 
 std::string to_text(const Training& training) {
-  std::string out = fmt::format("trained ppo on {} ({}): {} episodes in {} epochs, {:.1f} s\n", training.instance,
-                                training.problem->name(), training.episodes, training.epochs, training.seconds);
+  std::string out = fmt::format("trained ppo on {} ({}{}): {} episodes in {} epochs, {:.1f} s\n", training.instance,
+                                training.problem->name(),
+                                training.problem->acting() == Acting::concurrent ? ", acting while planning" : "",
+                                training.episodes, training.epochs, training.seconds);
   if (training.exact) {
     out += fmt::format("exact success probability of the trained policy (greedy): {:.4f}\n", *training.exact);
     if (training.exact_reward) {

@@ -520,7 +520,7 @@ TEST(Cli, RunActsWhilePlanningWithTheRealPlanner) {
   for (const auto& [arguments, message] : std::vector<std::pair<std::vector<std::string>, std::string>>{
            {{"--solver", "dp-rerun", "--belief", testing::source_path("data/instances/navigation.json").string()},
             "--belief: acting"},
-           {{"--solver", "ppo"}, "'ppo' does not act while planning"}}) {
+           {{"--solver", "ppo"}, "ppo needs a trained policy"}}) {
     std::vector<std::string> command{"run", "--domain", "navigation", "--episodes", "2", "--act", "concurrent"};
     command.insert(command.end(), arguments.begin(), arguments.end());
     const auto refused = ontime(command);

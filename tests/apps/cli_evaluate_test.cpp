@@ -134,7 +134,7 @@ TEST(Cli, EvaluateActsWhilePlanningByEachAllocatorsCommitRule) {
   EXPECT_FALSE(json::parse(plan_first.out).contains("acting"));
 
   for (const auto& [arguments, message] : std::vector<std::pair<std::vector<std::string>, std::string>>{
-           {{"--solver", "ppo"}, "'ppo' does not act while planning (SPEC §10) yet"},
+           {{"--solver", "ppo"}, "ppo needs a trained policy"},
            {{"--solver", "dp-rerun", "--belief", paper("instance1")}, "--belief: acting while planning"},
            {{"--solver", "thompson", "--exact"}, "exact evaluation needs an allocator whose move depends only on"},
            {{"--solver", "dp-rerun", "--act", "sometimes"}, "--act"}}) {
@@ -170,7 +170,7 @@ TEST(Cli, TableSetsPlanFirstBesideActingWhilePlanning) {
   EXPECT_NE(markdown.out.find("| instance2 (concurrent)  |"), std::string::npos) << markdown.out;
 
   for (const auto& [arguments, message] : std::vector<std::pair<std::vector<std::string>, std::string>>{
-           {{"--act", "concurrent", "--solvers", "dp-rerun,ppo"}, "allocator 'ppo' does not act while planning"},
+           {{"--act", "concurrent", "--solvers", "dp-rerun,ppo"}, "ppo needs a trained policy"},
            {{"--act", "concurrent,concurrent"}, "instance given twice"},
            {{"--act", "plan-first,sometimes"}, "--act"}}) {
     std::vector<std::string> command{"table", paper("instance1"), "--episodes", "10"};

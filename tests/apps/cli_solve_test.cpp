@@ -82,8 +82,8 @@ TEST(Cli, SolveActsWhilePlanningWhenAsked) {
       {{"solve", instance, "--tolerance", "0.1"}, "--tolerance is for the layered solver"},
       {{"solve", instance, "--max-seconds", "5"}, "takes it with --method search"},
       {{"solve", instance, "--gap", "0.1"}, "--gap is for --method search"},
-      {{"evaluate", instance, "--solver", "ppo", "--episodes", "10"}, "'ppo' does not act while planning"},
-      {{"table", instance, "--episodes", "10", "--solvers", "ppo"}, "'ppo' does not act while planning"},
+      {{"evaluate", instance, "--solver", "ppo", "--episodes", "10"}, "ppo needs a trained policy"},
+      {{"table", instance, "--episodes", "10", "--solvers", "ppo"}, "ppo needs a trained policy"},
       {{"solve", paper("instance1"), "--act", "interleaved"}, "--act"},
   };
   for (const auto& [arguments, message] : refused) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -19,6 +20,50 @@ namespace ontime {
 namespace {
 
 using namespace cli_test;
+
+// Trained acting while planning (SPEC §10), a policy chooses each start and step: evaluate and
+// table take it with --act concurrent (its exact value the one train printed, at most the
+// concurrent optimum), and plan-first refuses it, naming the rule.
+TEST(Cli, TrainActingWhilePlanningWritesAPolicyOfThatMode) {
+  const auto directory = scratch("train-concurrent");
+  const std::string policy = (directory / "instance2.json").string();
+  const auto trained = ontime({"train", paper("instance2"), "--act", "concurrent", "--episodes", "300", "--seed", "2",
+                               "--out", policy, "--no-plot", "--json"});
+  ASSERT_EQ(trained.exit_code, 0) << trained.err;
+  const json report = json::parse(trained.out);
+  EXPECT_EQ(report["acting"], "concurrent");
+  std::ifstream file(policy);
+  const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  EXPECT_NE(bytes.find("\"acting\": \"concurrent\""), std::string::npos);
+
+  const auto evaluated = ontime({"evaluate", paper("instance2"), "--act", "concurrent", "--solver", "ppo", "--policy",
+                                 policy, "--episodes", "500", "--exact", "--json"});
+  ASSERT_EQ(evaluated.exit_code, 0) << evaluated.err;
+  const json evaluation = json::parse(evaluated.out);
+  EXPECT_EQ(evaluation["exact_success_probability"].get<double>(), report["exact_success_probability"].get<double>());
+  const auto optimum = ontime({"solve", paper("instance2"), "--act", "concurrent", "--json"});
+  ASSERT_EQ(optimum.exit_code, 0) << optimum.err;
+  EXPECT_LE(report["exact_success_probability"].get<double>(),
+            json::parse(optimum.out)["optimal_success_probability"].get<double>() + 1e-12);
+  const auto table = ontime({"table", paper("instance2"), "--act", "concurrent", "--solvers", "ppo,dp-rerun",
+                             "--policy", policy, "--episodes", "200", "--json"});
+  ASSERT_EQ(table.exit_code, 0) << table.err;
+  const double rate = json::parse(table.out)["rows"][0]["solvers"]["ppo"]["success_rate"].get<double>();
+  const double exact = report["exact_success_probability"].get<double>();
+  EXPECT_NEAR(rate, exact, 4 * std::sqrt(exact * (1 - exact) / 200));
+
+  const auto plan_first =
+      ontime({"evaluate", paper("instance2"), "--solver", "ppo", "--policy", policy, "--episodes", "10"});
+  EXPECT_EQ(plan_first.exit_code, 2);
+  EXPECT_NE(plan_first.err.find("trained acting while planning ('paper-instance-2'), not plan-first (SPEC §10)"),
+            std::string::npos)
+      << plan_first.err;
+  // The plan-first report says so too.
+  const auto plain = ontime({"train", paper("instance2"), "--episodes", "20", "--out",
+                             (directory / "plain.json").string(), "--no-plot", "--json"});
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_EQ(json::parse(plain.out)["acting"], "plan-first");
+}
 
 TEST(Cli, TrainWritesAPolicyThatEvaluateAndTableUse) {
   const auto directory = scratch("train");

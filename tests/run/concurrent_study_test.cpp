@@ -61,16 +61,24 @@ TEST(ConcurrentStudy, TheSearchersTimePerDecisionIsItsTimeBudget) {
 }
 
 TEST(ConcurrentStudy, AnAllocatorWithoutACommitRuleIsRefusedBeforeAnyWork) {
+  // Every built-in kind has a commit rule: an extension's kind without one stands in.
+  AllocatorKind plan_first_only = allocator_registry().find("dp-rerun");
+  plan_first_only.name = "plan-first-only";
+  plan_first_only.commit_rule.clear();
+  plan_first_only.make_concurrent = {};
+  allocator_registry().add(plan_first_only);
   StudySettings settings = study_settings(10);
-  settings.reference = "ppo";
+  settings.reference = "plan-first-only";
   const std::vector<StudyInstance> instances{
       {testing::paper_instance("instance4").with_acting(Acting::concurrent), "instance4.json", "instance4"}};
   try {
     check_study_request(StudyKind::compute_time, instances, settings);
-    ADD_FAILURE() << "ppo was taken as the reference acting while planning";
+    ADD_FAILURE() << "a kind without a commit rule was taken as the reference acting while planning";
   } catch (const UsageError& error) {
-    EXPECT_NE(std::string(error.what()).find("does not act while planning"), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("'plan-first-only' does not act while planning"), std::string::npos)
+        << error.what();
   }
+  allocator_registry().remove("plan-first-only");
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "ontime/allocators/ppo.hpp"
+#include "ontime/mdp/concurrent_mdp.hpp"
 #include "ontime/mdp/mdp.hpp"
 #include "ontime/util/output_set.hpp"
 
@@ -39,6 +40,13 @@ struct PpoTraining {
 
 // Trains on `episodes` simulated episodes. Throws UsageError for invalid hyperparameters.
 PpoTraining train_ppo(const Mdp& mdp, std::uint64_t episodes, std::uint64_t seed,
+                      const PpoHyperparameters& hyperparameters = {},
+                      const std::function<void(std::uint64_t done, std::uint64_t total)>& progress = {});
+// The same acting while planning (SPEC §10): episodes of ConcurrentSession, the actor's outputs
+// the moves (ppo_move_output) masked to the useful ones, a complete plan sure to succeed run by
+// itself (as ConcurrentPpoAllocator runs it, so no decision is recorded there). The policy says
+// Acting::concurrent and drives ConcurrentPpoAllocator. Same seed, same policy, bit for bit.
+PpoTraining train_ppo(const ConcurrentMdp& mdp, std::uint64_t episodes, std::uint64_t seed,
                       const PpoHyperparameters& hyperparameters = {},
                       const std::function<void(std::uint64_t done, std::uint64_t total)>& progress = {});
 

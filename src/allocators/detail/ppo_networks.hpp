@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "allocators/detail/neural_network.hpp"
+#include "ontime/mdp/concurrent_mdp.hpp"
 #include "ontime/mdp/mdp.hpp"
 #include "ontime/mdp/state.hpp"
 
@@ -16,7 +17,8 @@ namespace ontime {
 
 using PolicyNetwork = Mlp<float>;
 
-// The trained networks of a PpoPolicy: the actor's outputs are preferences over the skeletons,
+// The trained networks of a PpoPolicy: the actor's outputs are preferences over the skeletons
+// (acting while planning: over the moves, ppo_move_output),
 // the critic's single output estimates the state's value.
 struct PpoNetworks {
   PolicyNetwork actor;
@@ -25,6 +27,8 @@ struct PpoNetworks {
 
 // The features of a state (normalised_state, ontime/allocators/ppo.hpp) in a network's input.
 void state_features(const Mdp& mdp, const State& state, PolicyNetwork::Vector& features);
+// The same acting while planning (concurrent_normalised_state).
+void concurrent_state_features(const ConcurrentMdp& mdp, const ConcurrentState& state, PolicyNetwork::Vector& features);
 
 // The clipped surrogate loss of PPO, -mean(min(r A, clip(r, 1 - e, 1 + e) A)) with
 // r = exp(log pi(a | s) - old log pi), over a batch of logits (one column per sample) with

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "allocators/detail/ppo_networks.hpp"
 #include "ontime/allocators/ppo.hpp"
@@ -71,10 +72,17 @@ class PolicyReader {
       fail("version", "this version of ontime reads policy files of version " + std::to_string(kVersion));
     }
     detail::check_known_keys(root, "",
-                             {"format", "version", "instance", "instance_digest", "skeletons", "chain_inputs",
+                             {"format", "version", "acting", "instance", "instance_digest", "skeletons", "chain_inputs",
                               "deadline", "seed", "episodes", "features", "hyperparameters", "actor", "critic"},
                              source_);
     PpoPolicy policy;
+    // (Optional: a policy trained acting while planning, SPEC §10; absent means plan-first.)
+    if (root.contains("acting")) {
+      const std::optional<Acting> acting =
+          root["acting"].is_string() ? parse_acting(root["acting"].get<std::string>()) : std::nullopt;
+      if (!acting) fail("acting", "must be \"plan-first\" or \"concurrent\"");
+      policy.acting = *acting;
+    }
     policy.instance = text_at(root, "instance");
     if (root.contains("instance_digest")) {
       policy.instance_digest = text_at(root, "instance_digest");
@@ -112,9 +120,12 @@ class PolicyReader {
     h.max_episode_steps = static_cast<int>(integer_at(hyper, "max_episode_steps", 1, 100000000, "hyperparameters"));
     h.target_kl = number_at(hyper, "target_kl", "hyperparameters");
 
-    const int inputs = feature_count(policy.skeleton_count, policy.chain_inputs);
+    const bool concurrent = policy.acting == Acting::concurrent;
+    const int inputs = concurrent ? concurrent_feature_count(policy.skeleton_count, policy.chain_inputs)
+                                  : feature_count(policy.skeleton_count, policy.chain_inputs);
+    const int outputs = concurrent ? concurrent_move_count(policy.skeleton_count) : policy.skeleton_count;
     policy.networks = std::make_shared<const PpoNetworks>(
-        PpoNetworks{network_at(root, "actor", inputs, policy.skeleton_count), network_at(root, "critic", inputs, 1)});
+        PpoNetworks{network_at(root, "actor", inputs, outputs), network_at(root, "critic", inputs, 1)});
     return policy;
   }
 
@@ -163,7 +174,7 @@ class PolicyReader {
     }
     if (sizes.front() != inputs || sizes.back() != outputs) {
       fail(sizes_path, "expected " + std::to_string(inputs) + " inputs and " + std::to_string(outputs) +
-                           " outputs for " + std::to_string(outputs == 1 ? inputs / 3 : outputs) + " skeletons");
+                           " outputs for the policy's skeletons, chain inputs and acting mode");
     }
     const std::string layers_path = detail::json_member(key, "layers");
     if (!network.contains("layers") || !network["layers"].is_array() || network["layers"].size() + 1 != sizes.size()) {
@@ -230,13 +241,20 @@ std::string ppo_policy_to_json(const PpoPolicy& policy) {
   Json root;
   root["format"] = kFormat;
   root["version"] = kVersion;
+  if (policy.acting == Acting::concurrent) root["acting"] = acting_name(policy.acting);
   root["instance"] = policy.instance;
   if (!policy.instance_digest.empty()) root["instance_digest"] = policy.instance_digest;
   root["skeletons"] = policy.skeleton_count;
   root["deadline"] = policy.deadline;
   root["seed"] = policy.seed;
   root["episodes"] = policy.episodes;
-  if (policy.chain_inputs > 0) {
+  if (policy.acting == Acting::concurrent) {
+    if (policy.chain_inputs > 0) root["chain_inputs"] = policy.chain_inputs;
+    root["features"] =
+        "time / D, robot's steps left / D; per skeleton: live, started / length, refined / length, spent / D, "
+        "robot's backlog / D, next may start now" +
+        std::string(policy.chain_inputs > 0 ? "; per chain: its state one-hot" : "");
+  } else if (policy.chain_inputs > 0) {
     root["chain_inputs"] = policy.chain_inputs;
     root["features"] =
         "time / D; per skeleton: refined / length, spent / D, execution / D; per chain: its state one-hot; per timed "
