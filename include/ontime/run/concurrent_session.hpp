@@ -47,7 +47,8 @@
 // per planner step and no time elsewhere, a live session makes exactly ConcurrentMdp's transitions.
 //
 // Cost: a move copies one state (ConcurrentMdp's words); nothing else is allocated per move but,
-// live, one timeline entry (reserved up front) and one per execution.
+// live, one timeline entry (reserved up front) and one per execution, and with chains one word of
+// their path per step of CT (amortised).
 
 #include <cstdint>
 #include <functional>
