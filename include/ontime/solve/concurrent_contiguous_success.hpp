@@ -52,7 +52,7 @@
 //   P_k(s) = sum_o P(o | s, devoted_move(s, k)) ([o ends the episode] R(o) + [else] P_k(o)),
 // the sum over the outcomes of the move in SPEC §10 (a step's refinement outcome and the chains'
 // step; a start's draw from its chain's state), the chains read in s and following their model
-// from there (docs/theory.md, "Acting while planning: Eq. (1) with chains"). Timing::exact takes it
+// from there (docs/theory.md, "Eq. (1) with chains and expiry"). Timing::exact takes it
 // (aggregation `self` only: `sum` and `max` have no form there): the memoised policy evaluation of
 // ConcurrentSolver, one memo per skeleton shared by every later query of the object. Cost: at most
 // the states that policy reaches from the states asked about (ResourceLimitError past
