@@ -100,6 +100,31 @@ def test_chains_acting_while_planning_as_the_command_line(cli):
     assert search["exact"] and search["optimal_expected_reward"] == memoised["optimal_expected_reward"]
 
 
+def test_dp_and_dp_rerun_with_chains_acting_while_planning_as_the_command_line(cli):
+    """SPEC §10 with §9: dp and dp-rerun value a skeleton by the exact value of its devoted eager
+    policy; from Python the same exact values as from the command line, below the optimum; a session
+    of dp-rerun plays the cup in its simulated door and refuses the report of an execution it did not
+    start; an aggregation other than self is refused naming the rule."""
+    cup = PAPER.parent / "chains" / "cup-through-the-door.json"
+    optimum = ontime.solve(cup, act="concurrent")["optimal_expected_reward"]
+    for solver in ("dp", "dp-rerun"):
+        got = ontime.evaluate(cup, solver, act="concurrent", episodes=100, seed=2, exact=True)
+        expected = cli("evaluate", str(cup), "--act", "concurrent", "--solver", solver, "--episodes", "100", "--seed",
+                       "2", "--exact", "--json", "--no-timing")
+        assert got["exact_expected_reward"] == expected["exact_expected_reward"]
+        assert 0.5 * optimum < got["exact_expected_reward"] <= optimum + 1e-12
+    session = ontime.ConcurrentSession(cup, "dp-rerun", seed=5)
+    with pytest.raises(ontime.UsageError, match="was never started"):
+        session.report_execution_finished("place(cup)@door")
+    while session.status == ontime.Status.running:
+        move = session.choose()
+        if move["start"] is None:
+            session.report_refined(1) if move["action"] is not None else session.report_not_yet()
+    assert session.started[0] == "grasp(cup)"
+    with pytest.raises(ontime.UsageError, match="has no form with chains or expiry"):
+        ontime.evaluate(cup, "dp-rerun", act="concurrent", episodes=10, aggregation="sum")
+
+
 @pytest.mark.parametrize("arguments, message", [
     ({"act": "interleaved"}, "act must be 'plan-first' or 'concurrent'"),
     ({"act": 1}, "act must be 'plan-first' or 'concurrent'"),

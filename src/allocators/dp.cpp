@@ -52,8 +52,8 @@ AllocatorKind dp_kind() {
             return [chosen] { return std::make_unique<DpAllocator>(chosen); };
           },
           .commit_rule =
-              "eager along the one skeleton most likely to succeed alone acting while planning (Eq. (1) "
-              "acting while planning, from the start)",
+              "eager along the one skeleton most likely to succeed alone by Eq. (1) acting while planning, from the "
+              "start (chains: the devoted policy's exact value)",
           .make_concurrent = [](const ConcurrentMdp& mdp, const ParameterReader&) -> ConcurrentAllocatorFactory {
             ConcurrentContiguousSuccess values(mdp, Aggregation::self);
             const ConcurrentState start = mdp.start();

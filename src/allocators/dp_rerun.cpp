@@ -110,21 +110,22 @@ AllocatorKind dp_rerun_kind() {
         return [model = &mdp, table] { return std::make_unique<DpRerunAllocator>(*model, table); };
       },
       .commit_rule =
-          "eager along the best skeleton by Eq. (1) acting while planning (its refined actions run "
-          "back to back while the rest is planned; give-ups blaming a started motion block)",
+          "eager along the best skeleton by Eq. (1) acting while planning, the robot working meanwhile (give-ups "
+          "blaming a started motion block; chains: the devoted policy's exact value)",
       .make_concurrent = [](const ConcurrentMdp& mdp, const ParameterReader& parameters) -> ConcurrentAllocatorFactory {
-        const Aggregation aggregation = parse_aggregation(parameters.text("aggregation"));
-        ConcurrentContiguousSuccess::check_supported(mdp);
+        // With chains or expiry only `self` has a form (the devoted policy's exact value): the default there.
+        std::optional<Aggregation> aggregation;
+        if (parameters.given("aggregation")) aggregation = parse_aggregation(parameters.text("aggregation"));
+        ConcurrentContiguousSuccess::check_supported(mdp, aggregation.value_or(Aggregation::self));
         return
             [model = &mdp, aggregation] { return std::make_unique<ConcurrentDpRerunAllocator>(*model, aggregation); };
       }};
 }
 
-ConcurrentDpRerunAllocator::ConcurrentDpRerunAllocator(const ConcurrentMdp& mdp, Aggregation aggregation)
-    : mdp_(&mdp), values_(mdp, aggregation) {}
+ConcurrentDpRerunAllocator::ConcurrentDpRerunAllocator(const ConcurrentMdp& mdp, std::optional<Aggregation> aggregation)
+    : mdp_(&mdp), values_(mdp, aggregation.value_or(mdp.is_timed() ? Aggregation::self : Aggregation::sum)) {}
 
 ConcurrentMdp::Move ConcurrentDpRerunAllocator::choose(const ConcurrentState& state) {
-  const Problem& problem = mdp_->problem();
   int best = -1;
   double best_value = -1.0;
   for (int k = 0; k < mdp_->skeleton_count(); ++k) {
@@ -136,12 +137,7 @@ ConcurrentMdp::Move ConcurrentDpRerunAllocator::choose(const ConcurrentState& st
     }
   }
   if (best < 0) return {};  // nothing can finish: every move is as good
-  const int depth = mdp_->executed_depth(state);
-  const int refined = ConcurrentMdp::refined(state, best);
-  if (ConcurrentMdp::robot_left(state) == 0 && refined > depth)
-    return {problem.action_at(best, depth), ConcurrentMdp::kWait};
-  if (refined < problem.skeleton_length(best)) return {-1, best};
-  return {};
+  return ConcurrentContiguousSuccess::devoted_move(*mdp_, state, best);
 }
 
 }  // namespace ontime

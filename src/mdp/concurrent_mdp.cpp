@@ -210,6 +210,11 @@ bool ConcurrentMdp::may_start_now(const ConcurrentState& state, int action) cons
 ConcurrentMdp::StartOutcome ConcurrentMdp::start_action(const ConcurrentState& state, int action, Steps drawn) const {
   const std::vector<int> children = startable(state);
   if (!std::binary_search(children.begin(), children.end(), action)) {
+    if (timed_ && action >= 0 && action < action_count_ && !may_start_now(state, action)) {
+      throw UsageError("action " + problem_->action(action).id +
+                       " cannot be started now: it expires (SPEC §9), past its step `after` or while its chain is in a "
+                       "blocking state");
+    }
     throw UsageError("action " + std::to_string(action) +
                      " cannot be started now: the robot starts a refined action just after what it has executed, "
                      "on a skeleton that can still finish, and only while it is idle");
@@ -271,10 +276,19 @@ std::uint16_t clock_word(Steps value, Steps deadline) {
 
 }  // namespace
 
+std::uint16_t ConcurrentMdp::checked_chains(int joint) const {
+  if (joint < 0 || joint >= mdp_.joint_chain_states()) {
+    throw UsageError("the chains' joint state " + std::to_string(joint) + " is not one of the " +
+                     std::to_string(mdp_.joint_chain_states()) + " states of this problem's chains");
+  }
+  return static_cast<std::uint16_t>(joint);
+}
+
 ConcurrentState ConcurrentMdp::on_clock(const ConcurrentState& state, const ClockReading& clock) const {
   ConcurrentState next = state;
   next[0] = clock_word(std::max(time(state), clock.time), deadline_);
   next[1] = clock_word(clock.robot_left, deadline_);
+  if (clock.chains >= 0 && mdp_.has_chains()) next[3] = checked_chains(clock.chains);
   canonicalise(next);
   return next;
 }
@@ -287,14 +301,8 @@ ConcurrentState ConcurrentMdp::step(const ConcurrentState& state, int choice, co
   ConcurrentState next = state;
   next[0] = clock_word(std::max(time(state), clock.time), deadline_);
   next[1] = clock_word(clock.robot_left, deadline_);
-  if (mdp_.has_chains()) {
-    // The chains move whatever the step does (SPEC §9).
-    if (observation.chains >= mdp_.joint_chain_states()) {
-      throw UsageError("the chains' joint state " + std::to_string(observation.chains) + " is not one of the " +
-                       std::to_string(mdp_.joint_chain_states()) + " states of this problem's chains");
-    }
-    next[3] = observation.chains;
-  }
+  // The chains move whatever the step does (SPEC §9).
+  if (mdp_.has_chains()) next[3] = checked_chains(observation.chains);
   if (choice == kWait) {
     if (observation.refined || observation.is_backtrack()) {
       throw UsageError("a motion cannot be found, nor an attempt give up, in a step in which the planner idles");
@@ -343,14 +351,18 @@ ConcurrentState ConcurrentMdp::step(const ConcurrentState& state, int choice, co
 }
 
 ConcurrentState ConcurrentMdp::state_of(Steps time, Steps robot_left, int executed, std::span<const Steps> execution,
-                                        std::span<const Steps> effort) const {
+                                        std::span<const Steps> effort, std::uint16_t chains) const {
   ConcurrentState state = start();
   state[0] = clock_word(time, deadline_);
   state[1] = clock_word(robot_left, deadline_);
   state[2] = static_cast<std::uint16_t>(executed + 1);
+  if (mdp_.has_chains()) state[3] = checked_chains(chains);
   for (int a = 0; a < action_count_; ++a) {
     const Steps known = execution[static_cast<std::size_t>(a)];
-    execution_word(state, a) = known < 0 ? kUnknown : clock_word(known, deadline_);
+    // An execution a chain draws when the action starts is not known before (SPEC §9).
+    execution_word(state, a) = known < 0                           ? kUnknown
+                               : problem_->execution_chain(a) >= 0 ? kDrawnAtStart
+                                                                   : clock_word(known, deadline_);
   }
   for (int k = 0; k < skeleton_count_; ++k) {
     int refined = 0;

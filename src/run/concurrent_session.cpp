@@ -15,20 +15,6 @@
 
 namespace ontime {
 
-namespace {
-
-// Chains or expiry (SPEC §9) in a session on the robot's clock, or in one whose skeletons change:
-// not yet (the model clock's episodes take them).
-void refuse_timed(const ConcurrentMdp& mdp, const char* session) {
-  if (!mdp.is_timed()) return;
-  throw UsageError(mdp.problem().name() + ": " + session +
-                   " acting while planning (SPEC §10) does not take exogenous chains or expiry (SPEC §9) yet: its "
-                   "chains would have to follow the clock (or the skeletons' changes); episodes on the model clock "
-                   "take them (ontime evaluate --act concurrent without --live)");
-}
-
-}  // namespace
-
 ConcurrentSession::ConcurrentSession(const ConcurrentMdp& mdp, ConcurrentAllocator& allocator, std::uint64_t seed)
     : ConcurrentSession(mdp, &allocator, seed) {
   allocator.begin_episode(seed);
@@ -40,7 +26,6 @@ ConcurrentSession::ConcurrentSession(const ConcurrentMdp& mdp, std::uint64_t see
 ConcurrentSession::ConcurrentSession(const ConcurrentMdp& mdp, ConcurrentAllocator& allocator, std::uint64_t seed,
                                      const Clock& clock, LiveOptions options)
     : ConcurrentSession(mdp, &allocator, seed) {
-  refuse_timed(mdp, "a live session");
   live_.start(clock, options, mdp.problem().step_seconds(), mdp.deadline());
   execution_seconds_.assign(static_cast<std::size_t>(mdp.problem().action_count()), -1.0);
   allocator.begin_episode(seed);
@@ -51,14 +36,15 @@ ConcurrentSession::ConcurrentSession(const Problem& problem, AllocatorMaker make
     : mdp_(nullptr),
       allocator_(nullptr),
       seed_(seed),
+      exogenous_(detail::exogenous_stream(seed)),
       owned_mdp_(std::make_unique<ConcurrentMdp>(problem)),
       owned_allocator_(made_allocator(make_allocator, *owned_mdp_)),  // before the maker moves below
       make_allocator_(std::move(make_allocator)) {
   // The members before the owned ones point into them.
   mdp_ = owned_mdp_.get();
-  refuse_timed(*mdp_, "a session whose skeletons change");
   allocator_ = owned_allocator_.get();
   before_ = state_ = mdp_->start();
+  chain_path_.assign(1, ConcurrentMdp::chains(state_));
   const auto actions = static_cast<std::size_t>(problem.action_count());
   attempts_.assign(actions, ActionAttempt{});
   execution_steps_.assign(actions, -1);
@@ -72,7 +58,6 @@ ConcurrentSession::ConcurrentSession(const Problem& problem, AllocatorMaker make
 
 ConcurrentSession::ConcurrentSession(const ConcurrentMdp& mdp, const Clock& clock, LiveOptions options)
     : ConcurrentSession(mdp, nullptr, 0) {
-  refuse_timed(mdp, "a live session");
   live_.start(clock, options, mdp.problem().step_seconds(), mdp.deadline());
   execution_seconds_.assign(static_cast<std::size_t>(mdp.problem().action_count()), -1.0);
 }
@@ -84,7 +69,8 @@ ConcurrentSession::ConcurrentSession(const ConcurrentMdp& mdp, ConcurrentAllocat
       before_(state_),
       attempts_(static_cast<std::size_t>(mdp.problem().action_count())),
       seed_(seed),
-      exogenous_(detail::exogenous_stream(seed)) {
+      exogenous_(detail::exogenous_stream(seed)),
+      chain_path_(1, ConcurrentMdp::chains(state_)) {
   end_if_stuck();
 }
 
@@ -162,9 +148,14 @@ ConcurrentDecision ConcurrentSession::start(int action) {
   started_.push_back(action);
   double end = 0;
   if (live) {
-    // The robot begins the motion once it is free: now, or when the motion before it ends.
+    // The robot begins the motion once it is free: now, or when the motion before it ends. An
+    // execution drawn from a chain when it starts (SPEC §9) lasts the steps drawn, whatever was
+    // reported with its motion.
     const double begins = std::max(elapsed, robot_free_);
-    end = begins + execution_seconds_[static_cast<std::size_t>(action)];
+    const double seconds = drawn < 0         ? execution_seconds_[static_cast<std::size_t>(action)]
+                           : drawn == kNever ? std::numeric_limits<double>::infinity()
+                                             : static_cast<double>(drawn) * live_.step_seconds();
+    end = begins + seconds;
     robot_free_ = end;
     live_.record_execution(action, begins, end);
     finish = std::isinf(end) ? kNever : live_.whole_steps(end);
@@ -191,7 +182,7 @@ ConcurrentDecision ConcurrentSession::start(int action) {
     state_ = std::move(outcome.next);
     if (live) {
       const Steps time = ConcurrentMdp::time(state_);
-      state_ = mdp_->on_clock(state_, {.time = time, .robot_left = robot_left_at(time)});
+      state_ = mdp_->on_clock(state_, clock_reading(time));
     }
     end_if_stuck();
   }
@@ -203,10 +194,23 @@ Steps ConcurrentSession::robot_left_at(Steps time) const {
   return std::clamp<Steps>(live_.whole_steps(robot_free_) - time, 0, mdp_->deadline() + 1);
 }
 
+ConcurrentMdp::ClockReading ConcurrentSession::clock_reading(Steps time) {
+  return {.time = time, .robot_left = robot_left_at(time), .extra_effort = 0, .chains = chains_at(time)};
+}
+
+std::uint16_t ConcurrentSession::chains_at(Steps time) {
+  if (!mdp_->plan_first_mdp().has_chains()) return 0;
+  // One draw of their joint transition per step, from the path's end: as far as `time` needs.
+  while (chain_path_.size() <= static_cast<std::size_t>(time)) {
+    chain_path_.push_back(mdp_->plan_first_mdp().sample_chain_step(chain_path_.back(), exogenous_));
+  }
+  return chain_path_[static_cast<std::size_t>(time)];
+}
+
 bool ConcurrentSession::catch_up() {
   const double elapsed = live_.elapsed();
   const Steps time = std::max<Steps>(ConcurrentMdp::time(state_), live_.steps_at(elapsed));
-  state_ = mdp_->on_clock(state_, {.time = time, .robot_left = robot_left_at(time)});
+  state_ = mdp_->on_clock(state_, clock_reading(time));
   end_if_stuck();
   return status_ == Status::running;
 }
@@ -257,10 +261,7 @@ Status ConcurrentSession::report_with_seconds(const Observation& observation, do
   if (live_.is_live()) return report_on_clock(observation, execution_seconds);
   before_ = state_;
   // The simulated chains (SPEC §9) move one step of their joint transition, whatever the step.
-  const Observation seen = mdp_->plan_first_mdp().has_chains()
-                               ? observation.with_chains(mdp_->plan_first_mdp().sample_chain_step(
-                                     ConcurrentMdp::chains(before_), exogenous_))
-                               : observation;
+  const Observation seen = observation.with_chains(chains_at(ConcurrentMdp::time(before_) + 1));
   state_ = mdp_->step(before_, pending_skeleton_, seen);  // checks what the step cannot reveal
   pending_ = false;
   if (pending_action_ >= 0) {
@@ -282,8 +283,10 @@ Status ConcurrentSession::report_on_clock(const Observation& observation, double
   const Steps effort = live_.effort_of(planning);
   const Steps time = std::max<Steps>(ConcurrentMdp::time(state_), live_.steps_at(elapsed));
   before_ = state_;
+  // The simulated chains (SPEC §9) follow the clock: one step of their path per step of CT,
+  // however many steps the call took.
   state_ = mdp_->step(
-      before_, pending_skeleton_, observation,
+      before_, pending_skeleton_, observation.with_chains(chains_at(time)),
       {.time = time, .robot_left = robot_left_at(time), .extra_effort = observation.refined ? 0 : effort - 1});
   pending_ = false;
   LiveStep& step = live_.last_step();
@@ -346,7 +349,7 @@ Status ConcurrentSession::report_execution_left(int action, double seconds) {
   robot_free_ = elapsed + seconds;
   live_.move_last_execution_end(robot_free_);
   const Steps time = std::max<Steps>(ConcurrentMdp::time(state_), live_.steps_at(elapsed));
-  state_ = mdp_->on_clock(state_, {.time = time, .robot_left = robot_left_at(time)});
+  state_ = mdp_->on_clock(state_, clock_reading(time));
   end_if_stuck();
   return status_;
 }
@@ -407,8 +410,10 @@ void ConcurrentSession::change_skeletons(const Problem& next) {
   execution.resize(actions, -1);
   std::vector<Steps> effort(actions, 0);
   for (std::size_t a = 0; a < attempts_.size() && a < actions; ++a) effort[a] = attempts_[a].effort;
-  ConcurrentState state = mdp->state_of(ConcurrentMdp::time(state_), ConcurrentMdp::robot_left(state_),
-                                        ConcurrentMdp::executed(state_), execution, effort);
+  // The chains carry over in their order (the problem keeps them): the same joint state.
+  ConcurrentState state =
+      mdp->state_of(ConcurrentMdp::time(state_), ConcurrentMdp::robot_left(state_), ConcurrentMdp::executed(state_),
+                    execution, effort, ConcurrentMdp::chains(state_));
 
   // Nothing below throws.
   mdp_ = mdp.get();

@@ -5,6 +5,7 @@
 #include <span>
 #include <string>
 
+#include "ontime/solve/concurrent_solver.hpp"
 #include "ontime/util/error.hpp"
 
 namespace ontime {
@@ -15,15 +16,42 @@ ConcurrentContiguousSuccess::ConcurrentContiguousSuccess(const ConcurrentMdp& md
       aggregation_(aggregation),
       relaxed_(timing == Timing::relax && mdp.is_timed()),
       deadline_(mdp.deadline()) {
-  if (timing == Timing::refuse) check_supported(mdp);
+  if (timing != Timing::exact || !mdp.is_timed()) return;
+  check_supported(mdp, aggregation);
+  devoted_.reserve(static_cast<std::size_t>(mdp.skeleton_count()));
+  for (int k = 0; k < mdp.skeleton_count(); ++k) {
+    devoted_.push_back(std::make_unique<ConcurrentSolver>(
+        mdp, [model = &mdp, k](const ConcurrentState& state) { return devoted_move(*model, state, k); }));
+  }
 }
 
-void ConcurrentContiguousSuccess::check_supported(const ConcurrentMdp& mdp) {
-  if (mdp.is_timed()) {
-    throw UsageError(mdp.problem().name() +
-                     ": dp and dp-rerun acting while planning (SPEC §10) do not value exogenous chains or expiry "
-                     "(SPEC §9) yet (the optimal allocator and the eager kinds take them)");
+ConcurrentContiguousSuccess::~ConcurrentContiguousSuccess() = default;
+ConcurrentContiguousSuccess::ConcurrentContiguousSuccess(ConcurrentContiguousSuccess&&) noexcept = default;
+ConcurrentContiguousSuccess& ConcurrentContiguousSuccess::operator=(ConcurrentContiguousSuccess&&) noexcept = default;
+
+void ConcurrentContiguousSuccess::check_supported(const ConcurrentMdp& mdp, Aggregation aggregation) {
+  if (mdp.is_timed() && aggregation != Aggregation::self) {
+    throw UsageError(mdp.problem().name() + ": aggregation '" + std::string(to_string(aggregation)) +
+                     "' has no form with chains or expiry (SPEC §9) in Eq. (1) acting while planning (SPEC §10); "
+                     "'self' is the one taken");
   }
+}
+
+ConcurrentMdp::Move ConcurrentContiguousSuccess::devoted_move(const ConcurrentMdp& mdp, const ConcurrentState& state,
+                                                              int k) {
+  if (!ConcurrentMdp::is_live(state, k)) return {};
+  const Problem& problem = mdp.problem();
+  const int depth = mdp.executed_depth(state);
+  const int refined = ConcurrentMdp::refined(state, k);
+  if (ConcurrentMdp::robot_left(state) == 0 && refined > depth) {
+    const int next = problem.action_at(k, depth);
+    if (!mdp.is_timed()) return {next, ConcurrentMdp::kWait};
+    // With chains or expiry it starts as soon as it may: until then the planner refines k.
+    const std::vector<int> startable = mdp.startable(state);
+    if (std::binary_search(startable.begin(), startable.end(), next)) return {next, ConcurrentMdp::kWait};
+  }
+  if (refined < problem.skeleton_length(k)) return {-1, k};
+  return {};
 }
 
 // value, fresh and after_found recurse one level per action of the skeleton (at most
@@ -32,6 +60,11 @@ void ConcurrentContiguousSuccess::check_supported(const ConcurrentMdp& mdp) {
 double ConcurrentContiguousSuccess::value(int k, int l, Steps spent, Steps time, std::int64_t backlog) {
   if (mdp_->has_backtracking()) {
     throw UsageError("Eq. (1) acting while planning with backtracking needs the restore values: value it from a state");
+  }
+  if (mdp_->is_timed() && !relaxed_) {
+    throw UsageError(
+        "Eq. (1) acting while planning with chains or expiry (SPEC §9) values the devoted policy from a state: the "
+        "robot's backlog is not a number there");
   }
   if (time + backlog > deadline_) return 0.0;
   const Problem& problem = mdp_->problem();
@@ -47,6 +80,11 @@ double ConcurrentContiguousSuccess::value(int k, int l, Steps spent, Steps time,
 }
 
 double ConcurrentContiguousSuccess::value(const ConcurrentState& state, int k) {
+  if (!devoted_.empty()) {
+    // Once k is dropped the devoted policy starts nothing: the episode cannot end through it.
+    if (!ConcurrentMdp::is_live(state, k)) return 0.0;
+    return devoted_[static_cast<std::size_t>(k)]->solve(state);
+  }
   if (mdp_->has_backtracking()) return give_up_value(state, k);
   const Problem& problem = mdp_->problem();
   const std::int64_t free = mdp_->robot_free(state, k);

@@ -299,23 +299,6 @@ TEST(ConcurrentEpisodesWithChains, TheSameSeedGivesTheSameEpisodesOnAnyThreadCou
   }
 }
 
-TEST(ConcurrentEpisodesWithChains, WhatIsNotThereYetIsRefusedNamingTheRule) {
-  const Problem problem = chain_instance("cup-through-the-door");
-  const ConcurrentMdp mdp(problem);
-  const auto refused = [](const auto& make, const std::string& rule) {
-    try {
-      make();
-      ADD_FAILURE() << "not refused: " << rule;
-    } catch (const UsageError& error) {
-      EXPECT_NE(std::string(error.what()).find(rule), std::string::npos) << error.what();
-      EXPECT_NE(std::string(error.what()).find("SPEC §9"), std::string::npos) << error.what();
-    }
-  };
-  const ManualClock clock;
-  refused([&] { ConcurrentSession session(mdp, clock); }, "a live session");
-  refused([&] { ConcurrentSession session(problem, {}, 1); }, "a session whose skeletons change");
-}
-
 TEST(ConcurrentEpisodesWithChains, AStartTheChainsBlockIsRefused) {
   // The door is locked for good: through, once refined, may never start.
   const Problem problem = parse_problem(R"({"deadline": 6, "acting": "concurrent",

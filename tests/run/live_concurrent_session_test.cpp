@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <stdexcept>
@@ -55,13 +56,22 @@ Outcomes concurrent_outcomes(const ConcurrentMdp& mdp, const WorldFactory& world
 
 // With a manual clock advanced by exactly one slice per planner step and nothing else, a live
 // concurrent session makes ConcurrentMdp's transitions: the same episodes succeed, with the same
-// rewards, as in the model's episodes.
+// rewards, as in the model's episodes. With exogenous chains and expiry (SPEC §9) too: the live
+// session follows the chains along its clock and draws a chain-dependent execution at its start,
+// as the model's does (the two small examples; the cup's has give-ups and rewards).
 TEST(LiveConcurrentSession, ExactSlicesAndInstantDecisionsGiveTheModelsEpisodes) {
+  std::vector<Problem> problems;
   for (const char* name : {"instance1", "instance2", "instance3", "instance4", "instance5"}) {
-    const Problem problem = testing::paper_instance(name).with_acting(Acting::concurrent);
+    problems.push_back(testing::paper_instance(name).with_acting(Acting::concurrent));
+  }
+  for (const char* name : {"meeting-through-the-queue", "cup-through-the-door"}) {
+    problems.push_back(load_problem(testing::source_path(std::string("data/instances/chains/") + name + ".json"))
+                           .with_acting(Acting::concurrent));
+  }
+  for (const Problem& problem : problems) {
     const ConcurrentMdp mdp(problem);
     for (const char* solver : {"dp-rerun", "greedy", "round-robin", "optimal"}) {
-      SCOPED_TRACE(std::string(name) + " " + solver);
+      SCOPED_TRACE(problem.name() + " " + solver);
       const ConcurrentAllocatorFactory factory = make_concurrent_allocator_factory(solver, mdp);
       MonteCarloOptions options;
       options.episodes = 2000;
@@ -327,6 +337,189 @@ TEST(LiveConcurrentSession, ArrivingSkeletonsCarryTheStateOverAsIfTheyHadBeenThe
   }
   ConcurrentSession not_owning(full_mdp);
   EXPECT_THROW(not_owning.add_skeleton({"a"}), std::logic_error);
+}
+
+// A door open or closed at every step after the first w.p. 1/2 each; a is found at once and runs 2
+// steps; b's execution is drawn from the door's state when it starts (1 step open, 3 closed); c
+// (found in 1 or 2 steps, 1 to execute) cannot start while the door is closed (with `locked`, the
+// door starts closed and stays so). Deadline 10 steps of 1 s.
+Problem door_problem(bool with_c, bool locked = false) {
+  std::string text =
+      R"({"deadline": 10, "step_seconds": 1, "acting": "concurrent", "chains": {"door": {"states": ["open", "closed"], )";
+  text += locked ? R"("start": "closed", "transitions": [[1, 0], [0, 1]]}},)"
+                 : R"("start": "open", "transitions": [[0.5, 0.5], [0.5, 0.5]]}},)";
+  text += R"("actions": {"a": {"planning": {"pmf": {"1": 1}}, "execution": {"pmf": {"2": 1}}},
+    "b": {"planning": {"pmf": {"1": 1}},
+          "execution": {"chain": "door", "by_state": {"open": {"pmf": {"1": 1}}, "closed": {"pmf": {"3": 1}}}}})";
+  text += with_c ? R"(, "c": {"planning": {"pmf": {"1": 0.5, "2": 0.5}}, "execution": {"pmf": {"1": 1}},
+          "expires": {"chain": "door", "states": ["closed"]}}}, "skeletons": [["a", "b"], ["a", "c"]]})"
+                 : R"(}, "skeletons": [["a", "b"]]})";
+  return parse_problem(text, "door");
+}
+
+// SPEC §9's chains follow a live session's clock: a call that takes three slices moves them three
+// steps, as three steps on the model's clock do (the same seed, the same path), and so does a slow
+// decision: the state before the move holds their state at its CT.
+TEST(LiveConcurrentSession, TheChainsFollowTheClockHoweverManyStepsACallTakes) {
+  const Problem problem = door_problem(true);
+  const ConcurrentMdp mdp(problem);
+  const ConcurrentMdp::Move wait{-1, ConcurrentMdp::kWait};
+  std::vector<int> seen(2, 0);
+  for (std::uint64_t seed = 1; seed <= 16; ++seed) {
+    SCOPED_TRACE(seed);
+    ManualClock clock;
+    ConcurrentSession live(problem, ConcurrentSession::AllocatorMaker{}, seed, &clock);
+    ConcurrentSession model(mdp, seed);
+    // a is found in one slice and started at once on both.
+    live.decide({-1, 0});
+    model.decide({-1, 0});
+    clock.advance(1);
+    live.report_refined(2);
+    model.report_refined(2);
+    live.decide({0, ConcurrentMdp::kWait});
+    model.decide({0, ConcurrentMdp::kWait});
+    ASSERT_EQ(live.state(), model.state());
+    // An idle call of three slices; three idle steps on the model's clock.
+    live.decide(wait);
+    clock.advance(3);
+    live.report_not_yet();
+    for (int step = 0; step < 3; ++step) {
+      model.decide(wait);
+      model.report_not_yet();
+    }
+    EXPECT_EQ(live.steps_used(), 4);
+    EXPECT_EQ(live.state(), model.state());
+    ++seen[ConcurrentMdp::chains(model.state())];
+    // A decision that takes two slices: the move is made at CT 6.
+    clock.advance(2);
+    live.decide(wait);
+    for (int step = 0; step < 2; ++step) {
+      model.decide(wait);
+      model.report_not_yet();
+    }
+    EXPECT_EQ(live.steps_used(), 6);
+    EXPECT_EQ(ConcurrentMdp::chains(live.state()), ConcurrentMdp::chains(model.state()));
+    ++seen[ConcurrentMdp::chains(model.state())];
+  }
+  // Both states of the door were met, so that the comparisons above could tell them apart.
+  EXPECT_GT(seen[0], 0);
+  EXPECT_GT(seen[1], 0);
+}
+
+// The moves of the streaming test below: start what the robot may start (a first, then c), else
+// refine c (missed once, then found), else idle; the same on both sessions, which must agree.
+void follow_the_door(ConcurrentSession& growing, ConcurrentSession& from_start, ManualClock* clock,
+                     ManualClock* from_start_clock) {
+  int attempts_on_c = 0;
+  for (int move = 0; move < 40 && from_start.status() == Status::running; ++move) {
+    ASSERT_EQ(growing.status(), Status::running);
+    ASSERT_EQ(growing.state(), from_start.state());
+    const ConcurrentMdp& mdp = from_start.mdp();
+    const ConcurrentState& state = from_start.state();
+    const std::vector<int> startable = mdp.startable(state);
+    const auto may_start = [&](const char* id) {
+      const int action = from_start.problem().find_action(id);
+      return std::find(startable.begin(), startable.end(), action) != startable.end() ? action : -1;
+    };
+    ConcurrentMdp::Move chosen{-1, ConcurrentMdp::kWait};
+    if (may_start("a") >= 0 || may_start("c") >= 0) {
+      chosen = {std::max(may_start("a"), may_start("c")), ConcurrentMdp::kWait};
+    } else if (ConcurrentMdp::is_live(state, 1) && ConcurrentMdp::refined(state, 1) < 2) {
+      chosen = {-1, 1};
+    } else if (may_start("b") >= 0) {
+      chosen = {may_start("b"), ConcurrentMdp::kWait};
+    }
+    growing.decide(chosen);
+    from_start.decide(chosen);
+    if (chosen.is_start()) continue;
+    if (clock != nullptr) clock->advance(1);
+    if (from_start_clock != nullptr) from_start_clock->advance(1);
+    const bool found = chosen.refine == 1 && ++attempts_on_c == 2;
+    for (ConcurrentSession* session : {&growing, &from_start}) {
+      if (found) {
+        session->report_refined(1);
+      } else {
+        session->report_not_yet();
+      }
+    }
+  }
+  EXPECT_NE(from_start.status(), Status::running);
+  EXPECT_EQ(growing.status(), from_start.status());
+  EXPECT_EQ(growing.reward(), from_start.reward());
+  EXPECT_EQ(growing.started(), from_start.started());
+}
+
+// Skeletons that stream in with exogenous chains (SPEC §9): a skeleton that arrives once a and b
+// are refined finds the state it would have had from the start, the chains' state and b's
+// execution to be drawn at its start included, and the episode goes on as if it had been there
+// (the same moves, the same chains, the same end), on the model's steps and on the clock.
+TEST(LiveConcurrentSession, SkeletonsThatStreamInCarryTheChainsOver) {
+  const Problem first = door_problem(false);
+  const Problem full = door_problem(true);
+  const ConcurrentMdp full_mdp(full);
+  const Action c = full.action(full.find_action("c"));
+  std::vector<int> arrived_in(2, 0);  // the door's state when c arrived
+  int successes = 0;
+  for (const bool live : {false, true}) {
+    for (std::uint64_t seed = 1; seed <= 12; ++seed) {
+      SCOPED_TRACE(std::string(live ? "live" : "steps") + " seed " + std::to_string(seed));
+      ManualClock clock;
+      ManualClock full_clock;
+      ConcurrentSession growing(first, ConcurrentSession::AllocatorMaker{}, seed, live ? &clock : nullptr);
+      // On the model's steps the session from the start does not own its problem.
+      ConcurrentSession from_start =
+          live ? ConcurrentSession(full, ConcurrentSession::AllocatorMaker{}, seed, &full_clock)
+               : ConcurrentSession(full_mdp, seed);
+      // a found (2 steps), then b (its execution reported but drawn when it starts): on both.
+      for (const Steps reported : {2, 5}) {
+        growing.decide({-1, 0});
+        from_start.decide({-1, 0});
+        clock.advance(1);
+        full_clock.advance(1);
+        growing.report_refined(reported);
+        from_start.report_refined(reported);
+      }
+      EXPECT_EQ(growing.add_skeleton({"a", "c"}, {c}), 1);
+      EXPECT_EQ(full_mdp.execution(growing.state(), full.find_action("b")), ConcurrentMdp::kDrawnAtStart);
+      ++arrived_in[ConcurrentMdp::chains(growing.state())];
+      follow_the_door(growing, from_start, live ? &clock : nullptr, live ? &full_clock : nullptr);
+      successes += from_start.status() == Status::success ? 1 : 0;
+    }
+  }
+  EXPECT_GT(arrived_in[0], 0);
+  EXPECT_GT(arrived_in[1], 0);
+  EXPECT_GT(successes, 0);
+}
+
+// What a live session with chains did not expect is refused naming the rule: the report of an
+// execution it never started, of one that is not the robot's current one, and a start the door
+// blocks (SPEC §9: a locked door, so that c can never start).
+TEST(LiveConcurrentSession, WithChainsAReportOrAStartItDidNotExpectIsRefusedNamingTheRule) {
+  const Problem problem = door_problem(true, true);
+  const ConcurrentMdp mdp(problem);
+  ManualClock clock;
+  ConcurrentSession session(mdp, clock);
+  session.decide({-1, 1});  // a, shared by both skeletons
+  clock.advance(1);
+  session.report_refined(2);
+  const auto refused = [](const auto& call, const std::string& rule) {
+    try {
+      call();
+      ADD_FAILURE() << "not refused: " << rule;
+    } catch (const UsageError& error) {
+      EXPECT_NE(std::string(error.what()).find(rule), std::string::npos) << error.what();
+    }
+  };
+  refused([&] { session.report_execution_finished(0); }, "was never started");
+  session.decide({0, ConcurrentMdp::kWait});
+  refused([&] { session.report_execution_left(1, 1.0); }, "was never started");
+  session.decide({-1, 1});  // c
+  clock.advance(1);
+  session.report_refined(1);
+  clock.advance(2);  // a ends at 3 s
+  refused([&] { session.decide({2, ConcurrentMdp::kWait}); }, "it expires (SPEC §9)");
+  EXPECT_EQ(session.status(), Status::running);
+  EXPECT_EQ(session.started(), std::vector<int>{0});
 }
 
 }  // namespace

@@ -132,7 +132,6 @@ TEST(RegretActingWhilePlanning, TheEstimateHoldsTheExactRegretOfStationaryAlloca
     const ConcurrentMdp mdp(problem);
     const double optimum = ConcurrentSolver(mdp).solve(mdp.start());
     for (const std::string name : {"dp-rerun", "greedy", "round-robin", "averaged"}) {
-      if (name == "dp-rerun" && problem.is_timed()) continue;  // (it does not take chains acting while planning)
       SCOPED_TRACE(name + " on " + problem.name());
       const auto allocator = make_concurrent_allocator_factory(name, mdp)();
       const double exact = optimum - evaluate_exactly(mdp, *allocator).expected_reward;

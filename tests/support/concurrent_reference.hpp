@@ -17,6 +17,10 @@
 // plan_first() values the plan-first policies of the same MDP (SPEC §2 and §8 read as a policy
 // of §10: the robot never moves until a skeleton is refined in full, then runs the first one that
 // fits from that step): its optimum must be OptimalSolver's; not with chains or expiry.
+// devoted(k) values one policy of the same MDP, the devoted eager one of skeleton k: the planner
+// refines k alone, the robot starts k's next action as soon as it is refined, the robot is idle and
+// the action may start, and the planner idles once k has nothing left to refine (or the next
+// action is blocked for good). The episode may still end through a skeleton that is a prefix of k.
 // Exponential; small instances only.
 
 #include <algorithm>
@@ -35,6 +39,13 @@ class ConcurrentReference {
   double optimum() { return solve(false); }
   // The best plan-first policy, valued in the same model.
   double plan_first() { return solve(true); }
+  // The devoted eager policy of skeleton k (above), valued in the same model.
+  double devoted(int k) {
+    devoted_ = k;
+    const double value = solve(false);
+    devoted_ = -1;
+    return value;
+  }
 
  private:
   static constexpr long kUnrefined = -1;
@@ -74,6 +85,11 @@ class ConcurrentReference {
 
   double value(const Node& node) {
     if (const auto found = memo_.find(node); found != memo_.end()) return found->second;
+    if (devoted_ >= 0) {
+      const double devoted = devoted_value(node);
+      memo_.emplace(node, devoted);
+      return devoted;
+    }
     double best = 0.0;
     const int skeletons = problem_.skeleton_count();
     const std::size_t depth = node.executed.size();
@@ -99,39 +115,7 @@ class ConcurrentReference {
         const int child = problem_.action_at(k, static_cast<int>(depth));
         const long x = node.execution[static_cast<std::size_t>(child)];
         if ((x < 0 && x != kDrawnAtStart) || !may_start(node, child)) continue;
-        int ending = -1;
-        for (int m = 0; m < skeletons; ++m) {
-          if (through_executed(node, m) && problem_.skeleton_length(m) == static_cast<int>(depth) + 1 &&
-              problem_.action_at(m, static_cast<int>(depth)) == child) {
-            ending = m;
-          }
-        }
-        const auto start_with = [&](long steps) {
-          if (ending >= 0) return reward(ending, node.time + steps);
-          Node next = node;
-          next.executed.push_back(child);
-          next.robot_left = steps;
-          forget_unusable(next);
-          return value(next);
-        };
-        double start_value = 0.0;
-        if (x != kDrawnAtStart) {
-          start_value = start_with(x);
-        } else {
-          // Drawn now, from the row of the chain's state.
-          const int chain = problem_.execution_chain(child);
-          const Distribution& drawn =
-              problem_.action(child)
-                  .execution_by_state[static_cast<std::size_t>(node.chains[static_cast<std::size_t>(chain)])];
-          double in_time = 0.0;
-          for (Steps steps = 0; steps <= problem_.deadline(); ++steps) {
-            if (drawn.pmf(steps) <= 0) continue;
-            in_time += drawn.pmf(steps);
-            start_value += drawn.pmf(steps) * start_with(steps);
-          }
-          if (1.0 - in_time > 1e-15) start_value += (1.0 - in_time) * start_with(problem_.deadline() + 1L);
-        }
-        best = std::max(best, start_value);
+        best = std::max(best, start_value(node, child));
       }
     }
     if (node.time < problem_.deadline()) {
@@ -160,6 +144,68 @@ class ConcurrentReference {
     }
     memo_.emplace(node, best);
     return best;
+  }
+
+  // The value of starting refined `child` of the executed path now (it may start).
+  double start_value(const Node& node, int child) {
+    const int skeletons = problem_.skeleton_count();
+    const std::size_t depth = node.executed.size();
+    const long x = node.execution[static_cast<std::size_t>(child)];
+    int ending = -1;
+    for (int m = 0; m < skeletons; ++m) {
+      if (through_executed(node, m) && problem_.skeleton_length(m) == static_cast<int>(depth) + 1 &&
+          problem_.action_at(m, static_cast<int>(depth)) == child) {
+        ending = m;
+      }
+    }
+    const auto start_with = [&](long steps) {
+      if (ending >= 0) return reward(ending, node.time + steps);
+      Node next = node;
+      next.executed.push_back(child);
+      next.robot_left = steps;
+      forget_unusable(next);
+      return value(next);
+    };
+    double total = 0.0;
+    if (x != kDrawnAtStart) {
+      total = start_with(x);
+    } else {
+      // Drawn now, from the row of the chain's state.
+      const int chain = problem_.execution_chain(child);
+      const Distribution& drawn =
+          problem_.action(child)
+              .execution_by_state[static_cast<std::size_t>(node.chains[static_cast<std::size_t>(chain)])];
+      double in_time = 0.0;
+      for (Steps steps = 0; steps <= problem_.deadline(); ++steps) {
+        if (drawn.pmf(steps) <= 0) continue;
+        in_time += drawn.pmf(steps);
+        total += drawn.pmf(steps) * start_with(steps);
+      }
+      if (1.0 - in_time > 1e-15) total += (1.0 - in_time) * start_with(problem_.deadline() + 1L);
+    }
+    return total;
+  }
+
+  // The devoted policy's move (devoted()) in `node`, and its value.
+  double devoted_value(const Node& node) {
+    const int k = devoted_;
+    if (!through_executed(node, k)) return 0.0;
+    const std::size_t depth = node.executed.size();
+    if (node.robot_left == 0 && static_cast<int>(depth) < problem_.skeleton_length(k)) {
+      const int child = problem_.action_at(k, static_cast<int>(depth));
+      const long x = node.execution[static_cast<std::size_t>(child)];
+      if ((x >= 0 || x == kDrawnAtStart) && may_start(node, child)) return start_value(node, child);
+    }
+    if (node.time >= problem_.deadline()) return 0.0;
+    Node idle = node;
+    ++idle.time;
+    idle.robot_left = std::max(0L, node.robot_left - 1);
+    for (const int action : problem_.skeleton(k)) {
+      const long x = node.execution[static_cast<std::size_t>(action)];
+      if (x == kBlocked) break;
+      if (x == kUnrefined) return refine_value(idle, action);
+    }
+    return after_step(idle);
   }
 
   // One step of effort on `action` from `after` (the step's time and robot already advanced).
@@ -288,6 +334,7 @@ class ConcurrentReference {
 
   const Problem& problem_;
   bool plan_first_ = false;
+  int devoted_ = -1;  // the skeleton of devoted(), -1 otherwise
   std::map<Node, double> memo_;
 };
 

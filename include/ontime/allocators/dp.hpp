@@ -5,6 +5,9 @@
 // backtracking, SPEC §7, its extension: backtracking_success.hpp; with chains or expiry, SPEC §9,
 // the exact value of refining the skeleton alone: timed_contiguous_success.hpp), picks the largest
 // once (ties: lowest index) and refines only that skeleton for the whole episode.
+// Acting while planning (SPEC §10) the registry's kind picks the skeleton by Eq. (1) acting while
+// planning from the start (ConcurrentContiguousSuccess, aggregation `self`: with chains or expiry
+// the devoted eager policy's exact value) and follows it by the eager commit rule.
 // No guarantee beyond optimality among "one skeleton, refined contiguously" policies.
 // Cost: one ContiguousSuccessTable build at construction; O(1) per decision.
 

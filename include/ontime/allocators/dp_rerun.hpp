@@ -67,14 +67,20 @@ class DpRerunAllocator final : public Allocator {
 // rest is planned) and follows the best (ties: lowest index): while the robot is idle and the
 // best skeleton's next action to execute is refined, it starts it (committing to the skeletons
 // through it); otherwise it spends the step on the best skeleton's next action, or waits when that
-// skeleton is refined in full. With backtracking (SPEC §7) Eq. (1) has its give-up term.
+// skeleton is refined in full (ConcurrentContiguousSuccess::devoted_move). With backtracking
+// (SPEC §7) Eq. (1) has its give-up term. With chains or expiry (SPEC §9) a skeleton is worth the
+// exact value of its devoted eager policy from the state (the chains read now and modelled from
+// there), aggregation `self` only, and "starts" means as soon as the action may start: while it is
+// blocked the planner refines the skeleton, or idles when the plan is complete.
 // Stationary: ConcurrentSolver's policy mode values it exactly.
 // Cost: per move, one Eq. (1) query per live skeleton: a sum over at most D - CT planning steps of
-// memoised values (memoised per allocator, so each thread's allocator has its own memo).
+// memoised values (memoised per allocator, so each thread's allocator has its own memo); with
+// chains or expiry a lookup once the devoted policy's states from there are valued.
 class ConcurrentDpRerunAllocator final : public ConcurrentAllocator {
  public:
-  // The allocator for `mdp`, Eq. (1) combining sharing skeletons by `aggregation` (sum: Table I's).
-  explicit ConcurrentDpRerunAllocator(const ConcurrentMdp& mdp, Aggregation aggregation = Aggregation::sum);
+  // The allocator for `mdp`, Eq. (1) combining sharing skeletons by `aggregation` (none: sum,
+  // Table I's; with chains or expiry self, the only one taken there: another throws UsageError).
+  explicit ConcurrentDpRerunAllocator(const ConcurrentMdp& mdp, std::optional<Aggregation> aggregation = std::nullopt);
   std::string_view name() const noexcept override { return "dp-rerun"; }
   // The move in a state where some skeleton is live: a start or a step, as above.
   ConcurrentMdp::Move choose(const ConcurrentState& state) override;

@@ -219,6 +219,9 @@ class ConcurrentMdp {
     Steps time = 0;
     Steps robot_left = 0;
     Steps extra_effort = 0;
+    // Exogenous chains (SPEC §9): their joint state at `time` for on_clock (a session that follows
+    // them along its clock); -1 keeps the state's. step() reads the observation's instead.
+    int chains = -1;
   };
   // step() with CT, r and the effort read off the clock instead of one step each: the planner's
   // PT grows by 1 + extra_effort on a miss. step(state, choice, observation) is this with CT + 1,
@@ -226,7 +229,8 @@ class ConcurrentMdp {
   ConcurrentState step(const ConcurrentState& state, int choice, const Observation& observation,
                        const ClockReading& clock) const;
   // The state brought up to the clock between steps: CT raised to clock.time, r set to
-  // clock.robot_left (canonical; extra_effort is not used).
+  // clock.robot_left, the chains' joint state set to clock.chains unless it is -1 (canonical;
+  // extra_effort is not used). Throws UsageError for a joint state the chains do not have.
   ConcurrentState on_clock(const ConcurrentState& state, const ClockReading& clock) const;
 
   // The state of what is known, for a session whose skeletons change (run/concurrent_session.hpp):
@@ -234,9 +238,11 @@ class ConcurrentMdp {
   // none), and per action its execution time in steps once refined (-1: not refined) and the steps
   // of effort spent on it (its PT while unrefined). A skeleton has refined its leading actions
   // whose execution is known; canonical (the skeletons not through the prefix, or unable to finish,
-  // dropped). Both spans have an entry per action.
+  // dropped). Both spans have an entry per action. With exogenous chains (SPEC §9) `chains` is
+  // their joint state now, and a refined action whose execution a chain draws when it starts holds
+  // kDrawnAtStart whatever its entry says (UsageError for a joint state the chains do not have).
   ConcurrentState state_of(Steps time, Steps robot_left, int executed, std::span<const Steps> execution,
-                           std::span<const Steps> effort) const;
+                           std::span<const Steps> effort, std::uint16_t chains = 0) const;
 
   // The state with the robot's current execution finished now (r = 0; canonical): what a robot
   // that finished sooner than its motion's execution time reports. The state itself while it is
@@ -291,6 +297,8 @@ class ConcurrentMdp {
   bool through_executed(const ConcurrentState& state, int k) const noexcept;
   // Drops the skeletons that are not live and forgets the executions no live skeleton runs.
   void canonicalise(ConcurrentState& state) const;
+  // `joint` as the chains' joint state word; UsageError for one the chains do not have.
+  std::uint16_t checked_chains(int joint) const;
   [[noreturn]] static void reject_choice(int choice);
   // The attempt on `action` (the next action of `group`'s live skeletons) gave up and blames
   // `culprit`; `next` has the step's time and robot applied. Not canonical.

@@ -17,14 +17,18 @@
 // robot has run one more step of its current execution. The session fails when no skeleton can
 // finish by the deadline any more.
 //
-// Exogenous chains and expiry (SPEC §9), on the model's clock: the session simulates the chains
-// from its seed (the stream plan-first Session draws them from): every step moves them by one draw
-// of their joint transition, whatever the report says (its `chains` is not used), and an action
-// whose execution depends on a chain has it drawn when it starts, from the chain's state then
-// (ConcurrentMdp::sample_start_execution). A start is carried out only while the action may start
-// (ConcurrentMdp::startable; UsageError otherwise). A live session and one that owns its problem
-// refuse chains or expiry (UsageError naming the rule): their chains would have to follow the clock
-// or carry over to new skeletons.
+// Exogenous chains and expiry (SPEC §9): the session simulates the chains from its seed (the
+// stream plan-first Session draws them from), one path by step of CT: every step moves them by one
+// draw of their joint transition, whatever the report says (its `chains` is not used), and an
+// action whose execution depends on a chain has it drawn when it starts, from the chain's state
+// then (ConcurrentMdp::sample_start_execution). A start is carried out only while the action may
+// start (ConcurrentMdp::startable; UsageError otherwise). Live, the chains follow the clock: the
+// state before every move and after every report holds their state at its CT, one step of their
+// path per step of CT however many a call or a decision took (as a plan-first live session carried
+// out in a world), and a chain-dependent execution lasts the steps drawn at its start (its seconds:
+// those steps times step_seconds; the seconds reported with its motion are not used). A session
+// that owns its problem carries the chains' joint state over to each new problem (the skeletons
+// change, the chains do not).
 //
 // A live session (constructed with a Clock) runs on the robot's seconds as a live Session does
 // (session.hpp, docs/live.md; the ledger is the same, live_ledger.hpp). The deadline is
@@ -43,7 +47,8 @@
 // per planner step and no time elsewhere, a live session makes exactly ConcurrentMdp's transitions.
 //
 // Cost: a move copies one state (ConcurrentMdp's words); nothing else is allocated per move but,
-// live, one timeline entry (reserved up front) and one per execution.
+// live, one timeline entry (reserved up front) and one per execution, and with chains one word of
+// their path per step of CT (amortised).
 
 #include <cstdint>
 #include <functional>
@@ -82,7 +87,7 @@ class ConcurrentSession {
   // simulated chains (SPEC §9), as the allocator's session's seed does.
   explicit ConcurrentSession(const ConcurrentMdp& mdp, std::uint64_t seed = 0);
   // The same two live on `clock` (which must outlive the session); the deadline starts now. Throw
-  // UsageError for a decision share outside (0, 1e6] or a problem with chains or expiry.
+  // UsageError for a decision share outside (0, 1e6].
   ConcurrentSession(const ConcurrentMdp& mdp, ConcurrentAllocator& allocator, std::uint64_t seed, const Clock& clock,
                     LiveOptions options = {});
   ConcurrentSession(const ConcurrentMdp& mdp, const Clock& clock, LiveOptions options = {});
@@ -201,6 +206,11 @@ class ConcurrentSession {
   void end_if_stuck();
   // Live: the whole steps the robot's current execution still needs at CT `time`.
   Steps robot_left_at(Steps time) const;
+  // Live: what the clock says at CT `time` (r, and with chains or expiry their state then).
+  ConcurrentMdp::ClockReading clock_reading(Steps time);
+  // The simulated chains' joint state at step `time` (0 without chains), their path drawn from
+  // exogenous_ as far as it is needed.
+  std::uint16_t chains_at(Steps time);
   // Live: the state brought up to the clock before a move; false when the session ended meanwhile.
   bool catch_up();
   // report() with the execution in seconds (NaN: from the steps), and its live half.
@@ -226,7 +236,8 @@ class ConcurrentSession {
   std::vector<int> started_;
   std::vector<ActionAttempt> attempts_;
   std::uint64_t seed_ = 0;
-  SplitMix64 exogenous_{0};  // the simulated chains' draws (chains or expiry, SPEC §9)
+  SplitMix64 exogenous_{0};                // the simulated chains' draws (chains or expiry, SPEC §9)
+  std::vector<std::uint16_t> chain_path_;  // their joint state by step, drawn as far as needed
 
   // Sessions that own their problem.
   std::unique_ptr<ConcurrentMdp> owned_mdp_;

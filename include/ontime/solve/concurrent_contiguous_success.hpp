@@ -39,10 +39,30 @@
 // with an explicit stack (a give-up sends a value back to an earlier position at a later time, so
 // recursion could go D deep). The first query of a state costs O(positions x D x (|supp e| |N| +
 // |culprits|)) per value it reaches; later ones a hash lookup or one sum over the attempt.
+//
+// With exogenous chains or expiry (SPEC §9, §10 "With chains and expiry") an execution drawn from a
+// chain is known only when its action starts, from the chain's state then, and an action may start
+// only up to its step `after` and outside its chain's blocking states: the robot's backlog is no
+// longer a number, and the sums above have no term for the chains. What they compute, with
+// aggregation `self`, is the value of one policy, the devoted eager one (devoted_move: the planner
+// on k alone, each of k's actions started as soon as it is refined, the robot is free and the
+// action may start; the planner idles while a complete plan waits for its next action), and that
+// policy has an exact value with chains too, as plan-first Eq. (1) with chains has
+// (timed_contiguous_success.hpp):
+//   P_k(s) = sum_o P(o | s, devoted_move(s, k)) ([o ends the episode] R(o) + [else] P_k(o)),
+// the sum over the outcomes of the move in SPEC §10 (a step's refinement outcome and the chains'
+// step; a start's draw from its chain's state), the chains read in s and following their model
+// from there (docs/theory.md, "Eq. (1) with chains and expiry"). Timing::exact takes it
+// (aggregation `self` only: `sum` and `max` have no form there): the memoised policy evaluation of
+// ConcurrentSolver, one memo per skeleton shared by every later query of the object. Cost: at most
+// the states that policy reaches from the states asked about (ResourceLimitError past
+// ConcurrentSolver::kDefaultMaxStates per skeleton); a query of a state already reached is one
+// hash lookup. Without chains or expiry Timing::exact changes nothing.
 
 #include <absl/container/flat_hash_map.h>
 
 #include <cstdint>
+#include <memory>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -53,12 +73,15 @@
 
 namespace ontime {
 
+class ConcurrentSolver;
+
 class ConcurrentContiguousSuccess {
  public:
   // How a problem with exogenous chains or expiry (SPEC §9) is taken.
   enum class Timing {
-    // UsageError (check_supported): Eq. (1) here has no form for chains.
-    refuse,
+    // The exact value of the devoted eager policy (above), with aggregation `self` only
+    // (check_supported).
+    exact,
     // The relaxation of ConcurrentValueBounds' upper bound: every execution drawn from a chain
     // when it starts takes its fastest over the chain's states (ConcurrentMdp::fastest_execution),
     // and no action expires or is blocked. With `self` the value is then at least what the devoted
@@ -69,22 +92,38 @@ class ConcurrentContiguousSuccess {
   };
 
   // The values of `mdp`'s skeletons with Eq. (1)'s `aggregation`; memoised as they are asked for.
-  // Throws UsageError (check_supported) when the problem has chains or expiry, unless `timing`
-  // relaxes them.
-  ConcurrentContiguousSuccess(const ConcurrentMdp& mdp, Aggregation aggregation, Timing timing = Timing::refuse);
+  // Throws UsageError (check_supported) when the problem has chains or expiry and `timing` is exact
+  // with an aggregation other than `self`.
+  ConcurrentContiguousSuccess(const ConcurrentMdp& mdp, Aggregation aggregation, Timing timing = Timing::exact);
+  ~ConcurrentContiguousSuccess();
+  ConcurrentContiguousSuccess(const ConcurrentContiguousSuccess&) = delete;
+  ConcurrentContiguousSuccess& operator=(const ConcurrentContiguousSuccess&) = delete;
+  ConcurrentContiguousSuccess(ConcurrentContiguousSuccess&&) noexcept;
+  ConcurrentContiguousSuccess& operator=(ConcurrentContiguousSuccess&&) noexcept;
 
-  // Eq. (1) here has no form for chains: UsageError naming the rule when `mdp` has chains or
-  // expiry (SPEC §9), before any allocator built on these values is made. Backtracking (SPEC §7)
-  // is taken (the give-up term above).
-  static void check_supported(const ConcurrentMdp& mdp);
+  // With chains or expiry (SPEC §9) only the devoted policy's exact value (aggregation `self`) is
+  // a form of Eq. (1): UsageError naming the rule for `sum` or `max` there, before any allocator
+  // built on these values is made. Every aggregation is taken without them; backtracking (SPEC §7)
+  // is taken (the give-up term above; with chains, in the devoted policy's value).
+  static void check_supported(const ConcurrentMdp& mdp, Aggregation aggregation);
+
+  // The move of the devoted eager policy of live skeleton k in a running state: while the robot is
+  // idle and k's next action to execute is refined (and, with chains or expiry, may start now:
+  // ConcurrentMdp::startable), its start; else a step on k while k has an action left to refine;
+  // else the planner idles (kWait). kWait too once k is dropped. The commit rule of dp-rerun acting
+  // while planning (the best skeleton's devoted move). O(K) without chains or expiry; with them
+  // O(K * A_max) for the startable actions.
+  static ConcurrentMdp::Move devoted_move(const ConcurrentMdp& mdp, const ConcurrentState& state, int k);
 
   // PS(k, l, spent, time, backlog); 0 when the backlog alone passes the deadline. Without
-  // backtracking only (with it a value needs the restore values: UsageError).
+  // backtracking only (with it a value needs the restore values: UsageError), and with chains or
+  // expiry only under Timing::relax (else UsageError: the backlog is not a number).
   double value(int k, int l, Steps spent, Steps time, std::int64_t backlog);
   // The same for live skeleton k in `state` (its backlog: ConcurrentMdp::robot_free(state, k) -
   // CT); for a skeleton refined in full, its reward at the end of that backlog (0 past D). With
   // backtracking, V above from the state (the executed actions blamed: 0; each refined action not
-  // started keeps its robot-free time and its start, the robot going on eagerly from now).
+  // started keeps its robot-free time and its start, the robot going on eagerly from now). With
+  // chains or expiry and Timing::exact, P_k(state) above (ResourceLimitError past the state cap).
   double value(const ConcurrentState& state, int k);
 
   // How the skeletons that share an action are combined.
@@ -121,6 +160,8 @@ class ConcurrentContiguousSuccess {
   const ConcurrentMdp* mdp_;
   Aggregation aggregation_;
   bool relaxed_ = false;  // Timing::relax on a problem with chains or expiry
+  // Timing::exact on a problem with chains or expiry: per skeleton, the devoted policy's evaluation.
+  std::vector<std::unique_ptr<ConcurrentSolver>> devoted_;
   Steps deadline_;
   std::unordered_map<std::uint64_t, double> fresh_;  // (k, l, T, w) packed
   absl::flat_hash_map<GiveUpKey, double> give_up_memo_;
