@@ -228,11 +228,6 @@ AllocatorKind branch_and_bound_kind() {
           throw UsageError(
               "parameter 'trials': acting while planning (SPEC §10) the search is all trials; it takes no share");
         }
-        if (mdp.has_backtracking()) {
-          throw UsageError(mdp.problem().name() +
-                           ": branch-and-bound acting while planning (SPEC §10) does not take backtracking (SPEC §7) "
-                           "yet: its bounds assume no give-up");
-        }
         BranchAndBoundOptions options;
         options.budget = detail::default_budget(parameters);
         options.max_states = parameters.integer("max-states");

@@ -771,14 +771,7 @@ AllocatorKind mcts_kind() {
         options.exploration = parameters.real("exploration");
         options.backup = read_backup(parameters);
         const std::string leaf = parameters.text("leaf");
-        if (leaf != "rollout") {
-          if (mdp.has_backtracking()) {
-            throw UsageError("parameter 'leaf': '" + leaf +
-                             "' bounds of acting while planning (SPEC §10) assume no give-up; with backtracking "
-                             "(SPEC §7) use 'rollout'");
-          }
-          options.leaf = leaf == "upper" ? MctsLeaf::upper : MctsLeaf::lower;
-        }
+        if (leaf != "rollout") options.leaf = leaf == "upper" ? MctsLeaf::upper : MctsLeaf::lower;
         options.budget = detail::default_budget(parameters);
         options.max_tree_bytes = static_cast<std::size_t>(parameters.integer("max-tree-mib")) << 20;
         const std::string rollout = parameters.text("rollout");
