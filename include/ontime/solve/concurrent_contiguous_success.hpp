@@ -105,6 +105,8 @@ class ConcurrentContiguousSuccess {
     double reward = 0;
     double give_up = 0;
   };
+  // The pair above for live skeleton k at `state` (a skeleton refined in full: its reward at the
+  // end of its backlog, no give-up).
   GiveUpRelaxed give_up_relaxed(const ConcurrentState& state, int k);
 
  private:
