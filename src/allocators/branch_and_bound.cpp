@@ -222,7 +222,8 @@ AllocatorKind branch_and_bound_kind() {
                              {"max_gap", "the largest certified gap of a decision"}}},
       .commit_rule =
           "the search's: starts an action when starting has the best certified lower end (the "
-          "optimum's where the search closes)",
+          "optimum's where the search closes), weighing that a later give-up blaming a started motion blocks its "
+          "action",
       .make_concurrent = [](const ConcurrentMdp& mdp, const ParameterReader& parameters) -> ConcurrentAllocatorFactory {
         if (parameters.given("trials")) {
           throw UsageError(

@@ -765,7 +765,7 @@ AllocatorKind mcts_kind() {
                              {"peak_tree_bytes", "the most bytes a tree held"}}},
       .commit_rule =
           "the search's: starts an action when the search values starting above planning on (its most "
-          "simulated move)",
+          "simulated move), weighing that a later give-up blaming a started motion blocks its action",
       .make_concurrent = [](const ConcurrentMdp& mdp, const ParameterReader& parameters) -> ConcurrentAllocatorFactory {
         ConcurrentMctsOptions options;
         options.exploration = parameters.real("exploration");
