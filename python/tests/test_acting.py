@@ -62,13 +62,17 @@ def test_the_same_figures_as_the_command_line(cli):
 
 def test_backtracking_acting_while_planning_as_the_command_line(cli):
     """SPEC §7 with §10: the kitchen whose placements may blame their grasps gains by acting while
-    planning; dp-rerun takes it (Eq. (1) with its give-up term), at most the optimum."""
+    planning; the search gives its optimum to the bit; dp-rerun takes it (Eq. (1) with its give-up
+    term), at most the optimum."""
     kitchen = PAPER.parent / "kitchen-grasps.json"
     from_cli = cli("solve", str(kitchen), "--act", "concurrent", "--json", "--no-timing")
     concurrent = ontime.solve(kitchen, act="concurrent")
     assert concurrent["optimal_success_probability"] == from_cli["optimal_success_probability"]
     assert concurrent["optimal_success_probability"] > \
         ontime.solve(kitchen, method="memoised")["optimal_success_probability"] + 0.01
+    search = ontime.solve(kitchen, act="concurrent", method="search")
+    assert search["exact"] and search["optimal_success_probability"] == concurrent["optimal_success_probability"]
+    assert search["first_choice"] == concurrent["first_choice"]
     exact = ontime.evaluate(kitchen, "optimal", act="concurrent", episodes=200, exact=True)
     assert exact["exact_success_probability"] == concurrent["optimal_success_probability"]
     dp_rerun = ontime.evaluate(kitchen, "dp-rerun", act="concurrent", episodes=10, exact=True)
@@ -78,9 +82,8 @@ def test_backtracking_acting_while_planning_as_the_command_line(cli):
 def test_chains_acting_while_planning_as_the_command_line(cli):
     """SPEC §9 with §10: the robot may wait at a door that locks at random; exact from Python as from
     the command line; its episodes (the session simulates the door) earn the optimum within 4
-    standard errors; mcts's bound leaves, which assume no give-up, are refused on it (it has give-ups),
-    naming the rule, and on the meeting instance (chains, no give-up) the search gives the memoised
-    optimum to the bit."""
+    standard errors; the search gives the memoised optimum to the bit on it (it has give-ups) and on
+    the meeting instance (chains, no give-up)."""
     cup = PAPER.parent / "chains" / "cup-through-the-door.json"
     from_cli = cli("solve", str(cup), "--act", "concurrent", "--json", "--no-timing")
     concurrent = ontime.solve(cup, act="concurrent")
@@ -92,12 +95,11 @@ def test_chains_acting_while_planning_as_the_command_line(cli):
     optimum = concurrent["optimal_expected_reward"]
     assert evaluated["exact_expected_reward"] == pytest.approx(optimum, abs=1e-12)
     assert abs(evaluated["mean_reward"] - optimum) <= 4 * (optimum * (1 - optimum) / episodes) ** 0.5
-    with pytest.raises(ontime.UsageError, match=r"assume no give-up"):
-        ontime.evaluate(cup, "mcts", act="concurrent", episodes=10, backup="bellman", leaf="upper")
     meeting = PAPER.parent / "chains" / "meeting-through-the-queue.json"
-    memoised = ontime.solve(meeting, act="concurrent")
-    search = ontime.solve(meeting, act="concurrent", method="search")
-    assert search["exact"] and search["optimal_expected_reward"] == memoised["optimal_expected_reward"]
+    for instance in (cup, meeting):
+        memoised = ontime.solve(instance, act="concurrent")
+        search = ontime.solve(instance, act="concurrent", method="search")
+        assert search["exact"] and search["optimal_expected_reward"] == memoised["optimal_expected_reward"]
 
 
 def test_dp_and_dp_rerun_with_chains_acting_while_planning_as_the_command_line(cli):

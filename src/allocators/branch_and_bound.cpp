@@ -222,16 +222,12 @@ AllocatorKind branch_and_bound_kind() {
                              {"max_gap", "the largest certified gap of a decision"}}},
       .commit_rule =
           "the search's: starts an action when starting has the best certified lower end (the "
-          "optimum's where the search closes)",
+          "optimum's where the search closes), weighing that a later give-up blaming a started motion blocks its "
+          "action",
       .make_concurrent = [](const ConcurrentMdp& mdp, const ParameterReader& parameters) -> ConcurrentAllocatorFactory {
         if (parameters.given("trials")) {
           throw UsageError(
               "parameter 'trials': acting while planning (SPEC §10) the search is all trials; it takes no share");
-        }
-        if (mdp.has_backtracking()) {
-          throw UsageError(mdp.problem().name() +
-                           ": branch-and-bound acting while planning (SPEC §10) does not take backtracking (SPEC §7) "
-                           "yet: its bounds assume no give-up");
         }
         BranchAndBoundOptions options;
         options.budget = detail::default_budget(parameters);

@@ -765,20 +765,13 @@ AllocatorKind mcts_kind() {
                              {"peak_tree_bytes", "the most bytes a tree held"}}},
       .commit_rule =
           "the search's: starts an action when the search values starting above planning on (its most "
-          "simulated move)",
+          "simulated move), weighing that a later give-up blaming a started motion blocks its action",
       .make_concurrent = [](const ConcurrentMdp& mdp, const ParameterReader& parameters) -> ConcurrentAllocatorFactory {
         ConcurrentMctsOptions options;
         options.exploration = parameters.real("exploration");
         options.backup = read_backup(parameters);
         const std::string leaf = parameters.text("leaf");
-        if (leaf != "rollout") {
-          if (mdp.has_backtracking()) {
-            throw UsageError("parameter 'leaf': '" + leaf +
-                             "' bounds of acting while planning (SPEC §10) assume no give-up; with backtracking "
-                             "(SPEC §7) use 'rollout'");
-          }
-          options.leaf = leaf == "upper" ? MctsLeaf::upper : MctsLeaf::lower;
-        }
+        if (leaf != "rollout") options.leaf = leaf == "upper" ? MctsLeaf::upper : MctsLeaf::lower;
         options.budget = detail::default_budget(parameters);
         options.max_tree_bytes = static_cast<std::size_t>(parameters.integer("max-tree-mib")) << 20;
         const std::string rollout = parameters.text("rollout");

@@ -16,6 +16,15 @@ ConcurrentContiguousSuccess::ConcurrentContiguousSuccess(const ConcurrentMdp& md
       aggregation_(aggregation),
       relaxed_(timing == Timing::relax && mdp.is_timed()),
       deadline_(mdp.deadline()) {
+  const Problem& problem = mdp.problem();
+  for (int k = 0; k < problem.skeleton_count(); ++k) {
+    std::vector<char> after(static_cast<std::size_t>(problem.skeleton_length(k)) + 1, 0);
+    for (int l = problem.skeleton_length(k); l-- > 0;) {
+      after[static_cast<std::size_t>(l)] = static_cast<char>(after[static_cast<std::size_t>(l) + 1] != 0 ||
+                                                             !problem.culprits(problem.action_at(k, l)).empty());
+    }
+    gives_up_after_.push_back(std::move(after));
+  }
   if (timing != Timing::exact || !mdp.is_timed()) return;
   check_supported(mdp, aggregation);
   devoted_.reserve(static_cast<std::size_t>(mdp.skeleton_count()));
@@ -54,6 +63,34 @@ ConcurrentMdp::Move ConcurrentContiguousSuccess::devoted_move(const ConcurrentMd
   return {};
 }
 
+std::uint64_t ConcurrentContiguousSuccess::memo_key(int k, int l, Steps time, std::int64_t last) {
+  return (static_cast<std::uint64_t>(k) << 40U) | (static_cast<std::uint64_t>(l) << 32U) |
+         (static_cast<std::uint64_t>(time) << 16U) | static_cast<std::uint64_t>(last);
+}
+
+double ConcurrentContiguousSuccess::ending(int k, std::int64_t finish) const {
+  if (finish > deadline_) return 0.0;
+  const Problem& problem = mdp_->problem();
+  return problem.has_rewards() ? problem.reward_at(k, static_cast<Steps>(finish)) : 1.0;
+}
+
+std::span<const Mdp::ExecutionOutcome> ConcurrentContiguousSuccess::execution_outcomes(
+    int action, std::array<Mdp::ExecutionOutcome, 1>& fastest) const {
+  if (!relaxed_ || mdp_->problem().execution_chain(action) < 0) {
+    return mdp_->plan_first_mdp().execution_outcomes(action);
+  }
+  const Steps steps = mdp_->fastest_execution(action);
+  fastest[0] = {steps == kNever ? deadline_ + 1 : steps, 1.0};
+  return fastest;
+}
+
+double ConcurrentContiguousSuccess::attempt_survival(int action, Steps spent) const {
+  const Action& attempt = mdp_->problem().action(action);
+  double ended = 0.0;
+  for (Steps u = 1; u <= spent; ++u) ended += attempt.planning.pmf(u) + attempt.backtrack.pmf(u);
+  return 1.0 - ended;
+}
+
 // value, fresh and after_found recurse one level per action of the skeleton (at most
 // Problem::kMaxSkeletonLength deep, whatever the deadline), each level memoised by fresh.
 // NOLINTNEXTLINE(misc-no-recursion)
@@ -90,18 +127,14 @@ double ConcurrentContiguousSuccess::value(const ConcurrentState& state, int k) {
   const std::int64_t free = mdp_->robot_free(state, k);
   const Steps now = ConcurrentMdp::time(state);
   const int refined = ConcurrentMdp::refined(state, k);
-  if (refined == problem.skeleton_length(k)) {
-    if (free > deadline_) return 0.0;
-    return problem.has_rewards() ? problem.reward_at(k, static_cast<Steps>(free)) : 1.0;
-  }
+  if (refined == problem.skeleton_length(k)) return ending(k, free);
   return value(k, refined, mdp_->spent(state, k), now, free - now);
 }
 
 // NOLINTNEXTLINE(misc-no-recursion)
 double ConcurrentContiguousSuccess::fresh(int k, int l, Steps time, std::int64_t backlog) {
   if (time + backlog > deadline_) return 0.0;
-  const std::uint64_t key = (static_cast<std::uint64_t>(k) << 40U) | (static_cast<std::uint64_t>(l) << 32U) |
-                            (static_cast<std::uint64_t>(time) << 16U) | static_cast<std::uint64_t>(backlog);
+  const std::uint64_t key = memo_key(k, l, time, backlog);
   if (const auto found = fresh_.find(key); found != fresh_.end()) return found->second;
   const double computed = value(k, l, 0, time, backlog);
   fresh_.emplace(key, computed);
@@ -112,21 +145,9 @@ double ConcurrentContiguousSuccess::fresh(int k, int l, Steps time, std::int64_t
 double ConcurrentContiguousSuccess::after_found(int k, int l, Steps time, std::int64_t backlog) {
   const Problem& problem = mdp_->problem();
   const int action = problem.action_at(k, l);
-  // A skeleton that ends with this action is worth its reward at the end of its backlog.
-  const auto ending = [&](int m, std::int64_t finish) {
-    if (finish > deadline_) return 0.0;
-    return problem.has_rewards() ? problem.reward_at(m, static_cast<Steps>(finish)) : 1.0;
-  };
-  // Relaxed (Timing::relax), an execution drawn from a chain when it starts takes its fastest.
-  std::span<const Mdp::ExecutionOutcome> outcomes = mdp_->plan_first_mdp().execution_outcomes(action);
   std::array<Mdp::ExecutionOutcome, 1> fastest{};
-  if (relaxed_ && problem.execution_chain(action) >= 0) {
-    const Steps steps = mdp_->fastest_execution(action);
-    fastest[0] = {steps == kNever ? deadline_ + 1 : steps, 1.0};
-    outcomes = fastest;
-  }
   double total = 0.0;
-  for (const Mdp::ExecutionOutcome& outcome : outcomes) {
+  for (const Mdp::ExecutionOutcome& outcome : execution_outcomes(action, fastest)) {
     const std::int64_t after = backlog + outcome.steps;
     if (time + after > deadline_) continue;
     const auto worth = [&](int m) {  // NOLINT(misc-no-recursion)
@@ -161,10 +182,6 @@ double ConcurrentContiguousSuccess::give_up_attempt(const GiveUpKey& key, Steps 
   const Action& action = problem.action(action_index);
   const bool blamed = problem.culprit_slot(action_index) >= 0;
   const std::int64_t beyond = std::int64_t{deadline_} + 1;
-  const auto ending = [&](int m, std::int64_t finish) {
-    if (finish > deadline_) return 0.0;
-    return problem.has_rewards() ? problem.reward_at(m, static_cast<Steps>(finish)) : 1.0;
-  };
   double total = 0.0;
   for (std::int64_t t = 1; key.time + t <= deadline_; ++t) {
     const auto now = static_cast<std::int32_t>(key.time + t);
@@ -249,21 +266,14 @@ double ConcurrentContiguousSuccess::give_up_value(const ConcurrentState& state, 
       continue;
     }
     const std::int64_t start = std::min(free, beyond);
-    restores =
-        restores_.append(restores, problem.culprit_slot(action) >= 0
-                                       ? (static_cast<std::uint32_t>(start) << 16U) | static_cast<std::uint32_t>(start)
-                                       : 0U);
+    // A culprit refined and not started: the policy starts it when the robot is free, S = F, the
+    // restore value a later give-up reads (as give_up_attempt appends it).
+    restores = restores_.append(restores, problem.culprit_slot(action) >= 0 ? static_cast<std::uint32_t>(start) : 0U);
     free = std::min(start + mdp_->execution(state, action), beyond);
   }
-  if (refined == problem.skeleton_length(k)) {
-    if (free > deadline_) return 0.0;
-    return problem.has_rewards() ? problem.reward_at(k, static_cast<Steps>(free)) : 1.0;
-  }
-  const Action& action = problem.action(problem.action_at(k, refined));
+  if (refined == problem.skeleton_length(k)) return ending(k, free);
   const Steps spent = mdp_->spent(state, k);
-  double ended = 0.0;
-  for (Steps u = 1; u <= spent; ++u) ended += action.planning.pmf(u) + action.backtrack.pmf(u);
-  const double alive = 1.0 - ended;
+  const double alive = attempt_survival(problem.action_at(k, refined), spent);
   if (alive <= 0.0 || now >= deadline_) return 0.0;
   const GiveUpKey key{k, refined, static_cast<std::int32_t>(now), static_cast<std::int32_t>(free), restores};
   if (spent == 0) {
@@ -272,6 +282,75 @@ double ConcurrentContiguousSuccess::give_up_value(const ConcurrentState& state, 
     if (ready) return known;
   }
   return give_up_settled(key, spent) / alive;
+}
+
+// relaxed_attempt and relaxed_fresh recurse one level per action of the skeleton (a give-up ends
+// the relaxed episode, so nothing goes back), each level memoised by relaxed_fresh.
+// NOLINTNEXTLINE(misc-no-recursion)
+ConcurrentContiguousSuccess::GiveUpRelaxed ConcurrentContiguousSuccess::relaxed_attempt(int k, int l, Steps spent,
+                                                                                        Steps time, std::int64_t free) {
+  const Problem& problem = mdp_->problem();
+  const int action_index = problem.action_at(k, l);
+  const Action& action = problem.action(action_index);
+  const std::int64_t beyond = std::int64_t{deadline_} + 1;
+  const bool last = l + 1 == problem.skeleton_length(k);
+  std::array<Mdp::ExecutionOutcome, 1> fastest{};
+  const std::span<const Mdp::ExecutionOutcome> outcomes = execution_outcomes(action_index, fastest);
+  GiveUpRelaxed total;
+  for (Steps t = 1; time + t <= deadline_; ++t) {
+    const Steps now = time + t;
+    const double found = action.planning.pmf(spent + t);
+    if (found > 0.0) {
+      // The robot starts the motion when it is free, and is free again at the end of its execution.
+      const std::int64_t start = std::max<std::int64_t>(free, now);
+      GiveUpRelaxed after;
+      for (const Mdp::ExecutionOutcome& outcome : outcomes) {
+        const std::int64_t finish = std::min(start + outcome.steps, beyond);
+        if (last) {
+          after.reward += outcome.probability * ending(k, finish);
+          continue;
+        }
+        const GiveUpRelaxed next = relaxed_fresh(k, l + 1, now, finish);
+        after.reward += outcome.probability * next.reward;
+        after.give_up += outcome.probability * next.give_up;
+      }
+      total.reward += found * after.reward;
+      total.give_up += found * after.give_up;
+    }
+    total.give_up += action.backtrack.pmf(spent + t);  // ends the relaxed episode, whoever is blamed
+  }
+  return total;
+}
+
+// NOLINTNEXTLINE(misc-no-recursion)
+ConcurrentContiguousSuccess::GiveUpRelaxed ConcurrentContiguousSuccess::relaxed_fresh(int k, int l, Steps time,
+                                                                                      std::int64_t free) {
+  // No step left; or the robot past the deadline and nothing left that may give up.
+  if (time >= deadline_) return {};
+  if (free > deadline_ && gives_up_after_[static_cast<std::size_t>(k)][static_cast<std::size_t>(l)] == 0) return {};
+  // Computed before it is stored: the recursion inserts more values (and may move the table).
+  const std::uint64_t key = memo_key(k, l, time, free);
+  if (const auto found = relaxed_memo_.find(key); found != relaxed_memo_.end()) return found->second;
+  const GiveUpRelaxed computed = relaxed_attempt(k, l, 0, time, free);
+  relaxed_memo_.emplace(key, computed);
+  return computed;
+}
+
+ConcurrentContiguousSuccess::GiveUpRelaxed ConcurrentContiguousSuccess::give_up_relaxed(const ConcurrentState& state,
+                                                                                        int k) {
+  const Problem& problem = mdp_->problem();
+  const Steps now = ConcurrentMdp::time(state);
+  // The robot runs k's refined actions after E back to back from now (with Timing::relax, an
+  // execution drawn when it starts at its fastest).
+  const std::int64_t free = std::min(mdp_->robot_free(state, k), std::int64_t{deadline_} + 1);
+  const int refined = ConcurrentMdp::refined(state, k);
+  if (refined == problem.skeleton_length(k)) return {ending(k, free), 0.0};
+  const Steps spent = mdp_->spent(state, k);
+  if (spent == 0) return relaxed_fresh(k, refined, now, free);
+  const double alive = attempt_survival(problem.action_at(k, refined), spent);
+  if (alive <= 0.0 || now >= deadline_) return {};
+  const GiveUpRelaxed total = relaxed_attempt(k, refined, spent, now, free);
+  return {total.reward / alive, total.give_up / alive};
 }
 
 }  // namespace ontime

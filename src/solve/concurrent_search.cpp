@@ -186,7 +186,7 @@ ConcurrentSolution solve_memoised(const ConcurrentMdp& mdp, const ConcurrentSolv
 }
 
 ConcurrentSolution solve_by_search(const ConcurrentMdp& mdp, const ConcurrentSolveOptions& options) {
-  ConcurrentSearch search(mdp, options.max_states);  // refuses backtracking (its bounds)
+  ConcurrentSearch search(mdp, options.max_states);
   ConcurrentSolution solution;
   const ConcurrentState start = mdp.start();
   const auto from_records = [&](std::string stopped_by) {

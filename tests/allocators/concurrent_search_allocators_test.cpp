@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ontime/allocators/allocator_registry.hpp"
@@ -74,13 +75,19 @@ TEST(ConcurrentSearchAllocators, MctsAndBranchAndBoundPlayAllowedMovesOnly) {
   const int count = testing::repetitions_to_check(40);
   int moves = 0;
   for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
-    // Every fourth instance backtracks (SPEC §7): mcts with rollouts takes it, branch-and-bound not.
+    // Every fourth instance backtracks (SPEC §7): mcts, with rollouts or bound leaves, and
+    // branch-and-bound take it.
     const Problem problem = acting_instance(seed);
     const ConcurrentMdp mdp(seed % 4 == 1 ? testing::with_backtracking(problem, seed) : problem);
-    const ParameterValues small{{"iterations", "200"}, {"backup", seed % 2 == 0 ? "bellman" : "mean"}};
-    for (const std::string name : {"mcts", "branch-and-bound"}) {
-      if (mdp.has_backtracking() && name == "branch-and-bound") continue;
-      const auto allocator = make_concurrent_allocator_factory(name, mdp, small)();
+    std::vector<std::pair<std::string, ParameterValues>> kinds{
+        {"mcts", {{"iterations", "200"}, {"backup", seed % 2 == 0 ? "bellman" : "mean"}}},
+        {"branch-and-bound", {{"iterations", "200"}}}};
+    if (mdp.has_backtracking()) {
+      kinds.push_back({"mcts", {{"iterations", "200"}, {"backup", "bellman"}, {"leaf", "upper"}}});
+      kinds.push_back({"mcts", {{"iterations", "200"}, {"backup", "bellman"}, {"leaf", "lower"}}});
+    }
+    for (const auto& [name, values] : kinds) {
+      const auto allocator = make_concurrent_allocator_factory(name, mdp, values)();
       play(mdp, *allocator, seed, [&](const ConcurrentState& state, const Move& move) {
         ASSERT_TRUE(allowed(mdp, state, move)) << name << " seed " << seed;
         ++moves;
@@ -123,14 +130,16 @@ TEST(ConcurrentSearchAllocators, WithChainsTheyPlayAllowedMovesOnly) {
       ++moves;
     });
   }
-  // The cup through the door also gives up (SPEC §7): mcts with rollouts takes it.
+  // The cup through the door also gives up (SPEC §7): mcts, with rollouts or bound leaves, takes it.
   const ConcurrentMdp cup(chain_instance("cup-through-the-door"));
-  const auto allocator = make_concurrent_allocator_factory("mcts", cup, {{"iterations", "200"}})();
-  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
-    play(cup, *allocator, seed, [&](const ConcurrentState& state, const Move& move) {
-      ASSERT_TRUE(allowed(cup, state, move)) << "cup seed " << seed;
-      ++moves;
-    });
+  for (const ParameterValues& values : kinds) {
+    const auto allocator = make_concurrent_allocator_factory("mcts", cup, values)();
+    for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+      play(cup, *allocator, seed, [&](const ConcurrentState& state, const Move& move) {
+        ASSERT_TRUE(allowed(cup, state, move)) << "cup seed " << seed;
+        ++moves;
+      });
+    }
   }
   EXPECT_GT(moves, 16 * count);
 }
@@ -171,6 +180,26 @@ TEST(ConcurrentSearchAllocators, WithChainsBranchAndBoundWithoutALimitMakesOptim
     decided += check_moves_are_optimal(ConcurrentMdp(timed_instance(seed + 300)), seed);
   }
   EXPECT_GT(decided, count);
+}
+
+// With backtracking (SPEC §7; a third with rewards), and on the cup through the door (a give-up with
+// chains, SPEC §9): its bounds value give-ups.
+TEST(ConcurrentSearchAllocators, WithBacktrackingBranchAndBoundWithoutALimitMakesOptimalMoves) {
+  const int count = testing::repetitions_to_check(150);
+  int decided = 0, backtracking = 0;
+  for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(count); ++seed) {
+    const ConcurrentMdp mdp(testing::with_backtracking(acting_instance(seed + 600), seed));
+    backtracking += mdp.has_backtracking() ? 1 : 0;
+    decided += check_moves_are_optimal(mdp, seed);
+  }
+  EXPECT_GT(backtracking, count * 3 / 4);
+  EXPECT_GT(decided, count / 4);
+  const ConcurrentMdp cup(chain_instance("cup-through-the-door"));
+  int on_cup = 0;
+  for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(testing::repetitions_to_check(8)); ++seed) {
+    on_cup += check_moves_are_optimal(cup, seed);
+  }
+  EXPECT_GT(on_cup, 0);
 }
 
 TEST(ConcurrentSearchAllocators, OptionsWithoutAMeaningInThisModeAreRefused) {
@@ -231,8 +260,7 @@ TEST(ConcurrentSearchAllocators, WithALargeBudgetTheyReachTheOptimum) {
 
 TEST(ConcurrentSearchAllocators, WithChainsBranchAndBoundReachesTheOptimum) {
   // The meeting through the coffee queue (an execution drawn from the queue's state when it
-  // starts, a door that locks for good, SPEC §9); the cup through the door also gives up (SPEC §7),
-  // which branch-and-bound's bounds do not take.
+  // starts, a door that locks for good, SPEC §9).
   // Every decision's search closes (about 900 backups each: the relaxed upper ends are loose), so
   // its moves are optimal and its mean reward is V* within four standard errors.
   const auto episodes = static_cast<std::uint64_t>(testing::repetitions_to_check(600));
@@ -241,8 +269,6 @@ TEST(ConcurrentSearchAllocators, WithChainsBranchAndBoundReachesTheOptimum) {
       expect_at_the_optimum(mdp, "branch-and-bound", {{"iterations", "1000000"}}, episodes);
   EXPECT_EQ(sampled.statistics.find("exact_decisions"), sampled.statistics.find(kSearchesCounter));
   EXPECT_GT(sampled.statistics.find(kSearchesCounter).value_or(0.0), static_cast<double>(episodes));
-  const ConcurrentMdp cup(chain_instance("cup-through-the-door"));
-  EXPECT_THROW((void)make_concurrent_allocator_factory("branch-and-bound", cup), UsageError);
 }
 
 }  // namespace

@@ -21,11 +21,16 @@
 // skeletons share long prefixes (their devoted successes are nearly the same event).
 // docs/theory.md, "Acting while planning: bounds on V* for the searches", has the proof.
 //
-// Not with backtracking (SPEC §7: a give-up may discard motions) nor chains or expiry (SPEC §9):
-// UsageError.
-// Cost: the values of unrefined actions, U(v, T, F), are memoised (A * (D + 1)^2 doubles, each
-// summed once over its planning and execution outcomes); a state costs a walk over its live
-// refined and current actions with those outcomes. Not thread-safe (the memo): one per thread.
+// With backtracking (SPEC §7) it is the chance of the union in the relaxation in which the first
+// give-up ends the episode (ConcurrentValueBounds): each attempt ends found, gives up or never, and
+// S_k also holds when one of the devoted policy's attempts gives up by D; a give-up counts with the
+// robot past the deadline (in the model it may discard a slow motion), so F runs to D + 1 and
+//   U(v, T, F) = 1 if F <= D and a skeleton ends at v, else 1 - prod over c of (1 - E[U(c, ...)]),
+// a give-up of c adding its chance to E[U(c, ...)]. Not with chains or expiry (SPEC §9): UsageError.
+// Cost: the values of unrefined actions, U(v, T, F), are memoised (A * (D + 1)^2 doubles, with
+// backtracking A * (D + 1) * (D + 2), each summed once over its planning and execution outcomes);
+// a state costs a walk over its live refined and current actions with those outcomes. Not
+// thread-safe (the memo): one per thread.
 
 #include <vector>
 
@@ -55,9 +60,16 @@ class ConcurrentClairvoyantBound {
   double expect(int a, Steps spent, Steps time, Steps free, After&& after) const;
   // The value of action v at a state: refined, current or fresh for the live skeletons through it.
   double at_state(const ConcurrentState& state, int v, Steps time, Steps free);
+  // With backtracking: whether an action below v (v = -1: anywhere) may give up.
+  bool gives_up_below(int v) const {
+    return backtracking_ && gives_up_below_[v < 0 ? gives_up_below_.size() - 1 : static_cast<std::size_t>(v)] != 0;
+  }
 
   const ConcurrentMdp* mdp_;
   Steps deadline_;
+  bool backtracking_;
+  std::size_t free_side_ = 0;               // the values of F memoised: D + 1, with backtracking D + 2
+  std::vector<char> gives_up_below_;        // per action, then the roots (index A)
   std::vector<std::vector<int>> children_;  // per action, then the roots (index A): next actions
   std::vector<char> ends_;                  // per action: some skeleton ends there
   std::vector<double> memo_;                // [v][T][F]; negative: not computed

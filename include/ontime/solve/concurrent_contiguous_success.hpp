@@ -61,8 +61,10 @@
 
 #include <absl/container/flat_hash_map.h>
 
+#include <array>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -129,9 +131,43 @@ class ConcurrentContiguousSuccess {
   // How the skeletons that share an action are combined.
   Aggregation aggregation() const noexcept { return aggregation_; }
 
+  // With backtracking (SPEC §7), the devoted policy of live skeleton k from `state` (the planner on
+  // k alone, the robot eager along k) in the relaxation in which the first give-up ends the episode
+  // (ConcurrentValueBounds' upper end): `reward`, its expected reward from finishing k with no
+  // give-up before; `give_up`, the chance that one of k's attempts gives up by the deadline (its
+  // robot's backlog may be past D: a give-up in the model may discard a slow motion). With
+  // aggregation self only; executions relaxed as `Timing` says. Memoised per (skeleton, position,
+  // time, robot's free step) with nothing spent, A * D^2 pairs at most; a query is one sum over at
+  // most D - CT planning steps. Without backtracking `give_up` is 0 and `reward` is value(state, k)
+  // up to rounding.
+  struct GiveUpRelaxed {
+    double reward = 0;
+    double give_up = 0;
+  };
+  // The pair above for live skeleton k at `state` (a skeleton refined in full: its reward at the
+  // end of its backlog, no give-up).
+  GiveUpRelaxed give_up_relaxed(const ConcurrentState& state, int k);
+
  private:
   double fresh(int k, int l, Steps time, std::int64_t backlog);
   double after_found(int k, int l, Steps time, std::int64_t backlog);
+  // (k, l, T, w or F) packed into one word, the key of both memos (each part below 2^16, k and l
+  // below 2^8).
+  static std::uint64_t memo_key(int k, int l, Steps time, std::int64_t last);
+  // R_k at `finish`, 0 past the deadline (1 without rewards).
+  double ending(int k, std::int64_t finish) const;
+  // The execution outcomes of `action`; relaxed (Timing::relax), an execution drawn from a chain
+  // when it starts takes its fastest, written into `fastest`.
+  std::span<const Mdp::ExecutionOutcome> execution_outcomes(int action,
+                                                            std::array<Mdp::ExecutionOutcome, 1>& fastest) const;
+  // 1 - sum over u <= spent of (p(u) + q(u)): the chance that an attempt on `action` lasts
+  // `spent` steps.
+  double attempt_survival(int action, Steps spent) const;
+  // give_up_relaxed's sum over the attempt at position l of k, `spent` steps old, found or given up
+  // at T + t (not divided by its survival); `free` the robot's free step (saturated at D + 1).
+  GiveUpRelaxed relaxed_attempt(int k, int l, Steps spent, Steps time, std::int64_t free);
+  // The same with nothing spent, memoised.
+  GiveUpRelaxed relaxed_fresh(int k, int l, Steps time, std::int64_t free);
 
   // With backtracking: a fresh attempt at position l of skeleton k at time T, the robot free at
   // F (absolute, at least T, saturated at D + 1), and the interned list of the starts S_i of the
@@ -163,7 +199,10 @@ class ConcurrentContiguousSuccess {
   // Timing::exact on a problem with chains or expiry: per skeleton, the devoted policy's evaluation.
   std::vector<std::unique_ptr<ConcurrentSolver>> devoted_;
   Steps deadline_;
-  std::unordered_map<std::uint64_t, double> fresh_;  // (k, l, T, w) packed
+  std::unordered_map<std::uint64_t, double> fresh_;                 // (k, l, T, w) packed
+  absl::flat_hash_map<std::uint64_t, GiveUpRelaxed> relaxed_memo_;  // (k, l, T, F) packed
+  // Per skeleton and position: whether an action from there on may give up.
+  std::vector<std::vector<char>> gives_up_after_;
   absl::flat_hash_map<GiveUpKey, double> give_up_memo_;
   std::vector<GiveUpKey> pending_;
   InternedLists<std::uint32_t> restores_;  // the lists of starts of the give-up keys

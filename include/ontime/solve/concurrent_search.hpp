@@ -106,8 +106,8 @@ struct ConcurrentSolution {
 //    ConcurrentSearch whose trials run first; the value and the first move to the bit the
 //    memoised solver's. With a gap, trials of bounded RTDP until the start's certified interval is
 //    that narrow. Where the cap or the stop ends it, the start's certified interval from the
-//    records (lower: a certified bound, not a policy's value). Refuses backtracking (SPEC §7) with
-//    UsageError, as ConcurrentValueBounds does; takes chains and expiry (SPEC §9).
+//    records (lower: a certified bound, not a policy's value). Takes backtracking (SPEC §7), chains
+//    and expiry (SPEC §9), as ConcurrentValueBounds does.
 // Cost: the search's time and memory are linear in the states it solves or bounds (a
 // ConcurrentSolver entry or a ConcurrentSearch record each); it solves at most the memoised
 // solver's states, far fewer where the bounds are tight.

@@ -33,13 +33,24 @@
 //   lower(state) = the largest expected reward of a start that ends the episode now (a last
 //   action the robot may start; 0 when there is none): the value of that start, at most V*.
 //
+// With backtracking (SPEC §7) the devoted value P_k (ConcurrentContiguousSuccess::value) has the
+// give-up term (a give-up that blames an executed action blocks k), still the exact value of the
+// devoted policy, so lower(state) is as above (with chains or expiry too: the best ending start).
+// The union bound is taken in the relaxation in which the first give-up ends the episode with
+// R_cap, at least what the model earns after it (ConcurrentContiguousSuccess::give_up_relaxed: the
+// relaxed devoted policy's reward A_k and give-up chance G_k):
+//   upper(state) = min(R_cap, sum over eligible k of A_k + R_cap * sum over k of G_k),
+// the second sum over the live skeletons no lower-indexed one spells again (a give-up on the
+// actions a skeleton below a live prefix adds ends the relaxed episode too). Without rewards also
+// the grouped form over A_k + G_k; without chains or expiry also R_cap times the chance of the union
+// of these events, over the tree (ConcurrentClairvoyantBound, which counts a give-up as an event).
+//
 // Cost: per state O(K^2) to find the eligible skeletons and group them, plus K queries of
 // ConcurrentContiguousSuccess (each a sum over at most D - CT planning steps of memoised values),
 // with chains or expiry plus one pass over the execution times of each startable action; memory:
 // that memo. Not thread-safe (the memo): one object per thread.
 
 #include <optional>
-#include <utility>
 #include <vector>
 
 #include "ontime/mdp/concurrent_mdp.hpp"
@@ -56,8 +67,8 @@ class ConcurrentValueBounds {
     double upper = 0;
   };
 
-  // Bounds for the states of `mdp`, which must outlive this object. Throws UsageError when the
-  // problem has backtracking (SPEC §7): a give-up may discard motions, which the proofs leave out.
+  // Bounds for the states of `mdp`, which must outlive this object; any problem of the model
+  // (backtracking, chains, expiry, rewards).
   explicit ConcurrentValueBounds(const ConcurrentMdp& mdp);
 
   // Both bounds at `state` (any state of the MDP, terminal or not).
@@ -70,16 +81,23 @@ class ConcurrentValueBounds {
   double upper(const ConcurrentState& state) { return bounds(state).upper; }
 
  private:
-  static void refuse_backtracking(const ConcurrentMdp& mdp);
+  // How live skeleton k stands among the live ones: eligible; below a live proper prefix (it
+  // never ends the episode); or a twin (the same actions as a live one of lower index).
+  enum class Standing { eligible, below_prefix, twin };
   // With chains or expiry: the largest expected reward of starting now an action whose every
   // outcome ends the episode (0 when there is none).
   double ending_start(const ConcurrentState& state) const;
-  bool eligible(const ConcurrentState& state, int k) const;
+  Standing standing(const ConcurrentState& state, int k) const;
+  // A group of skeletons sharing their next unrefined action, and their summed chance.
+  struct Group {
+    int next;
+    double chance;
+  };
 
   const ConcurrentMdp* mdp_;
   ConcurrentContiguousSuccess devoted_;
   std::optional<ConcurrentClairvoyantBound> clairvoyant_;  // without chains or expiry
-  std::vector<std::pair<int, double>> groups_;             // scratch: next unrefined action, summed devoted values
+  std::vector<Group> groups_;                              // scratch
 };
 
 }  // namespace ontime
