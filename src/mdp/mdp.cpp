@@ -35,9 +35,9 @@ Mdp::Mdp(const Problem& problem)
   // of another model under its name.
   if (problem.acting() != Acting::plan_first) {
     throw UsageError(problem.name() +
-                     " acts while planning (acting \"concurrent\", SPEC §10): only the exact solver of that model "
-                     "(ontime solve, --method memoised) takes it so far; the other solvers, the allocators, "
-                     "evaluation and sessions take plan-first instances (--act plan-first)");
+                     " acts while planning (acting \"concurrent\", SPEC §10): the plan-first model does not take "
+                     "it; that mode has its own (ConcurrentMdp, ConcurrentSession, the commands' --act concurrent), "
+                     "or read it plan-first (--act plan-first)");
   }
   const auto deadline = static_cast<std::size_t>(deadline_);
   const auto action_count = static_cast<std::size_t>(problem.action_count());

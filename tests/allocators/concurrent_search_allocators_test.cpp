@@ -86,8 +86,9 @@ TEST(ConcurrentSearchAllocators, MctsAndBranchAndBoundPlayAllowedMovesOnly) {
       kinds.push_back({"mcts", {{"iterations", "200"}, {"backup", "bellman"}, {"leaf", "upper"}}});
       kinds.push_back({"mcts", {{"iterations", "200"}, {"backup", "bellman"}, {"leaf", "lower"}}});
     }
-    for (const auto& [name, values] : kinds) {
-      const auto allocator = make_concurrent_allocator_factory(name, mdp, values)();
+    for (const auto& kind : kinds) {
+      const std::string& name = kind.first;  // (clang 14 cannot capture a structured binding in a lambda)
+      const auto allocator = make_concurrent_allocator_factory(name, mdp, kind.second)();
       play(mdp, *allocator, seed, [&](const ConcurrentState& state, const Move& move) {
         ASSERT_TRUE(allowed(mdp, state, move)) << name << " seed " << seed;
         ++moves;
