@@ -90,7 +90,8 @@ TEST(ConcurrentPpo, EveryUsefulMoveHasItsOwnOutput) {
   // On random states of random instances (with backtracking and chains too) the useful moves'
   // outputs are distinct and in range.
   int checked = 0;
-  for (std::uint64_t seed = 0; seed < static_cast<std::uint64_t>(testing::repetitions_to_check(60)); ++seed) {
+  const int instances = testing::repetitions_to_check(60);
+  for (std::uint64_t seed = 0; seed < static_cast<std::uint64_t>(instances); ++seed) {
     Problem problem = testing::random_instance(seed + 900, 4, 3, 10);
     if (seed % 3 == 1) problem = testing::with_backtracking(problem, seed);
     if (seed % 3 == 2) problem = testing::with_random_chains(problem, seed, false);
@@ -128,7 +129,7 @@ TEST(ConcurrentPpo, EveryUsefulMoveHasItsOwnOutput) {
       state = next[generator() % next.size()];
     }
   }
-  EXPECT_GT(checked, 100);
+  EXPECT_GT(checked, 2 * instances);  // random walks of several states each
 }
 
 // On instance 2 the untrained actor starts too soon (0.58); trained in the mode it learns better
