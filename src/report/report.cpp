@@ -561,15 +561,13 @@ std::string to_json(const Training& training) {
 }
 
 std::string to_text(const Training& training) {
+  const char* mode = training.problem->acting() == Acting::concurrent ? ", acting while planning" : "";
   std::string out = fmt::format("trained ppo on {} ({}{}): {} episodes in {} epochs, {:.1f} s\n", training.instance,
-                                training.problem->name(),
-                                training.problem->acting() == Acting::concurrent ? ", acting while planning" : "",
-                                training.episodes, training.epochs, training.seconds);
+                                training.problem->name(), mode, training.episodes, training.epochs, training.seconds);
   if (training.exact) {
     out += fmt::format("exact success probability of the trained policy (greedy): {:.4f}\n", *training.exact);
-    if (training.exact_reward) {
+    if (training.exact_reward)
       out += fmt::format("exact expected reward of the trained policy (greedy):    {:.6f}\n", *training.exact_reward);
-    }
   } else {
     out += fmt::format("exact success probability of the trained policy: not computed ({} skeletons; at most {})\n",
                        training.problem->skeleton_count(), kMaxExactSkeletons);
