@@ -7,6 +7,7 @@
 
 #include "common.hpp"
 #include "memory_limits.hpp"
+#include "ontime/allocators/concurrent_allocator.hpp"
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/model/instance_io.hpp"
 #include "ontime/model/problem.hpp"
@@ -31,20 +32,34 @@ struct EvaluateOptions {
   MonteCarloFlags monte_carlo;
 };
 
-// Acting while planning (SPEC §10): the allocator's concurrent form in the same hidden worlds.
-void run_concurrent(const EvaluateOptions& options, const Problem& problem) {
-  if (!options.belief.empty()) {
-    throw UsageError(
-        "--belief: acting while planning (concurrent, SPEC §10) is evaluated with the instance's own "
-        "distributions only so far");
+// The allocator's own instance under --belief: INSTANCE's skeletons with the belief's distributions.
+std::optional<Problem> planned_problem(const EvaluateOptions& options, const Problem& problem) {
+  if (options.belief.empty()) return std::nullopt;
+  const Problem belief = load_problem(options.belief);
+  try {
+    return with_distributions_of(problem, belief);
+  } catch (const UsageError& error) {
+    throw UsageError(options.belief + ": " + error.what() + " (--belief against " + options.instance + ")");
   }
+}
+
+// Acting while planning (SPEC §10): the allocator's concurrent form in the same hidden worlds. With
+// a belief, the allocator decides on its own model and sees the states with the skeletons the
+// instance counts as hopeless kept (HopelessSkeletons): what it believes is its own to judge.
+void run_concurrent(const EvaluateOptions& options, const Problem& problem) {
+  const std::optional<Problem> planned = planned_problem(options, problem);
   const ParameterValues parameters = options.allocator.values();
   options.monte_carlo.check_allocator_memory(options.solver, problem, parameters);
   if (options.exact || allocator_registry().find(options.solver).capabilities.has(Capability::optimal)) {
     check_exact_work(problem, max_states_of(parameters), options.instance, flag_spelling());
   }
-  const ConcurrentMdp mdp(problem);
-  const ConcurrentAllocatorFactory factory = make_concurrent_allocator_factory(options.solver, mdp, parameters);
+  const ConcurrentMdp mdp(problem, planned ? HopelessSkeletons::kept : HopelessSkeletons::dropped);
+  std::optional<ConcurrentMdp> planned_mdp;
+  if (planned) planned_mdp.emplace(*planned);
+  const ConcurrentAllocatorFactory factory =
+      planned_mdp
+          ? seen_by_belief(*planned_mdp, make_concurrent_allocator_factory(options.solver, *planned_mdp, parameters))
+          : make_concurrent_allocator_factory(options.solver, mdp, parameters);
   MonteCarloOptions monte_carlo = options.monte_carlo.options();
   monte_carlo.time_decisions = !options.no_timing;
   ProgressBar bar("evaluate " + options.solver);
@@ -60,6 +75,7 @@ void run_concurrent(const EvaluateOptions& options, const Problem& problem) {
                                       .parameters = parameters,
                                       .instance = options.instance,
                                       .problem = &problem,
+                                      .belief = options.belief,
                                       .seed = options.monte_carlo.seed,
                                       .result = result,
                                       .exact = exact,
@@ -80,8 +96,7 @@ void add_evaluate_command(CLI::App& app) {
                       "Instance the allocator plans with (a prediction, a pooled fit): its distributions for "
                       "INSTANCE's actions, matched by id; the episodes and the exact value are drawn from INSTANCE");
   add_act_option(*command, options->act,
-                 "Concurrent takes the allocators with a commit rule ('ontime allocators' names them), not --belief "
-                 "yet");
+                 "Concurrent takes the allocators with a commit rule ('ontime allocators' names them)");
   command->add_flag("--exact", options->exact, "Also compute the exact success probability (no sampling)");
   command->add_flag("--regret", options->regret,
                     "Also estimate the regret V* - V (the optimum less the allocator's success probability) from the "
@@ -102,16 +117,7 @@ void add_evaluate_command(CLI::App& app) {
       return;
     }
     const Mdp mdp(problem);
-    // The allocator's own instance: INSTANCE's skeletons with the belief's distributions.
-    std::optional<Problem> planned;
-    if (!options->belief.empty()) {
-      const Problem belief = load_problem(options->belief);
-      try {
-        planned.emplace(with_distributions_of(problem, belief));
-      } catch (const UsageError& error) {
-        throw UsageError(options->belief + ": " + error.what() + " (--belief against " + options->instance + ")");
-      }
-    }
+    const std::optional<Problem> planned = planned_problem(*options, problem);
     const Mdp planned_mdp(planned ? *planned : problem);
     const ParameterValues parameters = options->allocator.values();
     options->monte_carlo.check_allocator_memory(options->solver, problem, parameters);

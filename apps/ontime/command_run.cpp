@@ -78,7 +78,7 @@ void add_run_command(CLI::App& app) {
   command->add_flag("--exact", options->exact, "Also the exact success the allocator expects from the instance");
   add_act_option(*command, options->act,
                  "Concurrent: the robot executes each motion it starts while the planner refines the next from where "
-                 "that motion ends, on the model's steps (not yet --live, --effort wall or --belief)");
+                 "that motion ends (on the model's steps, or live on the robot's clock)");
   command->add_flag("--live", options->live,
                     "Live episodes on the clock (always with --effort wall): the allocator's thinking and the "
                     "planner's overruns are charged; with --effort checks planner calls count their nominal seconds");

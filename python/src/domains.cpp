@@ -204,17 +204,17 @@ void bind_domains(py::module_& m) {
         // Read as a problem: one acting while planning (SPEC §10) makes no plan-first Mdp.
         const std::shared_ptr<const Problem> chosen = problem_with_acting(problem, act);
         const std::string instance = instance_label(problem, *chosen);
-        std::shared_ptr<MdpHandle> believed;
+        std::shared_ptr<const Problem> believed;  // (read as a problem too, whatever its acting mode)
         domains::PlannerRunOptions options;
         if (!belief.is_none()) {
-          believed = to_mdp(belief, "belief");
+          believed = problem_with_acting(belief, {}, "belief");
           try {
-            (void)with_distributions_of(*chosen, *believed->problem);
+            (void)with_distributions_of(*chosen, *believed);
           } catch (const UsageError& error) {
             throw UsageError(std::string("belief: ") + error.what());
           }
-          options.belief = believed->problem.get();
-          options.belief_source = instance_label(belief, *believed->problem);
+          options.belief = believed.get();
+          options.belief_source = instance_label(belief, *believed);
         }
         options.solver = solver;
         options.parameters = parameter_values(kwargs);

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "bindings.hpp"
+#include "ontime/allocators/concurrent_allocator.hpp"
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/learn/online_adaptation.hpp"
 #include "ontime/report/report.hpp"
@@ -203,17 +204,20 @@ namespace {
 py::dict evaluate_concurrent(const py::object& source, const Problem& problem, const std::string& solver,
                              std::uint64_t episodes, std::uint64_t seed, unsigned threads, bool exact, bool regret,
                              const py::object& belief, const py::object& progress, const ParameterValues& values) {
-  if (!belief.is_none()) {
-    throw UsageError(
-        "belief: acting while planning (concurrent, SPEC §10) is evaluated with the problem's own "
-        "distributions only so far");
-  }
+  // With a belief the allocator decides on its own model, shown the states with the skeletons the
+  // problem counts as hopeless kept (HopelessSkeletons), as `ontime evaluate --belief` does.
+  std::optional<Problem> planned;
+  if (!belief.is_none()) planned.emplace(with_distributions_of(problem, *problem_with_acting(belief, {}, "belief")));
   MonteCarloResult result;
   std::optional<ExactEvaluation> exact_result;
   run_interruptibly(
       [&](const std::function<bool()>& stop, Progress& counters) {
-        const ConcurrentMdp mdp(problem);
-        const ConcurrentAllocatorFactory factory = make_concurrent_allocator_factory(solver, mdp, values);
+        const ConcurrentMdp mdp(problem, planned ? HopelessSkeletons::kept : HopelessSkeletons::dropped);
+        std::optional<ConcurrentMdp> planned_mdp;
+        if (planned) planned_mdp.emplace(*planned);
+        const ConcurrentAllocatorFactory factory =
+            planned_mdp ? seen_by_belief(*planned_mdp, make_concurrent_allocator_factory(solver, *planned_mdp, values))
+                        : make_concurrent_allocator_factory(solver, mdp, values);
         MonteCarloOptions options;
         options.episodes = episodes;
         options.seed = seed;
@@ -230,6 +234,7 @@ py::dict evaluate_concurrent(const py::object& source, const Problem& problem, c
                                                         .parameters = values,
                                                         .instance = instance_label(source, problem),
                                                         .problem = &problem,
+                                                        .belief = planned ? instance_label(belief, *planned) : "",
                                                         .seed = seed,
                                                         .result = result,
                                                         .exact = exact_result,
@@ -484,7 +489,7 @@ void bind_run(py::module_& m) {
         std::shared_ptr<MdpHandle> planned = mdp;
         if (!belief.is_none()) {
           planned = std::make_shared<MdpHandle>(std::make_shared<const Problem>(
-              with_distributions_of(*mdp->problem, *to_mdp(belief, "belief")->problem)));
+              with_distributions_of(*mdp->problem, *problem_with_acting(belief, {}, "belief"))));
         }
         const ParameterValues values = parameter_values(kwargs);
         std::optional<AllocatorFactory> factory;
@@ -516,7 +521,7 @@ void bind_run(py::module_& m) {
       "id) while the episodes and the exact value are drawn from `problem` (`ontime evaluate --belief`). "
       "act='concurrent' (or a problem whose acting is concurrent): the robot acts while planning (SPEC §10), "
       "the allocator by its commit rule (`ontime evaluate --act`), regret=True by the concurrent optimum's "
-      "losses; not yet with belief. "
+      "losses; with a belief, the allocator decides on the belief's model. "
       "Parameters of the allocator as keyword arguments. The GIL is released; Ctrl-C stops it "
       "(KeyboardInterrupt).");
 

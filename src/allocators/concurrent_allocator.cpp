@@ -143,4 +143,39 @@ ConcurrentAllocatorFactory eager_commit_factory(const ConcurrentMdp& mdp, Alloca
       [&mdp, plan_first = std::move(plan_first)] { return std::make_unique<EagerCommitAllocator>(mdp, plan_first()); };
 }
 
+namespace {
+
+// An allocator deciding on a belief's model, shown the world's states as that model holds them.
+class BelievingAllocator final : public ConcurrentAllocator {
+ public:
+  BelievingAllocator(const ConcurrentMdp& belief, std::unique_ptr<ConcurrentAllocator> inner)
+      : belief_(&belief), inner_(std::move(inner)) {}
+
+  std::string_view name() const noexcept override { return inner_->name(); }
+  void begin_episode(std::uint64_t seed) override { inner_->begin_episode(seed); }
+  ConcurrentMdp::Move choose(const ConcurrentState& state) override {
+    seen_ = belief_->canonical(state);
+    if (!belief_->any_live(seen_)) return {};  // hopeless by its model: the planner idles
+    return inner_->choose(seen_);
+  }
+  void observe(const ConcurrentState& before, int choice, const ConcurrentState& after) override {
+    inner_->observe(belief_->canonical(before), choice, belief_->canonical(after));
+  }
+  bool is_stationary() const noexcept override { return inner_->is_stationary(); }
+  void collect_statistics(Statistics& statistics) const override { inner_->collect_statistics(statistics); }
+
+ private:
+  const ConcurrentMdp* belief_;
+  std::unique_ptr<ConcurrentAllocator> inner_;
+  ConcurrentState seen_;  // scratch
+};
+
+}  // namespace
+
+ConcurrentAllocatorFactory seen_by_belief(const ConcurrentMdp& belief, ConcurrentAllocatorFactory allocators) {
+  return [&belief, allocators = std::move(allocators)] {
+    return std::make_unique<BelievingAllocator>(belief, allocators());
+  };
+}
+
 }  // namespace ontime

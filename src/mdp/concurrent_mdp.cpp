@@ -5,13 +5,14 @@
 #include <string>
 
 namespace ontime {
-ConcurrentMdp::ConcurrentMdp(const Problem& problem)
+ConcurrentMdp::ConcurrentMdp(const Problem& problem, HopelessSkeletons hopeless)
     : problem_(std::make_unique<const Problem>(problem.with_acting(Acting::plan_first))),
       mdp_(*problem_),
       deadline_(problem.deadline()),
       skeleton_count_(problem.skeleton_count()),
       action_count_(problem.action_count()),
       backtracking_(problem.has_backtracking()),
+      keeps_hopeless_(backtracking_ || hopeless == HopelessSkeletons::kept),
       culprit_(static_cast<std::size_t>(problem.action_count()), 0),
       timed_(problem.is_timed()) {
   for (int a = 0; a < action_count_; ++a) {
@@ -59,8 +60,8 @@ ConcurrentState ConcurrentMdp::start() const {
 
 bool ConcurrentMdp::any_live(const ConcurrentState& state) const noexcept {
   for (int k = 0; k < skeleton_count_; ++k) {
-    // Without backtracking a kept skeleton can finish (canonicalise drops the others).
-    if (is_live(state, k) && (!backtracking_ || can_finish(state, k))) return true;
+    // Unless hopeless skeletons are kept, a live skeleton can finish (canonicalise drops the others).
+    if (is_live(state, k) && (!keeps_hopeless_ || can_finish(state, k))) return true;
   }
   return false;
 }
@@ -132,9 +133,10 @@ void ConcurrentMdp::canonicalise(ConcurrentState& state) const {
   const int depth = executed_depth(state);
   for (int k = 0; k < skeleton_count_; ++k) {
     if (!is_live(state, k)) continue;
-    // With backtracking a skeleton that cannot finish now may again (class comment): it is kept.
+    // With backtracking a skeleton that cannot finish now may again (class comment): it is kept,
+    // as every one is where HopelessSkeletons::kept asks for it.
     if (!through_executed(state, k) || problem_->skeleton_length(k) <= depth ||
-        (!backtracking_ && earliest_finish(state, k) > deadline_)) {
+        (!keeps_hopeless_ && earliest_finish(state, k) > deadline_)) {
       refined_word(state, k) = kDropped;
       spent_word(state, k) = 0;
     }
@@ -380,6 +382,12 @@ ConcurrentState ConcurrentMdp::state_of(Steps time, Steps robot_left, int execut
   return state;
 }
 
+ConcurrentState ConcurrentMdp::canonical(const ConcurrentState& state) const {
+  ConcurrentState seen = state;
+  canonicalise(seen);
+  return seen;
+}
+
 ConcurrentState ConcurrentMdp::execution_finished(const ConcurrentState& state) const {
   ConcurrentState next = state;
   next[1] = 0;
@@ -389,9 +397,9 @@ ConcurrentState ConcurrentMdp::execution_finished(const ConcurrentState& state) 
 
 int ConcurrentMdp::complete_plan(const ConcurrentState& state) const noexcept {
   for (int k = 0; k < skeleton_count_; ++k) {
-    // Without backtracking a kept skeleton refined in full ends by D (its earliest finish).
+    // Unless hopeless skeletons are kept, a live skeleton refined in full ends by D (its earliest finish).
     if (is_live(state, k) && refined(state, k) == problem_->skeleton_length(k) &&
-        (!backtracking_ || robot_free(state, k) <= deadline_)) {
+        (!keeps_hopeless_ || robot_free(state, k) <= deadline_)) {
       return k;
     }
   }

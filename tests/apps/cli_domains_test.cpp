@@ -16,6 +16,7 @@
 
 #include "apps/cli_test_support.hpp"
 #include "ontime/allocators/allocator_registry.hpp"
+#include "ontime/allocators/concurrent_allocator.hpp"
 #include "ontime/mdp/concurrent_mdp.hpp"
 #include "ontime/model/instance_io.hpp"
 #include "ontime/run/evaluation.hpp"
@@ -517,9 +518,36 @@ TEST(Cli, RunActsWhilePlanningWithTheRealPlanner) {
     }
   }
 
+  // With a belief: the instance itself gives the same episodes; one in which move(R1,R5) is never
+  // found gives the model value of dp-rerun deciding on its model (two skeletons hopeless to it).
+  const std::filesystem::path dir = scratch("concurrent-belief");
+  std::vector<Action> actions(navigation.actions().begin(), navigation.actions().end());
+  actions[static_cast<std::size_t>(navigation.find_action("move(R1,R5)"))].planning = Distribution::from_pmf({0.0});
+  save_problem(navigation.with_actions(std::move(actions)), dir / "belief.json");
+  const std::vector<std::string> few{"run",       "--domain", "navigation", "--solver",   "dp-rerun", "--episodes", "4",
+                                     "--threads", "1",        "--act",      "concurrent", "--exact",  "--json"};
+  std::vector<std::string> believing_command = few;
+  believing_command.insert(believing_command.end(), {"--belief", (dir / "belief.json").string()});
+  std::vector<std::string> same_command = few;
+  same_command.insert(same_command.end(),
+                      {"--belief", testing::source_path("data/instances/navigation.json").string()});
+  const auto alone = ontime(few);
+  const auto same = ontime(same_command);
+  const auto believing = ontime(believing_command);
+  ASSERT_EQ(believing.exit_code, 0) << believing.err;
+  EXPECT_EQ(json::parse(same.out)["successes"], json::parse(alone.out)["successes"]);
+  EXPECT_EQ(json::parse(same.out)["model_exact_success_probability"],
+            json::parse(alone.out)["model_exact_success_probability"]);
+  const json believed_out = json::parse(believing.out);
+  EXPECT_EQ(believed_out["belief"], (dir / "belief.json").string());
+  const ConcurrentMdp world(navigation, HopelessSkeletons::kept);
+  const ConcurrentMdp believed(with_distributions_of(navigation, load_problem((dir / "belief.json").string())));
+  const auto believing_allocator = seen_by_belief(believed, make_concurrent_allocator_factory("dp-rerun", believed))();
+  const double believed_exact = evaluate_exactly(world, *believing_allocator).success_probability;
+  EXPECT_EQ(believed_out["model_exact_success_probability"].get<double>(), believed_exact);
+  EXPECT_LT(believed_exact, exact - 0.05);
+
   for (const auto& [arguments, message] : std::vector<std::pair<std::vector<std::string>, std::string>>{
-           {{"--solver", "dp-rerun", "--belief", testing::source_path("data/instances/navigation.json").string()},
-            "--belief: acting"},
            {{"--solver", "ppo"}, "ppo needs a trained policy"}}) {
     std::vector<std::string> command{"run", "--domain", "navigation", "--episodes", "2", "--act", "concurrent"};
     command.insert(command.end(), arguments.begin(), arguments.end());

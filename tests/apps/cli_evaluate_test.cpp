@@ -135,7 +135,6 @@ TEST(Cli, EvaluateActsWhilePlanningByEachAllocatorsCommitRule) {
 
   for (const auto& [arguments, message] : std::vector<std::pair<std::vector<std::string>, std::string>>{
            {{"--solver", "ppo"}, "ppo needs a trained policy"},
-           {{"--solver", "dp-rerun", "--belief", paper("instance1")}, "--belief: acting while planning"},
            {{"--solver", "thompson", "--exact"}, "exact evaluation needs an allocator whose move depends only on"},
            {{"--solver", "dp-rerun", "--act", "sometimes"}, "--act"}}) {
     std::vector<std::string> command{"evaluate", paper("instance1"), "--act", "concurrent", "--episodes", "10"};

@@ -12,8 +12,11 @@
 #include <vector>
 
 #include "apps/cli_test_support.hpp"
+#include "ontime/allocators/allocator_registry.hpp"
+#include "ontime/allocators/concurrent_allocator.hpp"
 #include "ontime/allocators/dp_rerun.hpp"
 #include "ontime/learn/online_adaptation.hpp"
+#include "ontime/mdp/concurrent_mdp.hpp"
 #include "ontime/mdp/mdp.hpp"
 #include "ontime/model/instance_io.hpp"
 #include "ontime/run/evaluation.hpp"
@@ -115,6 +118,39 @@ TEST(Cli, EvaluateWithABeliefPlansWithItAndScoresInTheInstance) {
                                "--solver", "dp-rerun", "--episodes", "10"});
   EXPECT_EQ(lacking.exit_code, 2);
   EXPECT_NE(lacking.err.find("lacking.json: no distributions for the action"), std::string::npos) << lacking.err;
+}
+
+TEST(Cli, EvaluateWithABeliefActingWhilePlanningDecidesOnTheBeliefsModel) {
+  const auto folder = scratch("evaluate_belief_concurrent");
+  const Problem truth = testing::paper_instance("instance4").with_acting(Acting::concurrent);
+  save_problem(misleading_belief(truth), folder / "belief.json");
+  const std::vector<std::string> common{"--act", "concurrent", "--solver", "dp-rerun",    "--exact", "--seed",
+                                        "3",     "--episodes", "500",      "--no-timing", "--json"};
+  std::vector<std::string> plain_command{"evaluate", paper("instance4")};
+  plain_command.insert(plain_command.end(), common.begin(), common.end());
+  std::vector<std::string> believing_command = plain_command;
+  believing_command.insert(believing_command.end(), {"--belief", (folder / "belief.json").string()});
+  std::vector<std::string> same_command = plain_command;
+  same_command.insert(same_command.end(), {"--belief", paper("instance4")});
+  const auto plain = ontime(plain_command);
+  const auto believing = ontime(believing_command);
+  ASSERT_EQ(believing.exit_code, 0) << believing.err;
+  const json out = json::parse(believing.out);
+  EXPECT_EQ(out["belief"], (folder / "belief.json").string());
+  EXPECT_EQ(out["acting"], "concurrent");
+  // The exact value of dp-rerun deciding on the belief's model, in the world's (hopeless skeletons
+  // kept, so that the world's distributions tell the allocator nothing).
+  const ConcurrentMdp world(truth, HopelessSkeletons::kept);
+  const ConcurrentMdp believed(with_distributions_of(truth, misleading_belief(truth)));
+  const auto allocator = seen_by_belief(believed, make_concurrent_allocator_factory("dp-rerun", believed))();
+  const double expected = evaluate_exactly(world, *allocator).success_probability;
+  EXPECT_EQ(out["exact_success_probability"].get<double>(), expected);
+  EXPECT_LT(expected, json::parse(plain.out)["exact_success_probability"].get<double>());
+
+  // The instance itself as the belief: the same numbers as without one.
+  json same_out = json::parse(ontime(same_command).out);
+  same_out.erase("belief");
+  EXPECT_EQ(same_out, json::parse(plain.out));
 }
 
 TEST(Cli, AdaptRunsEpisodesWithTheUpdatedPriorAsTheLibraryDoes) {

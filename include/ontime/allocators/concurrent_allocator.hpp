@@ -88,6 +88,19 @@ class EagerCommitAllocator final : public ConcurrentAllocator {
 // mdp.plan_first_mdp()), chains and expiry (SPEC §9) included.
 ConcurrentAllocatorFactory eager_commit_factory(const ConcurrentMdp& mdp, AllocatorFactory plan_first);
 
+// Allocators that decide with a belief (other distributions for the same skeletons, SPEC §10
+// "Beliefs"): each allocator `allocators` makes decides on `belief` (the ConcurrentMdp of the
+// belief's problem) and is shown every state of the world's model as `belief` holds it
+// (ConcurrentMdp::canonical), so that the skeletons it counts as hopeless are the ones its own
+// distributions say are; the world's model should keep hopeless skeletons
+// (HopelessSkeletons::kept), or its states would tell what only the world's distributions imply.
+// Where `belief` counts every skeleton hopeless, the planner idles (ConcurrentMdp::kWait): no move
+// is worth anything there by the allocator's model. With the world's own distributions as the
+// belief, the moves are those of the allocators on the world's own model, state by state. `belief`
+// must outlive the factory and what it makes. Cost: one copy and canonicalisation of the state per
+// move, O(K * A_max + A), on top of the allocator's.
+ConcurrentAllocatorFactory seen_by_belief(const ConcurrentMdp& belief, ConcurrentAllocatorFactory allocators);
+
 // The state of SPEC §10 seen plan-first (SPEC §2), for a plan-first allocator: CT; per live
 // skeleton its l_k and PT_k, and as ET_k the steps the robot still needs for its refined actions
 // (ConcurrentMdp::robot_free less CT, at most D + 1), so that plan-first success from the view

@@ -60,6 +60,14 @@ namespace ontime {
 // A state of SPEC §10, the words described above.
 using ConcurrentState = std::vector<std::uint16_t>;
 
+// What the states hold of a skeleton that is through E but can no longer finish by D: `dropped`
+// (canonical: it reads as not live, and the executions only it would run are forgotten), or `kept`
+// (it stays live until E leaves it, as every skeleton does with backtracking). Kept, the states
+// say nothing the model's distributions alone imply, which is what an allocator deciding with
+// other distributions (a belief, SPEC §10 "Beliefs") must be shown: the skeletons it believes able
+// are its own to judge. The values of the states and of every policy are the same either way.
+enum class HopelessSkeletons { dropped, kept };
+
 class ConcurrentMdp {
  public:
   // An execution time that is not known (not refined, or no live skeleton will run it).
@@ -84,8 +92,9 @@ class ConcurrentMdp {
     friend bool operator==(const Move&, const Move&) = default;
   };
 
-  // Any acting mode is read as concurrent (the model of this class).
-  explicit ConcurrentMdp(const Problem& problem);
+  // Any acting mode is read as concurrent (the model of this class). `hopeless`: whether a
+  // skeleton that can no longer finish by D is dropped from the states (the default) or kept.
+  explicit ConcurrentMdp(const Problem& problem, HopelessSkeletons hopeless = HopelessSkeletons::dropped);
   ~ConcurrentMdp();
   ConcurrentMdp(const ConcurrentMdp&) = delete;
   ConcurrentMdp& operator=(const ConcurrentMdp&) = delete;
@@ -112,7 +121,7 @@ class ConcurrentMdp {
   static int executed(const ConcurrentState& state) noexcept { return static_cast<int>(state[2]) - 1; }
   // The chains' joint state (Mdp::joint_chain_state; 0 without chains).
   static std::uint16_t chains(const ConcurrentState& state) noexcept { return state[3]; }
-  // Whether skeleton k is through E and (without backtracking) can still finish by D.
+  // Whether skeleton k is through E and (unless hopeless skeletons are kept) can still finish by D.
   static bool is_live(const ConcurrentState& state, int k) noexcept { return refined_word(state, k) != kDropped; }
   // l_k of a live skeleton: its actions refined.
   static int refined(const ConcurrentState& state, int k) noexcept { return refined_word(state, k); }
@@ -244,6 +253,13 @@ class ConcurrentMdp {
   ConcurrentState state_of(Steps time, Steps robot_left, int executed, std::span<const Steps> execution,
                            std::span<const Steps> effort, std::uint16_t chains = 0) const;
 
+  // `state`, a state of a model of the same skeletons and deadline (the instance's own with
+  // hopeless skeletons kept, say), as this model holds it: canonical, the skeletons this model's
+  // distributions count as hopeless dropped unless it keeps them, and the executions no live
+  // skeleton runs forgotten. How an allocator deciding with other distributions sees the world's
+  // states (seen_by_belief, allocators/concurrent_allocator.hpp). O(K * A_max + A).
+  ConcurrentState canonical(const ConcurrentState& state) const;
+
   // The state with the robot's current execution finished now (r = 0; canonical): what a robot
   // that finished sooner than its motion's execution time reports. The state itself while it is
   // idle.
@@ -262,7 +278,11 @@ class ConcurrentMdp {
 
   // Whether value_key may merge executions: neither backtracking (SPEC §7) nor chains or expiry
   // (SPEC §9), under which the order and the timing of a skeleton's motions matter.
-  bool merges_backlogs() const noexcept { return !backtracking_ && !timed_; }
+  // Kept hopeless skeletons are not merged either (keys are the states themselves).
+  bool merges_backlogs() const noexcept { return !keeps_hopeless_ && !timed_; }
+  // Whether a skeleton that can no longer finish by D stays in the states (HopelessSkeletons::kept,
+  // or backtracking).
+  bool keeps_hopeless() const noexcept { return keeps_hopeless_; }
   // A key of `state` (canonical) such that two states with equal keys have equal optimal values
   // V* and allow the same moves, for the exact solver's memo (docs/theory.md, "Backlogs"): where
   // merges_backlogs(), the execution times of the refined actions that only one live skeleton k
@@ -316,6 +336,7 @@ class ConcurrentMdp {
   std::vector<Steps> next_finish_;
   std::vector<Steps> fastest_execution_;  // per action; kNever when none is finite
   bool backtracking_ = false;
+  bool keeps_hopeless_ = false;        // backtracking_, or HopelessSkeletons::kept
   std::vector<std::uint8_t> culprit_;  // per action: 1 when some action may blame it
   bool timed_ = false;
   // Moves the chains one step from `state`'s joint state into `next` (already canonical) and calls

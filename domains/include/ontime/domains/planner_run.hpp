@@ -74,8 +74,8 @@ void check_planner_run_request(const Problem& problem, const std::string& source
 void check_domain_actions(const Domain& domain, const Problem& problem, const std::string& source);
 
 // The episodes (and the exact value). The instance's action ids must be actions of the domain. An
-// instance acting while planning (SPEC §10) runs the allocator by its commit rule on the model's
-// steps (UsageError for live episodes or a belief, not there yet in that mode).
+// instance acting while planning (SPEC §10) runs the allocator by its commit rule, on the model's
+// steps or live, with a belief too (the allocator decides on the belief's model).
 PlannerRun run_planner_episodes(const Domain& domain, const Problem& problem, const PlannerRunOptions& options);
 
 }  // namespace ontime::domains
