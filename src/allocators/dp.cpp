@@ -1,10 +1,15 @@
 #include "ontime/allocators/dp.hpp"
 
+#include <cstdint>
+#include <memory>
 #include <optional>
+#include <string_view>
 
 #include "ontime/allocators/allocator_registry.hpp"
+#include "ontime/allocators/concurrent_allocator.hpp"
 #include "ontime/solve/backtracking_success.hpp"
 #include "ontime/solve/concurrent_contiguous_success.hpp"
+#include "ontime/solve/concurrent_devoted_optimum.hpp"
 #include "ontime/solve/timed_contiguous_success.hpp"
 
 namespace ontime {
@@ -38,6 +43,35 @@ int best_single_skeleton(const Mdp& mdp) {
   return best;
 }
 
+// dp acting while planning with chains or expiry: the devoted optimum of one skeleton, chosen once;
+// once that skeleton is dropped, of the live one whose earliest finish is least (ties: lowest
+// index), as the eager rule goes on.
+class ConcurrentDevotedAllocator final : public ConcurrentAllocator {
+ public:
+  ConcurrentDevotedAllocator(const ConcurrentMdp& mdp, int chosen) : mdp_(&mdp), devoted_(mdp), chosen_(chosen) {}
+  std::string_view name() const noexcept override { return "dp"; }
+  ConcurrentMdp::Move choose(const ConcurrentState& state) override {
+    int followed = chosen_;
+    if (!ConcurrentMdp::is_live(state, followed)) {
+      std::int64_t least = 0;
+      for (int k = 0; k < mdp_->skeleton_count(); ++k) {
+        if (!ConcurrentMdp::is_live(state, k)) continue;
+        const std::int64_t finish = mdp_->earliest_finish(state, k);
+        if (followed == chosen_ || finish < least) {
+          followed = k;
+          least = finish;
+        }
+      }
+    }
+    return devoted_.move(state, followed);
+  }
+
+ private:
+  const ConcurrentMdp* mdp_;
+  ConcurrentDevotedOptimum devoted_;
+  int chosen_;
+};
+
 }  // namespace
 
 DpAllocator::DpAllocator(const Mdp& mdp) : chosen_(best_single_skeleton(mdp)) {}
@@ -53,18 +87,31 @@ AllocatorKind dp_kind() {
           },
           .commit_rule =
               "eager along the one skeleton most likely to succeed alone by Eq. (1) acting while planning, from the "
-              "start (chains: the devoted policy's exact value)",
+              "start; chains, expiry: the skeleton of the best devoted optimum, followed by it (waiting for a chain "
+              "when that pays)",
           .make_concurrent = [](const ConcurrentMdp& mdp, const ParameterReader&) -> ConcurrentAllocatorFactory {
-            ConcurrentContiguousSuccess values(mdp, Aggregation::self);
+            // With chains or expiry a skeleton is worth its devoted optimum, which the robot follows.
+            std::optional<ConcurrentContiguousSuccess> values;
+            std::optional<ConcurrentDevotedOptimum> devoted;
+            if (mdp.is_timed()) {
+              devoted.emplace(mdp);
+            } else {
+              values.emplace(mdp, Aggregation::self);
+            }
             const ConcurrentState start = mdp.start();
             int chosen = 0;
             double best = -1;
             for (int k = 0; k < mdp.skeleton_count(); ++k) {
-              const double value = ConcurrentMdp::is_live(start, k) ? values.value(start, k) : 0.0;
+              double value = 0.0;
+              if (ConcurrentMdp::is_live(start, k))
+                value = devoted ? devoted->value(start, k) : values->value(start, k);
               if (value > best) {
                 best = value;
                 chosen = k;
               }
+            }
+            if (devoted) {
+              return [&mdp, chosen] { return std::make_unique<ConcurrentDevotedAllocator>(mdp, chosen); };
             }
             return eager_commit_factory(mdp, [chosen] { return std::make_unique<DpAllocator>(chosen); });
           }};

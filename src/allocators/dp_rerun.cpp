@@ -111,9 +111,10 @@ AllocatorKind dp_rerun_kind() {
       },
       .commit_rule =
           "eager along the best skeleton by Eq. (1) acting while planning, the robot working meanwhile (give-ups "
-          "blaming a started motion block; chains: the devoted policy's exact value)",
+          "blaming a started motion block); chains, expiry: the best skeleton's devoted optimum, which waits for a "
+          "chain when that pays",
       .make_concurrent = [](const ConcurrentMdp& mdp, const ParameterReader& parameters) -> ConcurrentAllocatorFactory {
-        // With chains or expiry only `self` has a form (the devoted policy's exact value): the default there.
+        // With chains or expiry only `self` has a form (the devoted optimum's value): the default there.
         std::optional<Aggregation> aggregation;
         if (parameters.given("aggregation")) aggregation = parse_aggregation(parameters.text("aggregation"));
         ConcurrentContiguousSuccess::check_supported(mdp, aggregation.value_or(Aggregation::self));
@@ -123,21 +124,23 @@ AllocatorKind dp_rerun_kind() {
 }
 
 ConcurrentDpRerunAllocator::ConcurrentDpRerunAllocator(const ConcurrentMdp& mdp, std::optional<Aggregation> aggregation)
-    : mdp_(&mdp), values_(mdp, aggregation.value_or(mdp.is_timed() ? Aggregation::self : Aggregation::sum)) {}
+    : mdp_(&mdp), values_(mdp, aggregation.value_or(mdp.is_timed() ? Aggregation::self : Aggregation::sum)) {
+  if (mdp.is_timed()) devoted_ = std::make_unique<ConcurrentDevotedOptimum>(mdp);
+}
 
 ConcurrentMdp::Move ConcurrentDpRerunAllocator::choose(const ConcurrentState& state) {
   int best = -1;
   double best_value = -1.0;
   for (int k = 0; k < mdp_->skeleton_count(); ++k) {
     if (!ConcurrentMdp::is_live(state, k)) continue;
-    const double value = values_.value(state, k);
+    const double value = devoted_ ? devoted_->value(state, k) : values_.value(state, k);
     if (value > best_value + 1e-12) {
       best_value = value;
       best = k;
     }
   }
   if (best < 0) return {};  // nothing can finish: every move is as good
-  return ConcurrentContiguousSuccess::devoted_move(*mdp_, state, best);
+  return devoted_ ? devoted_->move(state, best) : ConcurrentContiguousSuccess::devoted_move(*mdp_, state, best);
 }
 
 }  // namespace ontime

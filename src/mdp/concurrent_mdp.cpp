@@ -388,6 +388,19 @@ ConcurrentState ConcurrentMdp::canonical(const ConcurrentState& state) const {
   return seen;
 }
 
+ConcurrentState ConcurrentMdp::devoted_to(const ConcurrentState& state, int k) const {
+  ConcurrentState devoted = state;
+  for (int j = 0; j < skeleton_count_; ++j) {
+    // A skeleton whose path is a prefix of k's (k runs through its last action) is kept.
+    const std::span<const int> along = problem_->members(problem_->skeleton(j).back());
+    if (j == k || std::binary_search(along.begin(), along.end(), k)) continue;
+    refined_word(devoted, j) = kDropped;
+    spent_word(devoted, j) = 0;
+  }
+  canonicalise(devoted);
+  return devoted;
+}
+
 ConcurrentState ConcurrentMdp::execution_finished(const ConcurrentState& state) const {
   ConcurrentState next = state;
   next[1] = 0;

@@ -96,9 +96,8 @@ TEST(SeenByBelief, TheWorldsOwnDistributionsMakeTheSameMovesAndNumbers) {
     const ConcurrentMdp believed(with_distributions_of(problem, problem));
     for (const std::string& kind : allocator_registry().acting_names()) {
       if (kind == "ppo") continue;
-      const ParameterValues values = kind == "mcts" || kind == "branch-and-bound"
-                                         ? ParameterValues{{"iterations", "30"}}
-                                         : ParameterValues{};
+      const ParameterValues values =
+          kind == "mcts" || kind == "branch-and-bound" ? ParameterValues{{"iterations", "30"}} : ParameterValues{};
       const ConcurrentAllocatorFactory own = make_concurrent_allocator_factory(kind, canonical, values);
       const ConcurrentAllocatorFactory believing =
           seen_by_belief(believed, make_concurrent_allocator_factory(kind, believed, values));
@@ -174,7 +173,8 @@ TEST(SeenByBelief, AHandCaseEarnsWhatTheBeliefChooses) {
   }
   const Problem hopeless("belief", 3, 1.0, {{"a0", never, one_step}, {"a1", never, one_step}}, {{0}, {1}});
   const ConcurrentMdp believed_hopeless(with_distributions_of(world, hopeless));
-  const auto idle = seen_by_belief(believed_hopeless, make_concurrent_allocator_factory("dp-rerun", believed_hopeless))();
+  const auto idle =
+      seen_by_belief(believed_hopeless, make_concurrent_allocator_factory("dp-rerun", believed_hopeless))();
   EXPECT_EQ(idle->choose(keeping.start()), ConcurrentMdp::Move{});
   EXPECT_EQ(evaluate_exactly(keeping, *idle).expected_reward, 0.0);
 }

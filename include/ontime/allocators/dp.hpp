@@ -6,8 +6,9 @@
 // the exact value of refining the skeleton alone: timed_contiguous_success.hpp), picks the largest
 // once (ties: lowest index) and refines only that skeleton for the whole episode.
 // Acting while planning (SPEC §10) the registry's kind picks the skeleton by Eq. (1) acting while
-// planning from the start (ConcurrentContiguousSuccess, aggregation `self`: with chains or expiry
-// the devoted eager policy's exact value) and follows it by the eager commit rule.
+// planning from the start (ConcurrentContiguousSuccess, aggregation `self`) and follows it by the
+// eager commit rule; with chains or expiry, where waiting for a chain may pay, it picks the skeleton
+// of the largest devoted optimum (ConcurrentDevotedOptimum) and makes that optimum's moves.
 // No guarantee beyond optimality among "one skeleton, refined contiguously" policies.
 // Cost: one ContiguousSuccessTable build at construction; O(1) per decision.
 

@@ -26,6 +26,7 @@
 #include "ontime/mdp/concurrent_mdp.hpp"
 #include "ontime/solve/backtracking_success.hpp"
 #include "ontime/solve/concurrent_contiguous_success.hpp"
+#include "ontime/solve/concurrent_devoted_optimum.hpp"
 #include "ontime/solve/contiguous_success.hpp"
 #include "ontime/solve/timed_contiguous_success.hpp"
 
@@ -68,14 +69,15 @@ class DpRerunAllocator final : public Allocator {
 // best skeleton's next action to execute is refined, it starts it (committing to the skeletons
 // through it); otherwise it spends the step on the best skeleton's next action, or waits when that
 // skeleton is refined in full (ConcurrentContiguousSuccess::devoted_move). With backtracking
-// (SPEC §7) Eq. (1) has its give-up term. With chains or expiry (SPEC §9) a skeleton is worth the
-// exact value of its devoted eager policy from the state (the chains read now and modelled from
-// there), aggregation `self` only, and "starts" means as soon as the action may start: while it is
-// blocked the planner refines the skeleton, or idles when the plan is complete.
+// (SPEC §7) Eq. (1) has its give-up term. With chains or expiry (SPEC §9), where waiting for a chain
+// may pay, a skeleton is worth its devoted optimum from the state (ConcurrentDevotedOptimum: the
+// best a policy refining it alone can earn, choosing when the robot starts each action; the chains
+// read now and modelled from there), aggregation `self` only, and the move is that optimum's: the
+// robot starts an action when starting is worth more than waiting, by that value.
 // Stationary: ConcurrentSolver's policy mode values it exactly.
 // Cost: per move, one Eq. (1) query per live skeleton: a sum over at most D - CT planning steps of
 // memoised values (memoised per allocator, so each thread's allocator has its own memo); with
-// chains or expiry a lookup once the devoted policy's states from there are valued.
+// chains or expiry a lookup once the devoted states from there are solved.
 class ConcurrentDpRerunAllocator final : public ConcurrentAllocator {
  public:
   // The allocator for `mdp`, Eq. (1) combining sharing skeletons by `aggregation` (none: sum,
@@ -88,6 +90,7 @@ class ConcurrentDpRerunAllocator final : public ConcurrentAllocator {
  private:
   const ConcurrentMdp* mdp_;
   ConcurrentContiguousSuccess values_;
+  std::unique_ptr<ConcurrentDevotedOptimum> devoted_;  // with chains or expiry
 };
 
 }  // namespace ontime

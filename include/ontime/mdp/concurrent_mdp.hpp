@@ -260,6 +260,11 @@ class ConcurrentMdp {
   // states (seen_by_belief, allocators/concurrent_allocator.hpp). O(K * A_max + A).
   ConcurrentState canonical(const ConcurrentState& state) const;
 
+  // `state` with every skeleton dropped but live skeleton k and those whose path is a prefix of k's
+  // (canonical): the state of a policy devoted to k, in which only steps and starts along k (and the
+  // planner idling) are moves, and an episode still ends through such a prefix. O(K * A_max + A).
+  ConcurrentState devoted_to(const ConcurrentState& state, int k) const;
+
   // The state with the robot's current execution finished now (r = 0; canonical): what a robot
   // that finished sooner than its motion's execution time reports. The state itself while it is
   // idle.

@@ -113,7 +113,8 @@ class ConcurrentContiguousSuccess {
   // idle and k's next action to execute is refined (and, with chains or expiry, may start now:
   // ConcurrentMdp::startable), its start; else a step on k while k has an action left to refine;
   // else the planner idles (kWait). kWait too once k is dropped. The commit rule of dp-rerun acting
-  // while planning (the best skeleton's devoted move). O(K) without chains or expiry; with them
+  // while planning without chains or expiry (the best skeleton's devoted move; with them dp-rerun
+  // makes the devoted optimum's move, concurrent_devoted_optimum.hpp). O(K) without chains or expiry; with them
   // O(K * A_max) for the startable actions.
   static ConcurrentMdp::Move devoted_move(const ConcurrentMdp& mdp, const ConcurrentState& state, int k);
 
