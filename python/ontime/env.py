@@ -1,4 +1,4 @@
-"""A Gymnasium-style environment of the effort-allocation MDP.
+"""A Gymnasium-style environment of the effort-allocation MDP, plan-first or acting while planning.
 
     env = ontime.env.EffortAllocationEnv(ontime.load_problem("data/instances/paper/instance1.json"), seed=1)
     observation, info = env.reset(seed=1)
@@ -13,17 +13,58 @@ when gymnasium is importable, `observation_space` and `action_space` are gymnasi
 otherwise small equivalents with the same attributes and methods (shape, dtype, n, sample, contains,
 seed). Debian 12 packages no gymnasium.
 
-Episode: one simulated episode of the problem (a hidden sampled world). Action: a skeleton index in
-[0, K). Observation: the normalised MDP state the ppo allocator sees (float32, 1 + 3 K values: CT/D,
-then per skeleton l_k/A_k, PT_k/D, ET_k/D). Reward: on success the executed skeleton's reward at its
-finish (SPEC §8; 1 when the instance declares no rewards, as in the paper), 0 otherwise.
-The episode terminates on success or failure (deadline passed, or no skeleton can still meet it); it
-is never truncated. info["action_mask"] (also env.action_masks()) marks the useful choices: one per
-group of skeletons sharing their next action, among those that can still succeed.
+The acting mode (SPEC §10): `act=None` plays the instance's own ("acting" in its file, plan-first
+when absent), `act='plan-first'` or `act='concurrent'` reads it in that mode (as `ontime.evaluate`'s
+`act`); `env.act` says which.
+
+Plan-first (SPEC §2). Episode: one simulated episode of the problem (a hidden sampled world). Action:
+a skeleton index in [0, K). Observation: the normalised MDP state the ppo allocator sees (float32,
+1 + 3 K values: CT/D, then per skeleton l_k/A_k, PT_k/D, ET_k/D; with chains or expiry their
+features after). info["action_mask"] (also env.action_masks()) marks the useful choices: one per
+group of skeletons sharing their next action, among those that can still succeed. `env.state` is
+the MDP state (ontime.State).
+
+Acting while planning (act='concurrent', SPEC §10): the robot executes refined actions while the
+rest is planned. Episode: one ConcurrentSession episode in a hidden sampled world, carried out as
+`ontime.evaluate(problem, solver, act='concurrent')` carries out its allocators' moves. Action: one
+of 2 K + 1 moves, laid out as the concurrent ppo actor's outputs: k < K a step in which the planner
+refines skeleton k's next action, K + k the start of skeleton k's next action to execute (the robot
+begins it now; no time passes), 2 K a step in which the planner idles (the robot executes either
+way). Observation: the features the concurrent ppo policy sees (float32, 2 + 6 K values: CT/D, r/D,
+then per skeleton 1 when it is live (else 0 for all six), its actions started / length, l_k /
+length, PT_k/D, the robot's backlog along it / D and 1 when its next action may start now; with
+chains, each chain's state one-hot after). info["action_mask"] marks exactly the state's useful
+moves (the moves the exact solver considers, ConcurrentMdp::useful_moves, as the ppo trainer masks
+them); a masked-out action is refused (UsageError). After a step in which the planner worked on an
+action, info["found"] says whether its motion was found and info["execution_steps"] its execution
+time in steps (ontime.NEVER: it cannot be executed), and info["culprit"] the id of the action an
+attempt that gave up blamed (SPEC §7; else None); all three are None after a start or an idle step.
+`env.state` is a dict of the concurrent state (time, robot_left, started, live, refined, spent,
+startable). `env.action_of(move)` is the action of a move as ontime.ConcurrentSession's choose()
+returns it, so that a registry allocator's moves can be played (an allocator's move outside the
+useful moves has no action to play).
+
+Reward (both modes): on success the executed skeleton's reward at its finish (SPEC §8; 1 when the
+instance declares no rewards, as in the paper), 0 otherwise. The episode terminates on success or
+failure (deadline passed, or no skeleton can still meet it); it is never truncated.
 
 Seeding: reset(seed=s) restarts the episode count; episode e after it lives in the hidden world of
-stream e of s, the world episode e of `ontime.evaluate(..., seed=s)` lives in. reset() without a
-seed goes on to the next episode.
+stream e of s, the world episode e of `ontime.evaluate(..., seed=s)` lives in (in the same mode).
+reset() without a seed goes on to the next episode. `env.session_seed` is the seed of the current
+episode's session: acting while planning, the runner's (its simulated chains, SPEC §9, are those of
+episode e of evaluate), so that ontime.ConcurrentSession(problem, solver, seed=env.session_seed)
+told what each step revealed (report_refined, report_not_yet, report_backtrack) makes the same moves
+as the runner's allocator in that episode:
+
+    env = EffortAllocationEnv(problem, act="concurrent")
+    env.reset(seed=s)
+    session = ontime.ConcurrentSession(problem, "optimal", seed=env.session_seed)
+    move = session.choose()
+    observation, reward, terminated, truncated, info = env.step(env.action_of(move))
+    if move["start"] is None:  # a step: tell the session what it revealed
+        if info["found"]: session.report_refined(info["execution_steps"])
+        elif info["culprit"] is not None: session.report_backtrack(info["culprit"])
+        else: session.report_not_yet()
 """
 
 from __future__ import annotations
@@ -37,7 +78,7 @@ import numpy as np
 
 from ._arguments import _shown
 from ._arguments import name_wrong_arguments as _name_wrong_arguments
-from ._ontime import Problem, UsageError, _EnvironmentCore
+from ._ontime import Problem, UsageError, _ConcurrentEnvironmentCore, _environment_core
 
 __all__ = ["Box", "Discrete", "EffortAllocationEnv"]
 
@@ -167,20 +208,32 @@ class EffortAllocationEnv:
     render_mode = None
     spec = None
 
-    def __init__(self, problem: Problem, seed: int = 0):
-        self._core = _EnvironmentCore(problem, seed)  # the problem (a Problem, an Mdp or a path) and seed checked
-        self.problem = self._core.mdp.problem
+    def __init__(self, problem: Problem, seed: int = 0, act: Optional[str] = None):
+        if act is not None and not isinstance(act, str):
+            raise UsageError(f"parameter 'act': must be 'plan-first', 'concurrent' or None (got {_shown(act)})")
+        # The problem (a Problem, an Mdp or a path), the seed and the mode checked.
+        self._core = _environment_core(problem, seed, act)
+        self._concurrent = isinstance(self._core, _ConcurrentEnvironmentCore)
+        if self._concurrent:
+            self.act = "concurrent"
+            self.problem = self._core.problem
+            actions = self._core.action_count
+        else:
+            self.act = "plan-first"
+            self.problem = self._core.mdp.problem
+            actions = self._core.skeleton_count
         seed = int(seed)
-        skeletons = self._core.skeleton_count
         deadline = self.problem.deadline
-        high = 1.0 + 1.0 / deadline  # ET_k saturates at D + 1
+        # Every feature lies in [0, (D + 1) / D]: times and efforts at most D, executions and the
+        # robot's backlog saturate at D + 1, the rest are shares and flags.
+        high = 1.0 + 1.0 / deadline
         if _gym_spaces is not None:
             self.observation_space = _gym_spaces.Box(0.0, high, shape=(self._core.feature_size,), dtype=np.float32,
                                                      seed=seed)
-            self.action_space = _gym_spaces.Discrete(skeletons, seed=seed)
+            self.action_space = _gym_spaces.Discrete(actions, seed=seed)
         else:
             self.observation_space = Box(0.0, high, (self._core.feature_size,), np.float32, seed=seed)
-            self.action_space = Discrete(skeletons, seed=seed)
+            self.action_space = Discrete(actions, seed=seed)
         self._mask = None
 
     def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None):
@@ -194,8 +247,14 @@ class EffortAllocationEnv:
         return observation, {"action_mask": self._mask}
 
     def step(self, action):
-        """One step of effort on skeleton `action`; returns (observation, reward, terminated,
-        truncated, info)."""
+        """Plan-first, one step of effort on skeleton `action`; acting while planning, the move
+        `action` stands for (see the module). Returns (observation, reward, terminated, truncated,
+        info)."""
+        if self._concurrent:
+            observation, reward, terminated, truncated, found, execution, culprit = self._core.step(action)  # checked
+            self._mask = self._core.action_mask()
+            return observation, reward, terminated, truncated, {"action_mask": self._mask, "found": found,
+                                                                "execution_steps": execution, "culprit": culprit}
         observation, reward, terminated, truncated = self._core.step(action)  # a whole number, checked
         self._mask = self._core.action_mask()
         return observation, reward, terminated, truncated, {"action_mask": self._mask}
@@ -204,10 +263,34 @@ class EffortAllocationEnv:
         """The useful choices of the current state as booleans (MaskablePPO's convention)."""
         return self._core.action_mask().astype(bool)
 
+    def action_of(self, move: Mapping) -> int:
+        """Acting while planning: the action that plays `move` in the current state, a move as
+        ontime.ConcurrentSession's choose() and decide() return it ({'start': an action's id or
+        None, 'skeleton': a skeleton index or None, ...}; neither: the planner idles; a step on a
+        skeleton is the step of its group, the live skeletons sharing that next action, named by
+        the lowest index). UsageError
+        in plan-first mode, for a malformed move and for a start of an action no live skeleton
+        executes next. The action may still be masked out (a move outside the useful ones)."""
+        if not self._concurrent:
+            raise UsageError("action_of: moves are those of acting while planning (act='concurrent'); plan-first, "
+                             "the action is the skeleton index")
+        if not isinstance(move, Mapping):
+            raise UsageError(f"parameter 'move': must be a dict as ConcurrentSession.choose() returns "
+                             f"(got {_shown(move)})")
+        return self._core.action_of(move.get("start"), move.get("skeleton"))
+
     @property
     def state(self):
-        """The MDP state (ontime.State) of the current step."""
+        """Plan-first, the MDP state (ontime.State) of the current step; acting while planning, a
+        dict of the concurrent state: 'time' (CT), 'robot_left' (r), 'started' (the ids of the
+        actions started, in order), per skeleton 'live', 'refined' (l_k) and 'spent' (PT_k; both 0
+        once it is dropped), and 'startable' (the ids of the actions the robot may start now)."""
         return self._core.state
+
+    @property
+    def session_seed(self) -> int:
+        """The seed of the current episode's session (see the module)."""
+        return self._core.session_seed
 
     @property
     def unwrapped(self) -> "EffortAllocationEnv":

@@ -130,6 +130,16 @@ void bind_acting(py::module_& m) {
           "The step found a motion that takes `execution_steps` to execute (ontime.NEVER: it cannot be). Returns "
           "the status.")
       .def(
+          "report_backtrack",
+          [](ConcurrentSessionHandle& h, const py::object& culprit) {
+            const int index = action_index(*h.problem, culprit, "culprit");
+            return session_call([&] { return h.session->report(Observation::backtracked(index)); });
+          },
+          py::arg("culprit"),
+          "The step gave up (SPEC §7) blaming the earlier action `culprit` (its id): its motion and everything "
+          "refined after it are discarded (a culprit the robot executed stays, its action blocked). Returns the "
+          "status.")
+      .def(
           "report_execution_finished",
           [](ConcurrentSessionHandle& h, const py::object& action) {
             const int index = action_index(*h.problem, action, "action");

@@ -190,11 +190,19 @@ def sweep_calls(tmp_path):
             made.decide(refine=0)
         return made
 
+    def concurrent_backtracking():
+        """The caller's moves on grasp-and-place: pick(A) refined, a step on place(A,R1) awaiting its report."""
+        made = ontime.ConcurrentSession(grasps)
+        made.decide(refine=0)
+        made.report_refined(1)
+        made.decide(refine=0)
+        return made
+
     def belief():
         return ontime.OnlineBelief(two, 2.0)
 
-    def environment(reset=True):
-        made = ontime.env.EffortAllocationEnv(two, seed=1)
+    def environment(reset=True, act=None):
+        made = ontime.env.EffortAllocationEnv(moves if act else two, seed=1, act=act)
         if reset:
             made.reset(seed=1)
         return made
@@ -317,6 +325,8 @@ def sweep_calls(tmp_path):
         Call("ConcurrentSession.decide start", lambda: concurrent(refined=True).decide, fresh=True, start="a"),
         Call("ConcurrentSession.report_not_yet", lambda: concurrent(pending=True).report_not_yet, fresh=True),
         Call("ConcurrentSession.report_refined", lambda: concurrent(pending=True).report_refined, 2, fresh=True),
+        Call("ConcurrentSession.report_backtrack", lambda: concurrent_backtracking().report_backtrack, "pick(A)",
+             fresh=True),
         Call("ConcurrentSession.report_execution_finished",
              lambda: concurrent(started=True).report_execution_finished, "a", fresh=True),
         Call("PlanningPosterior.observe_found", lambda: posterior().observe_found, 2, fresh=True),
@@ -348,6 +358,10 @@ def sweep_calls(tmp_path):
         Call("env.EffortAllocationEnv.reset", lambda: environment(reset=False).reset, fresh=True, seed=1,
              options={}),
         Call("env.EffortAllocationEnv.step", lambda: environment().step, 0, fresh=True),
+        Call("env.EffortAllocationEnv concurrent", ontime.env.EffortAllocationEnv, moves, seed=1, act="concurrent"),
+        Call("env.EffortAllocationEnv.step concurrent", lambda: environment(act="concurrent").step, 0, fresh=True),
+        Call("env.EffortAllocationEnv.action_of", lambda: environment(act="concurrent").action_of,
+             {"start": None, "skeleton": 0}, fresh=True),
         Call("env.EffortAllocationEnv.action_masks", environment().action_masks),
         Call("env.EffortAllocationEnv.render", environment().render),
         Call("env.EffortAllocationEnv.close", environment().close),
