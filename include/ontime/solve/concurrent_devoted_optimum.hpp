@@ -38,7 +38,11 @@ class ConcurrentDevotedOptimum {
   double value(const ConcurrentState& state, int k);
   // The best move of `state` devoted to live skeleton k: a start of k's next action, a step on k or
   // the planner idling; where that state has none (nothing can finish), the devoted eager move
-  // (ConcurrentContiguousSuccess::devoted_move).
+  // (ConcurrentContiguousSuccess::devoted_move). Where it idles the planner (k and its prefixes
+  // refined in full) while another live skeleton has an action left to refine, and there is no
+  // backtracking, a step on the first such group instead (ConcurrentMdp::refine_choices): the state
+  // devoted to k after it is the same, and the planner's time is not thrown away, as an idle planner
+  // is not a useful move there (ConcurrentMdp::useful_moves).
   ConcurrentMdp::Move move(const ConcurrentState& state, int k);
 
  private:
