@@ -84,13 +84,14 @@ class EnvironmentCore {
   int skeleton_count() const { return mdp_->mdp.skeleton_count(); }
   int feature_size() const { return static_cast<int>(features_); }
 
-  // Episode e after the seed was last set draws its hidden world from stream_seed(seed, e), as
-  // episode e of the episode runner does.
+  // Episode e after the seed was last set is episode e of the episode runner: its hidden world
+  // drawn from stream_seed(seed, e), its session (the simulated chains, SPEC §9) seeded with
+  // stream_seed(that, 1) (run_episode).
   py::array_t<float> reset(std::optional<Seed> seed) {
     const std::uint64_t episode_seed = seeds_.next(seed);
     world_.begin_episode(episode_seed);
-    session_seed_ = episode_seed;
-    session_.emplace(mdp_->mdp, episode_seed);  // (its simulated chains, SPEC §9)
+    session_seed_ = stream_seed(episode_seed, 1);
+    session_.emplace(mdp_->mdp, session_seed_);
     return observation();
   }
 
