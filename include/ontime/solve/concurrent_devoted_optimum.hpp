@@ -31,6 +31,8 @@ namespace ontime {
 
 class ConcurrentDevotedOptimum {
  public:
+  // The devoted optima of `mdp`'s skeletons, solved as they are asked for, holding at most
+  // `max_states` states in all.
   explicit ConcurrentDevotedOptimum(const ConcurrentMdp& mdp,
                                     std::size_t max_states = ConcurrentSolver::kDefaultMaxStates);
 
