@@ -7,7 +7,7 @@
 
 #include "common.hpp"
 #include "memory_limits.hpp"
-#include "ontime/allocators/concurrent_allocator.hpp"
+#include "ontime/allocators/belief_models.hpp"
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/model/instance_io.hpp"
 #include "ontime/model/problem.hpp"
@@ -43,9 +43,8 @@ std::optional<Problem> planned_problem(const EvaluateOptions& options, const Pro
   }
 }
 
-// Acting while planning (SPEC §10): the allocator's concurrent form in the same hidden worlds. With
-// a belief, the allocator decides on its own model and sees the states with the skeletons the
-// instance counts as hopeless kept (HopelessSkeletons): what it believes is its own to judge.
+// Acting while planning (SPEC §10): the allocator's concurrent form in the same hidden worlds, with a
+// belief deciding on the belief's model (ConcurrentBeliefModels).
 void run_concurrent(const EvaluateOptions& options, const Problem& problem) {
   const std::optional<Problem> planned = planned_problem(options, problem);
   const ParameterValues parameters = options.allocator.values();
@@ -53,13 +52,9 @@ void run_concurrent(const EvaluateOptions& options, const Problem& problem) {
   if (options.exact || allocator_registry().find(options.solver).capabilities.has(Capability::optimal)) {
     check_exact_work(problem, max_states_of(parameters), options.instance, flag_spelling());
   }
-  const ConcurrentMdp mdp(problem, planned ? HopelessSkeletons::kept : HopelessSkeletons::dropped);
-  std::optional<ConcurrentMdp> planned_mdp;
-  if (planned) planned_mdp.emplace(*planned);
-  const ConcurrentAllocatorFactory factory =
-      planned_mdp
-          ? seen_by_belief(*planned_mdp, make_concurrent_allocator_factory(options.solver, *planned_mdp, parameters))
-          : make_concurrent_allocator_factory(options.solver, mdp, parameters);
+  const ConcurrentBeliefModels models(problem, planned ? &*planned : nullptr);
+  const ConcurrentMdp& mdp = models.world();
+  const ConcurrentAllocatorFactory factory = models.factory(options.solver, parameters);
   MonteCarloOptions monte_carlo = options.monte_carlo.options();
   monte_carlo.time_decisions = !options.no_timing;
   ProgressBar bar("evaluate " + options.solver);

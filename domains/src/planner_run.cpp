@@ -4,7 +4,7 @@
 #include <stdexcept>
 
 #include "episode_options.hpp"
-#include "ontime/allocators/concurrent_allocator.hpp"
+#include "ontime/allocators/belief_models.hpp"
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/domains/planner_world.hpp"
 #include "ontime/solve/optimal_solver.hpp"
@@ -50,17 +50,14 @@ void keep_live_episodes(const PlannerRunOptions& options, MonteCarloOptions& epi
 // Acting while planning (SPEC §10): the robot starts each refined motion while the planner refines
 // the next from where that motion ends (the planner world's starts, unless independent), on the
 // model's step clock, or live on the robot's clock (live ConcurrentSessions). With a belief the
-// allocator decides on its own model, shown the states with the skeletons the instance counts as
-// hopeless kept (HopelessSkeletons).
+// allocator decides on the belief's model (ConcurrentBeliefModels).
 PlannerRun run_concurrent_planner_episodes(const Domain& domain, const Problem& problem,
                                            const PlannerRunOptions& options) {
-  const ConcurrentMdp mdp(problem, options.belief != nullptr ? HopelessSkeletons::kept : HopelessSkeletons::dropped);
-  std::optional<ConcurrentMdp> planned_mdp;
-  if (options.belief != nullptr) planned_mdp.emplace(with_distributions_of(problem, *options.belief));
-  const ConcurrentAllocatorFactory factory =
-      planned_mdp ? seen_by_belief(*planned_mdp,
-                                   make_concurrent_allocator_factory(options.solver, *planned_mdp, options.parameters))
-                  : make_concurrent_allocator_factory(options.solver, mdp, options.parameters);
+  std::optional<Problem> planned;
+  if (options.belief != nullptr) planned.emplace(with_distributions_of(problem, *options.belief));
+  const ConcurrentBeliefModels models(problem, planned ? &*planned : nullptr);
+  const ConcurrentMdp& mdp = models.world();
+  const ConcurrentAllocatorFactory factory = models.factory(options.solver, options.parameters);
   PlannerWorldOptions planner;
   planner.effort = options.effort;
   planner.independent_starts = options.independent_starts;

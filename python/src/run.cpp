@@ -11,7 +11,7 @@
 #include <stdexcept>
 
 #include "bindings.hpp"
-#include "ontime/allocators/concurrent_allocator.hpp"
+#include "ontime/allocators/belief_models.hpp"
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/learn/online_adaptation.hpp"
 #include "ontime/report/report.hpp"
@@ -204,20 +204,17 @@ namespace {
 py::dict evaluate_concurrent(const py::object& source, const Problem& problem, const std::string& solver,
                              std::uint64_t episodes, std::uint64_t seed, unsigned threads, bool exact, bool regret,
                              const py::object& belief, const py::object& progress, const ParameterValues& values) {
-  // With a belief the allocator decides on its own model, shown the states with the skeletons the
-  // problem counts as hopeless kept (HopelessSkeletons), as `ontime evaluate --belief` does.
+  // With a belief the allocator decides on the belief's model (ConcurrentBeliefModels), as
+  // `ontime evaluate --belief` does.
   std::optional<Problem> planned;
   if (!belief.is_none()) planned.emplace(with_distributions_of(problem, *problem_with_acting(belief, {}, "belief")));
   MonteCarloResult result;
   std::optional<ExactEvaluation> exact_result;
   run_interruptibly(
       [&](const std::function<bool()>& stop, Progress& counters) {
-        const ConcurrentMdp mdp(problem, planned ? HopelessSkeletons::kept : HopelessSkeletons::dropped);
-        std::optional<ConcurrentMdp> planned_mdp;
-        if (planned) planned_mdp.emplace(*planned);
-        const ConcurrentAllocatorFactory factory =
-            planned_mdp ? seen_by_belief(*planned_mdp, make_concurrent_allocator_factory(solver, *planned_mdp, values))
-                        : make_concurrent_allocator_factory(solver, mdp, values);
+        const ConcurrentBeliefModels models(problem, planned ? &*planned : nullptr);
+        const ConcurrentMdp& mdp = models.world();
+        const ConcurrentAllocatorFactory factory = models.factory(solver, values);
         MonteCarloOptions options;
         options.episodes = episodes;
         options.seed = seed;
