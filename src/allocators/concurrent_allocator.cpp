@@ -99,18 +99,7 @@ int EagerCommitAllocator::skeleton_to_follow(const ConcurrentState& state) {
     plan_first_view(*mdp_, state, view_);
     choice = plan_first_->choose(view_);
   }
-  if (!has_work(choice)) {
-    choice = -1;
-    std::int64_t best = 0;
-    for (int k = 0; k < mdp_->skeleton_count(); ++k) {
-      if (!has_work(k)) continue;
-      const std::int64_t finish = mdp_->earliest_finish(state, k);
-      if (choice < 0 || finish < best) {
-        choice = k;
-        best = finish;
-      }
-    }
-  }
+  if (!has_work(choice)) choice = soonest_skeleton(*mdp_, state, true);
   kept_choice_ = choice;
   kept_time_ = time;
   return choice;
@@ -136,6 +125,21 @@ void EagerCommitAllocator::observe(const ConcurrentState& before, int choice, co
   plan_first_view(*mdp_, before, view_);
   plan_first_view(*mdp_, after, view_after_);
   plan_first_->observe(view_, choice, view_after_, Status::running);
+}
+
+int soonest_skeleton(const ConcurrentMdp& mdp, const ConcurrentState& state, bool with_work_left) {
+  int soonest = -1;
+  std::int64_t least = 0;
+  for (int k = 0; k < mdp.skeleton_count(); ++k) {
+    if (!ConcurrentMdp::is_live(state, k)) continue;
+    if (with_work_left && ConcurrentMdp::refined(state, k) >= mdp.problem().skeleton_length(k)) continue;
+    const std::int64_t finish = mdp.earliest_finish(state, k);
+    if (soonest < 0 || finish < least) {
+      soonest = k;
+      least = finish;
+    }
+  }
+  return soonest;
 }
 
 ConcurrentAllocatorFactory eager_commit_factory(const ConcurrentMdp& mdp, AllocatorFactory plan_first) {

@@ -1,6 +1,5 @@
 #include "ontime/allocators/dp.hpp"
 
-#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string_view>
@@ -51,19 +50,9 @@ class ConcurrentDevotedAllocator final : public ConcurrentAllocator {
   ConcurrentDevotedAllocator(const ConcurrentMdp& mdp, int chosen) : mdp_(&mdp), devoted_(mdp), chosen_(chosen) {}
   std::string_view name() const noexcept override { return "dp"; }
   ConcurrentMdp::Move choose(const ConcurrentState& state) override {
-    int followed = chosen_;
-    if (!ConcurrentMdp::is_live(state, followed)) {
-      std::int64_t least = 0;
-      for (int k = 0; k < mdp_->skeleton_count(); ++k) {
-        if (!ConcurrentMdp::is_live(state, k)) continue;
-        const std::int64_t finish = mdp_->earliest_finish(state, k);
-        if (followed == chosen_ || finish < least) {
-          followed = k;
-          least = finish;
-        }
-      }
-    }
-    return devoted_.move(state, followed);
+    const int followed =
+        ConcurrentMdp::is_live(state, chosen_) ? chosen_ : soonest_skeleton(*mdp_, state, /*with_work_left=*/false);
+    return followed < 0 ? ConcurrentMdp::Move{} : devoted_.move(state, followed);
   }
 
  private:

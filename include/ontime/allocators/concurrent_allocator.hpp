@@ -84,6 +84,12 @@ class EagerCommitAllocator final : public ConcurrentAllocator {
   int kept_time_ = -1;
 };
 
+// The live skeleton whose earliest finish (ConcurrentMdp::earliest_finish) is least, ties to the
+// lowest index, among those with an action left to refine when `with_work_left`; -1 when there is
+// none. Where the eager rule goes when its choice cannot be followed, and dp's devoted follower once
+// its skeleton is dropped. O(K * A_max).
+int soonest_skeleton(const ConcurrentMdp& mdp, const ConcurrentState& state, bool with_work_left);
+
 // A factory of EagerCommitAllocator around the allocators `plan_first` makes (for
 // mdp.plan_first_mdp()), chains and expiry (SPEC §9) included.
 ConcurrentAllocatorFactory eager_commit_factory(const ConcurrentMdp& mdp, AllocatorFactory plan_first);
