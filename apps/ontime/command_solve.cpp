@@ -15,6 +15,7 @@
 #include "ontime/allocators/optimal.hpp"
 #include "ontime/model/instance_io.hpp"
 #include "ontime/report/report.hpp"
+#include "ontime/solve/concurrent_layered_solver.hpp"
 #include "ontime/solve/concurrent_search.hpp"
 #include "ontime/solve/concurrent_solver.hpp"
 #include "ontime/solve/layered_solver.hpp"
@@ -61,30 +62,83 @@ void run_memoised(const SolveOptions& options, const Problem& problem, const Mdp
   fmt::print("{}", options.json ? report::to_json(solve) + "\n" : report::to_text(solve));
 }
 
-// Acting while planning (SPEC §10): the memoised solver of its MDP, or the search.
-void run_concurrent(const SolveOptions& options, const Problem& problem) {
-  const std::size_t max_states = options.max_states != 0 ? options.max_states : ConcurrentSolver::kDefaultMaxStates;
+// The layered solvers' settings from the command line: threads, the state cap, the memory and
+// disk caps (unless given, what this machine can give to each of `ranks`, so that a solve stops
+// with an interval rather than being killed), the scratch folder, and the stop once --max-seconds
+// have passed since `started`.
+LayeredSolveOptions layered_settings(const SolveOptions& options, std::chrono::steady_clock::time_point started,
+                                     const Ranks* ranks) {
+  LayeredSolveOptions settings;
+  settings.ranks = ranks;
+  settings.threads = options.threads;
+  settings.max_states = options.max_states;
+  settings.scratch_directory = options.scratch;
+  if (options.max_memory_mib != 0) {
+    check_memory_for("--max-memory-mib", static_cast<double>(options.max_memory_mib) * 1048576.0);
+    settings.max_memory_bytes = options.max_memory_mib << 20;
+  }
+  std::error_code error;
+  if (!options.scratch.empty() && !std::filesystem::is_directory(options.scratch, error)) {
+    throw UsageError("--scratch " + options.scratch + ": not a directory");
+  }
+  settings.max_disk_bytes = options.max_disk_mib << 20;
+  apply_tool_layered_settings(settings);
+  if (options.max_seconds > 0) {
+    const auto deadline = started + std::chrono::duration<double>(options.max_seconds);
+    settings.stop = [deadline] { return std::chrono::steady_clock::now() >= deadline; };
+  }
+  return settings;
+}
+
+// `solve(settings)` with a progress line: layers (levels acting while planning), not a percentage,
+// since how many there will be, and how large, is what the solve finds out. The line is cleared
+// (the bar destroyed) before the result is printed.
+template <class Solve>
+auto with_layer_progress(LayeredSolveOptions& settings, const char* layer, Solve&& solve) {
+  ProgressBar bar("solve");
+  std::uint64_t enumerated = 0;
+  settings.on_layer = [&bar, &enumerated, layer](const LayerFigures& figures) {
+    if (figures.backward) {
+      bar.status(fmt::format("backward pass: {} {} valued ({} states)", layer, figures.layer, figures.states));
+    } else {
+      enumerated += figures.states;
+      bar.status(fmt::format("forward pass: {} {} ({} states) expanded, {} states in all", layer, figures.layer,
+                             figures.states, enumerated));
+    }
+  };
+  auto solved = solve(settings);
+  settings.on_layer = nullptr;
+  return solved;
+}
+
+// Acting while planning (SPEC §10): the memoised solver of its MDP, the search or the layered solver.
+void run_concurrent(const SolveOptions& options, const Problem& problem, const std::string& method) {
   // The exact solvers' limits (skeletons) hold in this mode too.
   check_exact_work(problem, 1, options.instance, flag_spelling());
   const ConcurrentMdp mdp(problem);
-  check_memory_for(flag_spelling()("max-states"), ConcurrentSolver::max_bytes(problem, max_states));
   const auto started = std::chrono::steady_clock::now();
-  ConcurrentSolveOptions settings;
-  settings.max_states = max_states;
-  if (options.method == "search") {
-    settings.method = ConcurrentSolveOptions::Method::search;
-    settings.gap = options.gap;
-    if (options.max_seconds > 0) {
-      const auto deadline = started + std::chrono::duration<double>(options.max_seconds);
-      settings.stop = [deadline] { return std::chrono::steady_clock::now() >= deadline; };
+  report::ConcurrentSolve solve{.instance = options.instance, .problem = &problem, .method = method};
+  if (method == "layered") {
+    LayeredSolveOptions settings = layered_settings(options, started, nullptr);
+    solve.solution = with_layer_progress(
+        settings, "level", [&](const LayeredSolveOptions& with) { return solve_concurrent_layered(mdp, with); });
+  } else {
+    ConcurrentSolveOptions settings;
+    settings.max_states = options.max_states != 0 ? options.max_states : ConcurrentSolver::kDefaultMaxStates;
+    check_memory_for(flag_spelling()("max-states"), ConcurrentSolver::max_bytes(problem, settings.max_states));
+    if (method == "search") {
+      settings.method = ConcurrentSolveOptions::Method::search;
+      settings.gap = options.gap;
+      if (options.max_seconds > 0) {
+        const auto deadline = started + std::chrono::duration<double>(options.max_seconds);
+        settings.stop = [deadline] { return std::chrono::steady_clock::now() >= deadline; };
+      }
     }
+    solve.solution = solve_concurrent(mdp, settings);
   }
-  report::ConcurrentSolve solve{.instance = options.instance,
-                                .problem = &problem,
-                                .method = options.method == "search" ? "search" : "memoised",
-                                .solution = solve_concurrent(mdp, settings)};
   solve.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   solve.timing = !options.no_timing;
+  solve.stats = options.stats;
   fmt::print("{}", options.json ? report::to_json(solve) + "\n" : report::to_text(solve));
 }
 
@@ -107,48 +161,13 @@ void run_search(const SolveOptions& options, const Problem& problem, const Mdp& 
 }
 
 void run_layered(const SolveOptions& options, const Problem& problem, const Mdp& mdp) {
-  LayeredSolveOptions settings;
-  settings.threads = options.threads;
-  settings.max_states = options.max_states;
-  settings.ranks = job_ranks();
-  settings.scratch_directory = options.scratch;
+  const auto started = std::chrono::steady_clock::now();
+  LayeredSolveOptions settings = layered_settings(options, started, job_ranks());
   settings.policy_layers = options.policy.empty() ? 0 : options.policy_layers;
   settings.tolerance = options.tolerance;
   settings.split = options.method == "split" ? SplitMode::always : SplitMode::fallback;
-  if (options.max_memory_mib != 0) {
-    check_memory_for("--max-memory-mib", static_cast<double>(options.max_memory_mib) * 1048576.0);
-    settings.max_memory_bytes = options.max_memory_mib << 20;
-  }
-  std::error_code error;
-  if (!options.scratch.empty() && !std::filesystem::is_directory(options.scratch, error)) {
-    throw UsageError("--scratch " + options.scratch + ": not a directory");
-  }
-  settings.max_disk_bytes = options.max_disk_mib << 20;
-  // Unless capped on the command line, stop before the memory and the disk run out.
-  apply_tool_layered_settings(settings);
-  const auto started = std::chrono::steady_clock::now();
-  if (options.max_seconds > 0) {
-    const auto deadline = started + std::chrono::duration<double>(options.max_seconds);
-    settings.stop = [deadline] { return std::chrono::steady_clock::now() >= deadline; };
-  }
-  const LayeredSolution solution = [&] {
-    // Layers, not a percentage: how many there will be, and how large, is what the solve finds
-    // out. The line is cleared (the bar destroyed) before the result is printed.
-    ProgressBar bar("solve");
-    std::uint64_t enumerated = 0;
-    settings.on_layer = [&bar, &enumerated](const LayerFigures& layer) {
-      if (layer.backward) {
-        bar.status(fmt::format("backward pass: layer {} valued ({} states)", layer.layer, layer.states));
-      } else {
-        enumerated += layer.states;
-        bar.status(fmt::format("forward pass: layer {} ({} states) expanded, {} states in all", layer.layer,
-                               layer.states, enumerated));
-      }
-    };
-    LayeredSolution solved = solve_layered(mdp, settings);
-    settings.on_layer = nullptr;
-    return solved;
-  }();
+  const LayeredSolution solution =
+      with_layer_progress(settings, "layer", [&](const LayeredSolveOptions& with) { return solve_layered(mdp, with); });
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   report::Solve solve{.instance = options.instance,
                       .problem = &problem,
@@ -181,7 +200,9 @@ void add_solve_command(CLI::App& app) {
                    "bounds cannot settle)")
       ->check(CLI::IsMember({"layered", "split", "memoised", "search"}));
   CLI::Option* method_option = command->get_option("--method");
-  add_act_option(*command, options->act, "Concurrent is solved by the memoised solver (the default method then)");
+  add_act_option(*command, options->act,
+                 "Concurrent is solved by --method memoised (the default then), search or layered (levels of CT plus "
+                 "the actions started; no split, tolerance nor policy file)");
   add_number_option(*command, "--max-states", options->max_states,
                     "Cap on states: layered and search give an interval past it, memoised stops with an error "
                     "(default: none for layered, 10000000 for memoised and search)",
@@ -221,25 +242,34 @@ void add_solve_command(CLI::App& app) {
     Problem problem = load_problem(options->instance);
     if (!options->act.empty()) problem = problem.with_acting(*parse_acting(options->act));
     if (problem.acting() == Acting::concurrent) {
-      if (method_option->count() > 0 && options->method != "memoised" && options->method != "search") {
-        throw UsageError("--method " + options->method +
-                         ": acting while planning (concurrent, SPEC §10) is solved by --method memoised or search "
-                         "only so far");
+      // The memoised solver unless another is asked for.
+      const std::string method = method_option->count() > 0 ? options->method : "memoised";
+      if (method == "split") {
+        throw UsageError(
+            "--method split: acting while planning (concurrent, SPEC §10) is solved by --method "
+            "memoised, search or layered (a split bounds subtrees plan-first)");
       }
-      if (options->method != "search" && command->get_option("--max-seconds")->count() > 0) {
-        throw UsageError("--max-seconds: acting while planning (concurrent, SPEC §10) takes it with --method search");
+      if (method == "memoised" && command->get_option("--max-seconds")->count() > 0) {
+        throw UsageError(
+            "--max-seconds: acting while planning (concurrent, SPEC §10) takes it with --method search or layered");
       }
-      for (const char* flag : {"--policy", "--tolerance", "--scratch", "--max-memory-mib", "--max-disk-mib"}) {
+      for (const char* flag : {"--threads", "--max-memory-mib", "--max-disk-mib", "--scratch", "--stats"}) {
+        if (method != "layered" && command->get_option(flag)->count() > 0) {
+          throw UsageError(std::string(flag) +
+                           ": acting while planning (concurrent, SPEC §10) takes it with --method layered");
+        }
+      }
+      for (const char* flag : {"--policy", "--tolerance"}) {
         if (command->get_option(flag)->count() > 0) {
           throw UsageError(std::string(flag) +
-                           " is for the layered solver, which does not solve "
-                           "acting while planning (concurrent, SPEC §10) yet");
+                           " is for the plan-first layered solver: acting while planning (concurrent, SPEC §10) is "
+                           "solved exactly, and no policy file is written");
         }
       }
       if (split_over_ranks(job_ranks())) {
         throw UsageError("acting while planning (concurrent, SPEC §10) is solved in one process: no MPI ranks");
       }
-      run_concurrent(*options, problem);
+      run_concurrent(*options, problem, method);
       return;
     }
     if (problem.skeleton_count() > kMaxExactSkeletons) check_exact_work(problem, 1, options->instance);

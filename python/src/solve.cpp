@@ -9,6 +9,7 @@
 
 #include "bindings.hpp"
 #include "ontime/report/report.hpp"
+#include "ontime/solve/concurrent_layered_solver.hpp"
 #include "ontime/solve/concurrent_search.hpp"
 #include "ontime/solve/concurrent_solver.hpp"
 #include "ontime/solve/knapsack.hpp"
@@ -93,32 +94,59 @@ void bind_solve(py::module_& m) {
         // An Mdp is plan-first by construction; anything else is read as a problem with its mode.
         const std::shared_ptr<const Problem> chosen =
             act || !py::isinstance<MdpHandle>(problem) ? problem_with_acting(problem, act) : nullptr;
-        if (chosen && chosen->acting() == Acting::concurrent) {
-          const bool search = method_given && *method_given == "search";
-          if (method_given && *method_given != "memoised" && !search) {
-            throw UsageError("method '" + *method_given +
-                             "': acting while planning (act='concurrent', SPEC §10) is solved by method='memoised' "
-                             "or 'search' only so far");
+        // Both layered solvers' options: caps not given are what this machine can give, so that a
+        // solve stops with a certified interval rather than being killed (as the command line does).
+        const auto layered_options = [&] {
+          LayeredSolveOptions options;
+          options.max_states = max_states;
+          options.threads = threads;
+          if (!scratch.is_none()) options.scratch_directory = path_argument(scratch, "scratch");
+          if (max_memory_mib > 0) {
+            check_memory_for("max_memory_mib", static_cast<double>(max_memory_mib) * 1048576.0);
+            options.max_memory_bytes = max_memory_mib << 20;
           }
-          if (gap > 0 && !search) throw UsageError("gap is for method='search'");
-          if (tolerance > 0 || max_memory_mib > 0 || max_disk_mib > 0 || !scratch.is_none() || !policy.is_none()) {
+          options.max_disk_bytes = max_disk_mib << 20;
+          fill_default_caps(options);
+          return options;
+        };
+        if (chosen && chosen->acting() == Acting::concurrent) {
+          const std::string method = method_given.value_or("memoised");
+          if (method != "memoised" && method != "search" && method != "layered") {
+            throw UsageError("method '" + method +
+                             "': acting while planning (act='concurrent', SPEC §10) is solved by method='memoised', "
+                             "'search' or 'layered'");
+          }
+          if (gap > 0 && method != "search") throw UsageError("gap is for method='search'");
+          if ((max_memory_mib > 0 || max_disk_mib > 0 || !scratch.is_none()) && method != "layered") {
             throw UsageError(
-                "tolerance, max_memory_mib, max_disk_mib, scratch and policy are for the layered solver, which does "
-                "not solve acting while planning (act='concurrent', SPEC §10) yet");
+                "max_memory_mib, max_disk_mib and scratch: acting while planning (act='concurrent', "
+                "SPEC §10) takes them with method='layered'");
+          }
+          if (tolerance > 0 || !policy.is_none()) {
+            throw UsageError(
+                "tolerance and policy are for the plan-first layered solver: acting while planning "
+                "(act='concurrent', SPEC §10) is solved exactly, and no policy file is written");
           }
           check_exact_work(*chosen, 1, instance_label(problem, *chosen), python_spelling());
-          check_memory_for("max_states", ConcurrentSolver::max_bytes(*chosen, max_states));
-          report::ConcurrentSolve solve{.instance = instance_label(problem, *chosen), .problem = chosen.get()};
+          report::ConcurrentSolve solve{
+              .instance = instance_label(problem, *chosen), .problem = chosen.get(), .method = method};
           const ConcurrentMdp concurrent(*chosen);
-          solve.method = search ? "search" : "memoised";
+          LayeredSolveOptions by_levels;
+          ConcurrentSolveOptions options;
+          if (method == "layered") {
+            by_levels = layered_options();
+          } else {
+            check_memory_for("max_states", ConcurrentSolver::max_bytes(*chosen, max_states));
+            options.max_states = max_states;
+            options.method =
+                method == "search" ? ConcurrentSolveOptions::Method::search : ConcurrentSolveOptions::Method::memoised;
+            options.gap = gap;
+          }
           run_interruptibly([&](const std::function<bool()>& stop, Progress&) {
             const auto started = std::chrono::steady_clock::now();
-            ConcurrentSolveOptions options;
-            options.method = search ? ConcurrentSolveOptions::Method::search : ConcurrentSolveOptions::Method::memoised;
-            options.max_states = max_states;
-            options.gap = gap;
-            options.stop = stop;
-            solve.solution = solve_concurrent(concurrent, options);
+            by_levels.stop = options.stop = stop;
+            solve.solution = method == "layered" ? solve_concurrent_layered(concurrent, by_levels)
+                                                 : solve_concurrent(concurrent, options);
             solve.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
           });
           return json_object(report::to_json(solve));
@@ -164,21 +192,10 @@ void bind_solve(py::module_& m) {
           }
           return json_object(report::to_json(solve));
         }
-        LayeredSolveOptions options;
-        options.max_states = max_states;
-        options.threads = threads;
+        LayeredSolveOptions options = layered_options();
         options.tolerance = tolerance;
         options.split = method == "split" ? SplitMode::always : SplitMode::fallback;
-        if (!scratch.is_none()) options.scratch_directory = path_argument(scratch, "scratch");
-        if (max_memory_mib > 0) {
-          check_memory_for("max_memory_mib", static_cast<double>(max_memory_mib) * 1048576.0);
-          options.max_memory_bytes = max_memory_mib << 20;
-        }
-        options.max_disk_bytes = max_disk_mib << 20;
         if (!policy.is_none()) options.policy_layers = policy_layers;
-        // Caps not given: what this machine can give, so that a solve stops with a certified
-        // interval rather than being killed (as the command line does).
-        fill_default_caps(options);
         report::Solve solve{.instance = instance_label(problem, *mdp->problem),
                             .problem = mdp->problem.get(),
                             .mdp = &mdp->mdp,
@@ -217,7 +234,9 @@ void bind_solve(py::module_& m) {
       "a split nor a tolerance applies (UsageError), and "
       "a cap's interval comes from bounds that count a give-up as a success. act='concurrent' (or an instance "
       "whose \"acting\" is concurrent) solves acting while planning (SPEC §10: the robot executes refined actions "
-      "while the rest is planned) with the memoised solver of that model, as `ontime solve --act concurrent`; the "
+      "while the rest is planned) with the memoised solver of that model, as `ontime solve --act concurrent`, or "
+      "with method='search' or method='layered' (levels of CT plus the actions started, on `threads`, with "
+      "the layered solver's caps and scratch; cut by one, a certified interval); the "
       "result then has \"acting\": \"concurrent\". act='plan-first' reads any instance as plan-first.");
 }
 

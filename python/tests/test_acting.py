@@ -51,6 +51,26 @@ def test_the_search_gives_the_memoised_optimum_to_the_bit():
     assert cut["lower_bound"] <= memoised["optimal_success_probability"] <= cut["upper_bound"]
 
 
+def test_the_layered_solver_gives_the_memoised_optimum_to_the_bit(cli):
+    instance = PAPER / "instance1.json"
+    memoised = ontime.solve(instance, act="concurrent")
+    layered = ontime.solve(instance, act="concurrent", method="layered", threads=2)
+    assert layered["method"] == "layered" and layered["exact"]
+    assert layered["optimal_success_probability"] == memoised["optimal_success_probability"]
+    assert layered["first_choice"] == memoised["first_choice"]
+    from_cli = cli("solve", str(instance), "--act", "concurrent", "--method", "layered", "--json", "--no-timing")
+    assert {key: layered[key] for key in from_cli if key != "instance"} == \
+        {key: value for key, value in from_cli.items() if key != "instance"}
+    cut = ontime.solve(instance, act="concurrent", method="layered", max_states=1000)
+    assert not cut["exact"] and cut["stopped_by"] == "the state cap"
+    assert cut["lower_bound"] <= memoised["optimal_success_probability"] <= cut["upper_bound"]
+    for refused in ({"tolerance": 0.1}, {"policy": "policy.jsonl"}, {"method": "split"},
+                    {"method": "search", "max_memory_mib": 10}, {"method": "memoised", "max_disk_mib": 10}):
+        arguments = {"method": "layered", **refused}
+        with pytest.raises(ontime.UsageError, match="SPEC §10"):
+            ontime.solve(instance, act="concurrent", **arguments)
+
+
 def test_the_same_figures_as_the_command_line(cli):
     instance = PAPER / "instance2.json"
     from_cli = cli("solve", str(instance), "--act", "concurrent", "--json", "--no-timing")
@@ -131,9 +151,9 @@ def test_dp_and_dp_rerun_with_chains_acting_while_planning_as_the_command_line(c
 @pytest.mark.parametrize("arguments, message", [
     ({"act": "interleaved"}, "act must be 'plan-first' or 'concurrent'"),
     ({"act": 1}, "act must be 'plan-first' or 'concurrent'"),
-    ({"act": "concurrent", "method": "layered"}, "method='memoised' or 'search' only"),
+    ({"act": "concurrent", "method": "split"}, "method='memoised', 'search' or 'layered'"),
     ({"act": "concurrent", "gap": 0.1}, "gap is for method='search'"),
-    ({"act": "concurrent", "tolerance": 0.1}, "does not solve acting while planning"),
+    ({"act": "concurrent", "tolerance": 0.1}, "for the plan-first layered solver"),
 ])
 def test_bad_requests_raise_usage_errors(arguments, message):
     with pytest.raises(ontime.UsageError, match=message):

@@ -294,6 +294,26 @@ std::string to_json(const ConcurrentSolve& solve) {
   const int first = first_refined(solve);
   out["first_choice"] = first;
   out["first_action"] = first >= 0 ? problem.action(problem.action_at(first, 0)).id : "";
+  if (solve.method == "layered") {
+    if (solution.frontier_layer >= 0) out["frontier_level"] = solution.frontier_layer;
+    out["levels"] = solution.layers.size();
+    if (solve.timing) {
+      out["peak_memory_bytes"] = solution.peak_memory_bytes;
+      out["peak_disk_bytes"] = solution.peak_disk_bytes;
+    }
+    if (solve.stats) {
+      Json levels = Json::array();
+      for (const LayerFigures& level : solution.layers) {
+        Json figures{{"level", level.layer}, {"states", level.states}};
+        if (solve.timing) {
+          figures["forward_seconds"] = level.forward_seconds;
+          figures["backward_seconds"] = level.backward_seconds;
+        }
+        levels.push_back(figures);
+      }
+      out["level_figures"] = levels;
+    }
+  }
   return dump(out);
 }
 
@@ -318,6 +338,23 @@ std::string to_text(const ConcurrentSolve& solve) {
   }
   out += fmt::format("states                       {}\n", solution.solved);
   if (solve.method == "search") out += fmt::format("states bounded               {}\n", solution.records);
+  if (solve.method == "layered") {
+    out += fmt::format("levels                       {} (CT plus the actions started)", solution.layers.size());
+    out += solution.frontier_layer >= 0 ? fmt::format("; level {} bounded\n", solution.frontier_layer) : "\n";
+    if (solve.timing) {
+      out += fmt::format("peak memory, disk            {:.1f} MiB, {:.1f} MiB\n",
+                         static_cast<double>(solution.peak_memory_bytes) / 1048576.0,
+                         static_cast<double>(solution.peak_disk_bytes) / 1048576.0);
+    }
+    if (solve.stats) {
+      out += solve.timing ? "level     states   forward s  backward s\n" : "level     states\n";
+      for (const LayerFigures& level : solution.layers) {
+        out += fmt::format("{:>5} {:>10}", level.layer, level.states);
+        out +=
+            solve.timing ? fmt::format(" {:>11.4f} {:>11.4f}\n", level.forward_seconds, level.backward_seconds) : "\n";
+      }
+    }
+  }
   if (solve.timing) out += fmt::format("time                         {:.4f} s\n", solve.seconds);
   return out;
 }

@@ -66,27 +66,21 @@ double ConcurrentSolver::max_bytes(const Problem& problem, std::size_t max_state
   return capacity * slot * 1.5 + static_cast<double>(max_states) * (2.0 * heap + sizeof(ConcurrentState));
 }
 
-namespace {
-
-// The value of a state that needs no search: 0 when no skeleton can finish any more; for the
-// optimum, 1 when one is refined in full without rewards (ConcurrentMdp::certain_success).
-std::optional<double> terminal_value(const ConcurrentMdp& mdp, const ConcurrentState& state, bool optimum) {
+std::optional<double> settled_value(const ConcurrentMdp& mdp, const ConcurrentState& state, bool optimum) {
   if (!mdp.any_live(state)) return 0.0;
   if (optimum && mdp.certain_success(state)) return 1.0;
   return std::nullopt;
 }
 
-}  // namespace
-
 double ConcurrentSolver::solve(const ConcurrentState& root) {
   const ConcurrentMdp& mdp = *mdp_;
   const bool optimum = !impl_->policy;
-  if (const std::optional<double> value = terminal_value(mdp, root, optimum)) return *value;
+  if (const std::optional<double> value = settled_value(mdp, root, optimum)) return *value;
   auto& memo = impl_->memo;
   const Bounds& bounds = impl_->bounds;
   // A successor's value when it is known (terminal or memoised).
   const auto known = [&](const ConcurrentState& next) -> std::optional<double> {
-    if (const std::optional<double> value = terminal_value(mdp, next, optimum)) return value;
+    if (const std::optional<double> value = settled_value(mdp, next, optimum)) return value;
     if (const auto found = memo.find(impl_->key_of(mdp, next)); found != memo.end()) return found->second.value;
     return std::nullopt;
   };
@@ -201,7 +195,7 @@ double ConcurrentSolver::solve(const ConcurrentState& root) {
 }
 
 std::optional<double> ConcurrentSolver::value(const ConcurrentState& state) const {
-  if (const std::optional<double> terminal = terminal_value(*mdp_, state, !impl_->policy)) return terminal;
+  if (const std::optional<double> terminal = settled_value(*mdp_, state, !impl_->policy)) return terminal;
   ConcurrentState key = state;
   if (impl_->merge) mdp_->merge_backlogs(key);
   const auto found = impl_->memo.find(key);

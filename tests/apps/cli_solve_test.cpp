@@ -78,9 +78,9 @@ TEST(Cli, SolveActsWhilePlanningWhenAsked) {
   EXPECT_NEAR(json::parse(overridden.out)["optimal_success_probability"].get<double>(), 0.942, 1e-12);
 
   const std::vector<std::pair<std::vector<std::string>, std::string>> refused{
-      {{"solve", instance, "--method", "layered"}, "solved by --method memoised or search only"},
-      {{"solve", instance, "--tolerance", "0.1"}, "--tolerance is for the layered solver"},
-      {{"solve", instance, "--max-seconds", "5"}, "takes it with --method search"},
+      {{"solve", instance, "--method", "split"}, "solved by --method memoised, search or layered"},
+      {{"solve", instance, "--tolerance", "0.1"}, "--tolerance is for the plan-first layered solver"},
+      {{"solve", instance, "--max-seconds", "5"}, "takes it with --method search or layered"},
       {{"solve", instance, "--gap", "0.1"}, "--gap is for --method search"},
       {{"evaluate", instance, "--solver", "ppo", "--episodes", "10"}, "ppo needs a trained policy"},
       {{"table", instance, "--episodes", "10", "--solvers", "ppo"}, "ppo needs a trained policy"},
@@ -125,6 +125,61 @@ TEST(Cli, SolveSearchesActingWhilePlanning) {
   EXPECT_LE(interval["lower_bound"].get<double>(), 0.8766933308900257);
   EXPECT_GE(interval["upper_bound"].get<double>(), 0.8766933308900257);
   EXPECT_LE(interval["upper_bound"].get<double>() - interval["lower_bound"].get<double>(), 0.2);
+}
+
+// Acting while planning, `--method layered` gives the memoised solver's optimum to the bit and its
+// first choice, the same on any thread count; cut by a cap, an interval around it naming the
+// frontier level; the plan-first layered solver's options it does not take are refused.
+TEST(Cli, SolveActingWhilePlanningByLevels) {
+  const std::string meeting = testing::source_path("data/instances/chains/meeting-through-the-queue.json").string();
+  const std::string kitchen = testing::source_path("data/instances/kitchen-grasps.json").string();
+  for (const std::string& name : {paper("instance4"), meeting, kitchen}) {
+    const auto memoised = ontime({"solve", name, "--json", "--act", "concurrent"});
+    ASSERT_EQ(memoised.exit_code, 0) << memoised.err;
+    const json by_memo = json::parse(memoised.out);
+    const std::string key =
+        by_memo.contains("optimal_success_probability") ? "optimal_success_probability" : "optimal_expected_reward";
+    std::string first_output;
+    for (const char* threads : {"1", "2"}) {
+      const auto layered = ontime({"solve", name, "--json", "--act", "concurrent", "--method", "layered", "--threads",
+                                   threads, "--no-timing", "--stats"});
+      ASSERT_EQ(layered.exit_code, 0) << layered.err;
+      const json by_levels = json::parse(layered.out);
+      EXPECT_EQ(by_levels["method"], "layered");
+      EXPECT_TRUE(by_levels["exact"].get<bool>());
+      EXPECT_EQ(by_levels[key].get<double>(), by_memo[key].get<double>()) << name;
+      EXPECT_EQ(by_levels["first_choice"], by_memo["first_choice"]);
+      EXPECT_EQ(by_levels["level_figures"].size(), by_levels["levels"].get<std::size_t>());
+      if (first_output.empty()) first_output = layered.out;
+      EXPECT_EQ(layered.out, first_output) << name << ", " << threads << " threads";
+    }
+  }
+  const auto cut = ontime({"solve", kitchen, "--json", "--act", "concurrent", "--method", "layered", "--max-states",
+                           "2000", "--no-timing"});
+  ASSERT_EQ(cut.exit_code, 0) << cut.err;
+  const json interval = json::parse(cut.out);
+  EXPECT_FALSE(interval["exact"].get<bool>());
+  EXPECT_EQ(interval["stopped_by"], "the state cap");
+  EXPECT_GE(interval["frontier_level"].get<int>(), 1);
+  EXPECT_TRUE(interval["optimal_success_probability"].is_null());
+  const double optimum =
+      json::parse(ontime({"solve", kitchen, "--json", "--act", "concurrent"}).out)["optimal_success_probability"];
+  EXPECT_LE(interval["lower_bound"].get<double>(), optimum);
+  EXPECT_GE(interval["upper_bound"].get<double>(), optimum);
+  for (const std::vector<std::string>& refused : {std::vector<std::string>{"--method", "layered", "--tolerance", "0.1"},
+                                                  {"--method", "layered", "--policy", "policy.jsonl"},
+                                                  {"--scratch", "."},
+                                                  {"--method", "split"},
+                                                  {"--threads", "2"},
+                                                  {"--method", "search", "--max-memory-mib", "100"},
+                                                  {"--max-seconds", "5"}}) {
+    std::vector<std::string> arguments{"solve", paper("instance1"), "--act", "concurrent"};
+    arguments.insert(arguments.end(), refused.begin(), refused.end());
+    const auto result = ontime(arguments);
+    EXPECT_EQ(result.exit_code, 2) << refused.front() << ": " << result.out;
+    EXPECT_NE(result.err.find("concurrent, SPEC §10"), std::string::npos) << result.err;
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+  }
 }
 
 // `ontime solve INSTANCE --json` plan-first (memoised) and acting while planning: the two optima

@@ -81,10 +81,11 @@ std::string policy_lines(const Solve& solve);
 struct ConcurrentSolve {
   std::string instance = {};
   const Problem* problem = nullptr;
-  std::string method = "memoised";  // or "search"
+  std::string method = "memoised";  // or "search", "layered"
   ConcurrentSolution solution = {};
   double seconds = 0;
   bool timing = true;
+  bool stats = false;  // layered: states (and, with timing, seconds) per level
 };
 // Its JSON (`ontime solve --act concurrent --json`): the memoised solve's keys and "acting".
 std::string to_json(const ConcurrentSolve& solve);

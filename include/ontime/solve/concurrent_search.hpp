@@ -31,9 +31,11 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "ontime/mdp/concurrent_mdp.hpp"
 #include "ontime/solve/concurrent_value_bounds.hpp"
+#include "ontime/solve/layered_solver.hpp"
 
 namespace ontime {
 
@@ -96,7 +98,14 @@ struct ConcurrentSolution {
   ConcurrentMdp::Move first;  // the optimal first move (else: that of the best lower end)
   std::uint64_t solved = 0;   // states solved exactly
   std::uint64_t records = 0;  // search: states holding an interval
-  std::string stopped_by;     // when not exact: "the gap", "the state cap" or "the stop condition"
+  // When not exact: "the gap", "the state cap", "the stop condition" (layered: also "the memory cap", "the disk cap").
+  std::string stopped_by;
+  // solve_concurrent_layered only: the level whose states got bounds when cut (-1: none), the figures
+  // of each level, the most memory its levels and tables held and the most scratch it wrote.
+  int frontier_layer = -1;
+  std::vector<LayerFigures> layers;
+  std::uint64_t peak_memory_bytes = 0;
+  std::uint64_t peak_disk_bytes = 0;
 };
 
 // The optimum of acting while planning from the start (`ontime solve --act concurrent`, Python's
@@ -110,7 +119,8 @@ struct ConcurrentSolution {
 //    and expiry (SPEC §9), as ConcurrentValueBounds does.
 // Cost: the search's time and memory are linear in the states it solves or bounds (a
 // ConcurrentSolver entry or a ConcurrentSearch record each); it solves at most the memoised
-// solver's states, far fewer where the bounds are tight.
+// solver's states, far fewer where the bounds are tight. The third method, level by level with the
+// plan-first layered solver's options, is solve_concurrent_layered (concurrent_layered_solver.hpp).
 ConcurrentSolution solve_concurrent(const ConcurrentMdp& mdp, const ConcurrentSolveOptions& options);
 
 }  // namespace ontime

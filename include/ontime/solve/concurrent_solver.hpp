@@ -106,6 +106,11 @@ class ConcurrentSolver {
   std::unique_ptr<Impl> impl_;
 };
 
+// The value of a state that needs no solving: 0 when no skeleton can finish any more; for the
+// optimum (`optimum`, not a policy's value), 1 when ConcurrentMdp::certain_success holds; nullopt
+// otherwise. O(K * A_max).
+std::optional<double> settled_value(const ConcurrentMdp& mdp, const ConcurrentState& state, bool optimum = true);
+
 // Q of `move` in `state`, a running state of `mdp` that allows it: the expected reward over its
 // outcomes in the MDP's order, value(next) at each successor (a start that ends the episode: its
 // reward). A step at the deadline ends the episode: 0. With value = V* it is Q*; cost: the
