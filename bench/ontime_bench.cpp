@@ -271,6 +271,41 @@ void BM_ConcurrentSolve(benchmark::State& bench) {
 }
 BENCHMARK(BM_ConcurrentSolve)->DenseRange(0, 5)->Unit(benchmark::kMicrosecond);
 
+// Navigation acting while planning with its deadline cut to 16 steps (1.48 million states): range(0)
+// 0 the memoised solver; 1, 2 the layered solver (concurrent_layered_solver.hpp) on that many
+// threads, the same value to the bit. Its counters: the states and, layered, the peak memory and
+// scratch.
+void BM_ConcurrentNavigation16(benchmark::State& bench) {
+  const ontime::Problem navigation =
+      ontime::load_problem(std::string(ONTIME_SOURCE_DIR) + "/data/instances/navigation.json");
+  std::vector<std::vector<int>> skeletons;
+  for (int k = 0; k < navigation.skeleton_count(); ++k) {
+    skeletons.emplace_back(navigation.skeleton(k).begin(), navigation.skeleton(k).end());
+  }
+  const ontime::Problem problem("navigation-16", 16, navigation.step_seconds(),
+                                std::vector<ontime::Action>(navigation.actions().begin(), navigation.actions().end()),
+                                skeletons);
+  const ontime::ConcurrentMdp mdp(problem);
+  const auto threads = static_cast<unsigned>(bench.range(0));
+  for (auto _ : bench) {
+    if (threads == 0) {
+      ontime::ConcurrentSolver solver(mdp);
+      bench.counters["value"] = solver.solve(mdp.start());
+      bench.counters["states"] = static_cast<double>(solver.states());
+    } else {
+      ontime::LayeredSolveOptions options;
+      options.threads = threads;
+      const ontime::ConcurrentSolution solution = ontime::solve_concurrent_layered(mdp, options);
+      bench.counters["value"] = solution.lower;
+      bench.counters["states"] = static_cast<double>(solution.solved);
+      bench.counters["peak_MiB"] = static_cast<double>(solution.peak_memory_bytes) / (1 << 20);
+      bench.counters["disk_MiB"] = static_cast<double>(solution.peak_disk_bytes) / (1 << 20);
+    }
+  }
+  bench.SetLabel(threads == 0 ? "memoised" : "layered");
+}
+BENCHMARK(BM_ConcurrentNavigation16)->DenseRange(0, 2)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+
 void BM_OptimalSolve(benchmark::State& bench) {
   const ontime::Problem problem = paper(static_cast<int>(bench.range(0)));
   const ontime::Mdp mdp(problem);

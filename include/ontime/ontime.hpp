@@ -39,6 +39,7 @@
 #include "ontime/run/simulator.hpp"
 #include "ontime/run/world.hpp"
 #include "ontime/solve/concurrent_contiguous_success.hpp"
+#include "ontime/solve/concurrent_layered_solver.hpp"
 #include "ontime/solve/concurrent_search.hpp"
 #include "ontime/solve/concurrent_solver.hpp"
 #include "ontime/solve/concurrent_value_bounds.hpp"

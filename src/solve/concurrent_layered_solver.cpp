@@ -62,8 +62,8 @@ class KeyTable {
   KeyTable(KeyTable&&) = delete;
   KeyTable& operator=(KeyTable&&) = delete;
 
-  // The place of `key` (W words), inserted when new, and whether it was.
-  std::pair<std::uint32_t, bool> insert(const std::uint16_t* key) {
+  // The place of `key` (W words), inserted when new.
+  std::uint32_t insert(const std::uint16_t* key) {
     if (size() >= kMaxPlaces) {
       throw ResourceLimitError("the layered solver met a level of more than " + std::to_string(kMaxPlaces) +
                                " states, more than its places can name");
@@ -71,13 +71,12 @@ class KeyTable {
     words_.insert(words_.end(), key, key + width_);
     const auto [found, inserted] = set_.insert(static_cast<std::uint32_t>(size() - 1));
     if (!inserted) words_.resize(words_.size() - width_);
-    return {*found, inserted};
+    return *found;
   }
   std::uint64_t size() const noexcept { return words_.size() / width_; }
-  // What it holds in memory: the keys (a vector touches only the pages of its size) and the set's
-  // slots and control bytes.
+  // What it holds in memory: the keys' array and the set's slots and control bytes.
   std::uint64_t bytes() const noexcept {
-    return words_.size() * sizeof(std::uint16_t) + set_.capacity() * (sizeof(std::uint32_t) + 1);
+    return words_.capacity() * sizeof(std::uint16_t) + set_.capacity() * (sizeof(std::uint32_t) + 1);
   }
   // The keys, in the order they were placed; the table is empty after.
   std::vector<std::uint16_t> release() {
@@ -149,7 +148,9 @@ class LayeredConcurrentSearch {
       solution_.exact = true;
       return std::move(solution_);
     }
-    levels_.push_back(Level{.count = 1, .states = start, .codes = {}, .block_codes = {}});
+    ConcurrentState key = start;
+    if (merge_) mdp_.merge_backlogs(key);
+    levels_.push_back(Level{.count = 1, .states = key, .codes = {}, .block_codes = {}});
     solution_.solved = 1;
     forward();
     backward();
@@ -175,8 +176,9 @@ class LayeredConcurrentSearch {
     }
     disk_bytes_ += level.codes.size() * sizeof(std::uint32_t) + level.states.size() * sizeof(std::uint16_t);
     solution_.peak_disk_bytes = std::max(solution_.peak_disk_bytes, disk_bytes_);
-    level.states = {};
-    level.codes = {};
+    // Released, not just emptied (assigning {} would keep the capacity).
+    std::vector<std::uint16_t>().swap(level.states);
+    std::vector<std::uint32_t>().swap(level.codes);
   }
   void read_level(int n, Level& level, bool with_codes) {
     level.states.resize(level.count * width_);
@@ -196,18 +198,18 @@ class LayeredConcurrentSearch {
     }
   }
 
-  // The successors not settled of the states [begin, end) of `level`, in walk order (W words each),
-  // and their keys when backlogs merge.
-  void expand(const Level& level, std::uint64_t begin, std::uint64_t end, std::vector<std::uint16_t>& states,
-              std::vector<std::uint16_t>& keys) const {
+  // The keys of the successors not settled of the states [begin, end) of `level`, in walk order
+  // (W words each).
+  void expand(const Level& level, std::uint64_t begin, std::uint64_t end, std::vector<std::uint16_t>& keys) const {
     ConcurrentState key;
     const auto visit = [&](const ConcurrentState& next) {
       if (settled_value(mdp_, next)) return 0.0;
-      states.insert(states.end(), next.begin(), next.end());
       if (merge_) {
         key = next;
         mdp_.merge_backlogs(key);
         keys.insert(keys.end(), key.begin(), key.end());
+      } else {
+        keys.insert(keys.end(), next.begin(), next.end());
       }
       return 0.0;
     };
@@ -236,45 +238,31 @@ class LayeredConcurrentSearch {
       const std::uint64_t states = level.count;
       const std::uint64_t blocks = (states + kBlock - 1) / kBlock;
       KeyTable table(width_);
-      std::vector<std::uint16_t> representatives;  // merging: the first state of each key
       std::vector<std::uint32_t> codes;
       std::vector<std::uint64_t> block_codes(blocks + 1, 0);
-      struct Output {
-        std::vector<std::uint16_t> states, keys;
-      };
-      std::vector<Output> outputs(kChunkBlocks);
+      std::vector<std::vector<std::uint16_t>> outputs(kChunkBlocks);  // per block of a chunk: its successors' keys
       Cut cut = Cut::none;
       for (std::uint64_t first = 0; first < blocks && cut == Cut::none; first += kChunkBlocks) {
         const std::uint64_t chunk = std::min(kChunkBlocks, blocks - first);
         for_each_block(chunk, options_.threads, 1, [&](unsigned) {
           return [&](std::uint64_t begin, std::uint64_t end) {
             for (std::uint64_t b = begin; b < end; ++b) {
-              Output& output = outputs[b];
-              output.states.clear();
-              output.keys.clear();
+              outputs[b].clear();
               const std::uint64_t from = (first + b) * kBlock;
-              expand(level, from, std::min(states, from + kBlock), output.states, output.keys);
+              expand(level, from, std::min(states, from + kBlock), outputs[b]);
             }
           };
         });
         std::uint64_t scratch = 0;
         for (std::uint64_t b = 0; b < chunk; ++b) {
-          const Output& output = outputs[b];
-          scratch += (output.states.size() + output.keys.size()) * sizeof(std::uint16_t);
+          const std::vector<std::uint16_t>& keys = outputs[b];
+          scratch += keys.capacity() * sizeof(std::uint16_t);
           block_codes[first + b] = codes.size();
-          const std::vector<std::uint16_t>& keys = merge_ ? output.keys : output.states;
-          for (std::size_t at = 0; at < keys.size(); at += width_) {
-            const auto [place, inserted] = table.insert(keys.data() + at);
-            if (inserted && merge_) {
-              representatives.insert(representatives.end(), output.states.begin() + static_cast<std::ptrdiff_t>(at),
-                                     output.states.begin() + static_cast<std::ptrdiff_t>(at + width_));
-            }
-            codes.push_back(place);
-          }
+          for (std::size_t at = 0; at < keys.size(); at += width_) codes.push_back(table.insert(keys.data() + at));
         }
-        const std::uint64_t memory = level.states.size() * sizeof(std::uint16_t) + table.bytes() +
-                                     representatives.size() * sizeof(std::uint16_t) +
-                                     codes.size() * sizeof(std::uint32_t) + scratch;
+        // Capacities: a vector that grows holds its old and its new array for a while.
+        const std::uint64_t memory = level.states.capacity() * sizeof(std::uint16_t) + table.bytes() +
+                                     codes.capacity() * sizeof(std::uint32_t) + scratch;
         solution_.peak_memory_bytes = std::max(solution_.peak_memory_bytes, memory);
         // The level's files, once written, take its states and codes.
         const std::uint64_t disk =
@@ -292,8 +280,7 @@ class LayeredConcurrentSearch {
       block_codes[blocks] = codes.size();
       level.codes = std::move(codes);
       level.block_codes = std::move(block_codes);
-      Level next{
-          .count = 0, .states = merge_ ? std::move(representatives) : table.release(), .codes = {}, .block_codes = {}};
+      Level next{.count = 0, .states = table.release(), .codes = {}, .block_codes = {}};
       next.count = next.states.size() / width_;
       if (next.count == 0) {  // the last level: its states stay for the backward pass
         report(LayerFigures{.layer = static_cast<int>(n), .states = states, .forward_seconds = seconds_since(started)});
@@ -397,6 +384,10 @@ class LayeredConcurrentSearch {
       } else {
         value_level(n, next, exact, values);
       }
+      const std::uint64_t memory = level.states.size() * sizeof(std::uint16_t) +
+                                   level.codes.size() * sizeof(std::uint32_t) +
+                                   (values.size() + next.size()) * sizeof(Interval);
+      solution_.peak_memory_bytes = std::max(solution_.peak_memory_bytes, memory);
       const std::uint64_t states = level.count;
       level = Level{};  // valued: no longer needed
       remove_level_files(static_cast<int>(n));

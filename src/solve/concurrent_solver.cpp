@@ -137,7 +137,10 @@ double ConcurrentSolver::solve(const ConcurrentState& root) {
       continue;
     }
     if (++visits % 4096 == 0 && impl_->stop && impl_->stop()) throw Cancelled("solve stopped");
-    const ConcurrentState state = stack.back();
+    // Where backlogs merge, the key itself is the state expanded (a state of the MDP with the same
+    // value and moves): so a key's value does not depend on which of its states was met first, and
+    // every solver that expands keys (the search's exact pass, the layered solver) has its bits.
+    const ConcurrentState state = impl_->key_of(mdp, stack.back());
     const std::size_t depth = stack.size();
     values.clear();
     if (!optimum) {

@@ -295,7 +295,9 @@ class ConcurrentMdp {
   // hold 0), and when k is the only live skeleton and the robot executes, into r. Once the robot
   // starts an action no other live skeleton runs, k is the only live one and runs its refined
   // actions back to back (the forced start), so only their sum can change V*. The state itself
-  // otherwise. Policy values are not keyed so: a policy may read each execution time.
+  // otherwise. The key is itself a state of the model whose key it is (merging twice changes
+  // nothing), which the exact solvers expand in place of the states it stands for. Policy values
+  // are not keyed so: a policy may read each execution time.
   // Cost: O(K * A_max) word operations.
   void merge_backlogs(ConcurrentState& key) const;
 

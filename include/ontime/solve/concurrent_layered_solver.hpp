@@ -14,21 +14,17 @@
 // its place recorded. The backward pass values the levels from the last to the first, each state
 // from the places its outcomes point to, with no search.
 //
-// States are told apart as the memoised solver's memo tells them (ConcurrentMdp::merge_backlogs
-// where the model merges backlogs, the state itself otherwise); the first state of a key met is
-// the one expanded.
+// States are the memoised solver's keys (ConcurrentMdp::merge_backlogs where the model merges
+// backlogs, the state itself otherwise), each expanded as a state of the MDP, as the memoised
+// solver expands them: a key has the value and the moves of every state with that key
+// (docs/theory.md, "Backlogs").
 //
 // Guarantees. Each state's value is computed by one thread with the memoised solver's arithmetic
 // (ConcurrentSolver): the same moves, their outcomes summed in the same order from the same
 // successors' values, the same tie rule (the first move within ConcurrentSolver::kTieTolerance of
-// the largest value, that move's value). So the value and the first move are the memoised solver's
-// to the bit, whatever the thread count, where keys are the states themselves (with backtracking,
-// SPEC §7, chains or expiry, §9, or hopeless skeletons kept): both solvers value the same states.
-// Where backlogs merge, the states of one key have equal values (docs/theory.md, "Backlogs") but
-// each solver expands its own first one (breadth first here, depth first there), whose successors
-// may differ until they meet again (the robot between two of a skeleton's motions, say): the states
-// met then differ a little, the values do not, to the bit on every instance the tests solve (the
-// paths differ by starts, which multiply by 1 exactly).
+// the largest value, that move's value). Both solvers value the same keys, so the value and the
+// first move are the memoised solver's to the bit, and the states enumerated are its states,
+// whatever the thread count; with backtracking (SPEC §7), rewards (§8), chains and expiry (§9) too.
 //
 // A cut (a cap on states, memory or disk, or the stop condition, checked as the next level grows;
 // never before level 1, so that the start's move is chosen) ends the forward pass at level T: T's

@@ -23,7 +23,9 @@
 // so the robot starts an action only when starting is worth more than planning on while it waits.
 // Without backtracking, chains or expiry the memo is keyed by ConcurrentMdp::merge_backlogs
 // (states whose refined motions differ only within what one skeleton alone runs, with the same
-// sums, share their value).
+// sums, share their value), and the key itself is the state expanded: a key's value does not depend
+// on which of its states was met first, so solvers that meet them in other orders (the search, the
+// layered solver) have its bits.
 //
 // Branch and bound (set_bounds, `solve --method search`): given certified intervals around V* of
 // the states not solved yet, a state's moves get intervals from their successors (exact where
