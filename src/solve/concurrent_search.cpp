@@ -27,10 +27,19 @@ struct ConcurrentSearch::Impl {
 
   Impl(const ConcurrentMdp& model, std::uint64_t cap) : mdp(&model), max_states(cap), heuristic(model) {}
 
+  // The key of `state` in the table: the exact solver's (ConcurrentMdp::merge_backlogs where the
+  // model merges backlogs), so that trials walk the states the exact pass expands.
+  ConcurrentState key_of(const ConcurrentState& state) const {
+    ConcurrentState key = state;
+    mdp->merge_backlogs(key);
+    return key;
+  }
+
   // The interval of `state`: exact when terminal, else the table's, else the heuristic's (kept).
-  Interval interval(const ConcurrentState& state) {
-    if (!mdp->any_live(state)) return {};
-    if (mdp->certain_success(state)) return {1.0, 1.0};
+  Interval interval(const ConcurrentState& given) {
+    if (!mdp->any_live(given)) return {};
+    if (mdp->certain_success(given)) return {1.0, 1.0};
+    const ConcurrentState state = key_of(given);
     if (const auto found = table.find(state); found != table.end()) return found->second;
     Interval bounds = heuristic.bounds(state);
     if (bounds.lower < bounds.upper) {
@@ -72,14 +81,14 @@ struct ConcurrentSearch::Impl {
                                       const Interval v = interval(outcome.next);
                                       q.lower += probability * v.lower;
                                       q.upper += probability * v.upper;
-                                      successors.emplace_back(probability * (v.upper - v.lower), outcome.next);
+                                      successors.emplace_back(probability * (v.upper - v.lower), key_of(outcome.next));
                                     });
       } else {
         mdp->for_each_step_outcome(state, move.refine, [&](double probability, const ConcurrentState& next) {
           const Interval v = interval(next);
           q.lower += probability * v.lower;
           q.upper += probability * v.upper;
-          successors.emplace_back(probability * (v.upper - v.lower), next);
+          successors.emplace_back(probability * (v.upper - v.lower), key_of(next));
         });
       }
       if (q.upper > best_upper) {
@@ -99,7 +108,7 @@ struct ConcurrentSearch::Impl {
     } else if (kept.lower > kept.upper) {
       kept.lower = kept.upper;  // rounding only
     }
-    table[state] = kept;
+    table[key_of(state)] = kept;
     result.interval = kept;
     return result;
   }

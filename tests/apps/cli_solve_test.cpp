@@ -121,9 +121,9 @@ TEST(Cli, SolveSearchesActingWhilePlanning) {
   EXPECT_FALSE(interval["exact"].get<bool>());
   EXPECT_EQ(interval["stopped_by"], "the gap");
   EXPECT_TRUE(interval["optimal_success_probability"].is_null());
-  // Navigation's optimum at its own deadline (0.876693, `solve --method search`, 34 s) lies inside.
-  EXPECT_LE(interval["lower_bound"].get<double>(), 0.8766933308900257);
-  EXPECT_GE(interval["upper_bound"].get<double>(), 0.8766933308900257);
+  // Navigation's optimum at its own deadline (0.876693, `solve --method search`, 18 s) lies inside.
+  EXPECT_LE(interval["lower_bound"].get<double>(), 0.8766933308900258);
+  EXPECT_GE(interval["upper_bound"].get<double>(), 0.8766933308900258);
   EXPECT_LE(interval["upper_bound"].get<double>() - interval["lower_bound"].get<double>(), 0.2);
 }
 
