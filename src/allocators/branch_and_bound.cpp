@@ -150,8 +150,9 @@ ConcurrentBranchAndBoundAllocator::ConcurrentBranchAndBoundAllocator(const Concu
     : mdp_(&mdp), options_(std::move(options)), search_(mdp, options_.max_states) {}
 
 void ConcurrentBranchAndBoundAllocator::begin_episode(std::uint64_t seed) {
-  (void)seed;  // the search draws nothing
-  search_.clear();
+  episode_seed_ = seed;
+  restarts_ = 0;
+  search_.clear(seed);
   last_gap_ = 0.0;
 }
 
@@ -161,8 +162,9 @@ ConcurrentMdp::Move ConcurrentBranchAndBoundAllocator::choose(const ConcurrentSt
   const std::vector<ConcurrentMdp::Move> moves = mdp_->useful_moves(state);
   if (moves.empty()) return {};
   if (moves.size() == 1) return moves[0];
-  // Records at their cap start again (the cap counts the records of the episode so far).
-  if (search_.size() >= options_.max_states) search_.clear();
+  // Records at their cap start again (the cap counts the records of the episode so far), the
+  // trials drawing from a stream of the episode's seed.
+  if (search_.size() >= options_.max_states) search_.clear(stream_seed(episode_seed_, ++restarts_));
   const BudgetMonitor monitor(options_.budget);
   const ConcurrentSearchResult found =
       search_.search(state, [&](std::uint64_t work) { return monitor.exhausted(work); });

@@ -10,6 +10,7 @@
 #include "ontime/solve/concurrent_solver.hpp"
 #include "ontime/solve/concurrent_value_bounds.hpp"
 #include "ontime/util/error.hpp"
+#include "ontime/util/random.hpp"
 
 namespace ontime {
 
@@ -24,6 +25,7 @@ struct ConcurrentSearch::Impl {
   // Scratch of one backup: the successors of the move to descend by, with probability times gap.
   std::vector<std::pair<double, ConcurrentState>> descent;
   std::vector<ConcurrentState> path;
+  SplitMix64 generator{1};
 
   Impl(const ConcurrentMdp& model, std::uint64_t cap) : mdp(&model), max_states(cap), heuristic(model) {}
 
@@ -113,14 +115,26 @@ struct ConcurrentSearch::Impl {
     return result;
   }
 
-  // The successor of `descent` of the largest probability times gap (ties: the first), or null
-  // when none has a gap.
-  ConcurrentState* widest() {
-    auto next = descent.begin();
-    for (auto it = descent.begin(); it != descent.end(); ++it) {
-      if (it->first > next->first) next = it;
+  // The successors' summed probability times gap.
+  double descent_mass() const {
+    double mass = 0.0;
+    for (const auto& [weight, next] : descent) mass += weight;
+    return mass;
+  }
+
+  // A successor of `descent` drawn in proportion to probability times gap (`mass`, their sum), or
+  // null when none has a gap.
+  ConcurrentState* drawn(double mass) {
+    if (!(mass > 0.0)) return nullptr;
+    double draw = uniform01(generator) * mass;
+    ConcurrentState* chosen = nullptr;
+    for (auto& [weight, next] : descent) {
+      if (!(weight > 0.0)) continue;
+      chosen = &next;
+      draw -= weight;
+      if (draw < 0.0) break;
     }
-    return next == descent.end() || !(next->first > 0.0) ? nullptr : &next->second;
+    return chosen;
   }
 };
 
@@ -131,7 +145,10 @@ ConcurrentSearch::~ConcurrentSearch() = default;
 
 Interval ConcurrentSearch::interval(const ConcurrentState& state) { return impl_->interval(state); }
 
-void ConcurrentSearch::clear() { impl_->table.clear(); }
+void ConcurrentSearch::clear(std::uint64_t seed) {
+  impl_->table.clear();
+  impl_->generator = SplitMix64(seed);
+}
 
 std::uint64_t ConcurrentSearch::size() const noexcept { return impl_->table.size(); }
 
@@ -160,14 +177,17 @@ ConcurrentSearchResult ConcurrentSearch::search(const ConcurrentState& from,
     result.upper = std::min(root.interval.upper, root.upper_max);
     result.exact = root.lower_max >= root.upper_max;
     if (result.exact || stopped()) break;
-    const ConcurrentState* next = impl.widest();
+    const double start_gap = root.interval.upper - root.interval.lower;
+    const ConcurrentState* next = impl.drawn(impl.descent_mass());
     if (next == nullptr) break;  // closed but for rounding
     impl.path.assign(1, *next);
     for (;;) {
       const Impl::Backup backup = impl.back_up(impl.path.back());
       ++result.work;
       if (backup.interval.lower >= backup.interval.upper || stopped()) break;
-      next = impl.widest();
+      const double mass = impl.descent_mass();
+      if (mass <= start_gap / kTrialRatio) break;
+      next = impl.drawn(mass);
       if (next == nullptr) break;
       impl.path.push_back(*next);
     }

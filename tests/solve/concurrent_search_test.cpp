@@ -465,6 +465,36 @@ TEST(ConcurrentSearch, CutShortItsGapBoundsTheLoss) {
   EXPECT_GT(cut, count / 10);
 }
 
+// The trials draw their outcomes from the seed of the last clear(): the same seed walks the same
+// states to the same interval; another walks others, its interval as certified (navigation cut to
+// 12 steps, searches cut short).
+TEST(ConcurrentSearch, TheTrialsDrawFromTheirSeed) {
+  const ConcurrentMdp mdp(testing::navigation_with_deadline(12));
+  const ConcurrentState start = mdp.start();
+  const double optimum = ConcurrentSolver(mdp).solve(start);
+  const auto budget = [](std::uint64_t work) { return work >= 2000; };
+  ConcurrentSearch search(mdp);
+  search.clear(7);
+  const ConcurrentSearchResult first = search.search(start, budget);
+  const std::uint64_t first_records = search.size();
+  ASSERT_FALSE(first.exact);
+  search.clear(7);
+  const ConcurrentSearchResult again = search.search(start, budget);
+  EXPECT_EQ(again.lower, first.lower);
+  EXPECT_EQ(again.upper, first.upper);
+  EXPECT_EQ(again.move, first.move);
+  EXPECT_EQ(search.size(), first_records);
+  int differ = 0;
+  for (std::uint64_t seed = 8; seed < 12; ++seed) {
+    search.clear(seed);
+    const ConcurrentSearchResult other = search.search(start, budget);
+    EXPECT_LE(other.lower, optimum + kSearchRounding) << "seed " << seed;
+    EXPECT_GE(other.upper, optimum - kSearchRounding) << "seed " << seed;
+    differ += search.size() != first_records || other.lower != first.lower || other.upper != first.upper ? 1 : 0;
+  }
+  EXPECT_GE(differ, 3);
+}
+
 // The exact search (branch and bound over the trials' intervals) on `problem` gives the memoised
 // solver's value and first move to the bit, solving no more states; so does branch and bound on
 // the bounds alone. The states solved by the search and by the memoised solver.

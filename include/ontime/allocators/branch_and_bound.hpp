@@ -94,7 +94,7 @@ class BranchAndBoundAllocator final : public Allocator {
 // depth-first part), so `trial_share` is not read. The commit rule is the search's: the robot
 // starts an action when starting's certified lower end is the best. Without a search: a complete
 // plan without rewards runs at once (certain success), a forced start or the only useful move is
-// made. Deterministic (the search draws nothing; the records are cleared at each episode and at
+// made. Its trials draw from the episode's seed (the records are cleared at each episode, and at
 // `max_states`). Not stationary. Cost per decision: its budget; memory: the search's records.
 class ConcurrentBranchAndBoundAllocator final : public ConcurrentAllocator {
  public:
@@ -116,6 +116,7 @@ class ConcurrentBranchAndBoundAllocator final : public ConcurrentAllocator {
   BranchAndBoundOptions options_;
   ConcurrentSearch search_;
   double last_gap_ = 0.0;
+  std::uint64_t episode_seed_ = 1, restarts_ = 0;
   struct Counters {
     std::uint64_t searches = 0, work = 0, exact = 0;
     double gap_sum = 0.0, max_gap = 0.0;
